@@ -1,0 +1,45 @@
+# lightgear: `make run` sets up .venv and runs the paper example; `make test` runs the suite.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+export VTK_DEFAULT_OPENGL_WINDOW ?= vtkEGLRenderWindow
+export NUMBA_CACHE_DIR ?= $(CURDIR)/.lightgear-cache/numba
+export MPLBACKEND ?= Agg
+
+.PHONY: run test bench venv sysdeps clean
+
+run: $(STAMP)
+	$(VENV)/bin/lightgear run -o results/paper_example/paper_example.nc
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+bench: $(STAMP)
+	$(PY) benchmarks/run_all.py
+
+venv: $(STAMP)
+
+$(STAMP): pyproject.toml requirements.lock | sysdeps
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -r requirements.lock
+	$(PY) -m pip install -q --no-deps -e .
+	touch $(STAMP)
+
+# Off-screen rendering (pyvista/VTK) and gmsh need a few shared libraries from the OS.
+SYSLIBS := libGL.so.1 libGLU.so.1 libEGL.so.1 libXcursor.so.1 libXft.so.2 libXinerama.so.1 libgomp.so.1
+DEBPKGS := libgl1 libglu1-mesa libegl1 libegl-mesa0 libgl1-mesa-dri libxcursor1 libxft2 libxinerama1 libgomp1
+sysdeps:
+	@missing=""; for lib in $(SYSLIBS); do ldconfig -p | grep -q "$$lib" || missing="$$missing $$lib"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "Missing system libraries:$$missing"; \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    echo "Installing: $(DEBPKGS)"; apt-get update -qq && apt-get install -y -qq $(DEBPKGS) >/dev/null; \
+	  else \
+	    echo "Install them with: sudo apt-get install $(DEBPKGS)"; exit 1; \
+	  fi; \
+	fi
+
+clean:
+	rm -rf $(VENV) .lightgear-cache .pytest_cache

@@ -1,0 +1,410 @@
+"""Scenes: TOML files in engineering units, validated into typed objects.
+
+A scene file has the sections of `Scene` (``material``, ``pair``, ``gear1``, ``gear2`` with
+``body`` and ``spring`` subtables, ``contact``, ``quasi_static``, ``dynamic``, ``fe``,
+``outputs``). Every key is optional; missing keys take the defaults below, which are the
+paper's example (Table 1) with solid bodies. The embedded default scene
+``study/scenes/paper.toml`` is the paper's example with the lightened driven gear.
+
+Units (also in each field's metadata): lengths mm, angles deg, torque N·m, speed rad/s,
+time s, k_phi N·mm/rad^n_k, c_phi N·mm·s/rad (n_c = 1), k_con N/mm^m1,
+c_con N·s/mm per mm^m3 (m2 = 1), modulus MPa, density kg/m³.
+Conversion to the solver's SI happens once, in `Scene.pair_input` / `Scene.loads`.
+
+Errors: `SceneError` names the dotted field and the reason, before any work starts.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+import typing
+from dataclasses import dataclass, field, fields, replace
+from importlib import resources
+from pathlib import Path
+
+from solver import units
+from solver.geometry import (BodySpec, GeometryError, Material, ToothSpec, gear_geometry,
+                             pair_geometry, validate_body)
+
+
+class SceneError(ValueError):
+    """Invalid scene input; ``field`` is the dotted path of the offending key."""
+
+    def __init__(self, field: str, reason: str):
+        self.field = field
+        self.reason = reason
+        super().__init__(f"{field}: {reason}")
+
+
+def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None):
+    return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=lo_open, choices=choices))
+
+
+@dataclass(frozen=True)
+class MaterialSection:
+    youngs_modulus: float = _f(206000.0, "MPa", "Young's modulus", 0, lo_open=True)
+    poisson_ratio: float = _f(0.3, "1", "Poisson's ratio", 0.0, 0.499)
+    density: float = _f(7850.0, "kg/m^3", "density", 0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class PairSection:
+    backlash: float = _f(0.07, "mm", "circumferential backlash on the pitch circle, made by thinning both gears' teeth equally", 0.0)
+
+
+@dataclass(frozen=True)
+class BodySection:
+    rim_height: float = _f(6.075, "mm", "l1: rim height under the root circle", 0.0)
+    web_height: float = _f(23.25, "mm", "l2: radial height of the web", 0.0)
+    hub_height: float = _f(7.425, "mm", "l3: hub height above the bore", 0.0)
+    web_thickness: float = _f(17.0, "mm", "t1: axial thickness of the web (= face width for a solid gear)", 0, lo_open=True)
+    holes: int = _f(0, "1", "N: number of lightening holes in the web", 0)
+    hole_radius: float = _f(6.0, "mm", "R_h: hole radius", 0.0)
+    hole_circle_radius: float = _f(32.36, "mm", "R_ch: radius of the circle through the hole centres", 0.0)
+    hole_phase: float = _f(0.0, "deg", "polar angle of the first hole centre from tooth 0's axis")
+
+
+@dataclass(frozen=True)
+class SpringSection:
+    k_phi: float = _f(1.06e6, "N*mm/rad^n_k", "torsion spring stiffness of a tooth of the solid gear (eq. 1.2)", 0, lo_open=True)
+    n_k: float = _f(1.1, "1", "stiffness exponent (>= 1: a finite tangent at zero deflection)", 1.0, 3.0)
+    # Damping: 2 % of critical on the tooth's own mode (66 kHz, I_pivot 3.7e-9 kg·m², tangent
+    # 640 N·m/rad at 50 N·m): c = 2*0.02*sqrt(640*3.7e-9) = 6.2e-5 N·m·s/rad.
+    c_phi: float = _f(0.062, "N*mm*s/rad^n_c", "torsion spring damping coefficient", 0.0)
+    n_c: float = _f(1.0, "1", "damping exponent", 0.5, 2.0)
+    stiffness: str = _f("fe-ratio", "", "per-tooth springs of a lightened body: 'fe-ratio' scales k_phi by the FE stiffness ratio to the solid body, 'fe' uses FE values directly, 'uniform' ignores the lightening",
+                        choices=("fe-ratio", "fe", "uniform"))
+
+
+@dataclass(frozen=True)
+class GearSection:
+    module: float = _f(1.5, "mm", "module", 0, lo_open=True)
+    teeth: int = _f(67, "1", "number of teeth", 6)
+    pressure_angle: float = _f(20.0, "deg", "pressure angle", 10.0, 35.0)
+    addendum: float = _f(1.0, "1", "addendum coefficient", 0, lo_open=True)
+    dedendum: float = _f(1.25, "1", "dedendum coefficient", 0, lo_open=True)
+    fillet_radius: float = _f(0.45, "mm", "root fillet radius", 0.0)
+    face_width: float = _f(17.0, "mm", "face width t2", 0, lo_open=True)
+    pivot_radius: float = _f(0.0, "mm", "radius of the tooth pivot on the tooth axis; 0 = root circle", 0.0)
+    body: BodySection = field(default_factory=BodySection)
+    spring: SpringSection = field(default_factory=SpringSection)
+
+
+@dataclass(frozen=True)
+class ContactSection:
+    k_con: float = _f(5.64e6, "N/mm^m1", "contact stiffness (eq. 1.3; paper: fit of Weber's deflection)", 0, lo_open=True)
+    m1: float = _f(1.24, "1", "stiffness exponent (>= 1)", 1.0, 3.0)
+    # Damping: 5 % of critical on the local contact mode (tangent 1.3e9 N/m at 1 um and
+    # ~1e-3 kg equivalent tooth mass at the contact: c = 115 N·s/m), reached at the loaded
+    # penetration of 1 um with m3 = 1.5, so the force fades in from zero at first touch:
+    # c_con = 0.115 N·s/mm / (1e-3 mm)^1.5 = 3640.
+    c_con: float = _f(3640.0, "N*s/mm^(1+m3)", "contact damping coefficient", 0.0)
+    m2: float = _f(1.0, "1", "damping (velocity) exponent", 0.5, 2.0)
+    m3: float = _f(1.5, "1", "indentation exponent of the damping term", 0.0, 3.0)
+
+
+@dataclass(frozen=True)
+class QuasiStaticSection:
+    enabled: bool = _f(True, "", "compute the static transmission error")
+    method: str = _f("static", "", "'static': equilibrium at each angle; 'transient': the paper's slow ramp", choices=("static", "transient"))
+    torque: float = _f(50.0, "N*m", "resisting torque on gear 2")
+    rotation: float = _f(120.0, "deg", "driver rotation covered", 0, lo_open=True)
+    angle_step: float = _f(0.1, "deg", "driver angle resolution", 0, lo_open=True)
+    speed: float = _f(1.0, "rad/s", "driver speed of the slow-ramp transient", 0, lo_open=True)
+    ramp_time: float = _f(1e-3, "s", "speed and torque ramp time of the slow-ramp transient", 0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class DynamicSection:
+    enabled: bool = _f(True, "", "compute the dynamic transmission error")
+    method: str = _f("explicit", "", "time integrator", choices=("explicit", "implicit", "auto"))
+    speed: float = _f(100.0, "rad/s", "final driver speed")
+    torque: float = _f(50.0, "N*m", "final resisting torque on gear 2")
+    ramp_time: float = _f(0.01, "s", "speed and torque ramp time", 0, lo_open=True)
+    duration: float = _f(0.2, "s", "simulated time", 0, lo_open=True)
+    time_step: float = _f(0.0, "s", "integration step; 0 = from the scene's highest natural frequency", 0.0)
+    output_step: float = _f(1e-5, "s", "sampling interval of the stored DTE", 0, lo_open=True)
+    spectrum_start: float = _f(0.0, "s", "start of the steady part used for spectra; 0 = twice the ramp time", 0.0)
+
+
+@dataclass(frozen=True)
+class FESection:
+    mesh_size: float = _f(0.0, "mm", "target element size in the body; 0 = default from the module", 0.0)
+
+
+@dataclass(frozen=True)
+class Scene:
+    title: str = _f("", "", "free text")
+    material: MaterialSection = field(default_factory=MaterialSection)
+    pair: PairSection = field(default_factory=PairSection)
+    gear1: GearSection = field(default_factory=GearSection)
+    gear2: GearSection = field(default_factory=GearSection)
+    contact: ContactSection = field(default_factory=ContactSection)
+    quasi_static: QuasiStaticSection = field(default_factory=QuasiStaticSection)
+    dynamic: DynamicSection = field(default_factory=DynamicSection)
+    fe: FESection = field(default_factory=FESection)
+
+    # ---- conversion to the solver (the one place where units change) ----
+    def tooth_spec(self, g: int) -> ToothSpec:
+        gs = self.gear(g)
+        return ToothSpec(module=gs.module * units.MM, teeth=gs.teeth,
+                         pressure_angle=gs.pressure_angle * units.DEG,
+                         addendum_coef=gs.addendum, dedendum_coef=gs.dedendum,
+                         fillet_radius=gs.fillet_radius * units.MM,
+                         face_width=gs.face_width * units.MM,
+                         thinning=0.5 * self.pair.backlash * units.MM)
+
+    def body_spec(self, g: int) -> BodySpec:
+        b = self.gear(g).body
+        return BodySpec(rim_height=b.rim_height * units.MM, web_height=b.web_height * units.MM,
+                        hub_height=b.hub_height * units.MM, web_thickness=b.web_thickness * units.MM,
+                        holes=b.holes, hole_radius=b.hole_radius * units.MM,
+                        hole_circle_radius=b.hole_circle_radius * units.MM,
+                        hole_phase=b.hole_phase * units.DEG)
+
+    def material_spec(self) -> Material:
+        m = self.material
+        return Material(m.youngs_modulus * units.MPA, m.poisson_ratio, m.density)
+
+    def gear(self, g: int) -> GearSection:
+        if g not in (1, 2):
+            raise ValueError("gear index is 1 or 2")
+        return self.gear1 if g == 1 else self.gear2
+
+    def is_lightened(self, g: int) -> bool:
+        """True when gear g's body differs from a solid disc (holes or a thinner web)."""
+        gs = self.gear(g)
+        b = gs.body
+        return b.holes > 0 or (b.web_height > 0 and b.web_thickness < gs.face_width)
+
+    def pivot_radius(self, g: int) -> float:
+        """Tooth pivot radius [m]; the root circle when the scene gives 0."""
+        gs = self.gear(g)
+        if gs.pivot_radius > 0:
+            return gs.pivot_radius * units.MM
+        return gear_geometry(self.tooth_spec(g)).root_radius
+
+    # ---- text ----
+    def to_toml(self) -> str:
+        return dumps_toml(dataclasses.asdict(self))
+
+    def replace(self, **dotted) -> "Scene":
+        """A copy with fields overridden by dotted path, validated: ``replace(**{"gear2.body.holes": 3})``."""
+        data = dataclasses.asdict(self)
+        for path, value in dotted.items():
+            set_dotted(data, path, value)
+        return scene_from_dict(data)
+
+
+# ---------------------------------------------------------------- building and checking
+
+def _coerce(value, typ, path):
+    if typ is bool:
+        if isinstance(value, bool):
+            return value
+        raise SceneError(path, f"must be true or false, got {value!r}")
+    if typ is int:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or float(value) != int(value):
+            raise SceneError(path, f"must be an integer, got {value!r}")
+        return int(value)
+    if typ is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SceneError(path, f"must be a number, got {value!r}")
+        if not math.isfinite(value):
+            raise SceneError(path, f"must be finite, got {value!r}")
+        return float(value)
+    if typ is str:
+        if not isinstance(value, str):
+            raise SceneError(path, f"must be a string, got {value!r}")
+        return value
+    raise TypeError(typ)
+
+
+def _build(cls, table, path: str):
+    if not isinstance(table, dict):
+        raise SceneError(path or "scene", f"must be a table, got {table!r}")
+    hints = typing.get_type_hints(cls)
+    known = {f.name: f for f in fields(cls)}
+    for key in table:
+        if key not in known:
+            where = f"{path}.{key}" if path else key
+            raise SceneError(where, f"unknown key (expected one of: {', '.join(known)})")
+    kwargs = {}
+    for name, f in known.items():
+        where = f"{path}.{name}" if path else name
+        typ = hints[name]
+        if dataclasses.is_dataclass(typ):
+            kwargs[name] = _build(typ, table.get(name, {}), where)
+            continue
+        if name not in table:
+            continue
+        v = _coerce(table[name], typ, where)
+        md = f.metadata
+        unit = f" {md['unit']}" if md.get("unit") not in (None, "", "1") else ""
+        if md.get("choices") and v not in md["choices"]:
+            raise SceneError(where, f"must be one of {', '.join(map(repr, md['choices']))}, got {v!r}")
+        lo, hi = md.get("lo"), md.get("hi")
+        if lo is not None and (v < lo or (md.get("lo_open") and v == lo)):
+            rel = ">" if md.get("lo_open") else ">="
+            raise SceneError(where, f"must be {rel} {lo}{unit}, got {v}{unit}")
+        if hi is not None and v > hi:
+            raise SceneError(where, f"must be <= {hi}{unit}, got {v}{unit}")
+        kwargs[name] = v
+    return cls(**kwargs)
+
+
+def check_scene(scene: Scene) -> None:
+    """Physical consistency across fields (geometry, bodies, mesh). Raises SceneError."""
+    try:
+        geoms = []
+        for g in (1, 2):
+            geo = gear_geometry(scene.tooth_spec(g), prefix=f"gear{g}")
+            validate_body(geo, scene.body_spec(g), prefix=f"gear{g}.body")
+            geoms.append(geo)
+            gs = scene.gear(g)
+            if gs.pivot_radius > 0 and not (geo.base_radius * 0.5 < gs.pivot_radius * units.MM < geo.tip_radius):
+                raise GeometryError(f"gear{g}.pivot_radius", f"must lie between half the base radius and the tip radius ({geo.tip_radius * 1e3:.4g} mm), got {gs.pivot_radius} mm")
+        pair_geometry(*geoms)
+    except GeometryError as e:
+        raise SceneError(e.field, e.reason) from None
+    d = scene.dynamic
+    if d.output_step > d.duration:
+        raise SceneError("dynamic.output_step", f"longer than dynamic.duration ({d.duration} s)")
+    if d.time_step > d.output_step:
+        raise SceneError("dynamic.time_step", f"must not exceed dynamic.output_step ({d.output_step} s)")
+    if d.spectrum_start >= d.duration:
+        raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
+
+
+def scene_from_dict(data: dict) -> Scene:
+    scene = _build(Scene, data, "")
+    check_scene(scene)
+    return scene
+
+
+def loads_scene(text: str, source: str = "scene") -> Scene:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(source, f"not valid TOML: {e}") from None
+    return scene_from_dict(data)
+
+
+def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] = ()) -> Scene:
+    """Read a scene file (default: the embedded paper example), apply ``key=value`` overrides."""
+    if path is None:
+        text = default_scene_text()
+    else:
+        p = Path(path)
+        if not p.is_file():
+            raise SceneError("scene", f"no such file: {p}")
+        text = p.read_text()
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(str(path or "scene"), f"not valid TOML: {e}") from None
+    for item in overrides:
+        key, value = parse_override(item)
+        set_dotted(data, key, value)
+    return scene_from_dict(data)
+
+
+def default_scene_text() -> str:
+    return resources.files("study").joinpath("scenes/paper.toml").read_text()
+
+
+def default_scene() -> Scene:
+    return loads_scene(default_scene_text(), "paper.toml")
+
+
+def parse_override(item: str):
+    """``'gear2.body.holes=3'`` -> ('gear2.body.holes', 3); values parse as TOML, else as text."""
+    if "=" not in item:
+        raise SceneError(item, "an override must look like key=value")
+    key, raw = item.split("=", 1)
+    key = key.strip()
+    try:
+        value = tomllib.loads(f"v = {raw.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw.strip()
+    return key, value
+
+
+def set_dotted(data: dict, path: str, value) -> None:
+    parts = path.split(".")
+    node = data
+    for i, p in enumerate(parts[:-1]):
+        nxt = node.setdefault(p, {})
+        if not isinstance(nxt, dict):
+            raise SceneError(".".join(parts[: i + 1]), "is a value, not a table")
+        node = nxt
+    node[parts[-1]] = value
+
+
+def get_dotted(scene: Scene, path: str):
+    node = scene
+    for p in path.split("."):
+        if not hasattr(node, p):
+            raise SceneError(path, "no such scene field")
+        node = getattr(node, p)
+    return node
+
+
+def field_unit(path: str) -> str:
+    """Unit string of a scene field given by its dotted path ('' if none)."""
+    cls = Scene
+    parts = path.split(".")
+    for i, p in enumerate(parts):
+        fs = {f.name: f for f in fields(cls)}
+        if p not in fs:
+            raise SceneError(path, "no such scene field")
+        f = fs[p]
+        typ = typing.get_type_hints(cls)[p]
+        if i == len(parts) - 1:
+            return f.metadata.get("unit", "") if not dataclasses.is_dataclass(typ) else ""
+        cls = typ
+    return ""
+
+
+def field_doc(path: str) -> str:
+    cls = Scene
+    parts = path.split(".")
+    for i, p in enumerate(parts):
+        fs = {f.name: f for f in fields(cls)}
+        if p not in fs:
+            raise SceneError(path, "no such scene field")
+        if i == len(parts) - 1:
+            return fs[p].metadata.get("doc", p)
+        cls = typing.get_type_hints(cls)[p]
+    return path
+
+
+# ---------------------------------------------------------------- TOML writer
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    raise TypeError(f"cannot write {type(v)} to TOML")
+
+
+def dumps_toml(data: dict, prefix: str = "") -> str:
+    """Minimal TOML writer for nested tables of scalars (what scenes hold)."""
+    out = [f"{k} = {_toml_value(v)}" for k, v in data.items() if not isinstance(v, dict)]
+    for k, v in data.items():
+        if isinstance(v, dict):
+            name = f"{prefix}.{k}" if prefix else k
+            out.append(f"\n[{name}]")
+            out.append(dumps_toml(v, name))
+    return "\n".join(x for x in out if x) + ("\n" if not prefix else "")
+
+
+__all__ = ["Scene", "SceneError", "load_scene", "loads_scene", "default_scene", "default_scene_text",
+           "parse_override", "set_dotted", "get_dotted", "field_unit", "field_doc", "check_scene",
+           "scene_from_dict", "dumps_toml", "replace"]
