@@ -20,7 +20,6 @@ import math
 import tomllib
 import typing
 from dataclasses import dataclass, field, fields, replace
-from importlib import resources
 from pathlib import Path
 
 from solver import units
@@ -311,7 +310,7 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
 
 
 def default_scene_text() -> str:
-    return resources.files("study").joinpath("scenes/paper.toml").read_text()
+    return (Path(__file__).parent / "scenes" / "paper.toml").read_text()
 
 
 def default_scene() -> Scene:

@@ -1,0 +1,258 @@
+"""Explicit, symplectic time integration of the pair (numba): velocity Verlet.
+
+Degrees of freedom: the driven hub angle theta2 and the tooth rotations phi (relative to
+their hubs). The driver hub follows the prescribed speed ramp, and the load torque ramps on
+gear 2. The mass matrix of a gear is an arrowhead (hub row coupled to each tooth by
+I_cpl = I_P + m*r_pv*l_g), solved in O(active teeth) by its Schur complement; teeth not in
+the active set move rigidly with their hub (their inertia is in I_tot).
+
+Active set: teeth of the pre-search candidates; a tooth outside it stays integrated until
+|phi| < phi_quiet and |dphi| < dphi_quiet, then it is frozen at exactly zero.
+
+Damping forces use the predicted velocity v_half + dt/2*a_old, which keeps second order.
+Energy bookkeeping (trapezoidal in time): work in (driver + load torque), kinetic and
+potential energy, dissipated energy; the balance closes to O(dt^2).
+
+Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy balance.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from .laws import contact_energy, signed_pow, spring_energy
+from .layout import (C_CON, C_DDELTA, C_DELTA, C_FORCE, C_PHI, C_TOOTH1, C_TOOTH2, I_CPL, I_P,
+                     I_TOT, K_CON, M1, N_C, N_K, RB, TOOTH0)
+from .mesh import generalized_forces, mesh_contacts
+
+OK = 0
+NONFINITE = 1
+PENETRATION = 2
+ENERGY = 3
+
+
+@njit(cache=True)
+def driver_motion(t, speed, ramp):
+    """Driver angle [rad], speed [rad/s] and acceleration [rad/s²] of the speed ramp."""
+    if t < ramp:
+        acc = speed / ramp
+        return 0.5 * acc * t * t, acc * t, acc
+    return speed * (t - 0.5 * ramp), speed, 0.0
+
+
+@njit(cache=True)
+def load_torque(t, torque, ramp):
+    """Resisting torque on gear 2 [N m], ramped from zero."""
+    if t < ramp:
+        return torque * t / ramp
+    return torque
+
+
+@njit(cache=True)
+def _accelerations(q, act, nact, gp, acc1, acc, tz2):
+    """Solve the arrowhead systems. Returns (theta2'', driver reaction torque)."""
+    # gear 2: Schur complement on the hub
+    s = gp[1, I_TOT]
+    rhs = q[1]
+    for a in range(nact):
+        i = act[a]
+        if i >= tz2:
+            c = gp[1, I_CPL]
+            s -= c * c / gp[1, I_P]
+            rhs -= c * q[2 + i] / gp[1, I_P]
+    a2 = rhs / s
+    react = gp[0, I_TOT] * acc1 - q[0]
+    for a in range(nact):
+        i = act[a]
+        if i >= tz2:
+            acc[i] = (q[2 + i] - gp[1, I_CPL] * a2) / gp[1, I_P]
+        else:
+            acc[i] = (q[2 + i] - gp[0, I_CPL] * acc1) / gp[0, I_P]
+            react += gp[0, I_CPL] * acc[i]
+    return a2, react
+
+
+@njit(cache=True)
+def _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2):
+    ke = 0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2
+    pe = 0.0
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        w = w2 if g == 1 else w1
+        ke += gp[g, I_CPL] * w * dphi[i] + 0.5 * gp[g, I_P] * dphi[i] * dphi[i]
+        pe += spring_energy(phi[i], kphi[i], gp[g, N_K])
+    for c in range(nc):
+        pe += contact_energy(rec[c, C_DELTA], lp[K_CON], lp[M1])
+    return ke, pe
+
+
+@njit(cache=True)
+def _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2):
+    p = 0.0
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        if gp[g, C_PHI] != 0.0:
+            p += gp[g, C_PHI] * signed_pow(dphi[i], gp[g, N_C]) * dphi[i]
+    for c in range(nc):
+        d = rec[c, C_DELTA]
+        if d > 0.0:
+            fel = lp[K_CON] * d ** lp[M1]
+            p += (rec[c, C_FORCE] - fel) * rec[c, C_DDELTA]
+    return p
+
+
+@njit(cache=True)
+def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
+           theta2, w2, phi, dphi, phi_quiet, dphi_quiet, delta_max,
+           o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
+    """Integrate n_steps of size dt [s] from t = 0; write every out_every-th state.
+
+    theta2 [rad], w2 [rad/s], phi, dphi (Z1+Z2) are the initial state (phi, dphi updated in
+    place). Outputs: time [s], TE [m], max contact force over the interval [N], loaded
+    contacts, driver reaction torque [N m], kinetic, potential, input and dissipated energy
+    [J], theta2 [rad]. Returns (status, step reached, max active teeth).
+    """
+    ntooth = phi.shape[0]
+    tz2 = int(gp[1, TOOTH0])
+    rb1 = gp[0, RB]
+    rb2 = gp[1, RB]
+    rec = np.zeros((64, 15))
+    pairs = np.zeros((64, 3), dtype=np.int64)
+    q = np.zeros(ntooth + 2)
+    acc = np.zeros(ntooth)
+    vpred = np.zeros(ntooth)
+    active = np.zeros(ntooth, dtype=np.bool_)
+    act = np.zeros(ntooth, dtype=np.int64)
+    incand = np.zeros(ntooth, dtype=np.bool_)
+    for i in range(ntooth):
+        if phi[i] != 0.0 or dphi[i] != 0.0:
+            active[i] = True
+    max_act = 0
+
+    t = 0.0
+    th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
+    # initial forces
+    nc, npair = mesh_contacts(th1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec)
+    for p in range(npair):
+        active[int(pairs[p, 0])] = True
+        active[tz2 + int(pairs[p, 1])] = True
+    nact = 0
+    for i in range(ntooth):
+        if active[i]:
+            act[nact] = i
+            nact += 1
+    for i in range(ntooth + 2):
+        q[i] = 0.0
+    generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, load_torque(0.0, torque, torque_ramp), q)
+    a2, react = _accelerations(q, act, nact, gp, acc1, acc, tz2)
+    ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+    work = 0.0
+    diss = 0.0
+    p_in_old = react * w1 + load_torque(0.0, torque, torque_ramp) * w2
+    p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
+    fmax = 0.0
+    o = 0
+    o_time[0] = 0.0
+    o_te[0] = rb1 * th1 + rb2 * theta2
+    o_fmax[0] = 0.0
+    o_nc[0] = nc
+    o_react[0] = react
+    o_ke[0] = ke
+    o_pe[0] = pe
+    o_work[0] = 0.0
+    o_diss[0] = 0.0
+    o_theta2[0] = theta2
+    status = OK
+    step = 0
+    for step in range(1, n_steps + 1):
+        # half kick, drift
+        w2h = w2 + 0.5 * dt * a2
+        for a in range(nact):
+            i = act[a]
+            dphi[i] += 0.5 * dt * acc[i]
+            phi[i] += dt * dphi[i]
+        theta2 += dt * w2h
+        t = step * dt
+        th1, w1, acc1 = driver_motion(t, speed, speed_ramp)
+        tl = load_torque(t, torque, torque_ramp)
+        # predicted velocities for the damping terms
+        w2p = w2h + 0.5 * dt * a2
+        for a in range(nact):
+            i = act[a]
+            vpred[i] = dphi[i] + 0.5 * dt * acc[i]
+        # contacts; activate the teeth the pre-search finds
+        nc, npair = mesh_contacts(th1, theta2, phi, w1, w2p, vpred, gp, pp, lp, pairs, rec)
+        for p in range(npair):
+            for g in range(2):
+                i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
+                incand[i] = True
+                if not active[i]:
+                    active[i] = True
+                    act[nact] = i
+                    nact += 1
+                    acc[i] = 0.0
+                    vpred[i] = 0.0
+        for i in range(ntooth + 2):
+            q[i] = 0.0
+        generalized_forces(rec, nc, phi, vpred, act, nact, kphi, gp, tl, q)
+        a2, react = _accelerations(q, act, nact, gp, acc1, acc, tz2)
+        # second half kick
+        w2 = w2h + 0.5 * dt * a2
+        for a in range(nact):
+            i = act[a]
+            dphi[i] += 0.5 * dt * acc[i]
+        # guard and bookkeeping
+        for c in range(nc):
+            if rec[c, C_FORCE] > fmax:
+                fmax = rec[c, C_FORCE]
+            if rec[c, C_DELTA] > delta_max:
+                status = PENETRATION
+        p_in = react * w1 + tl * w2
+        p_d = _dissipation_power(vpred, act, nact, gp, rec, nc, lp, tz2)
+        work += 0.5 * dt * (p_in + p_in_old)
+        diss += 0.5 * dt * (p_d + p_d_old)
+        p_in_old = p_in
+        p_d_old = p_d
+        # freeze quiet teeth outside the candidates
+        a = 0
+        while a < nact:
+            i = act[a]
+            if not incand[i] and abs(phi[i]) < phi_quiet and abs(dphi[i]) < dphi_quiet:
+                phi[i] = 0.0
+                dphi[i] = 0.0
+                acc[i] = 0.0
+                active[i] = False
+                nact -= 1
+                act[a] = act[nact]
+            else:
+                a += 1
+        for p in range(npair):
+            incand[int(pairs[p, 0])] = False
+            incand[tz2 + int(pairs[p, 1])] = False
+        if nact > max_act:
+            max_act = nact
+        if step % out_every == 0:
+            o += 1
+            ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+            o_time[o] = t
+            o_te[o] = rb1 * th1 + rb2 * theta2
+            o_fmax[o] = fmax
+            nl = 0
+            for c in range(nc):
+                if rec[c, C_FORCE] > 0.0:
+                    nl += 1
+            o_nc[o] = nl
+            o_react[o] = react
+            o_ke[o] = ke
+            o_pe[o] = pe
+            o_work[o] = work
+            o_diss[o] = diss
+            o_theta2[o] = theta2
+            fmax = 0.0
+            if not (math.isfinite(theta2) and math.isfinite(w2) and math.isfinite(ke + pe)):
+                status = NONFINITE
+        if status != OK:
+            break
+    return status, step, max_act

@@ -1,0 +1,159 @@
+"""Static equilibrium of the pair at a sequence of driver angles (numba).
+
+Unknowns at each angle: the driven hub angle theta2 and the rotations of the teeth that the
+pre-search finds near the mesh (the others are unloaded: phi = 0). Newton on the tangent
+K = sum_c k_t G G^T + diag(spring tangents), with continuation from the previous angle and
+a backtracking line search on the residual. The spring tangent n*k*|phi|^(n-1) vanishes at
+phi = 0 for n > 1, so a tiny diagonal term (1e-9 of the tooth's k_phi) regularises teeth
+that carry no load; the residual, and so the solution, is exact.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from .layout import C_FORCE, C_G2, C_GA, C_GB, C_KT, C_TOOTH1, C_TOOTH2, JN_HALF, K_CON, M1, RB, TOOTH0
+from .mesh import generalized_forces, mesh_contacts, tooth_spring_tangent
+
+
+@njit(cache=True)
+def _unknowns(pairs, npair, gp, pos, lst):
+    """Teeth of the candidate pairs, numbered 1.. in pos (0 is theta2). Returns their count."""
+    n = 0
+    for i in range(npair):
+        for g in range(2):
+            t = int(pairs[i, g]) + int(gp[g, TOOTH0])
+            if pos[t] < 0:
+                n += 1
+                pos[t] = n
+                lst[n - 1] = t
+    return n
+
+
+@njit(cache=True)
+def _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros):
+    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+    generalized_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, q)
+    r[0] = q[1]
+    for a in range(nt):
+        r[1 + a] = q[2 + lst[a]]
+    return nc, npair
+
+
+@njit(cache=True)
+def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_iter,
+                 te_out, nc_out, force1_out, iter_out, theta2_out):
+    """Equilibrium at each driver angle theta1s[a] [rad] under the resisting torque [N m].
+
+    phi (Z1+Z2) is the start guess and is updated in place. Writes TE [m], the number of
+    loaded contacts, the force on each gear-1 tooth [N] (force1_out[a, k]), the Newton
+    iterations (negative when not converged) and theta2 [rad]. Returns the number of
+    angles that did not converge.
+    """
+    ntooth = phi.shape[0]
+    zeros = np.zeros(ntooth)
+    q = np.zeros(ntooth + 2)
+    pos = -np.ones(ntooth, dtype=np.int64)
+    lst = np.zeros(ntooth, dtype=np.int64)
+    rec = np.zeros((64, 15))
+    pairs = np.zeros((64, 3), dtype=np.int64)
+    r = np.zeros(ntooth + 1)
+    rb1 = gp[0, RB]
+    rb2 = gp[1, RB]
+    tol_abs = tol * max(abs(torque), 1e-3)
+    sgn = 1.0 if torque >= 0.0 else -1.0
+    theta2 = theta2_start
+    failures = 0
+    for a in range(theta1s.shape[0]):
+        theta1 = theta1s[a]
+        if a > 0:
+            theta2 -= rb1 / rb2 * (theta1s[a] - theta1s[a - 1])
+        it = 0
+        converged = False
+        while it < max_iter:
+            it += 1
+            # unknown set from the pre-search at the current iterate
+            for i in range(ntooth):
+                pos[i] = -1
+            nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+            nt = _unknowns(pairs, npair, gp, pos, lst)
+            for i in range(ntooth):
+                if pos[i] < 0:
+                    phi[i] = 0.0
+            nload = 0
+            for c in range(nc):
+                if rec[c, C_FORCE] > 0.0:
+                    nload += 1
+            if nload == 0:
+                if torque == 0.0:
+                    converged = True
+                    break
+                # no contact yet: close the gap rigidly, plus the contact-only penetration
+                te = rb1 * theta1 + rb2 * theta2
+                dpen = (abs(torque) / rb2 / lp[K_CON]) ** (1.0 / lp[M1])
+                theta2 = (sgn * (pp[JN_HALF] + dpen) - rb1 * theta1) / rb2
+                continue
+            nc, npair = _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros)
+            n = nt + 1
+            rn = 0.0
+            for i in range(n):
+                rn = max(rn, abs(r[i]))
+            if rn < tol_abs:
+                converged = True
+                break
+            # tangent
+            K = np.zeros((n, n))
+            for c in range(nc):
+                kt = rec[c, C_KT]
+                if kt <= 0.0:
+                    continue
+                ia = int(rec[c, C_TOOTH1]) + int(gp[0, TOOTH0])
+                ib = int(rec[c, C_TOOTH2]) + int(gp[1, TOOTH0])
+                idx = (0, pos[ia], pos[ib])
+                gv = (rec[c, C_G2], rec[c, C_GA], rec[c, C_GB])
+                for x in range(3):
+                    for y in range(3):
+                        K[idx[x], idx[y]] += kt * gv[x] * gv[y]
+            for m in range(nt):
+                i = lst[m]
+                K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
+            if K[0, 0] <= 0.0:
+                K[0, 0] = 1e-9
+            dx = np.linalg.solve(K, r[:n].copy())
+            # backtracking on the max-norm of the residual
+            th_old = theta2
+            ph_old = np.empty(nt)
+            for m in range(nt):
+                ph_old[m] = phi[lst[m]]
+            step = 1.0
+            for _ in range(30):
+                theta2 = th_old + step * dx[0]
+                for m in range(nt):
+                    phi[lst[m]] = ph_old[m] + step * dx[m + 1]
+                _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros)
+                rn2 = 0.0
+                for i in range(n):
+                    rn2 = max(rn2, abs(r[i]))
+                if rn2 < rn or rn2 < tol_abs:
+                    break
+                step *= 0.5
+            if abs(dx[0]) * step < 1e-16 and rn2 < 1e3 * tol_abs:
+                converged = True
+                break
+        # outputs from a final evaluation at the solution
+        nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+        te_out[a] = rb1 * theta1 + rb2 * theta2
+        theta2_out[a] = theta2
+        nload = 0
+        for k in range(force1_out.shape[1]):
+            force1_out[a, k] = 0.0
+        for c in range(nc):
+            f = rec[c, C_FORCE]
+            if f > 0.0:
+                nload += 1
+                force1_out[a, int(rec[c, C_TOOTH1])] += f
+        nc_out[a] = nload
+        iter_out[a] = it if converged else -it
+        if not converged:
+            failures += 1
+    return failures

@@ -1,0 +1,63 @@
+"""Static transmission error: equilibrium at each driver angle (no inertia, no time).
+
+`solve_static` runs Newton with continuation over a sequence of driver angles (kernel in
+`kernels/statics.py`). Angles are driver hub rotations [rad] from the nominal position.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .kernels.statics import static_sweep
+from .model import Model
+
+
+class StaticSolveError(RuntimeError):
+    """Newton failed to reach equilibrium at some angles."""
+
+
+@dataclass
+class StaticResult:
+    angle: np.ndarray          # driver rotation [rad]
+    te: np.ndarray             # transmission error [m]
+    theta2: np.ndarray         # driven hub angle [rad]
+    n_contacts: np.ndarray     # loaded contacts [-]
+    tooth_force: np.ndarray    # (angle, gear-1 tooth) normal force [N]
+    iterations: np.ndarray     # Newton iterations (negative: not converged)
+    torque: float              # resisting torque [N·m]
+
+    @property
+    def converged(self) -> np.ndarray:
+        return self.iterations > 0
+
+
+def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_iter: int = 60,
+                 phi0: np.ndarray | None = None, te0: float | None = None,
+                 raise_on_failure: bool = True) -> StaticResult:
+    """Equilibrium under ``torque`` [N·m] on gear 2 at driver angles ``angles`` [rad].
+
+    ``tol`` is relative to the torque (residual torques below tol*|torque| count as converged).
+    """
+    angles = np.ascontiguousarray(angles, dtype=float)
+    if angles.ndim != 1 or angles.size == 0:
+        raise ValueError("angles: need a non-empty 1-D array of driver angles")
+    n = angles.size
+    z1 = model.teeth[0]
+    te = np.zeros(n)
+    th2 = np.zeros(n)
+    nc = np.zeros(n, dtype=np.int64)
+    f1 = np.zeros((n, z1))
+    it = np.zeros(n, dtype=np.int64)
+    phi = np.zeros(model.n_teeth) if phi0 is None else np.array(phi0, dtype=float)
+    sgn = 1.0 if torque >= 0 else -1.0
+    te_start = sgn * model.backlash_offset if te0 is None else te0
+    theta2 = float(model.theta2_for_te(angles[0], te_start))
+    fails = static_sweep(angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
+                         model.law_par, model.k_phi, tol, max_iter, te, nc, f1, it, th2)
+    res = StaticResult(angles, te, th2, nc, f1, it, float(torque))
+    if fails and raise_on_failure:
+        bad = np.flatnonzero(it < 0)
+        raise StaticSolveError(f"static equilibrium not reached at {fails} of {n} angles, first at "
+                               f"{np.degrees(angles[bad[0]]):.3f} deg")
+    return res
