@@ -26,6 +26,7 @@ class StaticResult:
     tooth_force: np.ndarray    # (angle, gear-1 tooth) normal force [N]
     iterations: np.ndarray     # Newton iterations (negative: not converged)
     torque: float              # resisting torque [N·m]
+    phi_last: np.ndarray       # tooth rotations at the last angle [rad] (Z1 + Z2)
 
     @property
     def converged(self) -> np.ndarray:
@@ -55,7 +56,7 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     theta2 = float(model.theta2_for_te(angles[0], te_start))
     fails = static_sweep(angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
                          model.law_par, model.k_phi, tol, max_iter, te, nc, f1, it, th2)
-    res = StaticResult(angles, te, th2, nc, f1, it, float(torque))
+    res = StaticResult(angles, te, th2, nc, f1, it, float(torque), phi)
     if fails and raise_on_failure:
         bad = np.flatnonzero(it < 0)
         raise StaticSolveError(f"static equilibrium not reached at {fails} of {n} angles, first at "

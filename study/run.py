@@ -77,7 +77,7 @@ def run_static(scene: Scene, model: Model):
     th2 = np.interp(angles, th1, dyn.theta2, right=np.nan)
     nc = np.round(np.interp(angles, th1, dyn.n_contacts)).astype(np.int64)
     it = np.where(np.isfinite(te), 1, -1)
-    return StaticResult(angles, te, th2, nc, np.full((angles.size, model.teeth[0]), np.nan), it, qs.torque)
+    return StaticResult(angles, te, th2, nc, np.full((angles.size, model.teeth[0]), np.nan), it, qs.torque, np.full(model.n_teeth, np.nan))
 
 
 def run_dynamic(scene: Scene, model: Model):

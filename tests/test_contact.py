@@ -1,0 +1,117 @@
+"""Exact contact geometry against brute force, gradients against finite differences."""
+import math
+
+import numpy as np
+import pytest
+from matplotlib.path import Path
+
+from solver.kernels import layout as L
+from solver.kernels.contact import flank_flank, point_flank
+from solver.kernels.mesh import mesh_contacts, new_contact_buffer
+
+
+def _tooth_world(g, center, axis, phi=0.0, pivot_radius=None):
+    x, y = g.outline(n_involute=400, n_fillet=40, n_tip=40, n_root=8)
+    if phi:
+        # rotate about the pivot on the tooth axis
+        px = pivot_radius
+        c, s = math.cos(phi), math.sin(phi)
+        x, y = px + c * (x - px) - s * y, s * (x - px) + c * y
+    c, s = math.cos(axis), math.sin(axis)
+    return center[0] + c * x - s * y, center[1] + s * x + c * y
+
+
+def _brute_penetration(xa, ya, ca, xb, yb, cb):
+    """Deepest point of one outline inside the other, as distance to that outline [m]."""
+    best = 0.0
+    pa = Path(np.c_[np.r_[xa, ca[0]], np.r_[ya, ca[1]]])
+    pb = Path(np.c_[np.r_[xb, cb[0]], np.r_[yb, cb[1]]])
+    for xs, ys, poly, ox, oy in ((xa, ya, pb, xb, yb), (xb, yb, pa, xa, ya)):
+        pts = np.c_[xs, ys]
+        seg0 = np.c_[ox[:-1], oy[:-1]]
+        ab = np.c_[ox[1:], oy[1:]] - seg0
+        for p in pts[poly.contains_points(pts)]:
+            t = np.clip(((p - seg0) * ab).sum(1) / (ab * ab).sum(1), 0, 1)
+            best = max(best, np.min(np.hypot(*(seg0 + t[:, None] * ab - p).T)))
+    return best
+
+
+@pytest.mark.parametrize("deg, phi_a, phi_b", [(0.0, 0, 0), (2.0, 0, 0), (3.75, 0, 0), (3.9, 0, 0), (4.3, 0, 0),
+                                               (1.0, 2e-3, -1e-3), (3.9, 1.5e-3, 1.5e-3)])
+def test_penetration_matches_brute_force_distance(paper_solid_model, deg, phi_a, phi_b):
+    """Flank-flank and tip-corner contacts, rigid and with rotated teeth, against sampled outlines."""
+    m = paper_solid_model
+    g1, g2 = m.geometry
+    th1 = math.radians(deg)
+    th2 = m.theta2_for_te(th1, m.backlash_offset + 5.5e-6)
+    phi = np.zeros(m.n_teeth)
+    rec, pairs = new_contact_buffer()
+    # first find the contacts with rigid teeth, then rotate the teeth involved
+    nc, _ = mesh_contacts(th1, th2, phi, 0.0, 0.0, phi, m.gear_par, m.pair_par, m.law_par, pairs, rec)
+    assert nc >= 2
+    k, j = int(rec[0, L.C_TOOTH1]), int(rec[0, L.C_TOOTH2])
+    phi[k] = phi_a
+    phi[m.teeth[0] + j] = phi_b
+    nc, _ = mesh_contacts(th1, th2, phi, 0.0, 0.0, np.zeros_like(phi), m.gear_par, m.pair_par, m.law_par, pairs, rec)
+    rows = [c for c in range(nc) if int(rec[c, L.C_TOOTH1]) == k and int(rec[c, L.C_TOOTH2]) == j]
+    exact = max([rec[c, L.C_DELTA] for c in rows], default=0.0)
+    ax1 = th1 + m.gear_par[0, L.GAMMA0] + k * g1.pitch_angle
+    ax2 = th2 + m.gear_par[1, L.GAMMA0] + j * g2.pitch_angle
+    xa, ya = _tooth_world(g1, (0, 0), ax1, phi_a, m.gear_par[0, L.R_PV])
+    xb, yb = _tooth_world(g2, (m.pair.center_distance, 0), ax2, phi_b, m.gear_par[1, L.R_PV])
+    brute = _brute_penetration(xa, ya, (0, 0), xb, yb, (m.pair.center_distance, 0))
+    assert exact == pytest.approx(brute, abs=5e-9)   # 5 nm: sampling of the outlines
+
+
+def test_primitives_against_numeric_minimisation():
+    """point_flank equals the distance from a point to a densely sampled involute."""
+    rb, beta = 0.04, 0.3
+    u = np.linspace(0, 0.6, 200001)
+    t = beta - u
+    px = rb * np.cos(t) - rb * u * np.sin(t)
+    py = rb * np.sin(t) + rb * u * np.cos(t)
+    for q in [(0.0425, 0.012), (0.043, 0.0148), (0.041, 0.020)]:
+        d, uf, nx, ny = point_flank(q[0], q[1], 0.0, 0.0, rb, beta, 1.0)
+        dist = np.min(np.hypot(px - q[0], py - q[1]))
+        assert abs(d) == pytest.approx(dist, abs=1e-9)
+    # flank_flank: two identical circles, conjugate position -> zero penetration at the pitch point
+    a = 0.1
+    r = 0.05
+    rbv = r * math.cos(0.35)
+    inv = math.tan(0.35) - 0.35
+    delta, ua, ub, nx, ny, _, _ = flank_flank(0.0, 0.0, rbv, inv, a, 0.0, rbv, math.pi + inv, 1.0)
+    assert delta == pytest.approx(0.0, abs=1e-15)
+    assert ua == pytest.approx(math.tan(0.35)) and ub == pytest.approx(math.tan(0.35))
+
+
+def test_gradient_matches_finite_differences(paper_solid_model):
+    """G = d delta / d(theta1, phi_A, theta2, phi_B) of every contact, flank and corner."""
+    m = paper_solid_model
+    rec, pairs = new_contact_buffer()
+    kinds = set()
+    for deg in (1.0, 3.8, 4.3):
+        th1 = math.radians(deg)
+        th2 = m.theta2_for_te(th1, m.backlash_offset + 5.5e-6)
+        phi = np.zeros(m.n_teeth)
+        z = np.zeros(m.n_teeth)
+        nc, _ = mesh_contacts(th1, th2, phi, 0.0, 0.0, z, m.gear_par, m.pair_par, m.law_par, pairs, rec)
+        base = rec[:nc].copy()
+        h = 1e-8
+        for c in range(nc):
+            k, j = int(base[c, L.C_TOOTH1]), int(base[c, L.C_TOOTH2])
+            kinds.add(int(abs(base[c, L.C_KIND])))
+
+            def delta_at(d1=0.0, da=0.0, d2=0.0, db=0.0):
+                p = phi.copy()
+                p[k] += da
+                p[m.teeth[0] + j] += db
+                n2, _ = mesh_contacts(th1 + d1, th2 + d2, p, 0.0, 0.0, z, m.gear_par, m.pair_par, m.law_par, pairs, rec)
+                for r in range(n2):
+                    if int(rec[r, L.C_TOOTH1]) == k and int(rec[r, L.C_TOOTH2]) == j and rec[r, L.C_KIND] == base[c, L.C_KIND]:
+                        return rec[r, L.C_DELTA]
+                raise AssertionError("contact lost")
+
+            fd = [(delta_at(**{key: h}) - delta_at(**{key: -h})) / (2 * h) for key in ("d1", "da", "d2", "db")]
+            g = base[c, [L.C_G1, L.C_GA, L.C_G2, L.C_GB]]
+            np.testing.assert_allclose(g, fd, rtol=1e-5, atol=1e-9)
+    assert kinds >= {1, 2}
