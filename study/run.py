@@ -69,8 +69,8 @@ def run_static(scene: Scene, model: Model):
     # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles
     from solver.kernels.explicit import driver_motion
     from solver.statics import StaticResult
-    t_end = qs.ramp_time / 2 + angles[-1] / qs.speed
     dt_out = math.radians(qs.angle_step) / qs.speed / 4
+    t_end = qs.ramp_time / 2 + angles[-1] / qs.speed + 2 * dt_out
     dyn = simulate(model, qs.speed, qs.ramp_time, qs.torque, qs.ramp_time, t_end, output_step=dt_out)
     th1 = np.array([driver_motion(t, qs.speed, qs.ramp_time)[0] for t in dyn.time])
     te = np.interp(angles, th1, dyn.te, right=np.nan)

@@ -41,6 +41,12 @@ def driver_motion(t, speed, ramp):
 
 
 @njit(cache=True)
+def driver_acc_left(t, speed, ramp):
+    """Left limit of the driver acceleration at t [rad/s²]."""
+    return speed / ramp if t <= ramp else 0.0
+
+
+@njit(cache=True)
 def load_torque(t, torque, ramp):
     """Resisting torque on gear 2 [N m], ramped from zero."""
     if t < ramp:
@@ -49,9 +55,20 @@ def load_torque(t, torque, ramp):
 
 
 @njit(cache=True)
-def _accelerations(q, act, nact, gp, acc1, acc, tz2):
-    """Solve the arrowhead systems. Returns (theta2'', driver reaction torque)."""
-    # gear 2: Schur complement on the hub
+def driver_speed(t, speed, ramp):
+    """Driver speed [rad/s] of the ramp (continuous, with a kink at the ramp end)."""
+    return speed * t / ramp if t < ramp else speed
+
+
+@njit(cache=True)
+def _accelerations(q, act, nact, gp, acc, tz2):
+    """Solve the arrowhead systems for the force part of the accelerations.
+
+    Gear-1 teeth get (Q_phi)/I_P only: the prescribed driver's inertial coupling
+    -I_cpl/I_P * theta1'' is applied by the caller as exact velocity increments, since
+    theta1'' jumps at the end of the speed ramp. Returns (theta2'', S1, R1) with the driver
+    torque T = S1*theta1'' + R1.
+    """
     s = gp[1, I_TOT]
     rhs = q[1]
     for a in range(nact):
@@ -61,15 +78,17 @@ def _accelerations(q, act, nact, gp, acc1, acc, tz2):
             s -= c * c / gp[1, I_P]
             rhs -= c * q[2 + i] / gp[1, I_P]
     a2 = rhs / s
-    react = gp[0, I_TOT] * acc1 - q[0]
+    s1 = gp[0, I_TOT]
+    r1 = -q[0]
     for a in range(nact):
         i = act[a]
         if i >= tz2:
             acc[i] = (q[2 + i] - gp[1, I_CPL] * a2) / gp[1, I_P]
         else:
-            acc[i] = (q[2 + i] - gp[0, I_CPL] * acc1) / gp[0, I_P]
-            react += gp[0, I_CPL] * acc[i]
-    return a2, react
+            acc[i] = q[2 + i] / gp[0, I_P]
+            s1 -= gp[0, I_CPL] * gp[0, I_CPL] / gp[0, I_P]
+            r1 += gp[0, I_CPL] * acc[i]
+    return a2, s1, r1
 
 
 @njit(cache=True)
@@ -146,7 +165,9 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     for i in range(ntooth + 2):
         q[i] = 0.0
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, load_torque(0.0, torque, torque_ramp), q)
-    a2, react = _accelerations(q, act, nact, gp, acc1, acc, tz2)
+    a2, s1, r1 = _accelerations(q, act, nact, gp, acc, tz2)
+    react = s1 * acc1 + r1
+    cr1 = gp[0, I_CPL] / gp[0, I_P]
     ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
     work = 0.0
     diss = 0.0
@@ -167,14 +188,19 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     status = OK
     step = 0
     for step in range(1, n_steps + 1):
-        # half kick, drift
+        # half kick (the driver coupling of gear-1 teeth as its exact speed increment), drift
+        t_old = (step - 1) * dt
+        t = step * dt
+        dw_a = driver_speed(t_old + 0.5 * dt, speed, speed_ramp) - driver_speed(t_old, speed, speed_ramp)
+        dw_b = driver_speed(t, speed, speed_ramp) - driver_speed(t_old + 0.5 * dt, speed, speed_ramp)
         w2h = w2 + 0.5 * dt * a2
         for a in range(nact):
             i = act[a]
             dphi[i] += 0.5 * dt * acc[i]
+            if i < tz2:
+                dphi[i] -= cr1 * dw_a
             phi[i] += dt * dphi[i]
         theta2 += dt * w2h
-        t = step * dt
         th1, w1, acc1 = driver_motion(t, speed, speed_ramp)
         tl = load_torque(t, torque, torque_ramp)
         # predicted velocities for the damping terms
@@ -182,6 +208,8 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
         for a in range(nact):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
+            if i < tz2:
+                vpred[i] -= cr1 * dw_b
         # contacts; activate the teeth the pre-search finds
         nc, npair = mesh_contacts(th1, theta2, phi, w1, w2p, vpred, gp, pp, lp, pairs, rec)
         for p in range(npair):
@@ -197,21 +225,26 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
         for i in range(ntooth + 2):
             q[i] = 0.0
         generalized_forces(rec, nc, phi, vpred, act, nact, kphi, gp, tl, q)
-        a2, react = _accelerations(q, act, nact, gp, acc1, acc, tz2)
+        a2, s1, r1 = _accelerations(q, act, nact, gp, acc, tz2)
+        react = s1 * acc1 + r1
         # second half kick
         w2 = w2h + 0.5 * dt * a2
         for a in range(nact):
             i = act[a]
             dphi[i] += 0.5 * dt * acc[i]
+            if i < tz2:
+                dphi[i] -= cr1 * dw_b
         # guard and bookkeeping
         for c in range(nc):
             if rec[c, C_FORCE] > fmax:
                 fmax = rec[c, C_FORCE]
             if rec[c, C_DELTA] > delta_max:
                 status = PENETRATION
+        # one-sided driver torques where the speed ramp ends on this instant
+        p_in_left = (s1 * driver_acc_left(t, speed, speed_ramp) + r1) * w1 + tl * w2
         p_in = react * w1 + tl * w2
         p_d = _dissipation_power(vpred, act, nact, gp, rec, nc, lp, tz2)
-        work += 0.5 * dt * (p_in + p_in_old)
+        work += 0.5 * dt * (p_in_left + p_in_old)
         diss += 0.5 * dt * (p_d + p_d_old)
         p_in_old = p_in
         p_d_old = p_d
