@@ -10,7 +10,7 @@ export MPLBACKEND ?= Agg
 .PHONY: run test bench venv sysdeps clean
 
 run: $(STAMP)
-	$(VENV)/bin/lightgear run -o results/paper_example/paper_example.nc
+	$(PY) -m workflows.paper_example -o results/paper_example/paper_example.nc
 
 test: $(STAMP)
 	$(PY) -m pytest -q
