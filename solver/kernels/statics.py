@@ -17,6 +17,39 @@ from .mesh import generalized_forces, mesh_contacts, tooth_spring_tangent
 
 
 @njit(cache=True)
+def solve_dense(a, b):
+    """Solve a x = b by Gaussian elimination with partial pivoting (a, b overwritten).
+
+    The systems here are small (theta2 + the teeth near the mesh); a plain loop compiles in a
+    fraction of the time np.linalg.solve takes.
+    """
+    n = b.shape[0]
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(a[i, k]) > abs(a[p, k]):
+                p = i
+        if p != k:
+            for j in range(n):
+                a[k, j], a[p, j] = a[p, j], a[k, j]
+            b[k], b[p] = b[p], b[k]
+        piv = a[k, k]
+        for i in range(k + 1, n):
+            f = a[i, k] / piv
+            if f != 0.0:
+                for j in range(k, n):
+                    a[i, j] -= f * a[k, j]
+                b[i] -= f * b[k]
+    x = np.zeros(n)
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= a[i, j] * x[j]
+        x[i] = s / a[i, i]
+    return x
+
+
+@njit(cache=True)
 def _unknowns(pairs, npair, gp, pos, lst):
     """Teeth of the candidate pairs, numbered 1.. in pos (0 is theta2). Returns their count."""
     n = 0
@@ -119,7 +152,7 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
                 K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
             if K[0, 0] <= 0.0:
                 K[0, 0] = 1e-9
-            dx = np.linalg.solve(K, r[:n].copy())
+            dx = solve_dense(K, r[:n].copy())
             # backtracking on the max-norm of the residual
             th_old = theta2
             ph_old = np.empty(nt)
