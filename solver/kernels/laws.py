@@ -11,6 +11,8 @@ from numba import njit
 @njit(cache=True)
 def signed_pow(x, n):
     """sgn(x)|x|^n."""
+    if n == 1.0:
+        return x
     if x > 0.0:
         return x ** n
     if x < 0.0:
