@@ -1,0 +1,218 @@
+"""Plane-stress FE of a gear body (scikit-fem, quadratic triangles) and per-tooth stiffness.
+
+The body is clamped at the bore. Its thickness is the face width on the teeth, rim and hub and
+the web thickness t1 in the web; the stiffness matrix is the sum of the region matrices scaled
+by their thickness. One LU factorisation serves all Z load cases.
+
+Load case k: a force F on the drive (+) flank of tooth k at the pitch point, along the line of
+action (pushing the tooth toward negative polar angle, as the mating gear does), spread
+uniformly over a patch of half-width ``patch`` along the profile (a 2D point load has a
+mesh-dependent log singularity).
+
+Tooth stiffness about the pivot Q (on the tooth axis at the pivot radius): the load line
+crosses the tooth axis at C; a rigid rotation phi about Q moves C along the load by phi*lever,
+lever = distance from Q to the load line. So
+
+    k_phi = F * lever**2 / delta_C,   delta_C = u(C) . d
+
+Reading the deflection at the tooth centreline (not under the load) keeps the local contact
+flattening out of the spring: that part belongs to the contact law, whose Weber fit measures
+the flattening down to the same centreline (see `solver.weber`). delta_C holds tooth bending
+and shear, the fillet/foundation deflection and the wind-up of the whole body to the bore.
+
+Units: SI in and out (m, N, Pa, N·m/rad).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import BodySpec, GearGeometry, Material
+from .mesh import REGION_WEB, BodyMesh
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """Pitch-point load on the + flank of one tooth (gear frame)."""
+
+    point: np.ndarray       # load point P on the flank [m]
+    direction: np.ndarray   # unit load direction d (along the line of action)
+    centre_point: np.ndarray  # C: load line on the tooth axis [m]
+    lever: float            # distance pivot -> load line [m]
+
+
+def load_case(g: GearGeometry, tooth: int, pivot_radius: float) -> LoadCase:
+    """Geometry of the pitch-point load on tooth ``tooth`` with its pivot at ``pivot_radius`` [m]."""
+    u = math.tan(g.spec.pressure_angle)           # roll parameter of the pitch point
+    t = g.psi_base - u
+    rb = g.base_radius
+    p = np.array([rb * math.cos(t) - rb * u * math.sin(t), rb * math.sin(t) + rb * u * math.cos(t)])
+    d = np.array([math.sin(t), -math.cos(t)])     # -n(t): into the tooth, toward -polar angle
+    s = p[1] / math.cos(t)                        # P + s*d lies on the axis (y = 0)
+    c = p + s * d
+    q = np.array([pivot_radius, 0.0])
+    lever = abs((p[0] - q[0]) * d[1] - (p[1] - q[1]) * d[0])
+    a = tooth * g.pitch_angle
+    rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    return LoadCase(rot @ p, rot @ d, rot @ c, lever)
+
+
+@dataclass
+class BodyModel:
+    """Assembled and factorised plane-stress model of a clamped gear body."""
+
+    mesh: BodyMesh
+    basis: object           # skfem Basis (vector P2)
+    thickness: np.ndarray   # (m,) element thickness [m]
+    free: np.ndarray        # free DOF indices
+    solve: object           # factorised K_ff: rhs -> displacement of the free DOFs
+    material: Material
+    assembly_time: float = 0.0
+    factor_time: float = 0.0
+
+    @property
+    def n_dofs(self) -> int:
+        return self.basis.N
+
+
+def plane_stress_lame(E: float, nu: float) -> tuple[float, float]:
+    """Lame parameters (lambda*, mu) of plane stress [Pa]."""
+    mu = E / (2 * (1 + nu))
+    lam = E * nu / (1 - nu**2)   # = 2 lambda mu / (lambda + 2 mu)
+    return lam, mu
+
+
+def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material, order: int = 2) -> BodyModel:
+    """Assemble K (thickness-weighted), clamp the bore and factorise once."""
+    import time
+
+    import skfem
+    from scipy.sparse.linalg import splu
+    from skfem.models.elasticity import linear_elasticity
+
+    t0 = time.perf_counter()
+    m = skfem.MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy())
+    elem = skfem.ElementVector(skfem.ElementTriP2() if order == 2 else skfem.ElementTriP1())
+    basis = skfem.Basis(m, elem)
+    lam, mu = plane_stress_lame(material.youngs_modulus, material.poisson_ratio)
+    form = linear_elasticity(lam, mu)
+    thickness = np.where(mesh.region == REGION_WEB, web_thickness, face_width)
+    K = None
+    for t in np.unique(thickness):
+        idx = np.nonzero(thickness == t)[0]
+        Kr = t * skfem.asm(form, skfem.Basis(m, elem, elements=idx))
+        K = Kr if K is None else K + Kr
+    r_tol = 1e-6 * mesh.bore_radius + 1e-9
+    clamped = basis.get_dofs(lambda x: np.hypot(x[0], x[1]) < mesh.bore_radius + r_tol).all()
+    free = np.setdiff1d(np.arange(basis.N), clamped)
+    Kff = K[free][:, free].tocsc()
+    t1 = time.perf_counter()
+    lu = splu(Kff, permc_spec="COLAMD")
+    t2 = time.perf_counter()
+    return BodyModel(mesh, basis, thickness, free, lu.solve, material, t1 - t0, t2 - t1)
+
+
+def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) -> np.ndarray:
+    """Nodal forces of ``force`` [N] spread over the boundary within ``patch`` [m] of the load point."""
+    import skfem
+
+    m = model.basis.mesh
+    p, d = case.point, case.direction
+    # boundary facets whose mid-point lies within the patch (at least the nearest one)
+    bf = m.boundary_facets()
+    mid = m.p[:, m.facets[:, bf]].mean(axis=1)
+    dist = np.hypot(mid[0] - p[0], mid[1] - p[1])
+    sel = bf[dist <= patch]
+    if sel.size == 0:
+        sel = bf[[np.argmin(dist)]]
+    fb = skfem.FacetBasis(m, model.basis.elem, facets=sel)
+    length = float(skfem.asm(skfem.Functional(lambda w: 1.0 + 0 * w.x[0]), fb))
+    q = force / length
+
+    @skfem.LinearForm
+    def traction(v, w):
+        return q * (d[0] * v[0] + d[1] * v[1])
+
+    return skfem.asm(traction, fb)
+
+
+def solve_load(model: BodyModel, f: np.ndarray) -> np.ndarray:
+    """Displacement [m] of all DOFs for the nodal force vector f [N]."""
+    u = np.zeros(model.basis.N)
+    u[model.free] = model.solve(f[model.free])
+    return u
+
+
+def point_displacement(model: BodyModel, u: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Displacement (2,) [m] at point x (2,) [m]."""
+    P = model.basis.probes(np.asarray(x, float).reshape(2, 1))
+    return np.asarray(P @ u).ravel()
+
+
+def tooth_stiffness(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, force: float,
+                    patch: float) -> tuple[np.ndarray, np.ndarray]:
+    """Torsion stiffness k_phi [N·m/rad] of the listed teeth and their displacement fields.
+
+    All load cases go through the one factorisation as a block of right-hand sides.
+    Returns (k (n,), u (N_dofs, n)).
+    """
+    teeth = [int(i) for i in teeth]
+    cases = [load_case(g, i, pivot_radius) for i in teeth]
+    F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
+    U = np.zeros((model.basis.N, len(teeth)))
+    U[model.free] = model.solve(np.ascontiguousarray(F[model.free]))
+    P = model.basis.probes(np.column_stack([c.centre_point for c in cases]))  # rows: x of all points, then y
+    n = len(teeth)
+    uc = np.asarray(P @ U)
+    k = np.empty(n)
+    for j, c in enumerate(cases):
+        delta = uc[j, j] * c.direction[0] + uc[n + j, j] * c.direction[1]
+        if not delta > 0:
+            raise RuntimeError(f"tooth {teeth[j]}: non-positive deflection {delta:.3g} m at the tooth centreline")
+        k[j] = force * c.lever**2 / delta
+    return k, U
+
+
+def von_mises(model: BodyModel, u: np.ndarray) -> np.ndarray:
+    """Element-mean von Mises stress [Pa] (plane stress) of displacement u."""
+    from skfem.helpers import sym_grad
+
+    basis = model.basis
+    w = basis.interpolate(u)
+    eps = sym_grad(w)                     # (2, 2, nelem, nqp)
+    lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
+    tr = eps[0, 0] + eps[1, 1]
+    sxx = lam * tr + 2 * mu * eps[0, 0]
+    syy = lam * tr + 2 * mu * eps[1, 1]
+    sxy = 2 * mu * eps[0, 1]
+    vm = np.sqrt(sxx**2 - sxx * syy + syy**2 + 3 * sxy**2)
+    return vm.mean(axis=1)
+
+
+@dataclass(frozen=True)
+class BodyField:
+    """FE mesh and the response to one tooth load, for renders. SI units."""
+
+    points: np.ndarray        # (n, 2) vertex coordinates [m]
+    triangles: np.ndarray     # (m, 3)
+    thickness: np.ndarray     # (m,) element thickness [m]
+    web: np.ndarray           # (m,) True in the web
+    displacement: np.ndarray  # (n, 2) vertex displacement [m]
+    von_mises: np.ndarray     # (m,) element-mean von Mises stress [Pa]
+    tooth: int                # loaded tooth
+    load_N: float             # load [N]
+    load_point: np.ndarray    # (2,) [m]
+    load_direction: np.ndarray  # (2,)
+
+
+def body_field(model: BodyModel, g: GearGeometry, u: np.ndarray, tooth: int, force: float, pivot_radius: float) -> BodyField:
+    """Pack the vertex displacement and element stress of one load case."""
+    nv = model.mesh.points.shape[0]
+    # vertex DOFs of the vector P2 basis: nodal_dofs[c, vertex]
+    nd = model.basis.nodal_dofs
+    disp = np.column_stack([u[nd[0, :nv]], u[nd[1, :nv]]])
+    case = load_case(g, tooth, pivot_radius)
+    return BodyField(model.mesh.points, model.mesh.triangles, model.thickness, model.mesh.region == REGION_WEB,
+                     disp, von_mises(model, u), tooth, force, case.point, case.direction)
