@@ -191,6 +191,11 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float) -> BodyMesh:
     gmsh.option.setNumber("Mesh.Algorithm", 5)  # Delaunay: fast and robust for large planar meshes
     gmsh.model.mesh.generate(2)
 
+    return _collect(gmsh, surfaces, r_bore, h)
+
+
+def _collect(gmsh, surfaces: dict, r_bore: float, h: float) -> BodyMesh:
+    """Nodes and 3-node triangles of the meshed surfaces, tagged by region, counter-clockwise."""
     tags, xyz, _ = gmsh.model.mesh.getNodes()
     index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
     index[tags.astype(np.int64)] = np.arange(tags.size)
@@ -217,3 +222,30 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float) -> BodyMesh:
     flip = area2 < 0
     tri[flip] = tri[flip][:, [0, 2, 1]]
     return BodyMesh(points, tri, region, r_bore, h)
+
+
+def mesh_annulus(r_in: float, r_split: float, r_out: float, size: float) -> BodyMesh:
+    """Annulus r_in..r_out [m] meshed with element size ``size`` [m]; elements inside r_split are
+    tagged as web, outside as rim. An analytic check case for the FE (torsion of a thick ring)."""
+    if not 0 < r_in < r_split < r_out:
+        raise ValueError("mesh_annulus: need 0 < r_in < r_split < r_out")
+    import gmsh
+
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("annulus")
+        geo = gmsh.model.geo
+        c = geo.addPoint(0.0, 0.0, 0.0, size)
+
+        def circle(r):
+            pts = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0.0, size) for t in np.arange(4) * math.pi / 2]
+            return geo.addCurveLoop([geo.addCircleArc(pts[i], c, pts[(i + 1) % 4]) for i in range(4)])
+
+        lo, mid, hi = circle(r_in), circle(r_split), circle(r_out)
+        surfaces = {REGION_RIM: geo.addPlaneSurface([hi, mid]), REGION_WEB: geo.addPlaneSurface([mid, lo])}
+        geo.synchronize()
+        gmsh.model.mesh.generate(2)
+        return _collect(gmsh, surfaces, r_in, size)
+    finally:
+        gmsh.finalize()
