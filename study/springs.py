@@ -189,6 +189,8 @@ def add_arguments(p):
     p.add_argument("-o", "--output", default="results/stiffness.nc", help="archive to write (NetCDF)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene field by its dotted path")
+    p.add_argument("--identify", action="store_true",
+                   help="also fit (pivot radius, k_phi, n) of each gear's tooth to FE compliance along the profile")
 
 
 def main(args) -> int:
@@ -206,4 +208,41 @@ def main(args) -> int:
             off = hole_offset(scene, g)
             print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
                   f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
+        if args.identify:
+            fit, u, c = identify_spring(scene, g)
+            print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius * 1e3:.3f} mm, "
+                  f"k_phi {fit.k_phi * 1e3:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
+                  f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {u.size} load radii")
     return 0
+
+
+def identify_spring(scene: Scene, g: int, radii: int = 7, levels=(0.25, 0.5, 1.0)):
+    """Fit (pivot radius, k_phi, n) of gear g's tooth 0 to FE compliance at ``radii`` load points
+    from the start of active profile to near the tip and at ``levels`` times the reference load."""
+    from solver import fe
+    from solver.geometry import pair_geometry
+    from solver.identify import SpringFit, fit_pivot, fit_power_law
+    from solver.mesh import default_mesh_size, mesh_body
+
+    geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
+    pair = pair_geometry(gear_geometry(scene.tooth_spec(1)), gear_geometry(scene.tooth_spec(2)))
+    u = np.linspace(pair.u_sap[g - 1], geo.u_tip, radii + 2)[1:-1]
+    st = _settings(scene, g, scene.body_spec(g))
+    size = st["size"] or default_mesh_size(geo.spec.module)
+    mesh = mesh_body(geo, scene.body_spec(g), size, prefix=f"gear{g}.body")
+    model = fe.assemble(mesh, geo.spec.face_width, scene.body_spec(g).web_thickness, scene.material_spec())
+    patch = contact_patch(scene, g, st["force"], size)
+    comp, t = [], []
+    for ui in u:
+        case = fe.load_case(geo, 0, 0.0, ui)
+        f = fe.load_vector(model, case, 1.0, patch)
+        d = fe.point_displacement(model, fe.solve_load(model, f), case.centre_point) @ case.direction
+        comp.append(d)
+        t.append(geo.psi_base - ui)
+    r_q, k, err = fit_pivot(geo.base_radius, t, comp)
+    # load levels at the pitch point: moment and rotation about the identified pivot
+    case = fe.load_case(geo, 0, r_q)
+    c_pitch = np.interp(math.tan(geo.spec.pressure_angle), u, comp)
+    F = st["force"] * np.asarray(levels)
+    k_phi, n = fit_power_law(F * case.lever, F * c_pitch / case.lever)
+    return SpringFit(r_q, k_phi, n, err), u, np.array(comp)

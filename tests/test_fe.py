@@ -122,3 +122,23 @@ def test_load_case_geometry():
     a = 3 * g.pitch_angle
     R = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
     assert np.allclose(c3.point, R @ c.point) and c3.lever == pytest.approx(c.lever)
+
+
+def test_patch_load_equals_the_quadrature_of_a_uniform_traction():
+    mesh = mesh_annulus(A, C, B, 2e-3)
+    model = fe.assemble(mesh, T_RIM, T_WEB, STEEL)
+    d = np.array([0.6, 0.8])
+    case = fe.LoadCase(np.array([B, 0.0]), d, np.zeros(2), 1.0)
+    f = fe.load_vector(model, case, 10.0, 3e-3)
+    m = model.basis.mesh
+    bf = m.boundary_facets()
+    mid = m.p[:, m.facets[:, bf]].mean(axis=1)
+    sel = bf[np.hypot(mid[0] - B, mid[1]) <= 3e-3]
+    fb = skfem.FacetBasis(m, model.basis.elem, facets=sel)
+    length = skfem.asm(skfem.Functional(lambda w: 1.0 + 0 * w.x[0]), fb)
+    ref = skfem.asm(skfem.LinearForm(lambda v, w: 10.0 / length * (d[0] * v[0] + d[1] * v[1])), fb)
+    assert np.allclose(f, ref, atol=1e-12)
+    # the resultant is the requested force along d
+    nd = model.basis.nodal_dofs
+    total = np.array([f[nd[0]].sum() + f[model.basis.facet_dofs[0]].sum(), f[nd[1]].sum() + f[model.basis.facet_dofs[1]].sum()])
+    assert np.allclose(total, 10.0 * d, rtol=1e-12)

@@ -154,3 +154,20 @@ def test_web_thickness_trend_follows_iso_blank_factor(table1):
         ratios.append(fe_ratio)
         assert fe_ratio == pytest.approx(iso, abs=0.06)
     assert 1.0 > ratios[0] > ratios[1]
+
+
+def test_identification_recovers_a_known_spring_and_reads_the_fe():
+    from solver.identify import fit_pivot, fit_power_law, lever
+    rb, r_q, k = 0.047, 0.0445, 9.0e3
+    t = np.linspace(-0.45, -0.2, 6)
+    c = lever(rb, t, r_q) ** 2 / k
+    r_fit, k_fit, err = fit_pivot(rb, t, c)
+    assert r_fit == pytest.approx(r_q, rel=1e-10) and k_fit == pytest.approx(k, rel=1e-10) and err < 1e-10
+    phi = np.array([1e-4, 3e-4, 1e-3])
+    assert fit_power_law(1060.0 * phi**1.1, phi) == pytest.approx((1060.0, 1.1), rel=1e-10)
+    fit, u, comp = springs.identify_spring(small_scene(), 1, radii=5)
+    assert np.all(np.diff(comp) > 0)                     # higher load point: more compliant
+    assert fit.n == pytest.approx(1.0, abs=1e-9)          # the body FE is linear
+    g = gear_geometry(small_scene().tooth_spec(1))
+    assert 0.5 * g.root_radius < fit.pivot_radius < g.pitch_radius
+    assert fit.rms_rel_error < 0.1
