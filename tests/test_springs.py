@@ -171,3 +171,18 @@ def test_identification_recovers_a_known_spring_and_reads_the_fe():
     g = gear_geometry(small_scene().tooth_spec(1))
     assert 0.5 * g.root_radius < fit.pivot_radius < g.pitch_radius
     assert fit.rms_rel_error < 0.1
+
+
+def test_lightened_scene_runs_with_its_fe_springs_in_the_archive():
+    from study.run import run_scene
+    lite = small_scene(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})
+    solid = lite.replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 20.0})
+    ds = run_scene(lite, static=True, dynamic=False)
+    k = ds["tooth_stiffness"].sel(gear=2).values
+    r = ds["stiffness_ratio"].sel(gear=2).values
+    assert ds["tooth_stiffness"].attrs["units"] == "N mm rad-1"
+    assert np.allclose(k, lite.gear2.spring.k_phi * r) and r.max() < 1.0
+    assert np.all(ds["stiffness_ratio"].sel(gear=1).values == 1.0)
+    ste_solid = run_scene(solid, static=True, dynamic=False)["ste"].values
+    # softer driven teeth: more transmission error at every angle
+    assert np.all(ds["ste"].values > ste_solid)
