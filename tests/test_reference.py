@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from conftest import solid_scene
-from solver.integrate import simulate
+from solver.integrate import DivergenceError, simulate
 from solver.reference import PairEquations, simulate_explicit_all_teeth, simulate_scipy
 from study.run import build_scene_model
 
@@ -88,8 +88,12 @@ def test_bad_input_names_the_field(model):
 
 
 def test_failure_is_reported_not_silent(model):
-    """A step cap far too small for the span stops the solver: status != 0 and a message."""
-    r = simulate_scipy(model, 100.0, 0.002, 50.0, 0.002, 0.002, method="RK45", rtol=1e-3,
-                       max_step=1e-15)
-    assert r.status != 0 and "failed" in r.message and "t = " in r.message
+    """A penetration bound below the loaded penetration (about 1 um at 50 N·m) stops the run:
+    status != 0, a message naming the cause and the time, finite output up to there."""
+    short = (*RUN[:4], 0.0005)     # the load reaches 0.1 um of penetration after about 0.12 ms
+    r = simulate_scipy(model, *short, method="LSODA", rtol=1e-6, output_step=1e-4, delta_max=0.1e-6)
+    assert r.status == 2 and "penetration beyond the bound" in r.message and "t = " in r.message
     assert np.all(np.isfinite(r.te))
+    with pytest.raises(DivergenceError, match="penetration"):
+        simulate_scipy(model, *short, method="LSODA", rtol=1e-6, output_step=1e-4, delta_max=0.1e-6,
+                       raise_on_failure=True)
