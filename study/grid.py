@@ -13,6 +13,9 @@ A study TOML file::
     gear2.body.holes = [0, 3, 6]
     "dynamic.speed" = {start = 50.0, stop = 200.0, num = 4}   # linspace, both ends included
 
+    # dimension order = key order after TOML parsing: unquoted dotted keys with a common head
+    # (gear2.body.*) are grouped into one table; quote a key ("dynamic.speed") to keep it apart
+
     [[points]]                       # optional explicit points (then the archive has a `point`
     gear2.body.holes = 9             # dimension: the factorial points first, then these)
     dynamic.speed = 300.0
