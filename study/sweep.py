@@ -20,6 +20,9 @@ CLI: ``lightgear sweep STUDY.toml [-o OUT.nc] [--scheduler ADDR] [--workers N]``
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+import itertools
+import json
 import logging
 import math
 import os
@@ -178,6 +181,27 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
         yield client
 
 
+def body_group(scene: Scene) -> str:
+    """What a point's FE spring maps depend on (gears, bodies, material, mesh, FE load torque).
+
+    Points of one group share the disk-cached maps; `interleave` keeps them apart in the queue
+    so that two workers rarely compute the same map at once.
+    """
+    data = dataclasses.asdict(scene)
+    keep = {k: data[k] for k in ("gear1", "gear2", "material", "fe")}
+    keep["torque"] = scene.quasi_static.torque
+    return json.dumps(keep, sort_keys=True, default=str)
+
+
+def interleave(todo: dict) -> dict:
+    """Reorder {key: scene} round-robin over body groups (first point of every body first)."""
+    groups: dict[str, list] = {}
+    for key, scene in todo.items():
+        groups.setdefault(body_group(scene), []).append(key)
+    order = [k for round_ in itertools.zip_longest(*groups.values()) for k in round_ if k is not None]
+    return {k: todo[k] for k in order}
+
+
 def _in_process(todo: dict, outputs: Outputs):
     for key, scene in todo.items():
         yield key, run_point(scene, outputs)
@@ -248,6 +272,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
             todo[key] = p.scene
     reused = len(results) - n_invalid
     lost = {}
+    todo = interleave(todo)
     if todo:
         run = _in_process(todo, out) if workers == 0 and not scheduler else _with_dask(todo, out, scheduler, workers)
         with contextlib.closing(run), tqdm(total=len(todo), desc=study.title[:40], unit="point", disable=not progress,
