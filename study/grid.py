@@ -172,18 +172,23 @@ class Study:
 
 # ---------------------------------------------------------------- reading and checking
 
-def _flatten(table: dict, where: str, prefix: str = "") -> dict:
-    """Nested TOML tables -> {dotted path: leaf}; a leaf is a list, a range table or a scalar."""
+def _flatten(table: dict, where: str, prefix: str = "", repeat: bool = False) -> dict:
+    """Nested TOML tables -> {dotted path: leaf}; a leaf is a list, a range table or a scalar.
+
+    A path given twice (nested and quoted) is an error, unless ``repeat`` (scene overrides:
+    the later one wins).
+    """
     out = {}
     for k, v in table.items():
         path = f"{prefix}.{k}" if prefix else k
         if isinstance(v, dict) and not (set(v) & set(RANGE_KEYS)):
-            sub = _flatten(v, where, path)
+            sub = _flatten(v, where, path, repeat)
         else:
             sub = {path: v}
         for p in sub:
-            if p in out:
+            if p in out and not repeat:
                 raise SceneError(p, f"given twice in [{where}]")
+            out.pop(p, None)
         out.update(sub)
     return out
 
@@ -287,7 +292,7 @@ def _base_scene(spec, folder: Path | None) -> dict:
         spec = copy.deepcopy(spec)
         file = spec.pop("file", None)
         data = read(file) if file is not None else tomllib.loads(default_scene_text())
-        for path, v in _flatten(spec, "scene").items():
+        for path, v in _flatten(spec, "scene", repeat=True).items():
             set_dotted(data, path, v)
         return data
     raise SceneError("scene", f"must be a file name or a table, got {spec!r}")
@@ -335,6 +340,29 @@ def load_study(path: str | Path) -> Study:
     return loads_study(p.read_text(), p.parent)
 
 
+def _toml(v) -> str:
+    from .scene import _toml_value
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k} = {_toml(x)}" for k, x in v.items()) + "}"
+    return _toml_value(v)
+
+
+def dumps_study(raw: dict) -> str:
+    """A study as TOML text from its parsed tables (dotted keys quoted, so their order stays)."""
+    out = [f"{k} = {_toml(raw[k])}" for k in ("title", "scene") if k in raw and not isinstance(raw[k], dict)]
+    for table in ("scene", "grid", "outputs"):
+        if isinstance(raw.get(table), dict):
+            out.append(f"\n[{table}]")
+            flat = _flatten(raw[table], table, repeat=table == "scene") if table != "outputs" else raw[table]
+            out += [f'"{k}" = {_toml(v)}' for k, v in flat.items()]
+    for p in raw.get("points", []):
+        out.append("\n[[points]]")
+        out += [f'"{k}" = {_toml(v)}' for k, v in _flatten(p, "points").items()]
+    return "\n".join(out) + "\n"
+
+
 def check_points(study: Study) -> list[Point]:
     """The study's points; SceneError when no point is valid (nothing could be computed)."""
     points = study.points()
@@ -345,4 +373,4 @@ def check_points(study: Study) -> list[Point]:
     return points
 
 
-__all__ = ["Study", "Axis", "Point", "Outputs", "loads_study", "load_study", "check_points", "dim_name", "DIM_NAMES", "CURVES"]
+__all__ = ["Study", "Axis", "Point", "Outputs", "loads_study", "load_study", "dumps_study", "check_points", "dim_name", "DIM_NAMES", "CURVES"]
