@@ -287,3 +287,44 @@ def test_dask_sweep_is_interruptible_closes_its_cluster_and_resumes(swept, tmp_p
     assert again.reused == 2 and len(calls) == 6
     xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created=""),
                                 res.dataset.drop_vars("wall_time").assign_attrs(created=""))
+
+
+# ---------------------------------------------------------------- CLI, workflow, scheduling
+
+def test_cli_sweep_of_the_example_study(tmp_path, capsys):
+    from study.cli import main
+    out = tmp_path / "ex.nc"
+    assert main(["sweep", "study/scenes/example_study.toml", "-o", str(out), "--workers", "0", "--no-progress"]) == 0
+    assert "computed 4" in capsys.readouterr().out
+    with xr.open_dataset(out, engine="netcdf4") as ds:
+        assert ds["dte"].dims == ("n_holes", "speed", "time") and ds["time"].attrs["units"] == "s"
+        assert (ds["status"] == STATUS.index("ok")).all()
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[grid]\ngear2.body.holes = [1.5]\n")
+    assert main(["sweep", str(bad), "-o", str(tmp_path / "bad.nc"), "--workers", "0"]) == 2
+    assert "gear2.body.holes" in capsys.readouterr().err and not (tmp_path / "bad.nc").exists()
+
+
+def test_sensitivity_workflow_shrunk_to_a_tiny_grid(tmp_path, capsys):
+    from workflows.sensitivity_sweep import STUDY, main, study_text
+    full = loads_study(study_text(STUDY), STUDY.parent)
+    assert [a.name for a in full.axes] == ["n_holes", "hole_radius", "rim_thickness", "web_thickness", "speed"]
+    assert full.axes[0].values == (0, 3, 6, 9, 12) and all(p.scene is not None for p in full.points())
+    out = tmp_path / "s.nc"
+    assert main(["--study", "study/scenes/example_study.toml", "--grid", "gear2.body.holes=0,3",
+                 "--grid", "dynamic.speed=60", "--set", "dynamic.duration=0.008", "-o", str(out),
+                 "--workers", "0", "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "2 points: n_holes 2 x speed 1" in text and "dte_rms" in text
+    with xr.open_dataset(out, engine="netcdf4") as ds:
+        assert loads_study(ds.attrs["study"]).base["dynamic"]["duration"] == 0.008
+        assert ds["time"].values[-1] == pytest.approx(0.008)
+
+
+def test_points_sharing_a_body_are_queued_apart():
+    st = tiny_study("[grid]\ngear2.body.holes = [0, 4]\n\"dynamic.speed\" = [50.0, 60.0, 70.0]")
+    todo = {p.key(st.outputs): p.scene for p in st.points()}
+    order = list(sweep.interleave(todo).values())
+    holes = [s.gear2.body.holes for s in order]
+    assert sorted(holes) == [0, 0, 0, 4, 4, 4]
+    assert all(a != b for a, b in zip(holes, holes[1:]))
