@@ -86,6 +86,20 @@ def test_study_errors_name_the_field_before_any_work(grid, field, reason, monkey
     assert e.value.field == field and reason in str(e.value), str(e.value)
 
 
+def test_base_scene_from_a_file_or_a_table(tmp_path):
+    (tmp_path / "sc").mkdir()
+    (tmp_path / "sc" / "s.toml").write_text("[gear2.body]\nholes = 0\nweb_thickness = 17.0\n")
+    grid = "\n[grid]\ndynamic.speed = [50.0]\n"
+    st = loads_study('scene = "sc/s.toml"' + grid, tmp_path)
+    assert st.points()[0].scene.gear2.body.holes == 0 and st.points()[0].scene.gear2.teeth == 67
+    st = loads_study('[scene]\nfile = "sc/s.toml"\ngear2.body.web_thickness = 12.0' + grid, tmp_path)
+    assert st.points()[0].scene.gear2.body.web_thickness == 12.0
+    paper = loads_study(grid).points()[0].scene
+    assert paper == default_scene().replace(**{"dynamic.speed": 50.0})
+    with pytest.raises(SceneError, match="no such file"):
+        loads_study('scene = "nope.toml"' + grid, tmp_path)
+
+
 def test_a_study_whose_every_point_is_invalid_is_refused(tmp_path):
     st = tiny_study("[grid]\ngear2.body.holes = [3, 4]\ngear2.body.hole_radius = [2.5, 3.0]")
     with pytest.raises(SceneError, match="every point of the study is invalid.*holes cut the rim"):
@@ -274,10 +288,17 @@ def test_dask_sweep_is_interruptible_closes_its_cluster_and_resumes(swept, tmp_p
         stored.append(key)
         real_put(self, key, result)
 
+    import distributed
+    started = []
+    real_cluster = distributed.LocalCluster
+    monkeypatch.setattr(distributed, "LocalCluster", lambda **kw: started.append(kw) or real_cluster(**kw))
     monkeypatch.setattr(sweep.PartStore, "put", put)
     with pytest.raises(KeyboardInterrupt):
         run_sweep(tiny_study(), out, workers=2, progress=False)
     assert SpecCluster._instances and all(c.status.name == "closed" for c in SpecCluster._instances)
+    (kw,) = started
+    assert kw["n_workers"] == 2 and kw["threads_per_worker"] == 1 and kw["processes"]
+    assert kw["env"]["NUMBA_NUM_THREADS"] == "1"
     monkeypatch.setattr(sweep.PartStore, "put", real_put)
     # the two points computed on the workers are kept; the rest is computed here
     calls = []
