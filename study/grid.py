@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import (Scene, SceneError, default_scene_text, dumps_toml, field_unit, scene_fields_from_dict,
+from .scene import (Scene, SceneError, default_scene_text, field_unit, scene_fields_from_dict,
                     scene_from_dict, set_dotted)
 
 # dimension names for the fields an engineer sweeps most; others get the dotted path with '_'
@@ -140,7 +140,8 @@ class Study:
         return (n_grid + len(self.extra),)
 
     def base_scene_toml(self) -> str:
-        return dumps_toml(self.base)
+        """The base scene with every field spelled out (defaults included)."""
+        return scene_fields_from_dict(self.base).to_toml()
 
     def base_value(self, path: str):
         """Value of a dotted field in the base scene (the Scene default when the base omits it)."""

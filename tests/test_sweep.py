@@ -1,13 +1,11 @@
 """Parametric studies: grid checks, sweep = points run alone, resume, failures, archives, dask."""
 import math
-import pickle
 
 import numpy as np
 import pytest
 import xarray as xr
 
 import study.sweep as sweep
-from study.archive import study_key
 from study.grid import loads_study
 from study.run import run_scene, summarize
 from study.scene import SceneError, default_scene, loads_scene
