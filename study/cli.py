@@ -13,6 +13,7 @@ import sys
 COMMANDS = {
     "run": ("study.run", "run a scene (default: the paper example) and write its archive"),
     "stiffness": ("study.springs", "per-tooth FE stiffness map of a scene's gears (no solve)"),
+    "sweep": ("study.sweep", "run a parametric study (scene + grid) with dask into one NetCDF archive"),
     "fit-contact": ("study.fit_contact", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
 }
 

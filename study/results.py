@@ -102,15 +102,25 @@ def stiffness_variables(k_nmm: tuple, ratio: tuple) -> tuple[dict, dict]:
 
 
 def write_netcdf(ds: xr.Dataset, path) -> None:
-    """Write compressed NetCDF4 atomically (temporary file, then rename)."""
+    """Write compressed NetCDF4 atomically (temporary file, then rename).
+
+    The temporary name is unique per process and call, so concurrent writers of the same path
+    (dask workers filling the FE spring cache) never share a half-written file; the last
+    rename wins and readers only ever open complete files.
+    """
     import os
+    import uuid
     from pathlib import Path
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}.{uuid.uuid4().hex[:8]}")
     enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars if ds[v].dtype.kind in "fiu"}
-    ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
-    os.replace(tmp, path)
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
 
 
 def largest_peaks(ds: xr.Dataset, n: int = 5, min_order: float = 0.5):

@@ -282,6 +282,12 @@ def scene_from_dict(data: dict) -> Scene:
     return scene
 
 
+def scene_fields_from_dict(data: dict) -> Scene:
+    """Field-by-field validation only (keys, types, ranges), without the cross-field checks of
+    `check_scene`: a study uses it to check each grid value alone before checking combinations."""
+    return _build(Scene, data, "")
+
+
 def loads_scene(text: str, source: str = "scene") -> Scene:
     try:
         data = tomllib.loads(text)
@@ -406,4 +412,4 @@ def dumps_toml(data: dict, prefix: str = "") -> str:
 
 __all__ = ["Scene", "SceneError", "load_scene", "loads_scene", "default_scene", "default_scene_text",
            "parse_override", "set_dotted", "get_dotted", "field_unit", "field_doc", "check_scene",
-           "scene_from_dict", "dumps_toml", "replace"]
+           "scene_from_dict", "scene_fields_from_dict", "dumps_toml", "replace"]

@@ -53,6 +53,8 @@ def reference_torque(scene: Scene) -> float:
 
 
 def _settings(scene: Scene, g: int, body: BodySpec) -> dict:
+    if body.holes == 0:  # hole sizes do not matter without holes: one cache entry for all of them
+        body = dataclasses.replace(body, hole_radius=0.0, hole_circle_radius=0.0, hole_phase=0.0)
     geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
     size = scene.fe.mesh_size * units.MM if scene.fe.mesh_size > 0 else None
     return dict(tooth=dataclasses.asdict(scene.tooth_spec(g)), body=dataclasses.asdict(body),

@@ -1,0 +1,349 @@
+"""Parametric studies: grid checks, sweep = points run alone, resume, failures, archives, dask."""
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import study.sweep as sweep
+from study.grid import loads_study
+from study.run import run_scene, summarize
+from study.scene import SceneError, default_scene, loads_scene
+from study.sweep import STATUS, parts_folder, run_sweep
+
+# A 20-tooth solid-driver pair with small bodies, uniform springs (no FE), a few degrees of STE
+# and 10 ms of DTE: about a third of a second per point.
+BASE = """
+[scene]
+gear1.teeth = 20
+gear2.teeth = 20
+gear1.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0}
+gear2.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0, holes = 0, hole_radius = 1.5, hole_circle_radius = 8.1, web_thickness = 17.0}
+gear2.spring.stiffness = "uniform"
+quasi_static = {rotation = 6.0, angle_step = 0.5}
+dynamic = {duration = 0.01, ramp_time = 0.002}
+"""
+GRID = """
+[grid]
+gear2.body.holes = [0, 4]
+"dynamic.speed" = {start = 50.0, stop = 100.0, num = 2}
+gear2.body.web_thickness = [12.0, 17.0]
+[outputs]
+curves = ["ste", "dte_amplitude"]
+"""
+
+
+def tiny_study(grid=GRID, base=BASE, title="tiny"):
+    return loads_study(f'title = "{title}"\n' + base + grid)
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep") / "tiny.nc"
+    res = run_sweep(tiny_study(), out, workers=0, progress=False)
+    return res, out
+
+
+# ---------------------------------------------------------------- validation before work
+
+@pytest.mark.parametrize("text, field, reason", [
+    ("[gear2]\nteeth = 4", "gear2.teeth", "must be >= 6"),
+    ("[gear2.body]\nholez = 3", "gear2.body.holez", "unknown key"),
+    ("[gear2.body]\nholes = 2.5", "gear2.body.holes", "must be an integer"),
+    ("[gear2.body]\nrim_height = -1.0", "gear2.body.rim_height", "must be >= 0"),
+    ("[gear2.body]\nholes = 6\nhole_radius = 12.0", "gear2.body.hole_radius", "cut the rim"),
+    ("[dynamic]\nmethod = 'rk4'", "dynamic.method", "must be one of"),
+])
+def test_scene_errors_name_the_field(text, field, reason):
+    with pytest.raises(SceneError) as e:
+        loads_scene(text)
+    assert e.value.field == field and reason in str(e.value)
+
+
+@pytest.mark.parametrize("grid, field, reason", [
+    ("[grid]\ngear2.body.holez = [1, 2]", "gear2.body.holez", "no such scene field"),
+    ("[grid]\n\"gear2.body\" = [1, 2]", "gear2.body", "is a table"),
+    ("[grid]\ngear2.body.holes = [3, 4.5]", "gear2.body.holes", "must be an integer"),
+    ("[grid]\ngear2.body.hole_radius = [1.0, -2.0]", "gear2.body.hole_radius", "must be >= 0"),
+    ("[grid]\ndynamic.method = ['explicit', 'rk4']", "dynamic.method", "must be one of"),
+    ("[grid]\ndynamic.speed = {start = 1.0, stop = 2.0}", "dynamic.speed", "range"),
+    ("[grid]\ngear2.body.holes = {start = 0, stop = 3, num = 3}", "gear2.body.holes", "non-integer"),
+    ("[grid]\ndynamic.speed = []", "dynamic.speed", "empty"),
+    ("[grid]\ndynamic.speed = [50.0, 50.0]", "dynamic.speed", "repeats"),
+    ("[grid]\ndynamic.speed = 50.0", "dynamic.speed", "list of values or a range"),
+    ("[grid]\ndynamic.speed = [1.0]\n[outputs]\ncurves = ['dtee']", "outputs.curves", "unknown output"),
+    ("[grd]\ndynamic.speed = [1.0]", "grd", "unknown study key"),
+    ("[[points]]\ndynamic.sped = 3.0", "dynamic.sped", "no such scene field"),
+    ("[[points]]\ngear2.teeth = 3", "gear2.teeth", "points[0] value 3: must be >= 6"),
+    ("[outputs]\ncurves = ['ste']", "grid", "sweeps nothing"),
+])
+def test_study_errors_name_the_field_before_any_work(grid, field, reason, monkeypatch):
+    monkeypatch.setattr(sweep, "run_point", lambda *a: pytest.fail("work started"))
+    with pytest.raises(SceneError) as e:
+        tiny_study(grid)
+    assert e.value.field == field and reason in str(e.value), str(e.value)
+
+
+def test_base_scene_from_a_file_or_a_table(tmp_path):
+    (tmp_path / "sc").mkdir()
+    (tmp_path / "sc" / "s.toml").write_text("[gear2.body]\nholes = 0\nweb_thickness = 17.0\n")
+    grid = "\n[grid]\ndynamic.speed = [50.0]\n"
+    st = loads_study('scene = "sc/s.toml"' + grid, tmp_path)
+    assert st.points()[0].scene.gear2.body.holes == 0 and st.points()[0].scene.gear2.teeth == 67
+    st = loads_study('[scene]\nfile = "sc/s.toml"\ngear2.body.web_thickness = 12.0' + grid, tmp_path)
+    assert st.points()[0].scene.gear2.body.web_thickness == 12.0
+    paper = loads_study(grid).points()[0].scene
+    assert paper == default_scene().replace(**{"dynamic.speed": 50.0})
+    with pytest.raises(SceneError, match="no such file"):
+        loads_study('scene = "nope.toml"' + grid, tmp_path)
+
+
+def test_a_study_whose_every_point_is_invalid_is_refused(tmp_path):
+    st = tiny_study("[grid]\ngear2.body.holes = [3, 4]\ngear2.body.hole_radius = [2.5, 3.0]")
+    with pytest.raises(SceneError, match="every point of the study is invalid.*holes cut the rim"):
+        run_sweep(st, tmp_path / "x.nc", workers=0, progress=False)
+    assert not (tmp_path / "x.nc").exists()
+
+
+# ---------------------------------------------------------------- the sweep and its archive
+
+def test_sweep_equals_each_point_run_alone(swept):
+    res, _ = swept
+    ds = res.dataset
+    # dotted keys nest (TOML): gear2.* fields come first, then the quoted "dynamic.speed"
+    assert ds["status"].dims == ("n_holes", "web_thickness", "speed") and (ds["status"] == STATUS.index("ok")).all()
+    assert res.computed == 8 and res.reused == 0
+    base = default_scene().replace(**{k: v for k, v in _flat(loads_scene_data()).items()})
+    for h in (0, 4):
+        for w in (50.0, 100.0):
+            for t in (12.0, 17.0):
+                sc = base.replace(**{"gear2.body.holes": h, "dynamic.speed": w, "gear2.body.web_thickness": t})
+                alone = run_scene(sc)
+                s = summarize(alone)
+                pt = ds.sel(n_holes=h, speed=w, web_thickness=t)
+                for k in sweep.SCALARS:
+                    np.testing.assert_allclose(float(pt[k]), s.get(k, math.nan), rtol=1e-12, equal_nan=True, err_msg=k)
+                np.testing.assert_allclose(pt["ste"].values, alone["ste"].values, rtol=1e-12)
+                np.testing.assert_allclose(pt["dte_amplitude"].values, alone["dte_amplitude"].values, rtol=1e-12)
+    assert (ds["ste_p2p"] > 0).all() and (ds["dte_rms"] > 0).all()
+    # STE does not depend on the speed
+    np.testing.assert_array_equal(ds["ste"].sel(speed=50.0), ds["ste"].sel(speed=100.0))
+
+
+def loads_scene_data():
+    import tomllib
+    return tomllib.loads(BASE)["scene"]
+
+
+def _flat(d, prefix=""):
+    out = {}
+    for k, v in d.items():
+        p = f"{prefix}.{k}" if prefix else k
+        out.update(_flat(v, p) if isinstance(v, dict) else {p: v})
+    return out
+
+
+def test_archive_labels_units_and_netcdf_round_trip(swept):
+    res, out = swept
+    ds = res.dataset
+    for name, path, unit in (("n_holes", "gear2.body.holes", "1"), ("speed", "dynamic.speed", "rad s-1"),
+                             ("web_thickness", "gear2.body.web_thickness", "mm")):
+        assert ds[name].attrs["scene_field"] == path and ds[name].attrs["units"] == unit
+        assert ds[name].attrs["long_name"]
+    for name, v in ds.variables.items():
+        assert "long_name" in v.attrs, name
+        if v.dtype.kind in "fiu":
+            assert "units" in v.attrs, name
+    assert list(ds["status"].attrs["flag_meanings"].split()) == list(STATUS)
+    assert ds["dte_amplitude"].dims[-1] == "frequency" and ds["ste"].dims[-1] == "angle"
+    assert "dte" not in ds  # not asked for
+    assert loads_study(ds.attrs["study"]).shape == (2, 2, 2)
+    assert "software" in ds.attrs and "machine" in ds.attrs and "created" in ds.attrs
+    assert not parts_folder(out).exists()  # complete: the per-point files are gone
+    with xr.open_dataset(out, engine="netcdf4") as back:
+        xr.testing.assert_identical(back.load(), ds)
+        assert back["ste"].encoding.get("zlib")
+
+
+def test_rerunning_a_complete_study_computes_nothing(swept, monkeypatch):
+    res, out = swept
+    monkeypatch.setattr(sweep, "run_point", lambda *a: pytest.fail("recomputed"))
+    again = run_sweep(tiny_study(), out, workers=0, progress=False)
+    assert again.computed == 0
+    xr.testing.assert_identical(again.dataset, res.dataset)
+
+
+def test_interrupt_and_resume_give_the_same_archive(swept, tmp_path, monkeypatch):
+    res, _ = swept
+    out = tmp_path / "resumed.nc"
+    real = sweep.run_point
+    calls = []
+
+    def stop_on_fifth(scene, outputs):
+        if len(calls) == 4:
+            raise KeyboardInterrupt
+        calls.append(scene)
+        return real(scene, outputs)
+
+    monkeypatch.setattr(sweep, "run_point", stop_on_fifth)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(tiny_study(), out, workers=0, progress=False)
+    assert not out.exists()  # no half archive
+    parts = sorted(parts_folder(out).glob("*.pkl"))
+    assert len(parts) == 4
+    # a process killed while writing leaves a temporary file; a damaged record is recomputed
+    (parts_folder(out) / ".junk.123.tmp").write_bytes(b"\0" * 10)
+    parts[0].write_bytes(b"not a pickle")
+    calls.clear()
+    monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or real(s, o))
+    again = run_sweep(tiny_study(), out, workers=0, progress=False)
+    assert len(calls) == 5 and again.computed == 5 and again.reused == 3
+    drop = ["wall_time"]
+    xr.testing.assert_identical(again.dataset.drop_vars(drop).assign_attrs(created=""),
+                                res.dataset.drop_vars(drop).assign_attrs(created=""))
+
+
+def test_failing_points_are_recorded_and_the_sweep_goes_on(tmp_path, monkeypatch):
+    points = """
+[[points]]
+dynamic.speed = 60.0
+[[points]]
+gear2.body.holes = 4
+gear2.body.hole_radius = 2.5
+[[points]]
+dynamic.speed = 77.0
+[[points]]
+dynamic = {output_step = 1e-4, time_step = 5e-5}
+[outputs]
+scalars = ["ste_p2p", "dte_rms"]
+"""
+    import study.run
+    real = study.run.run_scene
+
+    def boom(scene, **kw):
+        if scene.dynamic.speed == 77.0:
+            raise RuntimeError("boom")
+        return real(scene, **kw)
+
+    monkeypatch.setattr(study.run, "run_scene", boom)
+    res = run_sweep(tiny_study(points), tmp_path / "p.nc", workers=0, progress=False)
+    ds = res.dataset
+    assert ds["status"].dims == ("point",) and ds.sizes["point"] == 4
+    assert ds["hole_radius"].attrs["scene_field"] == "gear2.body.hole_radius"
+    np.testing.assert_array_equal(ds["speed"], [60.0, 100.0, 77.0, 100.0])  # base value where not set
+    st = [STATUS[i] for i in ds["status"].values]
+    msg = list(ds["message"].values)
+    assert st == ["ok", "invalid", "failed", "diverged"], msg
+    assert "gear2.body.hole_radius" in msg[1] and "cut the rim" in msg[1]
+    assert msg[2].startswith("RuntimeError: boom")
+    assert "dynamic run stopped" in msg[3]
+    assert res.invalid == 1 and res.computed == 3
+    # diverged: the dynamic numbers are withheld, the static ones kept
+    assert np.isnan(ds["dte_rms"][3]) and np.isfinite(ds["ste_p2p"][3]) and np.isfinite(ds["dte_rms"][0])
+    assert np.isnan(ds["dte_rms"][1:3]).all()
+    assert "dte" not in ds and "ste" not in ds
+    with xr.open_dataset(tmp_path / "p.nc", engine="netcdf4") as back:
+        xr.testing.assert_identical(back.load(), ds)
+
+
+def test_only_the_asked_analyses_run(monkeypatch):
+    import study.run
+    seen = []
+    real = study.run.run_scene
+    monkeypatch.setattr(study.run, "run_scene", lambda s, **kw: seen.append(kw) or real(s, **kw))
+    st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['ste_p2p']")
+    r = sweep.run_point(st.points()[0].scene, st.outputs)
+    assert r["status"] == "ok" and seen == [{"static": True, "dynamic": False}]
+    assert set(r["scalars"]) == {"ste_p2p"} and r["curves"] == {}
+
+
+def test_archives_of_split_studies_open_together(swept, tmp_path):
+    res, _ = swept
+    paths = []
+    for w in (50.0, 100.0):
+        grid = GRID.replace('{start = 50.0, stop = 100.0, num = 2}', f"[{w}]")
+        p = tmp_path / f"w{w:g}.nc"
+        run_sweep(tiny_study(grid), p, workers=0, progress=False)
+        paths.append(p)
+    with xr.open_mfdataset(paths, engine="netcdf4", combine="by_coords") as both:
+        both = both.load()
+    xr.testing.assert_equal(both.drop_vars("wall_time"), res.dataset.drop_vars("wall_time"))
+
+
+# ---------------------------------------------------------------- dask
+
+def test_dask_sweep_is_interruptible_closes_its_cluster_and_resumes(swept, tmp_path, monkeypatch):
+    """One LocalCluster (2 workers) started by the code; Ctrl-C after two stored points."""
+    from distributed.deploy.spec import SpecCluster
+    res, _ = swept
+    out = tmp_path / "dask.nc"
+    real_put = sweep.PartStore.put
+    stored = []
+
+    def put(self, key, result):
+        if len(stored) == 2:
+            raise KeyboardInterrupt
+        stored.append(key)
+        real_put(self, key, result)
+
+    import distributed
+    started = []
+    real_cluster = distributed.LocalCluster
+    monkeypatch.setattr(distributed, "LocalCluster", lambda **kw: started.append(kw) or real_cluster(**kw))
+    monkeypatch.setattr(sweep.PartStore, "put", put)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(tiny_study(), out, workers=2, progress=False)
+    assert SpecCluster._instances and all(c.status.name == "closed" for c in SpecCluster._instances)
+    (kw,) = started
+    assert kw["n_workers"] == 2 and kw["threads_per_worker"] == 1 and kw["processes"]
+    assert kw["env"]["NUMBA_NUM_THREADS"] == "1"
+    monkeypatch.setattr(sweep.PartStore, "put", real_put)
+    # the two points computed on the workers are kept; the rest is computed here
+    calls = []
+    real = sweep.run_point
+    monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or real(s, o))
+    again = run_sweep(tiny_study(), out, workers=0, progress=False)
+    assert again.reused == 2 and len(calls) == 6
+    xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created=""),
+                                res.dataset.drop_vars("wall_time").assign_attrs(created=""))
+
+
+# ---------------------------------------------------------------- CLI, workflow, scheduling
+
+def test_cli_sweep_of_the_example_study(tmp_path, capsys):
+    from study.cli import main
+    out = tmp_path / "ex.nc"
+    assert main(["sweep", "study/scenes/example_study.toml", "-o", str(out), "--workers", "0", "--no-progress"]) == 0
+    assert "computed 4" in capsys.readouterr().out
+    with xr.open_dataset(out, engine="netcdf4") as ds:
+        assert ds["dte"].dims == ("n_holes", "speed", "time") and ds["time"].attrs["units"] == "s"
+        assert (ds["status"] == STATUS.index("ok")).all()
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[grid]\ngear2.body.holes = [1.5]\n")
+    assert main(["sweep", str(bad), "-o", str(tmp_path / "bad.nc"), "--workers", "0"]) == 2
+    assert "gear2.body.holes" in capsys.readouterr().err and not (tmp_path / "bad.nc").exists()
+
+
+def test_sensitivity_workflow_shrunk_to_a_tiny_grid(tmp_path, capsys):
+    from workflows.sensitivity_sweep import STUDY, main, study_text
+    full = loads_study(study_text(STUDY), STUDY.parent)
+    assert [a.name for a in full.axes] == ["n_holes", "hole_radius", "rim_thickness", "web_thickness", "speed"]
+    assert full.axes[0].values == (0, 3, 6, 9, 12) and all(p.scene is not None for p in full.points())
+    out = tmp_path / "s.nc"
+    assert main(["--study", "study/scenes/example_study.toml", "--grid", "gear2.body.holes=0,3",
+                 "--grid", "dynamic.speed=60", "--set", "dynamic.duration=0.008", "-o", str(out),
+                 "--workers", "0", "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "2 points: n_holes 2 x speed 1" in text and "dte_rms" in text
+    with xr.open_dataset(out, engine="netcdf4") as ds:
+        assert loads_study(ds.attrs["study"]).base["dynamic"]["duration"] == 0.008
+        assert ds["time"].values[-1] == pytest.approx(0.008)
+
+
+def test_points_sharing_a_body_are_queued_apart():
+    st = tiny_study("[grid]\ngear2.body.holes = [0, 4]\n\"dynamic.speed\" = [50.0, 60.0, 70.0]")
+    todo = {p.key(st.outputs): p.scene for p in st.points()}
+    order = list(sweep.interleave(todo).values())
+    holes = [s.gear2.body.holes for s in order]
+    assert sorted(holes) == [0, 0, 0, 4, 4, 4]
+    assert all(a != b for a, b in zip(holes, holes[1:]))
