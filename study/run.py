@@ -119,13 +119,15 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["static_torque_N_m"] = scene.quasi_static.torque
         c, v = results.static_variables(st, model.backlash_offset)
         coords.update(c); data.update(v)
+        c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes)
+        coords.update(c); data.update(v)
     if dynamic:
         t0 = time.perf_counter()
         dy = run_dynamic(scene, model)
         attrs["wall_time_dynamic_s"] = time.perf_counter() - t0
         start = d.spectrum_start or 2 * d.ramp_time
         attrs["spectrum_start_s"] = start
-        c, v, a = results.dynamic_variables(dy, start, driven_speed)
+        c, v, a = results.dynamic_variables(dy, start, driven_speed, scene.gear2.body.holes, z2)
         coords.update(c); data.update(v); attrs.update(a)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
