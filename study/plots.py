@@ -27,7 +27,7 @@ DPI = 110
 _PRETTY_UNITS = {"um": "µm", "degree": "°", "N mm rad-1": "N·mm/rad", "N m rad-1": "N·m/rad",
                  "N m": "N·m", "1": "–", "Hz": "Hz", "s": "s", "N": "N", "J": "J", "mm": "mm",
                  "rad s-1": "rad/s", "MPa": "MPa"}
-C_LIGHT, C_SOLID, C_HOLE = "#c0392b", "#2c3e50", "#2980b9"
+C_LIGHT, C_SOLID, C_HOLE, C_SIDE, C_OTHER = "#c0392b", "#2c3e50", "#2980b9", "#27ae60", "#7d3c98"
 
 
 def pretty_unit(unit: str | None) -> str:
@@ -233,32 +233,42 @@ def _peak_table(ds, prefix):
 
 
 def _spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
+    from matplotlib.lines import Line2D
     sel = (order > 0) & (order <= xmax)
     ax.semilogy(order[sel], np.maximum(amp[sel], 1e-12), color=C_SOLID, lw=0.8)
     pos = amp[sel][amp[sel] > 0]
     lo = max(float(np.percentile(pos, 5)) if pos.size else 1e-6, 1e-9)
     hi = float(pos.max()) if pos.size else 1.0
     ax.set_ylim(lo / 2, hi * 12)
+    others = [(o, a) for name, _, o, a in peaks if name.startswith("other") and np.isfinite(o) and o <= xmax]
+    for i, (o, a) in enumerate(sorted(others)):
+        ax.plot(o, a, "v", color=C_OTHER, ms=7)
+        ax.annotate(f"{o:.1f}", (o, a), xytext=(0, 8 + 11 * (i % 3)), textcoords="offset points", ha="center",
+                    fontsize=8, color=C_OTHER)
+    table = []
     for name, nominal, o, a in peaks:
-        if name.startswith("other"):
-            if np.isfinite(o) and o <= xmax:
-                ax.plot(o, a, "v", color="#7d3c98", ms=7)
-                ax.annotate(f"{o:.1f}", (o, a), xytext=(0, 8), textcoords="offset points", ha="center",
-                            fontsize=8, color="#7d3c98")
+        if name.startswith("other") or not np.isfinite(nominal) or nominal > xmax:
             continue
-        if not np.isfinite(nominal) or nominal > xmax:
-            continue
-        hole = "N" in name and not any(c.isdigit() or c == "Z" for c in name.replace("N", ""))
+        hole = name.endswith("N") and "Z" not in name
         mesh = "N" not in name
-        color = C_HOLE if hole else (C_LIGHT if mesh else "#27ae60")
+        color = C_HOLE if hole else (C_LIGHT if mesh else C_SIDE)
         ax.axvline(nominal, color=color, lw=1.0 if (hole or mesh) else 0.7, ls="-" if (hole or mesh) else ":", alpha=0.8)
         ax.text(nominal, 0.99, f" {name}", transform=ax.get_xaxis_transform(), rotation=90, va="top",
                 ha="right", fontsize=8, color=color)
         if np.isfinite(a) and (hole or mesh):
             ax.plot(o, a, "o", mfc="none", color=color, ms=7)
+            table.append(f"{name}: {a:.3g}")
     ax.set_xlim(0, xmax)
     ax.set_ylabel(f"{what} amplitude [µm]")
     ax.grid(alpha=0.3, which="both")
+    handles = [Line2D([], [], color=C_HOLE, label="hole order N, 2N"), Line2D([], [], color=C_LIGHT, label="mesh order kZ"),
+               Line2D([], [], color=C_SIDE, ls=":", label="sidebands kZ ± N"),
+               Line2D([], [], color=C_OTHER, marker="v", ls="", label="largest unexplained peaks (order)")]
+    leg = ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False)
+    leg.set_in_layout(True)
+    ax.text(1.01, 0.55, "peak amplitude [µm]\n" + ("\n".join(table) if table else "(none resolved)"),
+            transform=ax.transAxes, ha="left", va="top", fontsize=8, family="monospace",
+            bbox=dict(fc="white", ec="0.7"))
     ax.text(0.995, 0.02, res_text, transform=ax.transAxes, ha="right", va="bottom", fontsize=8, color="0.3",
             bbox=dict(fc="white", ec="none", alpha=0.8))
 
@@ -274,7 +284,7 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
         raise KeyError("dataset lacks dte_amplitude and ste_amplitude")
     z = float(ds.attrs.get("mesh_order", 0.0)) or 100.0
     nrow = int(has_dte) + int(has_ste)
-    fig, axes = plt.subplots(nrow, 1, figsize=(11, 3.8 * nrow + 1.0), constrained_layout=True, squeeze=False)
+    fig, axes = plt.subplots(nrow, 1, figsize=(13, 3.8 * nrow + 1.0), constrained_layout=True, squeeze=False)
     _title(fig, ds, "Amplitude spectra against the driven gear's order (N holes, Z teeth)")
     i = 0
     if has_dte:

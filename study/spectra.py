@@ -69,7 +69,7 @@ class Peak:
     amplitude: float   # amplitude there [signal units]
 
 
-def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 3, hole_harmonics: int = 2) -> list[tuple[str, float]]:
+def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 5, hole_harmonics: int = 2) -> list[tuple[str, float]]:
     """(name, order) of the orders a lightened gear pair excites: hole order N and its harmonics,
     mesh order Z and its harmonics, and the sidebands kZ +- N. NaN orders when N = 0 (kept so
     every scene has the same table)."""
@@ -83,25 +83,37 @@ def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 3, 
 
 
 def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resolution: float,
-                mesh_harmonics: int = 3, hole_harmonics: int = 2, unexplained: int = 4,
+                mesh_harmonics: int = 5, hole_harmonics: int = 2, unexplained: int = 4,
                 min_order: float = 0.5) -> list[Peak]:
-    """The amplitude found at each named order (largest value within the Hann main lobe,
-    +-2 resolution bins, of the nominal order) and the ``unexplained`` largest local maxima
-    that lie outside every named order's main lobe (names "other 1", ...; NaN when fewer)."""
+    """The amplitude found at each named order and the ``unexplained`` largest local maxima that
+    lie outside every named order's main lobe (names "other 1", ...; NaN when fewer).
+
+    A named order's amplitude is the largest value within the Hann main lobe (+-2 resolution
+    bins) of the nominal order, but no nearer to another named order (or to order 0) than half
+    way; it is NaN when that largest value is not a local maximum (no peak, or only the skirt
+    of a neighbouring peak the record is too short to resolve)."""
     order = np.asarray(order, float)
     amp = np.asarray(amplitude, float)
     tol = max(HANN_MAIN_LOBE_BINS * resolution, 1e-9)
+    table = named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics)
+    finite = np.array([0.0] + [o for _, o in table if np.isfinite(o)])
+    is_peak = np.zeros(amp.size, bool)
+    is_peak[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
     peaks = []
     nominal = []
-    for name, o in named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics):
-        sel = np.abs(order - o) <= tol if np.isfinite(o) else np.zeros(order.size, bool)
-        if sel.any():
-            i = np.flatnonzero(sel)[np.argmax(amp[sel])]
-            peaks.append(Peak(name, o, float(order[i]), float(amp[i])))
-        else:
-            peaks.append(Peak(name, o, float("nan"), float("nan")))
+    for name, o in table:
+        sel = np.zeros(order.size, bool)
         if np.isfinite(o):
+            # search the main lobe, but no closer to another named order (or to 0) than half way
+            d = np.abs(finite - o)
+            w = min(tol, 0.5 * d[d > 1e-9].min()) if np.any(d > 1e-9) else tol
+            sel = np.abs(order - o) <= w
             nominal.append(o)
+        i = np.flatnonzero(sel)[np.argmax(amp[sel])] if sel.any() else None
+        if i is not None and is_peak[i]:
+            peaks.append(Peak(name, o, float(order[i]), float(amp[i])))
+        else:     # nothing there, or only the skirt of a neighbour's lobe (not resolved)
+            peaks.append(Peak(name, o, float("nan"), float("nan")))
     nominal = np.asarray(nominal)
     is_max = np.zeros(amp.size, bool)
     is_max[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] > amp[2:])
