@@ -255,9 +255,10 @@ def _spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
         ax.axvline(nominal, color=color, lw=1.0 if (hole or mesh) else 0.7, ls="-" if (hole or mesh) else ":", alpha=0.8)
         ax.text(nominal, 0.99, f" {name}", transform=ax.get_xaxis_transform(), rotation=90, va="top",
                 ha="right", fontsize=8, color=color)
-        if np.isfinite(a) and (hole or mesh):
-            ax.plot(o, a, "o", mfc="none", color=color, ms=7)
-            table.append(f"{name}: {a:.3g}")
+        if np.isfinite(a):
+            table.append(f"{name:>5s}: {a:.3g}")
+            if hole or mesh:
+                ax.plot(o, a, "o", mfc="none", color=color, ms=7)
     ax.set_xlim(0, xmax)
     ax.set_ylabel(f"{what} amplitude [µm]")
     ax.grid(alpha=0.3, which="both")

@@ -206,5 +206,10 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         for f, o, a in results.largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
+    for what in ("dte", "ste"):
+        if f"{what}_peak_amplitude" in ds:
+            named = [(str(n), float(a)) for n, a in zip(ds[f"{what}_peak"].values, ds[f"{what}_peak_amplitude"].values)
+                     if np.isfinite(a) and not str(n).startswith("other")]
+            w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in named) + "\n")
     w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
       + f", total {wall:.2f} s\n")
