@@ -118,11 +118,12 @@ def test_stress_render_scale_spans_zero_to_the_fillet_peak(tiny, tmp_path):
     assert all(p > 5 * np.median(f.von_mises) / 1e6 for p, f in zip(peaks, fields))
     res = render.fe_stress_render(ds, tmp_path / "stress.png", fields=fields)
     assert res.clim == pytest.approx((0.0, max(peaks)))
-    img = _png(res.path)
+    img = _png(res.path)[:, : _png(res.path).shape[1] // 2]          # left column: stress
     cmap = matplotlib.colormaps[render.STRESS_CMAP]
     hot = np.array(cmap(1.0)[:3])
     cold = np.array(cmap(0.0)[:3])
     # the hot end of the scale appears (fillet) and the cold end covers much of the body
+    # (teeth away from the load carry nothing)
     assert np.any(np.abs(img - hot).max(axis=-1) < 0.08)
     assert np.mean(np.abs(img - cold).max(axis=-1) < 0.15) > 0.05
 
