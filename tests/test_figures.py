@@ -42,7 +42,7 @@ def _png(path):
     return img[..., :3]
 
 
-def test_every_supported_figure_is_written_and_not_blank(tiny, capsys):
+def test_every_supported_figure_is_written_and_not_blank(tiny):
     ds, out, paths = tiny
     names = sorted(p.name for p in paths)
     assert names == sorted(["ste.png", "dte.png", "spectrum.png", "tooth_stiffness.png", "gear_pair.png",
@@ -157,3 +157,17 @@ def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
     write_netcdf(ds, path)
     assert main(["render", str(path), "--no-renders"]) == 0
     assert {p.name for p in tmp_path.glob("*.png")} == {"ste.png", "dte.png", "spectrum.png", "tooth_stiffness.png"}
+
+
+def test_hole_passes_on_the_ste_axis_follow_the_gear_ratio():
+    # a hole centre of the driven gear reaches the mesh every 360/N deg of driven rotation,
+    # i.e. every 360/N * z2/z1 deg of driver rotation
+    base = default_scene()
+    for z1, z2, expect in ((67, 67, [0.0, 60.0, 120.0]), (40, 80, [0.0, 120.0])):
+        sc = base.replace(**{"gear1.teeth": z1, "gear2.teeth": z2, "gear1.body.web_height": 23.25 * z1 / 67 - 4,
+                             "gear2.body.hole_circle_radius": 32.36 + 0.75 * (z2 - 67)})
+        ds = xr.Dataset(attrs={"scene": sc.to_toml()})
+        np.testing.assert_allclose(plots.hole_mesh_angles(ds, 120.0), expect, atol=1e-9)
+    shifted = base.replace(**{"gear2.body.hole_phase": 15.0})
+    ds = xr.Dataset(attrs={"scene": shifted.to_toml()})
+    np.testing.assert_allclose(plots.hole_mesh_angles(ds, 120.0), [15.0, 75.0])
