@@ -15,6 +15,7 @@ COMMANDS = {
     "stiffness": ("study.springs", "per-tooth FE stiffness map of a scene's gears (no solve)"),
     "sweep": ("study.sweep", "run a parametric study (scene + grid) with dask into one NetCDF archive"),
     "fit-contact": ("study.fit_contact", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
+    "render": ("study.figures", "plots and renders (PNG) of a run or sweep archive"),
 }
 
 

@@ -8,6 +8,10 @@ The run archive of one scene holds:
   contact_force_max(time)  largest contact force over each output interval [N]
   dte_contacts(time), driver_torque(time), energy_balance_error(time)
   dte_amplitude(frequency) amplitude spectrum of DTE after the ramp [um], coordinate order
+  dte_peak_*(dte_peak)     named peaks of that spectrum (hole order N, mesh order Z, harmonics,
+                           sidebands kZ+-N, the largest unexplained ones): order, frequency, amplitude
+  ste_amplitude(ste_order) amplitude spectrum of STE over orders of the driven gear's rotation [um]
+  ste_peak_*(ste_peak)     named peaks of the STE spectrum
   tooth_stiffness(gear, tooth), stiffness_ratio(gear, tooth)
 Global attributes: the scene as TOML, backlash offset, mesh and hole orders, versions.
 """
@@ -22,7 +26,7 @@ import xarray as xr
 
 from solver import units
 
-from .spectra import WINDOW, amplitude_spectrum
+from .spectra import WINDOW, amplitude_spectrum, named_peaks, ste_order_spectrum
 
 
 def versions() -> str:
@@ -62,7 +66,41 @@ def static_variables(res, offset_m: float) -> dict:
     return coords, data
 
 
-def dynamic_variables(res, spectrum_start: float, driven_speed: float) -> tuple[dict, dict, dict]:
+def peak_variables(prefix: str, peaks, frequency_per_order: float | None = None) -> tuple[dict, dict]:
+    """A small table of named spectral peaks along dimension ``{prefix}_peak`` (names as coordinate)."""
+    dim = f"{prefix}_peak"
+    coords = {dim: _var(dim, np.array([p.name for p in peaks], dtype=object), "1",
+                        "peak name: N hole order, Z mesh order, kZ+-N sidebands, other k = k-th largest unexplained peak")}
+    what = prefix.upper()
+    data = {
+        f"{dim}_nominal_order": _var(dim, np.array([p.nominal for p in peaks]), "1", f"nominal order of the named {what} peak (driven-gear revolutions)"),
+        f"{dim}_order": _var(dim, np.array([p.order for p in peaks]), "1", f"order where the {what} peak was found (driven-gear revolutions)"),
+        f"{dim}_amplitude": _var(dim, np.array([p.amplitude for p in peaks]), "um", f"{what} amplitude at the peak"),
+    }
+    if frequency_per_order is not None:
+        data[f"{dim}_frequency"] = _var(dim, np.array([p.order for p in peaks]) * frequency_per_order, "Hz", f"frequency of the {what} peak")
+    return coords, data
+
+
+def ste_spectrum_variables(angle_deg, ste_um, z1: int, z2: int, hole_order: float, pad: int = 4) -> tuple[dict, dict]:
+    """STE amplitude spectrum over orders per revolution of the driven gear, and its named peaks."""
+    angle_deg = np.asarray(angle_deg, float)
+    if angle_deg.size < 16:
+        return {}, {}
+    step = float(angle_deg[1] - angle_deg[0])
+    order, amp, res = ste_order_spectrum(ste_um, step, z1, z2, pad=pad)
+    coords = {"ste_order": _var("ste_order", order, "1", "order of the driven gear's rotation (STE spectrum)")}
+    data = {"ste_amplitude": _var("ste_order", amp, "um", "one-sided amplitude spectrum of STE over driven-gear orders",
+                                  window=WINDOW, resolution_orders=res, zero_padding=pad,
+                                  record_driven_revolutions=1.0 / res,
+                                  comment="driven rotation = driver rotation * z1/z2; NaN samples interpolated")}
+    c, d = peak_variables("ste", named_peaks(order, amp, hole_order, z2, res))
+    coords.update(c); data.update(d)
+    return coords, data
+
+
+def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_order: float = 0.0,
+                      mesh_order: float | None = None) -> tuple[dict, dict, dict]:
     coords = {"time": _var("time", res.time, "s", "time")}
     data = {
         "dte": _var("time", res.te * units.UM_PER_M, "um", "dynamic transmission error rb1*theta1 + rb2*theta2"),
@@ -82,6 +120,10 @@ def dynamic_variables(res, spectrum_start: float, driven_speed: float) -> tuple[
                                "order of the driven gear's rotation")
         data["dte_amplitude"] = _var("frequency", a, "um", "one-sided amplitude spectrum of DTE after the ramp",
                                      window=WINDOW, resolution_Hz=1.0 / (sel.sum() * dt), start_s=float(res.time[sel][0]))
+        if f_rot > 0 and mesh_order:
+            peaks = named_peaks(f / f_rot, a, hole_order, mesh_order, 1.0 / (sel.sum() * dt) / f_rot)
+            c, v = peak_variables("dte", peaks, f_rot)
+            coords.update(c); data.update(v)
     attrs.update(dt_s=res.dt, steps=res.steps, omega_max_rad_s=res.omega_max, dynamic_status=res.message,
                  max_active_teeth=res.max_active_teeth)
     return coords, data, attrs

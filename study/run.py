@@ -119,13 +119,15 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["static_torque_N_m"] = scene.quasi_static.torque
         c, v = results.static_variables(st, model.backlash_offset)
         coords.update(c); data.update(v)
+        c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes)
+        coords.update(c); data.update(v)
     if dynamic:
         t0 = time.perf_counter()
         dy = run_dynamic(scene, model)
         attrs["wall_time_dynamic_s"] = time.perf_counter() - t0
         start = d.spectrum_start or 2 * d.ramp_time
         attrs["spectrum_start_s"] = start
-        c, v, a = results.dynamic_variables(dy, start, driven_speed)
+        c, v, a = results.dynamic_variables(dy, start, driven_speed, scene.gear2.body.holes, z2)
         coords.update(c); data.update(v); attrs.update(a)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
@@ -204,5 +206,10 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         for f, o, a in results.largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
+    for what in ("dte", "ste"):
+        if f"{what}_peak_amplitude" in ds:
+            named = [(str(n), float(a)) for n, a in zip(ds[f"{what}_peak"].values, ds[f"{what}_peak_amplitude"].values)
+                     if np.isfinite(a) and not str(n).startswith("other")]
+            w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in named) + "\n")
     w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
       + f", total {wall:.2f} s\n")

@@ -1,26 +1,137 @@
-"""Amplitude spectra of transmission-error signals.
+"""Amplitude spectra of transmission-error signals and the gear orders that explain their peaks.
 
 One-sided amplitude spectrum with a Hann window, scaled by the window's coherent gain so a
 sinusoid of amplitude A (um) inside the record reads A at its bin (within the window's
-scalloping loss, at most 15 % for Hann between bins). Resolution = 1 / record length.
+scalloping loss, at most 15 % for Hann between bins; exact at bin centres). Resolution =
+1 / record length; zero padding (``pad``) samples the same window-smoothed spectrum more
+finely (it lowers the scalloping loss, not the resolution).
+
+Orders are counted per revolution of the driven gear: the hole order is the number of holes
+N of the driven gear, the mesh order its tooth count Z. STE is sampled over driver angle; its
+spectrum over driven-gear orders uses the driven rotation theta2 = theta1 * z1 / z2.
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 WINDOW = "hann"
+HANN_MAIN_LOBE_BINS = 2.0   # half-width of the Hann main lobe in resolution bins
 
 
-def amplitude_spectrum(signal, dt: float, detrend: bool = True):
-    """Frequencies [Hz] and one-sided amplitudes (signal units) of a uniformly sampled signal."""
+def amplitude_spectrum(signal, dt: float, detrend: bool = True, pad: int = 1):
+    """Frequencies [1/dt units, e.g. Hz] and one-sided amplitudes (signal units) of a uniformly
+    sampled signal; ``pad`` >= 1 zero-pads the windowed record to pad times its length."""
     x = np.asarray(signal, dtype=float)
     if x.ndim != 1 or x.size < 8:
         raise ValueError("amplitude_spectrum needs a 1-D signal of at least 8 samples")
+    if not (dt > 0):
+        raise ValueError(f"amplitude_spectrum: sample step must be positive, got {dt}")
+    if int(pad) != pad or pad < 1:
+        raise ValueError(f"amplitude_spectrum: pad must be an integer >= 1, got {pad}")
     if detrend:
         x = x - x.mean()
     w = np.hanning(x.size)
-    spec = np.fft.rfft(x * w)
+    n = int(pad) * x.size
+    spec = np.fft.rfft(x * w, n=n)
     amp = 2.0 * np.abs(spec) / w.sum()
     amp[0] *= 0.5
-    freq = np.fft.rfftfreq(x.size, dt)
+    freq = np.fft.rfftfreq(n, dt)
     return freq, amp
+
+
+def fill_gaps(x) -> tuple[np.ndarray, int]:
+    """Signal with non-finite samples linearly interpolated from their neighbours, and their count."""
+    x = np.asarray(x, dtype=float).copy()
+    bad = ~np.isfinite(x)
+    nb = int(bad.sum())
+    if nb and nb < x.size:
+        i = np.arange(x.size)
+        x[bad] = np.interp(i[bad], i[~bad], x[~bad])
+    return x, nb
+
+
+def ste_order_spectrum(ste_um, angle_step_deg: float, z1: int, z2: int, pad: int = 4):
+    """Orders per driven-gear revolution [1] and amplitudes [um] of an STE sampled every
+    ``angle_step_deg`` degrees of driver rotation; also the resolution [orders]."""
+    step_rev = angle_step_deg / 360.0 * z1 / z2      # driven revolutions per sample
+    x, _ = fill_gaps(ste_um)
+    order, amp = amplitude_spectrum(x, step_rev, pad=pad)
+    return order, amp, 1.0 / (x.size * step_rev)
+
+
+@dataclass(frozen=True)
+class Peak:
+    name: str          # "N", "2N", "Z", "2Z", "Z-N", "Z+N", ..., "other 1", ...
+    nominal: float     # nominal order [1] (NaN for unexplained peaks)
+    order: float       # order of the largest amplitude found near it [1]
+    amplitude: float   # amplitude there [signal units]
+
+
+def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 5, hole_harmonics: int = 2) -> list[tuple[str, float]]:
+    """(name, order) of the orders a lightened gear pair excites: hole order N and its harmonics,
+    mesh order Z and its harmonics, and the sidebands kZ +- N. NaN orders when N = 0 (kept so
+    every scene has the same table)."""
+    n = float(hole_order) if hole_order and hole_order > 0 else float("nan")
+    z = float(mesh_order)
+    out = [("N" if h == 1 else f"{h}N", h * n) for h in range(1, hole_harmonics + 1)]
+    for k in range(1, mesh_harmonics + 1):
+        kz = "Z" if k == 1 else f"{k}Z"
+        out += [(f"{kz}-N", k * z - n), (kz, k * z), (f"{kz}+N", k * z + n)]
+    return out
+
+
+def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resolution: float,
+                mesh_harmonics: int = 5, hole_harmonics: int = 2, unexplained: int = 4,
+                min_order: float = 0.5) -> list[Peak]:
+    """The amplitude found at each named order and the ``unexplained`` largest local maxima that
+    lie outside every named order's main lobe (names "other 1", ...; NaN when fewer).
+
+    A named order's amplitude is the largest value within the Hann main lobe (+-2 resolution
+    bins) of the nominal order, but no nearer to another named order (or to order 0) than half
+    way; it is NaN when that largest value is not a local maximum (no peak, or only the skirt
+    of a neighbouring peak the record is too short to resolve)."""
+    order = np.asarray(order, float)
+    amp = np.asarray(amplitude, float)
+    tol = max(HANN_MAIN_LOBE_BINS * resolution, 1e-9)
+    table = named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics)
+    finite = np.array([0.0] + [o for _, o in table if np.isfinite(o)])
+    is_peak = np.zeros(amp.size, bool)
+    is_peak[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
+    peaks = []
+    nominal = []
+    for name, o in table:
+        sel = np.zeros(order.size, bool)
+        if np.isfinite(o):
+            # search the main lobe, but no closer to another named order (or to 0) than half way
+            d = np.abs(finite - o)
+            w = min(tol, 0.5 * d[d > 1e-9].min()) if np.any(d > 1e-9) else tol
+            sel = np.abs(order - o) <= w
+            nominal.append(o)
+        i = np.flatnonzero(sel)[np.argmax(amp[sel])] if sel.any() else None
+        if i is not None and is_peak[i]:
+            peaks.append(Peak(name, o, float(order[i]), float(amp[i])))
+        else:     # nothing there, or only the skirt of a neighbour's lobe (not resolved)
+            peaks.append(Peak(name, o, float("nan"), float("nan")))
+    nominal = np.asarray(nominal)
+    is_max = np.zeros(amp.size, bool)
+    is_max[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] > amp[2:])
+    is_max &= order >= min_order
+    if nominal.size:
+        is_max &= np.min(np.abs(order[:, None] - nominal[None, :]), axis=1) > tol
+    idx = np.flatnonzero(is_max)
+    idx = idx[np.argsort(-amp[idx])]
+    chosen: list[int] = []
+    for i in idx:   # one maximum per main lobe (zero padding makes side-by-side maxima)
+        if all(abs(order[i] - order[j]) > tol for j in chosen):
+            chosen.append(i)
+        if len(chosen) == unexplained:
+            break
+    for k in range(unexplained):
+        if k < len(chosen):
+            i = chosen[k]
+            peaks.append(Peak(f"other {k + 1}", float("nan"), float(order[i]), float(amp[i])))
+        else:
+            peaks.append(Peak(f"other {k + 1}", float("nan"), float("nan"), float("nan")))
+    return peaks

@@ -1,0 +1,173 @@
+"""Plots and renders: every file written, not blank, and showing the colours the data say.
+
+A tiny lightened pair (24 teeth, 4 holes, coarse FE mesh) runs the whole path: run archive ->
+make_figures -> PNGs; the renders run off-screen here (EGL), without skipping.
+"""
+import matplotlib
+import numpy as np
+import pytest
+import xarray as xr
+from matplotlib.image import imread
+
+from study import plots, render
+from study.figures import make_figures
+from study.run import run_scene
+from study.scene import default_scene
+
+TINY_LIGHTENED = {
+    "gear1.module": 2.0, "gear1.teeth": 24, "gear2.module": 2.0, "gear2.teeth": 24,
+    "gear1.body.rim_height": 3.0, "gear1.body.web_height": 12.0, "gear1.body.hub_height": 3.0,
+    "gear1.body.web_thickness": 17.0, "gear1.body.holes": 0,
+    "gear2.body.rim_height": 3.0, "gear2.body.web_height": 12.0, "gear2.body.hub_height": 3.0,
+    "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
+    "gear2.body.hole_circle_radius": 12.5,
+    "fe.mesh_size": 1.0,
+    "quasi_static.rotation": 45.0, "quasi_static.angle_step": 0.25,
+    "dynamic.duration": 0.03, "dynamic.ramp_time": 0.005,
+}
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    scene = default_scene().replace(**TINY_LIGHTENED)
+    ds = run_scene(scene)
+    out = tmp_path_factory.mktemp("figs")
+    paths = make_figures(ds, out)
+    return ds, out, paths
+
+
+def _png(path):
+    img = imread(path)
+    assert img.ndim == 3 and img.shape[0] > 300 and img.shape[1] > 300
+    return img[..., :3]
+
+
+def test_every_supported_figure_is_written_and_not_blank(tiny):
+    ds, out, paths = tiny
+    names = sorted(p.name for p in paths)
+    assert names == sorted(["ste.png", "dte.png", "spectrum.png", "tooth_stiffness.png", "gear_pair.png",
+                            "fe_stress_gear2.png"])
+    for p in paths:
+        img = _png(p)
+        white = np.all(img > 0.97, axis=-1).mean()
+        assert 0.05 < white < 0.98, f"{p.name}: {white:.1%} white"       # something drawn, not all ink
+        assert img.std() > 0.05, f"{p.name} looks blank"
+
+
+def test_archive_without_dynamics_skips_what_it_cannot_draw(tiny, tmp_path, capsys):
+    ds, _, _ = tiny
+    static_only = ds.drop_vars([v for v in ds.variables if "time" in ds[v].dims or "frequency" in ds[v].dims
+                                or v.startswith("dte_peak")])
+    paths = make_figures(static_only, tmp_path, renders=False)
+    assert sorted(p.name for p in paths) == ["spectrum.png", "ste.png", "tooth_stiffness.png"]
+    said = capsys.readouterr().out
+    assert "skip DTE plot" in said and "skip renders" in said
+
+
+def test_stiffness_map_colour_range_and_pixels_match_the_tooth_stiffness(tiny, tmp_path):
+    ds, _, _ = tiny
+    k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
+    k1 = ds["tooth_stiffness"].sel(gear=1).values[:24]
+    assert np.ptp(k2) > 0.005 * k2.mean()            # the holes make the driven teeth differ
+    res = render.gear_pair_render(ds, tmp_path / "pair.png")
+    # the colour bar spans exactly the lightened gear's stiffness; the solid driver (stiffer,
+    # one value) lies outside and is drawn grey
+    assert res.clim == pytest.approx((k2.min(), k2.max()), rel=1e-12)
+    assert k1.min() > res.clim[1]
+    assert len(res.probes) == 24
+    img = _png(res.path)
+    cmap = matplotlib.colormaps[render.STIFFNESS_CMAP]
+    err = []
+    for row, col, k in res.probes:
+        want = np.array(cmap((k - res.clim[0]) / (res.clim[1] - res.clim[0]))[:3])
+        err.append(np.abs(img[row - 1:row + 2, col - 1:col + 2].reshape(-1, 3) - want).max(axis=1).min())
+    err = np.array(err)
+    assert np.median(err) < 0.03 and np.mean(err < 0.06) >= 0.9, err
+    # the stiffest and the softest tooth show the two ends of the colour map
+    far = cmap(1.0)[:3], cmap(0.0)[:3]
+    assert np.abs(np.array(far[0]) - np.array(far[1])).max() > 0.5
+    # every tooth of both bodies got its own index (FE mesh and outline alike)
+    bodies = render.pair_bodies(ds)
+    for g in (1, 2):
+        assert set(np.unique(bodies[g].tooth)) == set(range(-1, 24))
+
+
+def test_extruded_body_keeps_web_thinner_and_scalars_per_tooth(tiny):
+    ds, _, _ = tiny
+    b = render.pair_bodies(ds)[2]
+    k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
+    val = np.where(b.tooth >= 0, k2[np.clip(b.tooth, 0, None)], np.nan)
+    mesh = render.extrude(b, 0.0, (0.0, 0.0), val, "k_phi")
+    z = mesh.points[:, 2]
+    assert z.max() == pytest.approx(17.0 / 2) and z.min() == pytest.approx(-17.0 / 2)
+    assert np.any(np.isclose(np.abs(z), 8.0 / 2))           # the web's faces
+    kk = mesh.cell_data["k_phi"]
+    assert np.nanmin(kk) == pytest.approx(k2.min()) and np.nanmax(kk) == pytest.approx(k2.max())
+
+
+def test_stress_render_scale_spans_zero_to_the_fillet_peak(tiny, tmp_path):
+    ds, _, _ = tiny
+    k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
+    sc = render._scene(ds)
+    teeth = [int(np.argmax(k2)), int(np.argmin(k2))]
+    fields = render.fe_fields(sc, 2, teeth)
+    from solver.geometry import gear_geometry
+    geo = gear_geometry(sc.tooth_spec(2))
+    peaks = [render._fillet_peak(f, geo, f.tooth) / 1e6 for f in fields]
+    # the loaded tooth's fillet carries far more than the body on average
+    assert all(p > 5 * np.median(f.von_mises) / 1e6 for p, f in zip(peaks, fields))
+    res = render.fe_stress_render(ds, tmp_path / "stress.png", fields=fields)
+    assert res.clim == pytest.approx((0.0, max(peaks)))
+    img = _png(res.path)[:, : _png(res.path).shape[1] // 2]          # left column: stress
+    cmap = matplotlib.colormaps[render.STRESS_CMAP]
+    hot = np.array(cmap(1.0)[:3])
+    cold = np.array(cmap(0.0)[:3])
+    # the hot end of the scale appears (fillet) and the cold end covers much of the body
+    # (teeth away from the load carry nothing)
+    assert np.any(np.abs(img - hot).max(axis=-1) < 0.08)
+    assert np.mean(np.abs(img - cold).max(axis=-1) < 0.15) > 0.05
+
+
+def test_sweep_view_facets_the_other_dimensions():
+    rng = np.random.default_rng(1)
+    ds = xr.Dataset(
+        {"dte_rms": (("n_holes", "speed", "web_thickness"), rng.random((3, 4, 2)), {"units": "um", "long_name": "DTE RMS"})},
+        coords={"n_holes": ("n_holes", [0, 4, 6], {"units": "1", "long_name": "holes"}),
+                "speed": ("speed", [50.0, 100.0, 150.0, 200.0], {"units": "rad s-1", "long_name": "driver speed"}),
+                "web_thickness": ("web_thickness", [8.0, 12.0], {"units": "mm", "long_name": "web thickness"})})
+    fig = plots.sweep_view(ds, "dte_rms", "speed", hue="n_holes")
+    axes = fig.axes
+    assert len(axes) == 2                                    # one panel per web thickness
+    lines = axes[1].get_lines()
+    assert len(lines) == 3                                   # one line per hole count
+    np.testing.assert_allclose(lines[2].get_ydata(), ds["dte_rms"].isel(web_thickness=1, n_holes=2).values)
+    assert "[rad/s]" in axes[0].get_xlabel() or "[rad/s]" in axes[1].get_xlabel()
+    assert "[µm]" in axes[0].get_ylabel()
+    with pytest.raises(ValueError, match="not a dimension"):
+        plots.sweep_view(ds, "dte_rms", "angle")
+    with pytest.raises(KeyError, match="no variable"):
+        plots.sweep_view(ds, "ste", "speed")
+
+
+def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
+    from study.cli import main
+    from study.results import write_netcdf
+    ds, _, _ = tiny
+    path = tmp_path / "run.nc"
+    write_netcdf(ds, path)
+    assert main(["render", str(path), "--no-renders"]) == 0
+    assert {p.name for p in tmp_path.glob("*.png")} == {"ste.png", "dte.png", "spectrum.png", "tooth_stiffness.png"}
+
+
+def test_hole_passes_on_the_ste_axis_follow_the_gear_ratio():
+    # a hole centre of the driven gear reaches the mesh every 360/N deg of driven rotation,
+    # i.e. every 360/N * z2/z1 deg of driver rotation
+    base = default_scene()
+    for z1, z2, expect in ((67, 67, [0.0, 60.0, 120.0]), (40, 80, [0.0, 120.0])):
+        sc = base.replace(**{"gear1.teeth": z1, "gear2.teeth": z2, "gear1.body.web_height": 23.25 * z1 / 67 - 4,
+                             "gear2.body.hole_circle_radius": 32.36 + 0.75 * (z2 - 67)})
+        ds = xr.Dataset(attrs={"scene": sc.to_toml()})
+        np.testing.assert_allclose(plots.hole_mesh_angles(ds, 120.0), expect, atol=1e-9)
+    shifted = base.replace(**{"gear2.body.hole_phase": 15.0})
+    ds = xr.Dataset(attrs={"scene": shifted.to_toml()})
+    np.testing.assert_allclose(plots.hole_mesh_angles(ds, 120.0), [15.0, 75.0])

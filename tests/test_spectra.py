@@ -1,0 +1,112 @@
+"""Spectra: known tones come back with the Hann window's known error; order axes; named peaks."""
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from study import results
+from study.spectra import amplitude_spectrum, named_orders, named_peaks, ste_order_spectrum
+
+HANN_SCALLOP = 1 - (np.sinc(0.5) / (1 - 0.5**2))   # 15.1 %: Hann loss half-way between bins
+
+
+def tone(n, dt, f, a, phase=0.3):
+    t = np.arange(n) * dt
+    return a * np.sin(2 * np.pi * f * t + phase)
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.25, 0.5])
+def test_single_tone_amplitude_and_frequency_within_hann_error(offset):
+    n, dt = 4000, 1e-4
+    df = 1 / (n * dt)
+    f0 = (137 + offset) * df
+    f, a = amplitude_spectrum(tone(n, dt, f0, 2.0) + 5.0, dt)
+    i = np.argmax(a)
+    assert abs(f[i] - f0) <= 0.5 * df + 1e-9
+    ratio = a[i] / 2.0
+    assert 1 - HANN_SCALLOP - 1e-3 <= ratio <= 1 + 1e-6
+    if offset == 0.0:
+        assert ratio == pytest.approx(1.0, abs=1e-6)        # exact at a bin centre
+    # zero padding samples between bins: the loss shrinks below 1 %
+    fp, ap = amplitude_spectrum(tone(n, dt, f0, 2.0), dt, pad=4)
+    assert ap.max() / 2.0 == pytest.approx(1.0, abs=0.01)
+    assert abs(fp[np.argmax(ap)] - f0) <= 0.125 * df + 1e-9
+    # resolution = 1 / record length, whatever the padding
+    assert f[1] - f[0] == pytest.approx(df) and fp[1] - fp[0] == pytest.approx(df / 4)
+
+
+def test_two_tones_and_dc_are_separated():
+    n, dt = 8192, 5e-5
+    df = 1 / (n * dt)
+    x = 3.0 + tone(n, dt, 400 * df, 1.5) + tone(n, dt, 1234 * df, 0.02, 1.1)
+    f, a = amplitude_spectrum(x, dt, detrend=False)
+    assert a[0] == pytest.approx(3.0, rel=1e-3)             # the mean reads as itself
+    assert a[400] == pytest.approx(1.5, rel=1e-6)
+    assert a[1234] == pytest.approx(0.02, rel=1e-3)        # a small tone beside a large one
+    assert a[800] < 1e-6                                    # Hann sidelobes fall off fast
+
+
+def test_bad_input_is_rejected():
+    with pytest.raises(ValueError, match="at least 8"):
+        amplitude_spectrum(np.ones(4), 1.0)
+    with pytest.raises(ValueError, match="pad"):
+        amplitude_spectrum(np.ones(64), 1.0, pad=0)
+    with pytest.raises(ValueError, match="sample step"):
+        amplitude_spectrum(np.ones(64), 0.0)
+
+
+def test_ste_order_axis_counts_driven_gear_revolutions():
+    # driver 20 teeth, driven 40: the driven gear turns half as fast; one driver revolution
+    # sampled every 0.1 deg = half a driven revolution -> resolution 2 orders
+    z1, z2, n_holes = 20, 40, 4
+    th1 = np.radians(np.arange(0, 360, 0.1))
+    th2 = th1 * z1 / z2
+    ste = 10 + 0.5 * np.cos(z2 * th2) + 0.1 * np.cos(n_holes * th2 + 0.7) + np.where(np.arange(th1.size) == 50, np.nan, 0)
+    order, amp, res = ste_order_spectrum(ste, 0.1, z1, z2, pad=1)
+    assert res == pytest.approx(2.0)
+    assert amp[np.argmin(abs(order - z2))] == pytest.approx(0.5, rel=2e-3)     # mesh order Z (gap interpolated)
+    assert amp[np.argmin(abs(order - n_holes))] == pytest.approx(0.1, rel=1e-2)  # hole order N
+    assert order[np.argmax(amp)] == pytest.approx(z2)
+
+
+def test_named_peaks_find_mesh_hole_sidebands_and_the_unexplained():
+    z, n = 30, 5
+    o = np.arange(0, 200, 0.125)
+    amp = np.full(o.size, 1e-4)
+    for order, a in ((n, 0.2), (z, 1.0), (2 * z, 0.3), (z + n, 0.05), (47.0, 0.4), (101.0, 0.1)):
+        amp[np.argmin(abs(o - order))] = a
+    peaks = {p.name: p for p in named_peaks(o, amp, n, z, resolution=0.5)}
+    assert peaks["Z"].amplitude == 1.0 and peaks["Z"].order == z
+    assert peaks["N"].amplitude == 0.2 and peaks["2Z"].amplitude == 0.3
+    assert peaks["Z+N"].amplitude == 0.05 and peaks["Z-N"].amplitude == pytest.approx(1e-4)
+    assert peaks["other 1"].order == 47.0 and peaks["other 2"].order == 101.0
+    assert np.isnan(peaks["other 1"].nominal)
+    # a solid gear (N = 0) keeps the same table with NaN hole entries
+    solid = named_peaks(o, amp, 0, z, resolution=0.5)
+    assert [p.name for p in solid] == list(peaks)
+    assert np.isnan({p.name: p for p in solid}["N"].amplitude)
+    assert [nm for nm, _ in named_orders(6, 67)][:5] == ["N", "2N", "Z-N", "Z", "Z+N"]
+
+
+def test_dte_spectrum_in_the_archive_has_orders_and_named_peaks():
+    z, n_holes, speed = 67, 6, 100.0          # driven speed [rad/s]
+    f_rot = speed / (2 * np.pi)
+    dt, T = 1e-5, 0.2
+    t = np.arange(int(round(T / dt)) + 1) * dt
+    te = 40e-6 + 0.3e-6 * np.sin(2 * np.pi * z * f_rot * t) + 0.05e-6 * np.sin(2 * np.pi * n_holes * f_rot * t)
+    res = SimpleNamespace(time=t, te=te, force_max=np.zeros_like(t), n_contacts=np.zeros(t.size, int),
+                          driver_torque=np.zeros_like(t), energy_error=np.zeros_like(t), status=0, dt=dt,
+                          steps=t.size, omega_max=1.0, message="ok", max_active_teeth=4)
+    coords, data, _ = results.dynamic_variables(res, 0.02, speed, n_holes, z)
+    order = coords["order"].values
+    np.testing.assert_allclose(order, coords["frequency"].values / f_rot)
+    names = list(coords["dte_peak"].values)
+    amp = dict(zip(names, data["dte_peak_amplitude"].values))
+    found = dict(zip(names, data["dte_peak_order"].values))
+    res_orders = data["dte_amplitude"].attrs["resolution_Hz"] / f_rot
+    assert 0.3 * (1 - HANN_SCALLOP) <= amp["Z"] <= 0.3 * 1.0001
+    assert 0.05 * (1 - HANN_SCALLOP) <= amp["N"] <= 0.05 * 1.0001
+    assert abs(found["Z"] - z) <= res_orders and abs(found["N"] - n_holes) <= res_orders
+    freq = dict(zip(names, data["dte_peak_frequency"].values))
+    assert freq["Z"] == pytest.approx(found["Z"] * f_rot)
+    assert data["dte_amplitude"].attrs["window"] == "hann"
