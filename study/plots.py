@@ -14,12 +14,14 @@ the variable when the dataset lacks what the plot needs (`study.figures` decides
 from __future__ import annotations
 
 import math
+import textwrap
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
@@ -63,9 +65,13 @@ def _save(fig, path) -> Path:
     return path
 
 
-def _title(fig, ds, what: str) -> None:
+def _title(fig, ds, what: str, width: int | None = None) -> None:
+    """Figure title: what is shown, then the archive's title; wrapped to ``width`` characters."""
     t = ds.attrs.get("title", "")
-    fig.suptitle(f"{what}\n{t}" if t else what, fontsize=12)
+    text = f"{what}\n{t}" if t else what
+    if width:
+        text = "\n".join(textwrap.fill(line, width) for line in text.split("\n"))
+    fig.suptitle(text, fontsize=12 if not width else 10)
 
 
 def _runs(mask: np.ndarray):
@@ -412,7 +418,9 @@ def sweep_view(ds: xr.Dataset, var: str, x: str, hue: str | None = None, col: st
                          "select or reduce them first")
     ncol = da.sizes[col] if col else 1
     nrow = da.sizes[row] if row else 1
-    fig, axes = plt.subplots(nrow, ncol, figsize=(min(4.2 * ncol, 20) + 1.5, min(3.3 * nrow, 16) + 1.0),
+    # wide enough for the hue legend beside the panels and a wrapped title above them
+    width = max(min(4.2 * ncol, 20) + (3.0 if hue else 1.5), 7.0)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(width, min(3.3 * nrow, 16) + 1.3),
                              sharex=True, sharey=True, squeeze=False, constrained_layout=True)
     xv = ds[x]
     cmap = plt.get_cmap("viridis")
@@ -436,12 +444,13 @@ def sweep_view(ds: xr.Dataset, var: str, x: str, hue: str | None = None, col: st
             ax.grid(alpha=0.3)
             if i == nrow - 1:
                 ax.set_xlabel(axis_label(xv, x))
-            if j == 0:
-                ax.set_ylabel(axis_label(da, var))
+            if j == 0:   # the long name is in the title; the axis keeps the variable and its unit
+                ax.set_ylabel(f"{var} [{pretty_unit(da.attrs.get('units'))}]")
     if hue:
         handles, labels = axes[0, 0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="outside right upper", fontsize=8, title=axis_label(ds[hue], hue))
-    _title(fig, ds, f"{da.attrs.get('long_name', var)} against {ds[x].attrs.get('long_name', x)}")
+        fig.legend(handles, labels, loc="outside right center", fontsize=8, title=axis_label(ds[hue], hue))
+    _title(fig, ds, f"{var}: {da.attrs.get('long_name', var)}, against {ds[x].attrs.get('long_name', x)}",
+           width=int(8 * width))
     if path is None:
         return fig
     return _save(fig, path)
