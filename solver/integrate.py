@@ -19,7 +19,9 @@ from .kernels.mesh import mesh_contacts, new_contact_buffer, tooth_spring_tangen
 from .model import Model
 from .statics import solve_static
 
-STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound", 3: "energy balance drift"}
+STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound", 3: "energy growth",
+               4: "Newton failure"}
+ENERGY_TOL = 0.05   # relative energy growth that stops a run (see `simulate`)
 
 
 class DivergenceError(RuntimeError):
@@ -50,6 +52,18 @@ class DynamicResult:
         """work - (kinetic + potential - initial) - dissipated [J]."""
         e = self.kinetic + self.potential
         return self.work - (e - e[0]) - self.dissipated
+
+
+def status_message(status: int, step: int, dt: float, delta_max: float, raise_on_failure: bool = False) -> str:
+    """'ok', or the guard's cause with the time [s], the step and dt [s]; raises if asked."""
+    if not status:
+        return "ok"
+    msg = f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"
+    if status == 2:
+        msg += f"; bound {delta_max * 1e6:.4g} um"
+    if raise_on_failure:
+        raise DivergenceError(msg)
+    return msg
 
 
 def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray):
@@ -123,7 +137,7 @@ def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[
 def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
              duration: float, dt: float | None = None, output_step: float = 1e-5,
              safety: float = 0.5, delta_max: float | None = None, raise_on_failure: bool = False,
-             phi_quiet: float = 1e-9) -> DynamicResult:
+             phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL) -> DynamicResult:
     """Integrate from rest with the driver speed ramp 0 -> speed [rad/s] over speed_ramp [s]
     and the resisting torque ramp 0 -> torque [N·m] over torque_ramp [s], for duration [s].
 
@@ -133,6 +147,9 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     ``phi_quiet`` [rad]: a tooth outside the mesh window is frozen once its rotation is below
     this (1e-9 rad moves the flank by about 3e-6 um) and its rate below phi_quiet times its
     natural frequency.
+    ``energy_tol`` [-]: the run stops ("energy growth") when the energy balance shows more
+    energy in the pair than the work put in, by more than this fraction of the larger of the
+    work and the stored energy: the signature of an unstable step.
     """
     for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp), ("output_step", output_step)):
         if not (v > 0 and math.isfinite(v)):
@@ -154,15 +171,9 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                    float(speed), float(speed_ramp), float(torque), float(torque_ramp),
                                    dt, n_steps, out_every, theta2, 0.0, phi, dphi,
-                                   phi_quiet, phi_quiet * omega_tooth, float(delta_max), *o)
+                                   phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
-    msg = "ok"
-    if status:
-        msg = f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"
-        if status == 2:
-            msg += f"; bound {delta_max * 1e6:.4g} um"
-        if raise_on_failure:
-            raise DivergenceError(msg)
+    msg = status_message(status, step, dt, delta_max, raise_on_failure)
     return DynamicResult(t, te, th2, fmax, nc.astype(int), react, ke, pe, work, diss, dt, step,
                          int(status), msg, omega_max, int(max_act))
