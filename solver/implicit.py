@@ -44,7 +44,8 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
                       duration: float, dt: float | None = None, output_step: float = 1e-5,
                       alpha: float = 0.0, newton_tol: float = 1e-13, max_iter: int = 12,
                       delta_max: float | None = None, raise_on_failure: bool = False,
-                      phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL) -> ImplicitResult:
+                      phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL,
+                      all_teeth: bool = False) -> ImplicitResult:
     """Integrate from rest with HHT-alpha; loads, outputs and guards as `integrate.simulate`.
 
     ``dt`` [s] defaults to four times the explicit stability step; it is rounded down so that
@@ -52,6 +53,8 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
     output_step falls on a step boundary). ``alpha`` in [-1/3, 0]. ``newton_tol`` [m]: Newton
     stops when its last correction moves no flank point by more than this; ``max_iter``
     Newton iterations per step before the run stops with "Newton failure".
+    ``all_teeth``: integrate every tooth from the start and never freeze one (the model of
+    the scipy peer `solver.reference`, for like-for-like error figures).
     """
     for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp),
                     ("output_step", output_step), ("newton_tol", newton_tol)):
@@ -74,8 +77,10 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
     o = [np.zeros(n_out) for _ in range(10)]
     o_newton = np.zeros(n_out, dtype=np.int64)
     theta2 = float(model.theta2_for_te(0.0, (1.0 if torque >= 0 else -1.0) * model.backlash_offset))
-    phi = np.zeros(model.n_teeth)
+    phi = np.full(model.n_teeth, 1e-300) if all_teeth else np.zeros(model.n_teeth)
     dphi = np.zeros(model.n_teeth)
+    if all_teeth:
+        phi_quiet = 0.0
     omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
     status, step, max_act, total = hht(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                        float(speed), float(speed_ramp), float(torque), float(torque_ramp),

@@ -17,6 +17,8 @@ of the speed ramp falls on a step boundary).
 Newton on x_{n+1} with the tangent M/(beta dt^2) + (1+alpha)(K + gamma/(beta dt) C), where
 K = sum_c k_t G G^T + spring tangents and C = sum_c dF/d(ddelta) G G^T + spring damping
 tangents (the geometric term F dG/dx is left out: it changes only the convergence rate).
+Teeth without a loaded contact are condensed out of each Newton system, so its cost stays
+that of the few teeth in the mesh even when every tooth is integrated.
 Converged when the last correction moves no flank point by more than newton_tol [m]; the
 forces are then re-evaluated at the converged state (they start the next step).
 
@@ -31,7 +33,7 @@ from .explicit import (ENERGY, NONFINITE, OK, PENETRATION, _dissipation_power, _
                        driver_motion, driver_speed, load_torque)
 from .laws import contact_damping_tangents, spring_damping_tangent
 from .layout import (C_CON, C_DDELTA, C_DELTA, C_FORCE, C_G2, C_GA, C_GB, C_KT, C_PHI, C_TOOTH1,
-                     C_TOOTH2, I_CPL, I_P, I_TOT, M2, M3, N_C, R_BND, RB, TOOTH0)
+                     C_TOOTH2, I_CPL, I_P, I_TOT, M2, M3, MAX_CONTACTS, N_C, R_BND, RB, TOOTH0)
 from .mesh import generalized_forces, mesh_contacts, tooth_spring_tangent
 from .statics import solve_dense
 
@@ -39,7 +41,7 @@ NEWTON = 4
 
 
 @njit(cache=True)
-def _activate(pairs, npair, tz2, active, act, nact, pos, incand):
+def _activate(pairs, npair, tz2, active, act, nact, incand):
     """Add the teeth of the candidate pairs to the active set; returns the new count."""
     for p in range(npair):
         for g in range(2):
@@ -48,50 +50,85 @@ def _activate(pairs, npair, tz2, active, act, nact, pos, incand):
             if not active[i]:
                 active[i] = True
                 act[nact] = i
-                pos[i] = nact + 1
                 nact += 1
     return nact
 
 
 @njit(cache=True)
-def _tangent(J, rec, nc, phi, dphi, act, nact, pos, kphi, gp, lp, tz2, cm, ck, cc):
-    """J = cm*M + ck*K + cc*C over (theta2, active teeth)."""
-    n = nact + 1
-    for r in range(n):
-        for s in range(n):
-            J[r, s] = 0.0
-    J[0, 0] = cm * gp[1, I_TOT]
+def _newton_step(rec, nc, phi, dphi, act, nact, kphi, gp, lp, tz2, cm, ck, cc, r, loc, cl, A, dx):
+    """Solve J dx = r for J = cm*M + ck*K + cc*C over (theta2, active teeth); r indexed as dx
+    (0: theta2, a + 1: tooth act[a]).
+
+    A tooth without a loaded contact couples to theta2 only (through the hub inertia of gear 2)
+    and is condensed out first; the dense solve runs over theta2 and the teeth in contact.
+    """
+    m = 0
+    for c in range(nc):
+        if rec[c, C_FORCE] <= 0.0:
+            continue
+        for g in range(2):
+            i = int(rec[c, C_TOOTH1]) if g == 0 else tz2 + int(rec[c, C_TOOTH2])
+            if loc[i] == 0:
+                m += 1
+                loc[i] = m
+                cl[m - 1] = i
+    n = m + 1
+    for u in range(n):
+        for v in range(n):
+            A[u, v] = 0.0
+    A[0, 0] = cm * gp[1, I_TOT]
+    b = np.empty(n)
+    b[0] = r[0]
     for a in range(nact):
         i = act[a]
         g = 1 if i >= tz2 else 0
-        J[a + 1, a + 1] = (cm * gp[g, I_P] + ck * tooth_spring_tangent(i, phi, kphi, gp)
-                           + cc * spring_damping_tangent(dphi[i], gp[g, C_PHI], gp[g, N_C]))
-        if g == 1:
-            J[0, a + 1] = cm * gp[1, I_CPL]
-            J[a + 1, 0] = cm * gp[1, I_CPL]
+        d = (cm * gp[g, I_P] + ck * tooth_spring_tangent(i, phi, kphi, gp)
+             + cc * spring_damping_tangent(dphi[i], gp[g, C_PHI], gp[g, N_C]))
+        c0 = cm * gp[1, I_CPL] if g == 1 else 0.0
+        k = loc[i]
+        if k > 0:
+            A[k, k] += d
+            A[0, k] += c0
+            A[k, 0] += c0
+            b[k] = r[a + 1]
+        else:
+            A[0, 0] -= c0 * c0 / d
+            b[0] -= c0 * r[a + 1] / d
     for c in range(nc):
         if rec[c, C_FORCE] <= 0.0:
             continue
         kd, cd = contact_damping_tangents(rec[c, C_DELTA], rec[c, C_DDELTA], rec[c, C_FORCE],
                                           lp[C_CON], lp[M2], lp[M3])
         w = ck * (rec[c, C_KT] + kd) + cc * cd
-        ia = int(rec[c, C_TOOTH1])
-        ib = tz2 + int(rec[c, C_TOOTH2])
-        i0 = 0
-        i1 = pos[ia]
-        i2 = pos[ib]
+        i1 = loc[int(rec[c, C_TOOTH1])]
+        i2 = loc[tz2 + int(rec[c, C_TOOTH2])]
         g0 = rec[c, C_G2]
         g1 = rec[c, C_GA]
         g2 = rec[c, C_GB]
-        J[i0, i0] += w * g0 * g0
-        J[i0, i1] += w * g0 * g1
-        J[i0, i2] += w * g0 * g2
-        J[i1, i0] += w * g1 * g0
-        J[i1, i1] += w * g1 * g1
-        J[i1, i2] += w * g1 * g2
-        J[i2, i0] += w * g2 * g0
-        J[i2, i1] += w * g2 * g1
-        J[i2, i2] += w * g2 * g2
+        A[0, 0] += w * g0 * g0
+        A[0, i1] += w * g0 * g1
+        A[0, i2] += w * g0 * g2
+        A[i1, 0] += w * g1 * g0
+        A[i1, i1] += w * g1 * g1
+        A[i1, i2] += w * g1 * g2
+        A[i2, 0] += w * g2 * g0
+        A[i2, i1] += w * g2 * g1
+        A[i2, i2] += w * g2 * g2
+    y = solve_dense(A[:n, :n], b)
+    dx[0] = y[0]
+    for a in range(nact):
+        i = act[a]
+        k = loc[i]
+        if k > 0:
+            dx[a + 1] = y[k]
+        else:
+            g = 1 if i >= tz2 else 0
+            d = (cm * gp[g, I_P] + ck * tooth_spring_tangent(i, phi, kphi, gp)
+                 + cc * spring_damping_tangent(dphi[i], gp[g, C_PHI], gp[g, N_C]))
+            c0 = cm * gp[1, I_CPL] if g == 1 else 0.0
+            dx[a + 1] = (r[a + 1] - c0 * y[0]) / d
+    for u in range(m):
+        loc[cl[u]] = 0
 
 
 @njit(cache=True)
@@ -123,20 +160,21 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
     vt = np.zeros(ntooth)
     active = np.zeros(ntooth, dtype=np.bool_)
     act = np.zeros(ntooth, dtype=np.int64)
-    pos = np.zeros(ntooth, dtype=np.int64)
     incand = np.zeros(ntooth, dtype=np.bool_)
-    J = np.zeros((ntooth + 1, ntooth + 1))
+    A = np.zeros((2 * MAX_CONTACTS + 1, 2 * MAX_CONTACTS + 1))
     r = np.zeros(ntooth + 1)
+    dx = np.zeros(ntooth + 1)
+    loc = np.zeros(ntooth, dtype=np.int64)
+    cl = np.zeros(2 * MAX_CONTACTS, dtype=np.int64)
     nact = 0
     for i in range(ntooth):
         if phi[i] != 0.0 or dphi[i] != 0.0:
             active[i] = True
             act[nact] = i
-            pos[i] = nact + 1
             nact += 1
     th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
     nc, npair = mesh_contacts(th1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec)
-    nact = _activate(pairs, npair, tz2, active, act, nact, pos, incand)
+    nact = _activate(pairs, npair, tz2, active, act, nact, incand)
     tl = load_torque(0.0, torque, torque_ramp)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     # initial accelerations: the explicit arrowhead solve, plus the driver coupling
@@ -226,7 +264,7 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
                 dphi[i] = vt[i] + gamma * dt * acc[i]
             nc, npair = mesh_contacts(th1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec)
             n_before = nact
-            nact = _activate(pairs, npair, tz2, active, act, nact, pos, incand)
+            nact = _activate(pairs, npair, tz2, active, act, nact, incand)
             for a in range(n_before, nact):
                 # a tooth entering the active set: at rest on its hub, zero force history
                 i = act[a]
@@ -256,9 +294,7 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
                 else:
                     ri -= gp[0, I_CPL] * a1m
                 r[a + 1] = ri
-            _tangent(J, rec, nc, phi, dphi, act, nact, pos, kphi, gp, lp, tz2, cm, ck, cc)
-            n = nact + 1
-            dx = solve_dense(J[:n, :n], r[:n])
+            _newton_step(rec, nc, phi, dphi, act, nact, kphi, gp, lp, tz2, cm, ck, cc, r, loc, cl, A, dx)
             last = abs(dx[0]) * rb2
             theta2 += dx[0]
             for a in range(nact):
@@ -301,8 +337,6 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
                 active[i] = False
                 nact -= 1
                 act[a] = act[nact]
-                pos[act[a]] = a + 1
-                pos[i] = 0
             else:
                 a += 1
         for p in range(npair):
