@@ -103,27 +103,26 @@ def highest_frequency(model: Model, torque: float, positions: int = 12) -> float
 
     The pair is linearised at static equilibrium under ``torque`` [N·m] (1 N·m if zero) at
     ``positions`` driver angles across one angular pitch; the generalised eigenproblem
-    K x = w² M x gives the frequencies.
+    K x = w² M x gives the frequencies. The equilibria come from one static sweep with
+    continuation (tooth rotations carried from angle to angle); positions where it does not
+    converge are left out.
     """
     angles = np.linspace(0.0, model.geometry[0].pitch_angle, positions, endpoint=False)
     load = torque if abs(torque) > 1e-9 else 1.0
-    st = solve_static(model, angles, load, raise_on_failure=False)
     wmax = 0.0
-    for a, theta1 in enumerate(angles):
-        phi = _phi_at(model, theta1, load, st.te[a])
-        M, K, _t = linearized_system(model, theta1, st.theta2[a], phi)
+    phi, te0, used = None, None, 0
+    for theta1 in angles:
+        st = solve_static(model, np.array([theta1]), load, phi0=phi, te0=te0, raise_on_failure=False)
+        if not st.converged[0]:
+            continue
+        phi, te0 = st.phi_last, float(st.te[0])
+        M, K, _t = linearized_system(model, theta1, st.theta2[0], phi)
         lam = scipy.linalg.eigh(K, M, eigvals_only=True)
         wmax = max(wmax, math.sqrt(max(lam.max(), 0.0)))
+        used += 1
+    if used == 0:
+        raise ValueError(f"no static equilibrium under {load} N·m found to estimate the highest natural frequency")
     return wmax
-
-
-def _phi_at(model: Model, theta1: float, torque: float, te0: float) -> np.ndarray:
-    from .kernels.statics import static_sweep
-    phi = np.zeros(model.n_teeth)
-    out = [np.zeros(1), np.zeros(1, dtype=np.int64), np.zeros((1, model.teeth[0])), np.zeros(1, dtype=np.int64), np.zeros(1)]
-    static_sweep(np.array([theta1]), float(torque), float(model.theta2_for_te(theta1, te0)), phi,
-                 model.gear_par, model.pair_par, model.law_par, model.k_phi, 1e-10, 60, *out)
-    return phi
 
 
 def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[float, float]:
