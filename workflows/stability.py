@@ -3,8 +3,8 @@
 Every scene ends either bounded and physically plausible, or with a named failure (the
 guard's cause, time and step; a Newton failure; a solver's wall-time limit): never with a
 silent NaN. Checks of plausibility on a run that the guards let through: TE and contact force
-finite and bounded (|TE| below the backlash offset plus a tenth of the module, force below
-50 times the static mesh force), and no energy growth (work in >= stored + dissipated energy
+finite and bounded (|TE| below the backlash offset plus a tenth of the module, the force below
+that of 20 um of penetration), and no energy growth (work in >= stored + dissipated energy
 within 2 % of the larger of work and stored energy).
 
 Scenes (overrides of the scene given, default the paper example; short runs: ``--duration``,
@@ -89,7 +89,8 @@ def plausibility(res, model, torque: float, method: str) -> str:
     te_bound = model.backlash_offset + 0.1 * model.geometry[0].spec.module
     if np.max(np.abs(res.te)) > te_bound:
         return f"|TE| {np.max(np.abs(res.te)) * 1e6:.4g} um beyond {te_bound * 1e6:.4g} um"
-    f_bound = 50 * max(abs(torque), 5.0) / model.base_radii[1]
+    k, m1 = model.law_par[0], model.law_par[1]
+    f_bound = k * 20e-6 ** m1          # 20 um of penetration: far beyond any elastic contact here
     if np.max(res.force_max) > f_bound:
         return f"contact force {np.max(res.force_max):.4g} N beyond {f_bound:.4g} N"
     e = res.kinetic + res.potential
