@@ -313,9 +313,9 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
             "reference": names[0],
             "cross_check": names[1],
             **{f"reference_difference_{k}_um": float(v) for k, v in zip(NORMS, e_chk)},
+            **results.provenance(),
             "machine": machine(),
             "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-            **results.provenance(),
             **(attrs or {}),
         },
     )
@@ -417,7 +417,7 @@ def plot(ds: xr.Dataset, path, norm: str = "linf") -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     footer = (f"{ds.attrs.get('case', '')}\nreference: {ds.attrs['reference']}; cross-check: {ds.attrs['cross_check']}\n"
-              f"{ds.attrs['machine']}; {ds.attrs.get('versions', '')}; {ds.attrs['date']}")
+              f"{ds.attrs['machine']}; {ds.attrs.get('software', '')}; {ds.attrs['date']}")
     fig.text(0.01, 0.005, footer, fontsize=6, va="bottom", wrap=True)
     fig.tight_layout(rect=(0, 0.1, 1, 1))
     fig.savefig(path, dpi=120)
