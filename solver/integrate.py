@@ -3,7 +3,8 @@
 `simulate` runs the explicit velocity-Verlet kernel (`kernels/explicit.py`) with a fixed
 step. By default the step comes from the scene's highest natural frequency: the model is
 linearised at static equilibrium at several positions across one mesh cycle under the full
-load, and ``dt = safety * 2 / omega_max`` (Verlet is stable for omega*dt < 2).
+load, and ``dt = safety * 2 / omega_max`` (Verlet is stable for omega*dt < 2), reduced where
+the modal damping of the loaded contacts asks for it (`stability_limit`).
 """
 from __future__ import annotations
 
@@ -15,11 +16,14 @@ import scipy.linalg
 
 from .kernels import layout as L
 from .kernels.explicit import verlet
+from .kernels.laws import contact_damping_tangents, spring_damping_tangent
 from .kernels.mesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
 from .model import Model
 from .statics import solve_static
 
-STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound", 3: "energy balance drift"}
+STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound", 3: "energy growth",
+               4: "Newton failure"}
+ENERGY_TOL = 0.05   # relative energy growth that stops a run (see `simulate`)
 
 
 class DivergenceError(RuntimeError):
@@ -52,10 +56,24 @@ class DynamicResult:
         return self.work - (e - e[0]) - self.dissipated
 
 
-def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray):
+def status_message(status: int, step: int, dt: float, delta_max: float, raise_on_failure: bool = False) -> str:
+    """'ok', or the guard's cause with the time [s], the step and dt [s]; raises if asked."""
+    if not status:
+        return "ok"
+    msg = f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"
+    if status == 2:
+        msg += f"; bound {delta_max * 1e6:.4g} um"
+    if raise_on_failure:
+        raise DivergenceError(msg)
+    return msg
+
+
+def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False):
     """Mass and tangent stiffness over the free DOFs (theta2, then the teeth near the mesh).
 
-    Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF.
+    Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF. With
+    ``damping`` also the damping tangent at rest, (M, K, C, dof_teeth): spring dampers and
+    contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1).
     """
     rec, pairs = new_contact_buffer()
     zeros = np.zeros(model.n_teeth)
@@ -67,13 +85,16 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
     n = len(teeth) + 1
     M = np.zeros((n, n))
     K = np.zeros((n, n))
+    C = np.zeros((n, n))
     M[0, 0] = gp[1, L.I_TOT]
+    lp = model.law_par
     for t, i in pos.items():
         g = 1 if t >= tz2 else 0
         M[i, i] = gp[g, L.I_P]
         if g == 1:
             M[0, i] = M[i, 0] = gp[1, L.I_CPL]
         K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
+        C[i, i] += spring_damping_tangent(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
     for c in range(nc):
         kt = rec[c, L.C_KT]
         ia = int(rec[c, L.C_TOOTH1])
@@ -81,49 +102,70 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
         idx = [0, pos[ia], pos[ib]]
         g = np.array([rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB]])
         K[np.ix_(idx, idx)] += kt * np.outer(g, g)
+        _kd, cd = contact_damping_tangents(rec[c, L.C_DELTA], 0.0, max(rec[c, L.C_FORCE], 1e-300),
+                                           lp[L.C_CON], lp[L.M2], lp[L.M3])
+        C[np.ix_(idx, idx)] += cd * np.outer(g, g)
+    if damping:
+        return M, K, C, teeth
     return M, K, teeth
 
 
-def highest_frequency(model: Model, torque: float, positions: int = 12) -> float:
-    """Highest natural frequency [rad/s] of the loaded pair over one mesh cycle.
+def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[float, float]:
+    """(critical Verlet step [s], highest natural frequency [rad/s]) of the loaded pair over one
+    mesh cycle.
 
     The pair is linearised at static equilibrium under ``torque`` [N·m] (1 N·m if zero) at
     ``positions`` driver angles across one angular pitch; the generalised eigenproblem
-    K x = w² M x gives the frequencies.
+    K x = w² M x gives the frequencies. Each mode i, with its modal damping ratio
+    zeta_i = x_i^T C x_i / (2 w_i) (mass-normalised x_i), limits the step to
+    2/w_i * (sqrt(1 + zeta_i²) - zeta_i): velocity Verlet with damping forces evaluated at the
+    predicted velocity is stable up to there (2/w_i undamped). A deep, damped contact (m3 > 1)
+    can make a lower but overdamped mode the limit. The equilibria come from one static sweep
+    with continuation (tooth rotations carried from angle to angle); positions where it does
+    not converge are left out.
     """
     angles = np.linspace(0.0, model.geometry[0].pitch_angle, positions, endpoint=False)
     load = torque if abs(torque) > 1e-9 else 1.0
-    st = solve_static(model, angles, load, raise_on_failure=False)
     wmax = 0.0
-    for a, theta1 in enumerate(angles):
-        phi = _phi_at(model, theta1, load, st.te[a])
-        M, K, _t = linearized_system(model, theta1, st.theta2[a], phi)
-        lam = scipy.linalg.eigh(K, M, eigvals_only=True)
-        wmax = max(wmax, math.sqrt(max(lam.max(), 0.0)))
-    return wmax
+    dt_crit = math.inf
+    phi, te0, used = None, None, 0
+    for theta1 in angles:
+        st = solve_static(model, np.array([theta1]), load, phi0=phi, te0=te0, raise_on_failure=False)
+        if not st.converged[0]:
+            continue
+        phi, te0 = st.phi_last, float(st.te[0])
+        M, K, C, _t = linearized_system(model, theta1, st.theta2[0], phi, damping=True)
+        lam, x = scipy.linalg.eigh(K, M)
+        w = np.sqrt(np.maximum(lam, 0.0))
+        h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
+        lim = 2.0 / np.maximum(np.hypot(w, h) + h, 1e-300)    # = 2/w (sqrt(1+zeta²) - zeta)
+        wmax = max(wmax, float(w.max()))
+        dt_crit = min(dt_crit, float(lim.min()))
+        used += 1
+    if used == 0:
+        raise ValueError(f"no static equilibrium under {load} N·m found to estimate the highest natural frequency")
+    return dt_crit, wmax
 
 
-def _phi_at(model: Model, theta1: float, torque: float, te0: float) -> np.ndarray:
-    from .kernels.statics import static_sweep
-    phi = np.zeros(model.n_teeth)
-    out = [np.zeros(1), np.zeros(1, dtype=np.int64), np.zeros((1, model.teeth[0])), np.zeros(1, dtype=np.int64), np.zeros(1)]
-    static_sweep(np.array([theta1]), float(torque), float(model.theta2_for_te(theta1, te0)), phi,
-                 model.gear_par, model.pair_par, model.law_par, model.k_phi, 1e-10, 60, *out)
-    return phi
+def highest_frequency(model: Model, torque: float, positions: int = 12) -> float:
+    """Highest natural frequency [rad/s] of the loaded pair over one mesh cycle (see
+    `stability_limit`)."""
+    return stability_limit(model, torque, positions)[1]
 
 
 def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[float, float]:
-    """(dt [s], omega_max [rad/s]) for the explicit integrator: safety * 2 / omega_max."""
-    w = highest_frequency(model, torque)
+    """(dt [s], omega_max [rad/s]) for the explicit integrator: safety times the critical step
+    of `stability_limit` (2/omega_max without damping)."""
+    dt_crit, w = stability_limit(model, torque)
     if not w > 0:
         raise ValueError("no loaded contact found to estimate the highest natural frequency")
-    return safety * 2.0 / w, w
+    return safety * dt_crit, w
 
 
 def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
              duration: float, dt: float | None = None, output_step: float = 1e-5,
              safety: float = 0.5, delta_max: float | None = None, raise_on_failure: bool = False,
-             phi_quiet: float = 1e-9) -> DynamicResult:
+             phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL) -> DynamicResult:
     """Integrate from rest with the driver speed ramp 0 -> speed [rad/s] over speed_ramp [s]
     and the resisting torque ramp 0 -> torque [N·m] over torque_ramp [s], for duration [s].
 
@@ -133,6 +175,9 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     ``phi_quiet`` [rad]: a tooth outside the mesh window is frozen once its rotation is below
     this (1e-9 rad moves the flank by about 3e-6 um) and its rate below phi_quiet times its
     natural frequency.
+    ``energy_tol`` [-]: the run stops ("energy growth") when the energy balance shows more
+    energy in the pair than the work put in, by more than this fraction of the larger of the
+    work and the stored energy: the signature of an unstable step.
     """
     for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp), ("output_step", output_step)):
         if not (v > 0 and math.isfinite(v)):
@@ -154,15 +199,9 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                    float(speed), float(speed_ramp), float(torque), float(torque_ramp),
                                    dt, n_steps, out_every, theta2, 0.0, phi, dphi,
-                                   phi_quiet, phi_quiet * omega_tooth, float(delta_max), *o)
+                                   phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
-    msg = "ok"
-    if status:
-        msg = f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"
-        if status == 2:
-            msg += f"; bound {delta_max * 1e6:.4g} um"
-        if raise_on_failure:
-            raise DivergenceError(msg)
+    msg = status_message(status, step, dt, delta_max, raise_on_failure)
     return DynamicResult(t, te, th2, fmax, nc.astype(int), react, ke, pe, work, diss, dt, step,
                          int(status), msg, omega_max, int(max_act))

@@ -371,7 +371,7 @@ class ScipyResult(DynamicResult):
 def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
                    duration: float, method: str = "LSODA", rtol: float = 1e-6, atol: float | None = None,
                    output_step: float = 1e-5, max_step: float | None = None, delta_max: float | None = None,
-                   raise_on_failure: bool = False) -> ScipyResult:
+                   raise_on_failure: bool = False, max_wall_time: float | None = None) -> ScipyResult:
     """Integrate the pair from rest with a `scipy.integrate` ODE solver (all teeth free).
 
     Same loads as `solver.integrate.simulate`: driver speed ramp 0 -> speed [rad/s] over
@@ -383,7 +383,8 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
     motion; rates get atol scaled by the highest tooth frequency). ``delta_max`` [m]
     (default a tenth of the module) bounds the penetration.
     A failure of the solver or a guard gives status != 0 and a message (or raises
-    `DivergenceError` with ``raise_on_failure``).
+    `DivergenceError` with ``raise_on_failure``). ``max_wall_time`` [s] stops a run that takes
+    longer (status 5, "wall-time limit").
     """
     if method not in METHODS:
         raise ValueError(f"method: must be one of {', '.join(METHODS)}, got {method!r}")
@@ -427,6 +428,11 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
                        f"{err or 'non-finite state'}")
                 break
             steps += 1
+            if max_wall_time is not None and _time.perf_counter() - t0 > max_wall_time:
+                status = 5
+                msg = (f"{method}: wall-time limit {max_wall_time:g} s reached at t = {solver.t:.6g} s "
+                       f"(step {steps})")
+                solver.status = "failed"
             sel = np.flatnonzero((t_out > t_old) & (t_out <= solver.t))
             if sel.size:
                 ys[sel] = solver.dense_output()(t_out[sel]).T
@@ -492,9 +498,66 @@ def simulate_explicit_all_teeth(model: Model, speed: float, speed_ramp: float, t
     delta_max = 0.1 * model.geometry[0].spec.module
     status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                    float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                   dt, n_steps, out_every, theta2, 0.0, phi, dphi, 0.0, 0.0, delta_max, *o)
+                                   dt, n_steps, out_every, theta2, 0.0, phi, dphi, 0.0, 0.0, delta_max, 0.05, *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
     msg = "ok" if status == 0 else f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"
     return DynamicResult(t, te, th2, fmax, nc.astype(int), react, ke, pe, work, diss, dt, step,
                          int(status), msg, float("nan"), int(max_act))
+
+
+def solve_static_scipy(model: Model, angles, torque: float, xtol: float = 1e-13) -> np.ndarray:
+    """Static TE [m] at driver angles [rad] under ``torque`` [N·m] with `scipy.optimize.root`
+    (MINPACK hybrd, finite-difference Jacobian) on the plain-Python contact and spring forces.
+
+    An independent check of the numba static kernel: unknowns are theta2 and the rotations of
+    the teeth in loaded contact (an unloaded tooth rests at phi = 0 exactly, where the spring
+    tangent of n_k > 1 vanishes); the set is updated until it no longer changes. The first
+    angle starts from rigid teeth closing the backlash, the others from the previous angle's
+    solution (continuation, as the static kernel does: where corner contacts make the
+    equilibrium non-unique, both then follow the same branch).
+    """
+    from scipy import optimize
+    eq = PairEquations(model, 0.0, 1.0, torque, 1.0)
+    rb1, rb2 = model.base_radii
+    z = eq.nt
+    out = np.empty(len(angles))
+    sgn = 1.0 if torque >= 0 else -1.0
+    k, m1 = eq.law[0], eq.law[1]
+    te = sgn * (model.backlash_offset + (abs(torque) / rb2 / k) ** (1.0 / m1))
+    phi = np.zeros(z)
+    for a, th1 in enumerate(angles):
+        theta2 = float(model.theta2_for_te(th1, te))
+        teeth: list[int] = []
+        for _ in range(20):
+            cons = eq.contacts(th1, theta2, phi, 0.0, 0.0, np.zeros(z))
+            new = sorted({c.ia for c in cons if c.force > 0} | {c.ib for c in cons if c.force > 0})
+            if new == teeth and _:
+                break
+            teeth = new
+            keep = np.zeros(z, bool)
+            keep[teeth] = True
+            phi[~keep] = 0.0
+
+            def residual(u, teeth=teeth):
+                p = np.zeros(z)
+                p[teeth] = u[1:] * 1e-3
+                q = np.empty(len(teeth) + 1)
+                q[0] = torque
+                tq = eq.spring_torques(p, np.zeros(z))
+                qt = {t: tq[t] for t in teeth}
+                for c in eq.contacts(th1, u[0], p, 0.0, 0.0, np.zeros(z)):
+                    q[0] -= c.force * c.g[2]
+                    if c.ia in qt:
+                        qt[c.ia] -= c.force * c.g[1]
+                    if c.ib in qt:
+                        qt[c.ib] -= c.force * c.g[3]
+                q[1:] = [qt[t] for t in teeth]
+                return q
+
+            sol = optimize.root(residual, np.r_[theta2, phi[teeth] * 1e3], method="hybr",
+                                options={"xtol": xtol})
+            theta2 = float(sol.x[0])
+            phi[teeth] = sol.x[1:] * 1e-3
+        out[a] = te = rb1 * th1 + rb2 * theta2
+    return out

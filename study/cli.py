@@ -16,6 +16,7 @@ COMMANDS = {
     "sweep": ("study.sweep", "run a parametric study (scene + grid) with dask into one NetCDF archive"),
     "fit-contact": ("study.fit_contact", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
     "render": ("study.figures", "plots and renders (PNG) of a run or sweep archive"),
+    "precision": ("study.precision", "work-precision study: TE error against wall time for every solver of a scene"),
 }
 
 

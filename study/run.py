@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from solver import units
+from solver.implicit import choose_method, simulate_implicit
 from solver.integrate import simulate
 from solver.model import ContactLaw, GearInput, Model, build_model
 from solver.statics import solve_static
@@ -81,9 +82,20 @@ def run_static(scene: Scene, model: Model):
 
 
 def run_dynamic(scene: Scene, model: Model):
+    """DTE run with the scene's integrator: dynamic.method 'explicit', 'implicit' or 'auto'
+    (chosen from the stability step; see `solver.implicit.choose_method`). The result carries
+    ``choice`` (the MethodChoice) for the archive."""
     d = scene.dynamic
-    return simulate(model, d.speed, d.ramp_time, d.torque, d.ramp_time, d.duration,
-                    dt=d.time_step or None, output_step=d.output_step)
+    choice = choose_method(model, d.torque, d.duration, d.method, d.time_step or None, d.alpha)
+    args = (model, d.speed, d.ramp_time, d.torque, d.ramp_time, d.duration)
+    if choice.method == "implicit":
+        res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha)
+    else:
+        res = simulate(*args, dt=choice.dt, output_step=d.output_step)
+    if math.isfinite(choice.omega_max):
+        res.omega_max = choice.omega_max
+    res.choice = choice
+    return res
 
 
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None) -> xr.Dataset:
@@ -129,6 +141,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["spectrum_start_s"] = start
         c, v, a = results.dynamic_variables(dy, start, driven_speed, scene.gear2.body.holes, z2)
         coords.update(c); data.update(v); attrs.update(a)
+        attrs["dynamic_method"] = dy.choice.method
+        attrs["dynamic_method_reason"] = dy.choice.reason
+        attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

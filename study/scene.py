@@ -117,7 +117,8 @@ class QuasiStaticSection:
 @dataclass(frozen=True)
 class DynamicSection:
     enabled: bool = _f(True, "", "compute the dynamic transmission error")
-    method: str = _f("explicit", "", "time integrator", choices=("explicit", "implicit", "auto"))
+    method: str = _f("explicit", "", "time integrator: 'explicit' (velocity Verlet), 'implicit' (HHT-alpha), 'auto' (explicit when its stability step is affordable for the duration, implicit otherwise)", choices=("explicit", "implicit", "auto"))
+    alpha: float = _f(0.0, "1", "HHT-alpha numerical damping of the implicit integrator: 0 = none (trapezoidal rule), down to -1/3", -1.0 / 3.0, 0.0)
     speed: float = _f(100.0, "rad/s", "final driver speed")
     torque: float = _f(50.0, "N*m", "final resisting torque on gear 2")
     ramp_time: float = _f(0.01, "s", "speed and torque ramp time", 0, lo_open=True)

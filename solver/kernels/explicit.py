@@ -124,14 +124,16 @@ def _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2):
 
 @njit(cache=True)
 def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
-           theta2, w2, phi, dphi, phi_quiet, dphi_quiet, delta_max,
+           theta2, w2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol,
            o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
     """Integrate n_steps of size dt [s] from t = 0; write every out_every-th state.
 
     theta2 [rad], w2 [rad/s], phi, dphi (Z1+Z2) are the initial state (phi, dphi updated in
     place). Outputs: time [s], TE [m], max contact force over the interval [N], loaded
     contacts, driver reaction torque [N m], kinetic, potential, input and dissipated energy
-    [J], theta2 [rad]. Returns (status, step reached, max active teeth).
+    [J], theta2 [rad]. The run stops (status 3) when the energy balance shows a growth
+    work - (kinetic + potential - initial) - dissipated < -energy_tol * (energy scale), checked
+    at the output instants. Returns (status, step reached, max active teeth).
     """
     ntooth = phi.shape[0]
     tz2 = int(gp[1, TOOTH0])
@@ -169,6 +171,7 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     react = s1 * acc1 + r1
     cr1 = gp[0, I_CPL] / gp[0, I_P]
     ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+    e0 = ke + pe
     work = 0.0
     diss = 0.0
     p_in_old = react * w1 + load_torque(0.0, torque, torque_ramp) * w2
@@ -286,6 +289,8 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
             fmax = 0.0
             if not (math.isfinite(theta2) and math.isfinite(w2) and math.isfinite(ke + pe)):
                 status = NONFINITE
+            elif status == OK and ke + pe - e0 + diss - work > energy_tol * max(abs(work), ke + pe, diss):
+                status = ENERGY
         if status != OK:
             break
     return status, step, max_act

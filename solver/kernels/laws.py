@@ -70,3 +70,40 @@ def contact_energy(delta, k, m1):
     if delta <= 0.0:
         return 0.0
     return k * delta ** (m1 + 1.0) / (m1 + 1.0)
+
+
+@njit(cache=True)
+def spring_damping_tangent(dphi, c, n_c):
+    """d|T_damping|/d dphi [N m s/rad]: c*n_c*|dphi|^(n_c-1).
+
+    At rest it is 0 for n_c != 1 (infinite for n_c < 1: Newton then runs on the inertia and
+    stiffness terms alone, the residual stays exact)."""
+    if c == 0.0:
+        return 0.0
+    if n_c == 1.0:
+        return c
+    a = abs(dphi)
+    if a == 0.0:
+        return 0.0
+    return c * n_c * a ** (n_c - 1.0)
+
+
+@njit(cache=True)
+def contact_damping_tangents(delta, ddelta, force, c, m2, m3):
+    """Tangents of the damping term c*sgn(dd)|dd|^m2*delta^m3 of eq. (1.3).
+
+    Returns (dF/d delta [N/m], dF/d ddelta [N s/m]); both 0 where the force is clipped at zero
+    or the contact is open.
+    """
+    if delta <= 0.0 or force <= 0.0 or c == 0.0:
+        return 0.0, 0.0
+    sp = signed_pow(ddelta, m2)
+    kd = m3 * c * sp * delta ** (m3 - 1.0) if m3 != 0.0 else 0.0
+    a = abs(ddelta)
+    if m2 == 1.0:
+        cd = c * delta ** m3
+    elif a == 0.0:
+        cd = 0.0
+    else:
+        cd = c * m2 * a ** (m2 - 1.0) * delta ** m3
+    return kd, cd

@@ -1,0 +1,116 @@
+"""Work-precision study on tiny cases: dataset contract, references that agree far below the
+smallest error, errors that fall with the step or tolerance, failed runs kept as NaN with
+their message, the plot."""
+import math
+
+import numpy as np
+import pytest
+
+from conftest import solid_scene
+from study import precision as P
+from study.run import build_scene_model
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return solid_scene()
+
+
+@pytest.fixture(scope="module")
+def model(scene):
+    return build_scene_model(scene)
+
+
+@pytest.fixture(scope="module")
+def dyn(scene, model):
+    """1 ms window (ramps end at 0.5 ms): explicit at 1 and 1/2 of the stability step, the
+    implicit one at 1 and 4 times it (the scipy stiff solvers take minutes here: they run in
+    the workflow, their code path is tested in test_reference.py)."""
+    return P.dynamic_study(scene, model, duration=0.001, repeats=1, explicit_fractions=(1, 2),
+                           implicit_multiples=(4, 1), alphas=(0.0,), scipy_methods=(), active_set=True)
+
+
+def test_dynamic_dataset_contract(dyn):
+    assert dict(dyn.sizes) == {"run": 6, "norm": 3}
+    assert list(dyn["norm"].values) == ["final", "l2", "linf"]
+    assert dyn["te_error"].attrs["units"] == "um" and dyn["wall_time"].attrs["units"] == "s"
+    assert dyn["step"].attrs["units"] == "s"
+    for key in ("reference", "cross_check", "machine", "case", "reference_difference_linf_um"):
+        assert key in dyn.attrs
+    assert set(dyn["method"].values) == {"explicit", "explicit, active set", "implicit alpha=0"}
+    assert np.all(dyn["status"].values == "ok"), dyn["message"].values
+    e = dyn["te_error"].values
+    assert np.all(e[:, 1] <= e[:, 2] + 1e-15)          # rms <= max
+    assert np.all(np.isfinite(dyn["wall_time"].values))
+    # the first run of a method carries its compile/first-call time, apart from the wall time
+    assert np.isfinite(dyn["first_call_time"].values[0])
+
+
+def test_references_agree_far_below_the_smallest_error(dyn):
+    """DOP853 at rtol 1e-10 and Verlet at 1/32 of its stability step: two different solvers
+    whose difference lies two orders of magnitude below the smallest error in the study."""
+    d = dyn.attrs["reference_difference_linf_um"]
+    assert d < 0.01 * np.nanmin(dyn["te_error"].sel(norm="linf").values)
+
+
+def test_errors_fall_with_the_step_at_least_at_second_order(dyn):
+    e = dyn["te_error"].sel(norm="linf").values
+    m = dyn["method"].values
+    ex = e[m == "explicit"]
+    im = e[m == "implicit alpha=0"]
+    assert ex[0] / ex[1] > 3.0                          # halved step: error / 4 or better
+    assert im[0] > 8 * im[1]                            # 4x smaller step: error / 16
+
+
+def test_static_study_and_failed_run_kept(scene, model, tmp_path):
+    ds = P.static_study(scene, model, rotation_deg=0.5, repeats=1, tols=(1e-2, 1e-8),
+                        explicit_fractions=(1,), implicit_multiples=(4,), alphas=(0.0,))
+    e = ds["te_error"].sel(norm="linf").values
+    m = ds["method"].values
+    st = e[m == "static Newton"]
+    assert st[1] < st[0] and st[1] < 1e-6            # tighter Newton, smaller error [um]
+    assert ds.attrs["reference_difference_linf_um"] < 1e-6
+    # the slow-ramp transient differs from the static STE by its own ringing, not by the solver
+    assert np.all(e[m != "static Newton"] > 1e-3)
+    c = P.cheapest(ds, 0.01)
+    assert c[0] == "static Newton"
+    # a run whose solver raises, and one stopped by a guard, stay as NaN with their message
+    bad = [P.Spec("broken", math.nan, 1e-3, lambda: 1 / 0),
+           P.Spec("guarded", 1e-6, math.nan, lambda: (np.zeros(3), 10, 2, "penetration beyond the bound at t = 1e-06 s"))]
+    ds2 = P.run_study(bad, np.zeros(3), np.zeros(3), ("a", "b"), repeats=1)
+    assert np.all(np.isnan(ds2["te_error"].values))
+    assert list(ds2["status"].values) == ["failed", "failed"]
+    assert "ZeroDivisionError" in ds2["message"].values[0] and "penetration" in ds2["message"].values[1]
+    P.plot(ds, tmp_path / "wp.png")
+    assert (tmp_path / "wp.png").stat().st_size > 10_000
+    from study import results
+    results.write_netcdf(ds2, tmp_path / "wp.nc")
+    import xarray as xr
+    back = xr.open_dataset(tmp_path / "wp.nc")
+    assert list(back["message"].values) == list(ds2["message"].values)
+
+
+def test_stability_suite_subset_ends_ok_or_named():
+    """Stiff and extreme scenes (solid bodies, no FE): every run ends bounded and plausible or
+    with a failure that names its cause, time and step; never a silent NaN."""
+    import re
+    from workflows import stability as S
+    names = ["contact stiffness x100", "no damping", "teeth 100x lighter", "zero torque", "overload x10"]
+    ds = S.run_suite(solid_scene(), duration=0.002, methods=("explicit", "implicit alpha=-0.1", "LSODA"),
+                     scipy_wall=1.0, names=names, progress=lambda *a: None)
+    assert list(ds["scene"].values) == names
+    st = ds["status"].values
+    msg = ds["message"].values
+    assert set(st.ravel()) <= {"ok", "failed"}, msg
+    for i, j in zip(*np.nonzero(st == "failed")):
+        assert re.search(r"at t = [0-9.e+-]+ s \(step \d+", msg[i, j]), msg[i, j]
+    ok = st == "ok"
+    assert np.all(np.isfinite(ds["te_min"].values[ok])) and np.all(np.isfinite(ds["te_max"].values[ok]))
+    # the undamped pair under the explicit integrator conserves energy: it must run through
+    assert st[names.index("no damping"), 0] == "ok"
+    # zero torque rattles across the backlash: both flanks hit
+    zt = names.index("zero torque")
+    if st[zt, 0] == "ok":
+        assert ds["te_min"].values[zt, 0] < 0 < ds["te_max"].values[zt, 0]
+    # the scipy peer at 1 s of wall time stops with its named limit
+    assert all(("wall-time limit" in m or s == "ok") for m, s in zip(msg[:, 2], st[:, 2]))
