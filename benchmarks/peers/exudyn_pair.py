@@ -42,10 +42,15 @@ def simulate_exudyn(model, speed: float, speed_ramp: float, torque: float, torqu
                     duration: float, dt: float, output_step: float = 1e-5, solver: str = "VelocityVerlet"):
     """Integrate the pair from rest in Exudyn at the fixed step dt [s] with `solver`
     (an `exudyn.DynamicSolverType` name). Returns (time [s], TE [m], wall time of the solve [s]).
+    dt is rounded down to divide output_step [s] (as `solver.integrate.simulate` does), so
+    the sensor samples fall on steps.
     """
+    import math
+
     import exudyn as exu
     from exudyn.itemInterface import NodeGenericODE2, ObjectGenericODE2, SensorNode
 
+    dt = output_step / max(1, int(math.ceil(output_step / dt - 1e-9)))
     eq = PairEquations(model, speed, speed_ramp, torque, torque_ramp)
     n = eq.n
     q0 = np.zeros(n)
