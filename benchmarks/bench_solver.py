@@ -105,6 +105,13 @@ def main(argv=None) -> int:
             rows.append(dict(case=case, method=f"lightgear explicit ({label})", **tim, error_um=err,
                              note=f"target < 1 s; dt {dy.dt * 1e6:.3g} us, {dy.steps} steps, up to {dy.max_active_teeth} "
                                   f"active teeth; {tim['cpu_min_s'] / dur:.2f} x real time; error vs dt/8 (default set)"))
+        from solver.reference import simulate_explicit_all_teeth
+        tim, da = best_of(lambda: simulate_explicit_all_teeth(m, speed, sramp, tq, tramp, dur, dt=dt), 1)
+        act = simulate(m, speed, sramp, tq, tramp, dur, dt=dt)
+        rows.append(dict(case=case, method="lightgear explicit, all teeth active", **tim,
+                         error_um=float(np.max(np.abs(act.te - da.te))) * 1e6,
+                         note="the full model (no tooth frozen); error column = what freezing idle teeth changes "
+                              "(default set vs this, same step)"))
         tim, _d = best_of(lambda: simulate(m, speed, sramp, tq, tramp, dur), 1)
         rows.append(dict(case=case, method="lightgear simulate() incl. step estimate", **tim,
                          note="as `lightgear run` calls it (dt from the eigenvalues at 12 positions)"))
