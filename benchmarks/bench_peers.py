@@ -141,6 +141,7 @@ def main(argv=None) -> int:
         m = common.model(kind)
         rows += static_rows(kind, m, common.scene(kind), rep)
         rows += dynamic_rows(kind, m, rep, args.quick)
+    common.add_ratios(rows)
     common.write_table("peers", "lightgear vs peers, Table 1 pairs (s; best of N; error = max |TE - TE_ref| um; "
                                 "ratio on CPU time to the fastest in the case)", rows)
     for line in summary(rows):
