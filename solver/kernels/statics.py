@@ -97,18 +97,23 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
     sgn = 1.0 if torque >= 0.0 else -1.0
     theta2 = theta2_start
     failures = 0
+    nc = 0
+    npair = 0
     for a in range(theta1s.shape[0]):
         theta1 = theta1s[a]
         if a > 0:
             theta2 -= rb1 / rb2 * (theta1s[a] - theta1s[a - 1])
         it = 0
         converged = False
+        fresh = False       # rec and pairs already hold the search at this very state
         while it < max_iter:
             it += 1
             # unknown set from the pre-search at the current iterate
             for i in range(ntooth):
                 pos[i] = -1
-            nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+            if not fresh:
+                nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+            fresh = False
             nt = _unknowns(pairs, npair, gp, pos, lst)
             for i in range(ntooth):
                 if pos[i] < 0:
@@ -126,7 +131,11 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
                 dpen = (abs(torque) / rb2 / lp[K_CON]) ** (1.0 / lp[M1])
                 theta2 = (sgn * (pp[JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
-            nc, npair = _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros)
+            # residual from the contacts just found (same state: no second search)
+            generalized_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, q)
+            r[0] = q[1]
+            for m in range(nt):
+                r[1 + m] = q[2 + lst[m]]
             n = nt + 1
             rn = 0.0
             for i in range(n):
@@ -163,18 +172,20 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
                 theta2 = th_old + step * dx[0]
                 for m in range(nt):
                     phi[lst[m]] = ph_old[m] + step * dx[m + 1]
-                _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros)
+                nc, npair = _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros)
                 rn2 = 0.0
                 for i in range(n):
                     rn2 = max(rn2, abs(r[i]))
                 if rn2 < rn or rn2 < tol_abs:
                     break
                 step *= 0.5
+            fresh = True
             if abs(dx[0]) * step < 1e-16 and rn2 < 1e3 * tol_abs:
                 converged = True
                 break
-        # outputs from a final evaluation at the solution
-        nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+        # outputs at the solution: a converged iteration ended on a search at this very state
+        if not converged:
+            nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
         te_out[a] = rb1 * theta1 + rb2 * theta2
         theta2_out[a] = theta2
         nload = 0

@@ -1,0 +1,101 @@
+"""Where the explicit solver's time goes: one velocity-Verlet step of the paper's dynamic case
+against its parts, each timed in a numba loop at a loaded state of the solid Table 1 pair.
+
+Parts: the contact search (pre-search + closed forms, `kernels/mesh.py mesh_contacts`), the
+generalised forces, the arrowhead solve and the energy/dissipation bookkeeping, for a small
+active set (the teeth near the mesh) and for every tooth active. The whole step comes from
+`simulate` runs of 20 ms at 100 rad/s (CPU time per step, best of 3).
+Run: python benchmarks/bench_profile.py   (writes results/benchmarks/profile.csv)
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import common  # noqa: I001  (first: pins BLAS to one thread before numpy loads)
+import numpy as np
+from numba import njit
+
+from solver.kernels.explicit import _accelerations, _dissipation_power, _energies
+from solver.kernels.mesh import generalized_forces, mesh_contacts
+
+COLUMNS = ("part", "active_teeth", "ns_per_call", "note")
+N_CALLS = 200_000
+
+
+@njit(cache=False)
+def _loop_contacts(n, th1, th2, phi, dphi, gp, pp, lp, pairs, rec):
+    s = 0
+    for k in range(n):
+        nc, npair = mesh_contacts(th1 + 1e-12 * k, th2, phi, 100.0, 100.0, dphi, gp, pp, lp, pairs, rec)
+        s += nc
+    return s
+
+
+@njit(cache=False)
+def _loop_forces(n, rec, nc, phi, dphi, act, nact, kphi, gp, q, acc, tz2, lp):
+    s = 0.0
+    for k in range(n):
+        generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, 50.0, q)
+        a2, s1, r1 = _accelerations(q, act, nact, gp, acc, tz2)
+        s += a2
+    return s
+
+
+@njit(cache=False)
+def _loop_bookkeeping(n, dphi, act, nact, gp, rec, nc, lp, tz2):
+    s = 0.0
+    for k in range(n):
+        s += _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
+    return s
+
+
+def per_call(fn, *args) -> float:
+    fn(10, *args)
+    best = float("inf")
+    for _ in range(3):
+        c0 = time.process_time()
+        fn(N_CALLS, *args)
+        best = min(best, time.process_time() - c0)
+    return best / N_CALLS * 1e9
+
+
+def main(argv=None) -> int:
+    from solver.integrate import simulate, stable_time_step
+    from solver.kernels import layout as L
+    from solver.kernels.mesh import new_contact_buffer
+    from solver.statics import solve_static
+    m = common.model("solid")
+    gp, pp, lp = m.gear_par, m.pair_par, m.law_par
+    tz2 = int(gp[1, L.TOOTH0])
+    theta1 = np.radians(2.0)
+    st = solve_static(m, np.array([theta1]), 50.0)
+    from solver.integrate import _phi_at
+    phi = _phi_at(m, theta1, 50.0, st.te[0])
+    dphi = np.zeros(m.n_teeth)
+    rec, pairs = new_contact_buffer()
+    nc, npair = mesh_contacts(theta1, st.theta2[0], phi, 100.0, 100.0, dphi, gp, pp, lp, pairs, rec)
+    rows = [dict(part="contact search (mesh_contacts)", active_teeth=None,
+                 ns_per_call=per_call(_loop_contacts, theta1, st.theta2[0], phi, dphi, gp, pp, lp, pairs, rec),
+                 note=f"{npair} candidate pairs, {nc} contacts")]
+    near = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
+    q = np.zeros(m.n_teeth + 2)
+    acc = np.zeros(m.n_teeth)
+    for label, act in (("near the mesh", np.array(near, dtype=np.int64)), ("all teeth", np.arange(m.n_teeth, dtype=np.int64))):
+        rows.append(dict(part="forces + arrowhead solve", active_teeth=act.size,
+                         ns_per_call=per_call(_loop_forces, rec, nc, phi, dphi, act, act.size, m.k_phi, gp, q, acc, tz2, lp),
+                         note=label))
+        rows.append(dict(part="dissipation power (energy balance)", active_teeth=act.size,
+                         ns_per_call=per_call(_loop_bookkeeping, dphi, act, act.size, gp, rec, nc, lp, tz2), note=label))
+    dt, _w = stable_time_step(m, 50.0)
+    for pq in (1e-9, 1e-6):
+        simulate(m, 100.0, 0.01, 50.0, 0.01, 1e-3, dt=dt)
+        tim, r = common.best_of(lambda: simulate(m, 100.0, 0.01, 50.0, 0.01, 0.02, dt=dt, phi_quiet=pq), 3)
+        rows.append(dict(part=f"whole step (simulate, phi_quiet {pq:g})", active_teeth=r.max_active_teeth,
+                         ns_per_call=tim["cpu_min_s"] / r.steps * 1e9, note=f"{r.steps} steps; active = most at once"))
+    common.write_table("profile", "Explicit step profile, solid Table 1 pair (CPU ns per call, best of 3)", rows, COLUMNS)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

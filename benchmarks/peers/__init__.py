@@ -1,0 +1,1 @@
+"""Peer implementations of the lightgear equations, used only by the benchmarks."""
