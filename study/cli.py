@@ -14,6 +14,7 @@ COMMANDS = {
     "run": ("study.run", "run a scene (default: the paper example) and write its archive"),
     "stiffness": ("study.springs", "per-tooth FE stiffness map of a scene's gears (no solve)"),
     "fit-contact": ("study.fit_contact", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
+    "reference": ("study.reference", "FE reference STE and load sharing (loaded-tooth-contact analysis)"),
 }
 
 
