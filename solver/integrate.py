@@ -137,6 +137,8 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp), ("output_step", output_step)):
         if not (v > 0 and math.isfinite(v)):
             raise ValueError(f"{name}: must be positive, got {v}")
+    if model.coupled:
+        raise NotImplementedError("body-torsion coupling: the explicit integrator has no rim degrees of freedom yet")
     omega_max = float("nan")
     if dt is None or dt <= 0:
         dt, omega_max = stable_time_step(model, torque, safety)

@@ -29,6 +29,7 @@ from .springs import _settings, cache_dir, contact_patch, reference_torque
 LTCA_VERSION = "1"          # bump when the influence coefficients' definition changes
 PROFILE_POINTS = 12         # roll-parameter grid points along each flank
 _memory: dict[str, BodyCompliance] = {}
+_bodies: dict = {}          # the last factorised body, reused by the next request for it
 
 
 def static_angles(scene: Scene, step_deg: float | None = None) -> np.ndarray:
@@ -55,9 +56,11 @@ def teeth_in_mesh(model, angles) -> tuple[list, list, int]:
     return sorted(s1), sorted(s2), spread
 
 
-def body_compliance_cached(scene: Scene, g: int, teeth: list, spread: int, n_u: int = PROFILE_POINTS) -> tuple[BodyCompliance, dict]:
+def body_compliance_cached(scene: Scene, g: int, teeth: list, spread: int, n_u: int = PROFILE_POINTS,
+                           u: np.ndarray | None = None) -> tuple[BodyCompliance, dict]:
     """Gear g's bulk compliance (cached). A solid body: columns of tooth 0, read at offsets
-    -spread..spread; a lightened body: every tooth in ``teeth`` loaded and read."""
+    -spread..spread; a lightened body: every tooth in ``teeth`` loaded and read. ``u``: the roll
+    grid (default: ``n_u`` points from the form circle to the tip)."""
     from solver import fe
     from solver.mesh import default_mesh_size, mesh_body
 
@@ -66,14 +69,14 @@ def body_compliance_cached(scene: Scene, g: int, teeth: list, spread: int, n_u: 
     st = _settings(scene, g, body)
     size = st["size"] or default_mesh_size(geo.spec.module)
     symmetric = not scene.is_lightened(g)
-    u = profile_grid(geo, n_u)
+    u = profile_grid(geo, n_u) if u is None else np.asarray(u, float)
     if symmetric:
         load, read = [0], list(range(-spread, spread + 1))
     else:
-        load = read = list(teeth)
-    key = hashlib.sha256(json.dumps({**st, "load": load, "read": read, "n_u": n_u, "ltca": LTCA_VERSION},
+        load = read = [int(t) for t in teeth]
+    key = hashlib.sha256(json.dumps({**st, "load": load, "read": read, "u": [float(x) for x in u], "ltca": LTCA_VERSION},
                                     sort_keys=True, default=float).encode()).hexdigest()[:20]
-    info = {"mesh_size_m": size, "cached": True, "wall_time_s": 0.0, "load_cases": len(load) * n_u}
+    info = {"mesh_size_m": size, "cached": True, "wall_time_s": 0.0, "load_cases": len(load) * u.size}
     if key in _memory:
         return _memory[key], info
     path = cache_dir() / f"ltca-{key}.npz"
@@ -86,8 +89,13 @@ def body_compliance_cached(scene: Scene, g: int, teeth: list, spread: int, n_u: 
         except (OSError, KeyError, ValueError):
             pass  # unreadable cache entry: recompute
     t0 = time.perf_counter()
-    mesh = mesh_body(geo, body, size, prefix=f"gear{g}.body")
-    model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, scene.material_spec())
+    bkey = json.dumps(st, sort_keys=True, default=float)
+    model = _bodies.get(bkey)
+    if model is None:
+        mesh = mesh_body(geo, body, size, prefix=f"gear{g}.body")
+        model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, scene.material_spec())
+        _bodies.clear()          # keep one factorisation in memory (they are large)
+        _bodies[bkey] = model
     patch = contact_patch(scene, g, st["force"], size)
     c = body_compliance(model, geo, u, load, read, patch, symmetric_body=symmetric)
     info.update(cached=False, wall_time_s=time.perf_counter() - t0, dofs=int(model.n_dofs))
