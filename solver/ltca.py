@@ -10,7 +10,8 @@ a, b tooth indices, ua, ub roll parameters on a grid along the profile, d the lo
 (along the line of action, into the tooth) and C the point where the load line crosses the
 tooth axis. Every load acts on the whole body, so the coupling between teeth through the rim
 and web (the "foundation") is in the off-diagonal blocks. Loads are spread over the Hertz
-half-width as in `solver.fe` (a 2D point load is log-singular). Reading at the centreline C,
+half-width as in `solver.fe` (a 2D point load is log-singular), with the patch ends at their
+exact positions on the flank so that G is smooth in the roll parameter. Reading at the centreline C,
 as `solver.fe.tooth_stiffness` does, keeps the local flattening out of G: that part comes from
 the contact law ``F = k_con*delta**m1`` in series, exactly as in the pseudo-rigid model, so the
 two differ only in how the bodies deform. G is symmetric by Maxwell-Betti up to the small
@@ -46,7 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .fe import BodyModel, load_case, load_vector
+from .fe import BodyModel, LoadCase, load_case
 from .geometry import GearGeometry
 from .kernels import layout as L
 from .kernels.contact import point_flank, tip_corner
@@ -122,6 +123,53 @@ def profile_grid(g: GearGeometry, n_u: int, u_start: float | None = None) -> np.
     return np.linspace(lo, g.u_tip, n_u)
 
 
+def flank_load_vector(model: BodyModel, g: GearGeometry, case: LoadCase, u: float, force: float,
+                      patch: float, samples: int = 33) -> np.ndarray:
+    """Nodal forces [N] of ``force`` spread uniformly over the flank within ``patch`` [m] (arc
+    length) either side of roll ``u``, along the load direction of ``case``.
+
+    Unlike `solver.fe.load_vector`, which loads whole boundary edges, the patch ends sit at
+    their exact positions on the involute (``samples`` points, each distributed by the quadratic
+    edge shape functions of the facet it lies on), so the load and its resultant move
+    continuously with u: the influence coefficients are smooth in u and can be interpolated.
+    """
+    m = model.basis.mesh
+    rb = g.base_radius
+    s0 = 0.5 * rb * u * u                       # involute arc length from the base circle
+    s = s0 + patch * ((np.arange(samples) + 0.5) / samples * 2.0 - 1.0)
+    s = np.clip(s, 0.5 * rb * g.u_form**2, 0.5 * rb * g.u_tip**2)
+    ui = np.sqrt(2.0 * s / rb)
+    x, y = g.flank_point(ui, 1)
+    a = math.atan2(case.point[1], case.point[0]) - math.atan2(*g.flank_point(u, 1)[::-1])
+    c, sn = math.cos(a), math.sin(a)
+    pts = np.stack([c * x - sn * y, sn * x + c * y])             # (2, samples) on tooth's flank
+    bf = m.boundary_facets()
+    e0 = m.p[:, m.facets[0, bf]]
+    e1 = m.p[:, m.facets[1, bf]]
+    mid = 0.5 * (e0 + e1)
+    near = np.argsort(np.hypot(mid[0] - case.point[0], mid[1] - case.point[1]))[:max(8, samples)]
+    f = np.zeros(model.basis.N)
+    nd = model.basis.nodal_dofs
+    q = force / samples
+    for k in range(samples):
+        p = pts[:, k]
+        d0, d1 = e0[:, near], e1[:, near]
+        L2 = ((d1 - d0) ** 2).sum(axis=0)
+        t = np.clip(((p[:, None] - d0) * (d1 - d0)).sum(axis=0) / L2, 0.0, 1.0)
+        dist = np.hypot(*(d0 + t * (d1 - d0) - p[:, None]))
+        j = int(np.argmin(dist))
+        tj = t[j]
+        fac = near[j]
+        n0, n1 = m.facets[0, bf[fac]], m.facets[1, bf[fac]]
+        w0, w1, wm = (1 - tj) * (1 - 2 * tj), tj * (2 * tj - 1), 4 * tj * (1 - tj)
+        for comp in range(2):
+            qc = q * case.direction[comp]
+            f[nd[comp, n0]] += qc * w0
+            f[nd[comp, n1]] += qc * w1
+            f[model.basis.facet_dofs[comp, bf[fac]]] += qc * wm
+    return f
+
+
 def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth, read_teeth,
                     patch: float, symmetric_body: bool = False, block: int = 48) -> BodyCompliance:
     """Influence coefficients [m/N] of a factorised body: unit loads at every (load tooth, u),
@@ -141,7 +189,8 @@ def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth
     cols = np.empty((m, len(loads)))
     for s in range(0, len(loads), block):
         chunk = loads[s:s + block]
-        F = np.column_stack([load_vector(model, load_case(g, b % z, 0.0, ui), 1.0, patch) for b, ui in chunk])
+        F = np.column_stack([flank_load_vector(model, g, load_case(g, b % z, 0.0, ui), ui, 1.0, patch)
+                             for b, ui in chunk])
         U = np.zeros((model.basis.N, len(chunk)))
         U[model.free] = model.solve(np.ascontiguousarray(F[model.free]))
         R = np.asarray(P @ U)
