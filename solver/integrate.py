@@ -1,7 +1,7 @@
 """Time integration of the pair under the prescribed speed ramp and the load-torque ramp.
 
-`simulate` runs the explicit velocity-Verlet kernel (`kernels/explicit.py`) with a fixed
-step. By default the step comes from the scene's highest natural frequency: the model is
+`simulate` runs the explicit velocity-Verlet kernel (`kernels/explicit.py`, or
+`kernels/explicit_coupled.py` for a body-torsion coupled model) with a fixed step. By default the step comes from the scene's highest natural frequency: the model is
 linearised at static equilibrium at several positions across one mesh cycle under the full
 load, and ``dt = safety * 2 / omega_max`` (Verlet is stable for omega*dt < 2).
 """
@@ -97,7 +97,9 @@ def highest_frequency(model: Model, torque: float, positions: int = 12) -> float
     wmax = 0.0
     for a, theta1 in enumerate(angles):
         phi = _phi_at(model, theta1, load, st.te[a])
-        M, K, _t = linearized_system(model, theta1, st.theta2[a], phi)
+        # a coupled model's mesh sits at the rim angles: the hub less the body wind-up
+        rim2 = st.theta2[a] - load / model.body_stiffness[1]
+        M, K, _t = linearized_system(model, theta1, rim2, phi)
         lam = scipy.linalg.eigh(K, M, eigvals_only=True)
         wmax = max(wmax, math.sqrt(max(lam.max(), 0.0)))
     return wmax
@@ -112,9 +114,24 @@ def _phi_at(model: Model, theta1: float, torque: float, te0: float) -> np.ndarra
     return phi
 
 
+def body_frequency(model: Model) -> float:
+    """Highest natural frequency [rad/s] of the body springs alone (hub against rim and teeth);
+    the tooth modes of `highest_frequency` are usually far above it."""
+    gp = model.gear_par
+    w = 0.0
+    for g in range(2):
+        if gp[g, L.K_BODY] > 0:
+            i_rim = gp[g, L.I_TOT] - gp[g, L.I_HUB]
+            inv = 1.0 / i_rim + (1.0 / gp[g, L.I_HUB] if g == 1 else 0.0)   # the driver's hub is prescribed
+            w = max(w, math.sqrt(gp[g, L.K_BODY] * inv))
+    return w
+
+
 def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[float, float]:
     """(dt [s], omega_max [rad/s]) for the explicit integrator: safety * 2 / omega_max."""
     w = highest_frequency(model, torque)
+    if model.coupled:
+        w = max(w, body_frequency(model))
     if not w > 0:
         raise ValueError("no loaded contact found to estimate the highest natural frequency")
     return safety * 2.0 / w, w
@@ -137,8 +154,6 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp), ("output_step", output_step)):
         if not (v > 0 and math.isfinite(v)):
             raise ValueError(f"{name}: must be positive, got {v}")
-    if model.coupled:
-        raise NotImplementedError("body-torsion coupling: the explicit integrator has no rim degrees of freedom yet")
     omega_max = float("nan")
     if dt is None or dt <= 0:
         dt, omega_max = stable_time_step(model, torque, safety)
@@ -153,10 +168,17 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     phi = np.zeros(model.n_teeth)
     dphi = np.zeros(model.n_teeth)
     omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
-    status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
-                                   float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                   dt, n_steps, out_every, theta2, 0.0, phi, dphi,
-                                   phi_quiet, phi_quiet * omega_tooth, float(delta_max), *o)
+    if model.coupled:
+        from .kernels.explicit_coupled import verlet_coupled
+        status, step, max_act = verlet_coupled(model.gear_par, model.pair_par, model.law_par, model.k_phi,
+                                               float(speed), float(speed_ramp), float(torque), float(torque_ramp),
+                                               dt, n_steps, out_every, 0.0, 0.0, theta2, 0.0, theta2, 0.0, phi, dphi,
+                                               phi_quiet, phi_quiet * omega_tooth, float(delta_max), *o)
+    else:
+        status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
+                                       float(speed), float(speed_ramp), float(torque), float(torque_ramp),
+                                       dt, n_steps, out_every, theta2, 0.0, phi, dphi,
+                                       phi_quiet, phi_quiet * omega_tooth, float(delta_max), *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
     msg = "ok"

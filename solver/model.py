@@ -32,6 +32,7 @@ class GearInput:
     c_phi: float = 0.0                  # N·m·s/rad (n_c = 1) or N·m/(rad/s)^n_c
     n_c: float = 1.0
     body_stiffness: float = math.inf    # hub -> rim torsion spring, N·m/rad (inf: rigid body)
+    body_damping_ratio: float = 0.02    # of critical on the body mode (as the teeth's 2 %)
 
 
 @dataclass(frozen=True)
@@ -163,6 +164,11 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
                 raise ValueError(f"{('gear1', 'gear2')[i]}: body torsion stiffness must be positive, got {gi.body_stiffness}")
             gp[i, L.K_BODY] = gi.body_stiffness
         gp[i, L.I_HUB] = hub_side_inertia(g, gi.body, material.density)
+        if gp[i, L.K_BODY] > 0:
+            # body mode: rim (with the teeth) against the hub; the driver's hub is prescribed
+            i_rim = gp[i, L.I_TOT] - gp[i, L.I_HUB]
+            i_eff = i_rim if i == 0 else i_rim * gp[i, L.I_HUB] / gp[i, L.I_TOT]
+            gp[i, L.C_BODY] = 2.0 * gi.body_damping_ratio * math.sqrt(gi.body_stiffness * i_eff)
     pp = np.zeros(L.N_PAIR_PAR)
     pp[L.JN_HALF] = 0.5 * pair.normal_backlash
     pp[L.ALPHA] = pair.pressure_angle
