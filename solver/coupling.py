@@ -15,6 +15,12 @@ displacement along the line of action read at the tooth centreline, [m/N]):
 * k_tooth[a] = lever**2 / (c_total[a] - c_body) [N·m/rad]: the tooth spring without the
   body wind-up.
 
+The body wind-up is a rotation about the gear centre (lever rb whatever the contact point),
+the tooth's own deflection a rotation about a point low in the tooth. So once the body part is
+split off, the tooth's pivot is refitted to the remaining compliance along the profile
+(`solver.identify.fit_pivot`; about 1 mm below the root circle for Table 1) and the lever
+above is taken about that pivot.
+
 With k_body -> infinity and k_tooth = k_fe the coupled model is the plain one.
 Units: SI.
 """
@@ -33,11 +39,14 @@ class BodyTorsionFit:
     k_total: np.ndarray      # (Z,) tooth springs with it (the plain model's FE springs) [N·m/rad]
     c_total: np.ndarray      # (Z,) own compliance at the pitch point [m/N]
     c_adjacent: np.ndarray   # (Z,) compliance under the neighbours' loads [m/N]
+    pivot_radius: float      # tooth pivot the levers are taken about [m]
 
 
-def body_torsion_fit(c_total, c_adjacent, lever: float, base_radius: float) -> BodyTorsionFit:
+def body_torsion_fit(c_total, c_adjacent, lever: float, base_radius: float,
+                     pivot_radius: float = float("nan")) -> BodyTorsionFit:
     """Body and tooth springs from the own and adjacent pitch-point compliances [m/N] of every
-    tooth, the load lever about the tooth pivot [m] and the base radius [m]."""
+    tooth, the pitch-point load lever about the tooth pivot [m] (at ``pivot_radius`` [m]) and the
+    base radius [m]."""
     c_total = np.asarray(c_total, float)
     c_adjacent = np.asarray(c_adjacent, float)
     if c_total.shape != c_adjacent.shape or c_total.ndim != 1:
@@ -48,7 +57,7 @@ def body_torsion_fit(c_total, c_adjacent, lever: float, base_radius: float) -> B
     if not 0 < c_body < c_total.min():
         raise ValueError(f"body compliance {c_body:.4g} m/N is not between 0 and the smallest tooth compliance {c_total.min():.4g} m/N")
     return BodyTorsionFit(base_radius**2 / c_body, c_body, lever**2 / (c_total - c_body), lever**2 / c_total,
-                          c_total, c_adjacent)
+                          c_total, c_adjacent, pivot_radius)
 
 
 def body_windup(torque: float, base_radii, k_body) -> float:

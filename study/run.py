@@ -62,11 +62,12 @@ def build_scene_model(scene: Scene, springs=None) -> Model:
         gs = scene.gear(g)
         if coupled:
             from .coupling import body_torsion
-            k_body, n_k = body_torsion(scene, g).k_body, 1.0
+            fit = body_torsion(scene, g)
+            k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
         else:
-            k_body, n_k = math.inf, gs.spring.n_k
+            k_body, n_k, pivot = math.inf, gs.spring.n_k, scene.pivot_radius(g)
         gears.append(GearInput(tooth=scene.tooth_spec(g), body=scene.body_spec(g),
-                               pivot_radius=scene.pivot_radius(g),
+                               pivot_radius=pivot,
                                k_phi=units.spring_stiffness_to_si(np.asarray(springs[g - 1][0], float)),
                                n_k=n_k, c_phi=units.spring_damping_to_si(gs.spring.c_phi),
                                n_c=gs.spring.n_c, body_stiffness=k_body))

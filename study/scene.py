@@ -136,7 +136,7 @@ class FESection:
 class CouplingSection:
     model: str = _f("none", "", "foundation coupling between the teeth: 'none' (the paper's per-tooth springs) or "
                     "'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and identified "
-                    "from the FE body; gear springs' k_phi and n_k are then not used)", choices=("none", "body-torsion"))
+                    "from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not used)", choices=("none", "body-torsion"))
 
 
 @dataclass(frozen=True)

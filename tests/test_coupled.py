@@ -114,7 +114,7 @@ def test_coupled_slow_transient_follows_coupled_statics(paper_solid_model):
 def _double_contact_errors(scene):
     """(plain-FE, coupled) STE errors [m] against the FE reference where the rigid geometry has
     two pairs in the path of contact, and the single-contact errors."""
-    from study.coupling import body_torsion
+    from study.coupling import plain_fe_springs
     from solver import units
     angles = np.radians(np.arange(0.0, scene.quasi_static.rotation, 0.25))
     res, model, _ = ref_mod.reference(scene, angles)
@@ -122,7 +122,7 @@ def _double_contact_errors(scene):
     lin = scene.replace(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0})
     sp = []
     for g in (1, 2):
-        k = body_torsion(scene, g).k_total / units.spring_stiffness_to_si(1.0)
+        k = plain_fe_springs(scene, g) / units.spring_stiffness_to_si(1.0)
         sp.append((k, np.ones_like(k)))
     plain = solve_static(build_scene_model(lin, tuple(sp)), angles, scene.quasi_static.torque).te - res.te
     coupled = solve_static(build_scene_model(scene.replace(**{"coupling.model": "body-torsion"})), angles,
