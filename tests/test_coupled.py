@@ -142,3 +142,27 @@ def test_coupled_model_closes_the_double_contact_gap(body):
     assert p2.mean() < 0                                      # plain: too stiff in double contact
     assert np.sqrt(np.mean(c2**2)) < 0.5 * np.sqrt(np.mean(p2**2))
     assert np.sqrt(np.mean(c1**2)) < np.sqrt(np.mean(p1**2)) + 2e-8
+
+
+def test_scipy_peer_refuses_a_coupled_model(paper_solid_model):
+    from solver.reference import simulate_scipy
+    with pytest.raises(ValueError, match="coupling"):
+        simulate_scipy(with_body_springs(paper_solid_model, K_BODY), 100.0, 0.01, 50.0, 0.01, 1e-4)
+
+
+def test_validation_workflow_writes_archive_and_figures(tmp_path):
+    import xarray as xr
+    from workflows import validation
+    s = small_scene(**{"fe.mesh_size": 1.8, **LIGHT})
+    path = tmp_path / "s.toml"
+    path.write_text(s.to_toml())
+    out = tmp_path / "v" / "validation.nc"
+    assert validation.main([str(path), "-o", str(out), "--step", "0.5"]) == 0
+    with xr.open_dataset(out) as ds:
+        assert list(ds["model"].values) == list(validation.MODELS)
+        assert ds["error_mean"].sel(model="fe-reference").values.tolist() == [0.0, 0.0]
+        assert np.isnan(ds["hole_amplitude"].sel(pair="solid", model="fe-reference"))
+        assert ds["hole_amplitude"].sel(pair="lightened", model="fe-reference") > 0
+        assert ds["ste"].attrs["units"] == "um"
+    assert {p.name for p in out.parent.glob("*.png")} == {"ste_solid.png", "ste_lightened.png", "load_sharing_solid.png",
+                                                          "load_sharing_lightened.png", "errors.png"}
