@@ -38,13 +38,13 @@ def body_torsion(scene: Scene, g: int) -> BodyTorsionFit:
         G = c.g[:, 0, 0, 0]                        # read offsets -1, 0, 1
         c_tot = np.full(z, G[1])
         c_adj = np.full(z, 0.5 * (G[0] + G[2]))
-    r_q = tooth_pivot(scene, g, float(np.mean(c_adj)))
-    return body_torsion_fit(c_tot, c_adj, load_case(geo, 0, r_q).lever, geo.base_radius, r_q)
+    r_q, k_q = tooth_pivot(scene, g, float(np.mean(c_adj)))
+    return body_torsion_fit(c_tot, c_adj, load_case(geo, 0, r_q).lever, geo.base_radius, r_q, k_q)
 
 
-def tooth_pivot(scene: Scene, g: int, c_body: float) -> float:
-    """Pivot radius [m] of gear g's tooth refitted to the FE compliance of tooth 0 along the
-    profile less the body compliance c_body [m/N] (see `solver.coupling`)."""
+def tooth_pivot(scene: Scene, g: int, c_body: float) -> tuple[float, float]:
+    """(pivot radius [m], spring [N·m/rad]) of gear g's tooth 0 refitted to its FE compliance
+    along the profile less the body compliance c_body [m/N] (see `solver.coupling`)."""
     from solver.identify import fit_pivot
     from .reference import PROFILE_POINTS
     geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
@@ -55,8 +55,8 @@ def tooth_pivot(scene: Scene, g: int, c_body: float) -> float:
         c, _ = body_compliance_cached(scene, g, [0], 1, PROFILE_POINTS)
         off = 1
     diag = np.array([c.g[off, i, 0, i] for i in range(c.u.size)])
-    r_q, _k, _err = fit_pivot(geo.base_radius, geo.psi_base - c.u, diag - c_body)
-    return r_q
+    r_q, k, _err = fit_pivot(geo.base_radius, geo.psi_base - c.u, diag - c_body)
+    return r_q, k
 
 
 def plain_fe_springs(scene: Scene, g: int) -> np.ndarray:

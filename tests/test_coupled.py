@@ -67,6 +67,10 @@ def test_body_torsion_fit_splits_the_shared_compliance():
     assert 1 / fit.k_tooth + 1 / (fit.k_body * (2e-3 / 0.05) ** 2) == pytest.approx(1 / fit.k_total)
     with pytest.raises(ValueError, match="body compliance"):
         body_torsion_fit(c_tot, c_adj * 3, 2e-3, 0.05)
+    prof = body_torsion_fit(c_tot, c_adj, 2e-3, 0.05, 0.047, k_profile=3000.0)
+    c_tooth = c_tot - 1.4e-9
+    assert prof.k_tooth[0] == 3000.0 and prof.k_tooth == pytest.approx(3000.0 * c_tooth[0] / c_tooth)
+    assert prof.k_body == fit.k_body and prof.pivot_radius == 0.047
 
 
 def test_coupling_model_is_validated():
