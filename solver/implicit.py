@@ -62,6 +62,9 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
             raise ValueError(f"{name}: must be positive, got {v}")
     if not -1.0 / 3.0 <= alpha <= 0.0:
         raise ValueError(f"alpha: must lie in [-1/3, 0] (HHT), got {alpha}")
+    if model.coupled:
+        raise ValueError("dynamic.method: the implicit integrator has no body-torsion coupling "
+                         "(coupling.model); use the explicit integrator for a coupled model")
     if max_iter < 1:
         raise ValueError(f"max_iter: must be at least 1, got {max_iter}")
     omega_max = float("nan")
@@ -126,6 +129,9 @@ def choose_method(model: Model, torque: float, duration: float, method: str = "a
         return MethodChoice("implicit", implicit_factor * dt_stable, w,
                             f"implicit at {implicit_factor:g} x the explicit stability step")
     n = duration / dt_stable
+    if model.coupled:     # only the explicit kernel carries the body-torsion DOFs
+        return MethodChoice("explicit", float(dt) if given else dt_stable, w,
+                            "auto: explicit, the only integrator of the body-torsion coupling")
     if n <= max_explicit_steps:
         return MethodChoice("explicit", float(dt) if given else dt_stable, w,
                             f"auto: explicit, {n:.3g} steps at the stability step "

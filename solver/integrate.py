@@ -1,8 +1,8 @@
 """Time integration of the pair under the prescribed speed ramp and the load-torque ramp.
 
-`simulate` runs the explicit velocity-Verlet kernel (`kernels/explicit.py`) with a fixed
-step. By default the step comes from the scene's highest natural frequency: the model is
-linearised at static equilibrium at several positions across one mesh cycle under the full
+`simulate` runs the explicit velocity-Verlet kernel (`kernels/explicit.py`, or
+`kernels/explicit_coupled.py` for a body-torsion coupled model) with a fixed step. By default
+the step comes from the scene's highest natural frequency: the model is linearised at static equilibrium at several positions across one mesh cycle under the full
 load, and ``dt = safety * 2 / omega_max`` (Verlet is stable for omega*dt < 2), reduced where
 the modal damping of the loaded contacts asks for it (`stability_limit`).
 """
@@ -134,7 +134,12 @@ def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[f
         if not st.converged[0]:
             continue
         phi, te0 = st.phi_last, float(st.te[0])
-        M, K, C, _t = linearized_system(model, theta1, st.theta2[0], phi, damping=True)
+        # a coupled model's mesh sits at the rim angles: the hubs less the body wind-up
+        kb1, kb2 = model.body_stiffness
+        rb1, rb2 = model.base_radii
+        rim1 = theta1 - load * rb1 / rb2 / kb1
+        rim2 = st.theta2[0] - load / kb2
+        M, K, C, _t = linearized_system(model, rim1, rim2, phi, damping=True)
         lam, x = scipy.linalg.eigh(K, M)
         w = np.sqrt(np.maximum(lam, 0.0))
         h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
@@ -153,10 +158,27 @@ def highest_frequency(model: Model, torque: float, positions: int = 12) -> float
     return stability_limit(model, torque, positions)[1]
 
 
+def body_frequency(model: Model) -> float:
+    """Highest natural frequency [rad/s] of the body springs alone (hub against rim and teeth);
+    the tooth modes of `highest_frequency` are usually far above it."""
+    gp = model.gear_par
+    w = 0.0
+    for g in range(2):
+        if gp[g, L.K_BODY] > 0:
+            i_rim = gp[g, L.I_TOT] - gp[g, L.I_HUB]
+            inv = 1.0 / i_rim + (1.0 / gp[g, L.I_HUB] if g == 1 else 0.0)   # the driver's hub is prescribed
+            w = max(w, math.sqrt(gp[g, L.K_BODY] * inv))
+    return w
+
+
 def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[float, float]:
     """(dt [s], omega_max [rad/s]) for the explicit integrator: safety times the critical step
     of `stability_limit` (2/omega_max without damping)."""
     dt_crit, w = stability_limit(model, torque)
+    if model.coupled:   # the body modes are not in the mesh linearisation
+        wb = body_frequency(model)
+        w = max(w, wb)
+        dt_crit = min(dt_crit, 2.0 / wb)
     if not w > 0:
         raise ValueError("no loaded contact found to estimate the highest natural frequency")
     return safety * dt_crit, w
@@ -196,10 +218,17 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     phi = np.zeros(model.n_teeth)
     dphi = np.zeros(model.n_teeth)
     omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
-    status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
-                                   float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                   dt, n_steps, out_every, theta2, 0.0, phi, dphi,
-                                   phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
+    if model.coupled:
+        from .kernels.explicit_coupled import verlet_coupled
+        status, step, max_act = verlet_coupled(model.gear_par, model.pair_par, model.law_par, model.k_phi,
+                                               float(speed), float(speed_ramp), float(torque), float(torque_ramp),
+                                               dt, n_steps, out_every, 0.0, 0.0, theta2, 0.0, theta2, 0.0, phi, dphi,
+                                               phi_quiet, phi_quiet * omega_tooth, float(delta_max), *o)
+    else:
+        status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
+                                       float(speed), float(speed_ramp), float(torque), float(torque_ramp),
+                                       dt, n_steps, out_every, theta2, 0.0, phi, dphi,
+                                       phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
     msg = status_message(status, step, dt, delta_max, raise_on_failure)

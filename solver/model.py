@@ -31,6 +31,8 @@ class GearInput:
     n_k: float = 1.1
     c_phi: float = 0.0                  # N·m·s/rad (n_c = 1) or N·m/(rad/s)^n_c
     n_c: float = 1.0
+    body_stiffness: float = math.inf    # hub -> rim torsion spring, N·m/rad (inf: rigid body)
+    body_damping_ratio: float = 0.02    # of critical on the body mode (as the teeth's 2 %)
 
 
 @dataclass(frozen=True)
@@ -84,8 +86,32 @@ class Model:
         return float(self.pair_par[L.JN_HALF])
 
     @property
+    def body_stiffness(self) -> tuple:
+        """Hub -> rim torsion stiffness of each body [N·m/rad] (inf: rigid, the plain model)."""
+        k = self.gear_par[:, L.K_BODY]
+        return tuple(float(x) if x > 0 else math.inf for x in k)
+
+    @property
+    def coupled(self) -> bool:
+        return bool(np.any(self.gear_par[:, L.K_BODY] > 0))
+
+    @property
     def inertia_total(self) -> tuple:
         return float(self.gear_par[0, L.I_TOT]), float(self.gear_par[1, L.I_TOT])
+
+
+def hub_side_inertia(g: GearGeometry, body: BodySpec, density: float) -> float:
+    """Inertia [kg·m²] on the hub side of the body spring: the hub ring and half the web (the
+    web's wind-up is the spring; its inertia is split between its ends)."""
+    r_rim = g.root_radius - body.rim_height
+    r_hub = r_rim - body.web_height
+    r_bore = r_hub - body.hub_height
+    hub = 0.5 * density * math.pi * (r_hub**4 - r_bore**4) * g.spec.face_width
+    web = 0.5 * density * math.pi * (r_rim**4 - r_hub**4) * body.web_thickness
+    if body.holes:
+        mh = density * math.pi * body.hole_radius**2 * body.web_thickness
+        web -= body.holes * mh * (0.5 * body.hole_radius**2 + body.hole_circle_radius**2)
+    return hub + 0.5 * web
 
 
 def _max_pivot_distance(g: GearGeometry, pivot_radius: float) -> float:
@@ -133,6 +159,16 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
         gp[i, L.N_C] = gi.n_c
         gp[i, L.TOOTH0] = tooth0[i]
         gp[i, L.NZ] = g.teeth
+        if gi.body_stiffness != math.inf:
+            if not gi.body_stiffness > 0:
+                raise ValueError(f"{('gear1', 'gear2')[i]}: body torsion stiffness must be positive, got {gi.body_stiffness}")
+            gp[i, L.K_BODY] = gi.body_stiffness
+        gp[i, L.I_HUB] = hub_side_inertia(g, gi.body, material.density)
+        if gp[i, L.K_BODY] > 0:
+            # body mode: rim (with the teeth) against the hub; the driver's hub is prescribed
+            i_rim = gp[i, L.I_TOT] - gp[i, L.I_HUB]
+            i_eff = i_rim if i == 0 else i_rim * gp[i, L.I_HUB] / gp[i, L.I_TOT]
+            gp[i, L.C_BODY] = 2.0 * gi.body_damping_ratio * math.sqrt(gi.body_stiffness * i_eff)
     pp = np.zeros(L.N_PAIR_PAR)
     pp[L.JN_HALF] = 0.5 * pair.normal_backlash
     pp[L.ALPHA] = pair.pressure_angle

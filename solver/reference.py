@@ -123,6 +123,8 @@ class PairEquations:
     """
 
     def __init__(self, model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float):
+        if model.coupled:
+            raise ValueError("coupling.model: the scipy peer has no body-torsion coupling; use the explicit integrator")
         gp = model.gear_par
         self.model = model
         self.speed, self.speed_ramp = float(speed), float(speed_ramp)

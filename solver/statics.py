@@ -2,6 +2,12 @@
 
 `solve_static` runs Newton with continuation over a sequence of driver angles (kernel in
 `kernels/statics.py`). Angles are driver hub rotations [rad] from the nominal position.
+
+Body-torsion coupling (``Model.coupled``): the teeth sit on a rigid rim joined to the hub by
+the body spring k_body. In statics the spring carries the whole gear torque (T on gear 2,
+T*rb1/rb2 on the driver under flank contact), so the rims stand at the hub angles less the
+constant wind-ups: the kernel solves the mesh in rim angles and the hubs' TE adds
+rb1*M1/k_body1 + rb2*T/k_body2.
 """
 from __future__ import annotations
 
@@ -54,8 +60,18 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     sgn = 1.0 if torque >= 0 else -1.0
     te_start = sgn * model.backlash_offset if te0 is None else te0
     theta2 = float(model.theta2_for_te(angles[0], te_start))
-    fails = static_sweep(angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
+    kb1, kb2 = model.body_stiffness
+    rb1, rb2 = model.base_radii
+    windup1 = torque * rb1 / rb2 / kb1          # driver rim lags its hub [rad]
+    windup2 = torque / kb2                      # driven hub lags its rim [rad]
+    rim_angles = angles - windup1 if model.coupled else angles
+    if model.coupled:
+        theta2 -= windup2
+    fails = static_sweep(rim_angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
                          model.law_par, model.k_phi, tol, max_iter, te, nc, f1, it, th2)
+    if model.coupled:
+        th2 += windup2
+        te[:] = rb1 * angles + rb2 * th2
     res = StaticResult(angles, te, th2, nc, f1, it, float(torque), phi)
     if fails and raise_on_failure:
         bad = np.flatnonzero(it < 0)

@@ -17,6 +17,7 @@ COMMANDS = {
     "fit-contact": ("study.fit_contact", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
     "render": ("study.figures", "plots and renders (PNG) of a run or sweep archive"),
     "precision": ("study.precision", "work-precision study: TE error against wall time for every solver of a scene"),
+    "reference": ("study.reference", "FE reference STE and load sharing (loaded-tooth-contact analysis)"),
 }
 
 

@@ -37,17 +37,41 @@ def tooth_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
     return fe_springs(scene, g)
 
 
+def coupled_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gear g's tooth springs without the body wind-up [N·m/rad] (linear, n_k = 1) and the
+    FE stiffness ratio [1] of the plain model's springs (body-torsion coupling)."""
+    from .coupling import body_torsion
+    fit = body_torsion(scene, g)
+    ratio = tooth_springs(scene, g)[1]
+    return fit.k_tooth / units.spring_stiffness_to_si(1.0), ratio
+
+
+def scene_springs(scene: Scene):
+    """((k1, r1), (k2, r2)): per-tooth springs [N·mm/rad^n_k] and stiffness ratios of both gears."""
+    if scene.coupling.model == "body-torsion":
+        return coupled_springs(scene, 1), coupled_springs(scene, 2)
+    return tooth_springs(scene, 1), tooth_springs(scene, 2)
+
+
 def build_scene_model(scene: Scene, springs=None) -> Model:
-    """The solver model of a scene (SI). ``springs`` = ((k1, r1), (k2, r2)) skips the FE."""
-    springs = springs or (tooth_springs(scene, 1), tooth_springs(scene, 2))
+    """The solver model of a scene (SI). ``springs`` = ((k1, r1), (k2, r2)) skips the FE of
+    the tooth springs (a body-torsion coupling still takes its body springs from the FE)."""
+    springs = springs or scene_springs(scene)
+    coupled = scene.coupling.model == "body-torsion"
     gears = []
     for g in (1, 2):
         gs = scene.gear(g)
+        if coupled:
+            from .coupling import body_torsion
+            fit = body_torsion(scene, g)
+            k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
+        else:
+            k_body, n_k, pivot = math.inf, gs.spring.n_k, scene.pivot_radius(g)
         gears.append(GearInput(tooth=scene.tooth_spec(g), body=scene.body_spec(g),
-                               pivot_radius=scene.pivot_radius(g),
+                               pivot_radius=pivot,
                                k_phi=units.spring_stiffness_to_si(np.asarray(springs[g - 1][0], float)),
-                               n_k=gs.spring.n_k, c_phi=units.spring_damping_to_si(gs.spring.c_phi),
-                               n_c=gs.spring.n_c))
+                               n_k=n_k, c_phi=units.spring_damping_to_si(gs.spring.c_phi),
+                               n_c=gs.spring.n_c, body_stiffness=k_body))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(c.c_con, c.m2, c.m3), c.m2, c.m3)
@@ -103,7 +127,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
     t0 = time.perf_counter()
-    springs = springs or (tooth_springs(scene, 1), tooth_springs(scene, 2))
+    springs = springs or scene_springs(scene)
     t_springs = time.perf_counter() - t0
     model = build_scene_model(scene, springs)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
@@ -120,6 +144,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         "driven_speed_rad_s": driven_speed,
         "ramp_time_s": d.ramp_time,
         "wall_time_springs_s": t_springs,
+        "coupling": scene.coupling.model,
+        "body_stiffness_N_m_rad": np.array([k if math.isfinite(k) else 0.0 for k in model.body_stiffness]),
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
         **results.provenance(),
     }

@@ -1,7 +1,7 @@
 """Scenes: TOML files in engineering units, validated into typed objects.
 
 A scene file has the sections of `Scene` (``material``, ``pair``, ``gear1``, ``gear2`` with
-``body`` and ``spring`` subtables, ``contact``, ``quasi_static``, ``dynamic``, ``fe``,
+``body`` and ``spring`` subtables, ``contact``, ``quasi_static``, ``dynamic``, ``fe``, ``coupling``,
 ``outputs``). Every key is optional; missing keys take the defaults below, which are the
 paper's example (Table 1) with solid bodies. The embedded default scene
 ``study/scenes/paper.toml`` is the paper's example with the lightened driven gear.
@@ -134,6 +134,13 @@ class FESection:
 
 
 @dataclass(frozen=True)
+class CouplingSection:
+    model: str = _f("none", "", "foundation coupling between the teeth: 'none' (the paper's per-tooth springs) or "
+                    "'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and identified "
+                    "from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not used)", choices=("none", "body-torsion"))
+
+
+@dataclass(frozen=True)
 class Scene:
     title: str = _f("", "", "free text")
     material: MaterialSection = field(default_factory=MaterialSection)
@@ -144,6 +151,7 @@ class Scene:
     quasi_static: QuasiStaticSection = field(default_factory=QuasiStaticSection)
     dynamic: DynamicSection = field(default_factory=DynamicSection)
     fe: FESection = field(default_factory=FESection)
+    coupling: CouplingSection = field(default_factory=CouplingSection)
 
     # ---- conversion to the solver (the one place where units change) ----
     def tooth_spec(self, g: int) -> ToothSpec:

@@ -22,7 +22,10 @@ C_PHI = 14      # spring damping [N m s^n_c / rad^n_c]
 N_C = 15        # spring damping exponent [-]
 TOOTH0 = 16     # index of the gear's first tooth in the per-tooth arrays
 NZ = 17         # number of teeth (stored as float)
-N_GEAR_PAR = 18
+K_BODY = 18     # body torsion stiffness hub -> rim [N m/rad]; 0 = rigid body (plain model)
+I_HUB = 19      # inertia on the hub side of the body spring [kg m^2] (the rim side: I_TOT - I_HUB)
+C_BODY = 20     # body spring damping [N m s/rad] (linear)
+N_GEAR_PAR = 21
 
 # law_par (contact law, eq. 1.3)
 K_CON = 0       # [N/m^m1]

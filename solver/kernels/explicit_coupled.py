@@ -1,0 +1,255 @@
+"""Velocity Verlet for the body-torsion coupled pair (numba).
+
+Degrees of freedom beyond the plain model (`explicit.py`): each gear's teeth sit on a rigid
+rim joined to its hub by the body spring k_body (``gear_par[:, K_BODY]``).
+
+* gear 1: hub prescribed (the speed ramp); rim angle r1 free;
+* gear 2: rim angle theta2 (the angle the contact search sees) and hub angle h2 free; the
+  resisting torque acts on the hub;
+* tooth rotations phi relative to their rim.
+
+The rim of gear g carries inertia I_TOT - I_HUB plus its teeth (the arrowhead mass matrix of
+the plain model with the rim in the hub's place); the hub carries I_HUB. The driver's hub is
+prescribed, so the teeth no longer see its acceleration: the driver torque is
+I_HUB1*theta1'' + k_body1*(theta1 - r1) + c_body1*(theta1' - r1'). The body springs carry
+linear damping c_body (``C_BODY``, from a damping ratio on the body mode). TE is read at the
+hubs: rb1*theta1 + rb2*h2. Energy bookkeeping as in `explicit.py` plus the hub kinetic
+energy and the body springs' potential energy.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from .explicit import OK, NONFINITE, PENETRATION, _dissipation_power, driver_acc_left, driver_motion, load_torque
+from .laws import contact_energy, spring_energy
+from .layout import C_BODY, C_DELTA, C_FORCE, I_CPL, I_HUB, I_P, I_TOT, K_BODY, K_CON, M1, N_K, RB, TOOTH0
+from .mesh import generalized_forces, mesh_contacts
+
+
+@njit(cache=True)
+def _rim_accelerations(q, act, nact, gp, acc, tz2, m1, m2):
+    """Arrowhead solves of both rims: returns (r1'', theta2''); fills the teeth's acc.
+
+    q[0], q[1]: generalised forces on the rims (contacts + body springs); m1, m2 the rim inertias.
+    """
+    s1 = m1
+    s2 = m2
+    rhs1 = q[0]
+    rhs2 = q[1]
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        c = gp[g, I_CPL]
+        if g == 1:
+            s2 -= c * c / gp[1, I_P]
+            rhs2 -= c * q[2 + i] / gp[1, I_P]
+        else:
+            s1 -= c * c / gp[0, I_P]
+            rhs1 -= c * q[2 + i] / gp[0, I_P]
+    a1 = rhs1 / s1
+    a2 = rhs2 / s2
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        ar = a2 if g == 1 else a1
+        acc[i] = (q[2 + i] - gp[g, I_CPL] * ar) / gp[g, I_P]
+    return a1, a2
+
+
+@njit(cache=True)
+def _energies_coupled(w1, v1, w2, wh2, th1, r1, th2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2):
+    ke = 0.5 * gp[0, I_HUB] * w1 * w1 + 0.5 * (gp[0, I_TOT] - gp[0, I_HUB]) * v1 * v1
+    ke += 0.5 * gp[1, I_HUB] * wh2 * wh2 + 0.5 * (gp[1, I_TOT] - gp[1, I_HUB]) * w2 * w2
+    pe = 0.5 * gp[0, K_BODY] * (th1 - r1) ** 2 + 0.5 * gp[1, K_BODY] * (h2 - th2) ** 2
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        w = w2 if g == 1 else v1
+        ke += gp[g, I_CPL] * w * dphi[i] + 0.5 * gp[g, I_P] * dphi[i] * dphi[i]
+        pe += spring_energy(phi[i], kphi[i], gp[g, N_K])
+    for c in range(nc):
+        pe += contact_energy(rec[c, C_DELTA], lp[K_CON], lp[M1])
+    return ke, pe
+
+
+@njit(cache=True)
+def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
+                   r1, v1, theta2, w2, h2, wh2, phi, dphi, phi_quiet, dphi_quiet, delta_max,
+                   o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
+    """Integrate n_steps of size dt [s] from t = 0 (see the module docstring).
+
+    Initial state: driver rim r1 [rad] and speed v1, driven rim theta2 and w2, driven hub h2
+    and wh2, phi and dphi (updated in place). Outputs as `explicit.verlet`, with TE and
+    theta2 at the hubs. Returns (status, step reached, max active teeth).
+    """
+    ntooth = phi.shape[0]
+    tz2 = int(gp[1, TOOTH0])
+    rb1 = gp[0, RB]
+    rb2 = gp[1, RB]
+    kb1 = gp[0, K_BODY]
+    kb2 = gp[1, K_BODY]
+    cb1 = gp[0, C_BODY]
+    cb2 = gp[1, C_BODY]
+    mr1 = gp[0, I_TOT] - gp[0, I_HUB]
+    mr2 = gp[1, I_TOT] - gp[1, I_HUB]
+    ih1 = gp[0, I_HUB]
+    ih2 = gp[1, I_HUB]
+    rec = np.zeros((64, 15))
+    pairs = np.zeros((64, 3), dtype=np.int64)
+    q = np.zeros(ntooth + 2)
+    acc = np.zeros(ntooth)
+    vpred = np.zeros(ntooth)
+    active = np.zeros(ntooth, dtype=np.bool_)
+    act = np.zeros(ntooth, dtype=np.int64)
+    incand = np.zeros(ntooth, dtype=np.bool_)
+    for i in range(ntooth):
+        if phi[i] != 0.0 or dphi[i] != 0.0:
+            active[i] = True
+    max_act = 0
+
+    t = 0.0
+    th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
+    tl = load_torque(0.0, torque, torque_ramp)
+    nc, npair = mesh_contacts(r1, theta2, phi, v1, w2, dphi, gp, pp, lp, pairs, rec)
+    for p in range(npair):
+        active[int(pairs[p, 0])] = True
+        active[tz2 + int(pairs[p, 1])] = True
+    nact = 0
+    for i in range(ntooth):
+        if active[i]:
+            act[nact] = i
+            nact += 1
+    for i in range(ntooth + 2):
+        q[i] = 0.0
+    generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, 0.0, q)
+    mb1 = kb1 * (th1 - r1) + cb1 * (w1 - v1)
+    mb2 = kb2 * (h2 - theta2) + cb2 * (wh2 - w2)
+    q[0] += mb1
+    q[1] += mb2
+    a1, a2 = _rim_accelerations(q, act, nact, gp, acc, tz2, mr1, mr2)
+    ah2 = (tl - mb2) / ih2
+    react = ih1 * acc1 + mb1
+    ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+    work = 0.0
+    diss = 0.0
+    p_in_old = react * w1 + tl * wh2
+    p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2) + cb1 * (w1 - v1) ** 2 + cb2 * (wh2 - w2) ** 2
+    fmax = 0.0
+    o = 0
+    o_time[0] = 0.0
+    o_te[0] = rb1 * th1 + rb2 * h2
+    o_fmax[0] = 0.0
+    o_nc[0] = nc
+    o_react[0] = react
+    o_ke[0] = ke
+    o_pe[0] = pe
+    o_work[0] = 0.0
+    o_diss[0] = 0.0
+    o_theta2[0] = h2
+    status = OK
+    step = 0
+    for step in range(1, n_steps + 1):
+        t = step * dt
+        # half kick, drift
+        v1h = v1 + 0.5 * dt * a1
+        w2h = w2 + 0.5 * dt * a2
+        wh2h = wh2 + 0.5 * dt * ah2
+        for a in range(nact):
+            i = act[a]
+            dphi[i] += 0.5 * dt * acc[i]
+            phi[i] += dt * dphi[i]
+        r1 += dt * v1h
+        theta2 += dt * w2h
+        h2 += dt * wh2h
+        th1, w1, acc1 = driver_motion(t, speed, speed_ramp)
+        tl = load_torque(t, torque, torque_ramp)
+        # predicted velocities for the damping terms
+        v1p = v1h + 0.5 * dt * a1
+        w2p = w2h + 0.5 * dt * a2
+        wh2p = wh2h + 0.5 * dt * ah2
+        for a in range(nact):
+            i = act[a]
+            vpred[i] = dphi[i] + 0.5 * dt * acc[i]
+        nc, npair = mesh_contacts(r1, theta2, phi, v1p, w2p, vpred, gp, pp, lp, pairs, rec)
+        for p in range(npair):
+            for g in range(2):
+                i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
+                incand[i] = True
+                if not active[i]:
+                    active[i] = True
+                    act[nact] = i
+                    nact += 1
+                    acc[i] = 0.0
+                    vpred[i] = 0.0
+        for i in range(ntooth + 2):
+            q[i] = 0.0
+        generalized_forces(rec, nc, phi, vpred, act, nact, kphi, gp, 0.0, q)
+        mb1 = kb1 * (th1 - r1) + cb1 * (w1 - v1p)
+        mb2 = kb2 * (h2 - theta2) + cb2 * (wh2p - w2p)
+        q[0] += mb1
+        q[1] += mb2
+        a1, a2 = _rim_accelerations(q, act, nact, gp, acc, tz2, mr1, mr2)
+        ah2 = (tl - mb2) / ih2
+        react = ih1 * acc1 + mb1
+        # second half kick
+        v1 = v1h + 0.5 * dt * a1
+        w2 = w2h + 0.5 * dt * a2
+        wh2 = wh2h + 0.5 * dt * ah2
+        for a in range(nact):
+            i = act[a]
+            dphi[i] += 0.5 * dt * acc[i]
+        for c in range(nc):
+            if rec[c, C_FORCE] > fmax:
+                fmax = rec[c, C_FORCE]
+            if rec[c, C_DELTA] > delta_max:
+                status = PENETRATION
+        # the driver's hub inertia sees the one-sided acceleration where the ramp ends
+        p_in_left = (ih1 * driver_acc_left(t, speed, speed_ramp) + mb1) * w1 + tl * wh2
+        p_in = react * w1 + tl * wh2
+        p_d = (_dissipation_power(vpred, act, nact, gp, rec, nc, lp, tz2)
+               + cb1 * (w1 - v1p) * (w1 - v1p) + cb2 * (wh2p - w2p) * (wh2p - w2p))
+        work += 0.5 * dt * (p_in_left + p_in_old)
+        diss += 0.5 * dt * (p_d + p_d_old)
+        p_in_old = p_in
+        p_d_old = p_d
+        a = 0
+        while a < nact:
+            i = act[a]
+            if not incand[i] and abs(phi[i]) < phi_quiet and abs(dphi[i]) < dphi_quiet:
+                phi[i] = 0.0
+                dphi[i] = 0.0
+                acc[i] = 0.0
+                active[i] = False
+                nact -= 1
+                act[a] = act[nact]
+            else:
+                a += 1
+        for p in range(npair):
+            incand[int(pairs[p, 0])] = False
+            incand[tz2 + int(pairs[p, 1])] = False
+        if nact > max_act:
+            max_act = nact
+        if step % out_every == 0:
+            o += 1
+            ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+            o_time[o] = t
+            o_te[o] = rb1 * th1 + rb2 * h2
+            o_fmax[o] = fmax
+            nl = 0
+            for c in range(nc):
+                if rec[c, C_FORCE] > 0.0:
+                    nl += 1
+            o_nc[o] = nl
+            o_react[o] = react
+            o_ke[o] = ke
+            o_pe[o] = pe
+            o_work[o] = work
+            o_diss[o] = diss
+            o_theta2[o] = h2
+            fmax = 0.0
+            if not (math.isfinite(theta2) and math.isfinite(h2) and math.isfinite(ke + pe)):
+                status = NONFINITE
+        if status != OK:
+            break
+    return status, step, max_act
