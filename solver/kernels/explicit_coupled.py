@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from .explicit import OK, NONFINITE, PENETRATION, _dissipation_power, driver_acc_left, driver_motion, load_torque
+from .active import clear_candidates, freeze_quiet_teeth, loaded_contacts
 from .laws import contact_energy, spring_energy
 from .layout import C_BODY, C_DELTA, C_FORCE, I_CPL, I_HUB, I_P, I_TOT, K_BODY, K_CON, M1, N_K, RB, TOOTH0
 from .mesh import generalized_forces, mesh_contacts
@@ -213,21 +214,8 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
         diss += 0.5 * dt * (p_d + p_d_old)
         p_in_old = p_in
         p_d_old = p_d
-        a = 0
-        while a < nact:
-            i = act[a]
-            if not incand[i] and abs(phi[i]) < phi_quiet and abs(dphi[i]) < dphi_quiet:
-                phi[i] = 0.0
-                dphi[i] = 0.0
-                acc[i] = 0.0
-                active[i] = False
-                nact -= 1
-                act[a] = act[nact]
-            else:
-                a += 1
-        for p in range(npair):
-            incand[int(pairs[p, 0])] = False
-            incand[tz2 + int(pairs[p, 1])] = False
+        nact = freeze_quiet_teeth(act, nact, active, incand, phi, dphi, acc, q, phi_quiet, dphi_quiet)
+        clear_candidates(incand, pairs, npair, tz2)
         if nact > max_act:
             max_act = nact
         if step % out_every == 0:
@@ -236,11 +224,7 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
             o_time[o] = t
             o_te[o] = rb1 * th1 + rb2 * h2
             o_fmax[o] = fmax
-            nl = 0
-            for c in range(nc):
-                if rec[c, C_FORCE] > 0.0:
-                    nl += 1
-            o_nc[o] = nl
+            o_nc[o] = loaded_contacts(rec, nc)
             o_react[o] = react
             o_ke[o] = ke
             o_pe[o] = pe

@@ -31,6 +31,7 @@ from numba import njit
 
 from .explicit import (ENERGY, NONFINITE, OK, PENETRATION, _dissipation_power, _energies,
                        driver_motion, driver_speed, load_torque)
+from .active import clear_candidates, freeze_quiet_teeth, loaded_contacts
 from .laws import contact_damping_tangents, spring_damping_tangent
 from .layout import (C_CON, C_DDELTA, C_DELTA, C_FORCE, C_G2, C_GA, C_GB, C_KT, C_PHI, C_TOOTH1,
                      C_TOOTH2, I_CPL, I_P, I_TOT, M2, M3, MAX_CONTACTS, N_C, R_BND, RB, TOOTH0)
@@ -326,22 +327,8 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
         p_in_old = p_in
         p_d_old = p_d
         # freeze quiet teeth outside the candidates
-        a = 0
-        while a < nact:
-            i = act[a]
-            if not incand[i] and abs(phi[i]) < phi_quiet and abs(dphi[i]) < dphi_quiet:
-                phi[i] = 0.0
-                dphi[i] = 0.0
-                acc[i] = 0.0
-                q[2 + i] = 0.0
-                active[i] = False
-                nact -= 1
-                act[a] = act[nact]
-            else:
-                a += 1
-        for p in range(npair):
-            incand[int(pairs[p, 0])] = False
-            incand[tz2 + int(pairs[p, 1])] = False
+        nact = freeze_quiet_teeth(act, nact, active, incand, phi, dphi, acc, q, phi_quiet, dphi_quiet)
+        clear_candidates(incand, pairs, npair, tz2)
         if nact > max_act:
             max_act = nact
         if step % out_every == 0:
@@ -350,11 +337,7 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
             o_time[o] = t
             o_te[o] = rb1 * th1 + rb2 * theta2
             o_fmax[o] = fmax
-            nl = 0
-            for c in range(nc):
-                if rec[c, C_FORCE] > 0.0:
-                    nl += 1
-            o_nc[o] = nl
+            o_nc[o] = loaded_contacts(rec, nc)
             o_react[o] = react
             o_ke[o] = ke
             o_pe[o] = pe

@@ -1,0 +1,52 @@
+"""The active-tooth set shared by the time integrators (numba).
+
+Teeth away from the mesh are left out of the integration, rigid to their hub; a tooth joins
+the set when the pre-search names it a candidate and leaves it once it is outside the
+candidates and at rest (rotation below ``phi_quiet`` [rad], rate below ``dphi_quiet``
+[rad/s]). Arrays: ``act`` the active tooth indices (first ``nact`` valid), ``active`` and
+``incand`` per-tooth flags, ``q`` the generalised forces (hubs first, then the teeth).
+"""
+from numba import njit
+
+from .layout import C_FORCE
+
+
+@njit(cache=True)
+def freeze_quiet_teeth(act, nact, active, incand, phi, dphi, acc, q, phi_quiet, dphi_quiet):
+    """Set the quiet teeth outside the candidates exactly to rest and drop them from the set.
+
+    Their rotation, rate, acceleration and generalised force become zero (rigid to the hub,
+    whose inertia already holds them). Returns the new number of active teeth.
+    """
+    a = 0
+    while a < nact:
+        i = act[a]
+        if not incand[i] and abs(phi[i]) < phi_quiet and abs(dphi[i]) < dphi_quiet:
+            phi[i] = 0.0
+            dphi[i] = 0.0
+            acc[i] = 0.0
+            q[2 + i] = 0.0
+            active[i] = False
+            nact -= 1
+            act[a] = act[nact]
+        else:
+            a += 1
+    return nact
+
+
+@njit(cache=True)
+def clear_candidates(incand, pairs, npair, tz2):
+    """Reset the candidate flags of this step's pre-search pairs (gear-2 teeth offset by tz2)."""
+    for p in range(npair):
+        incand[int(pairs[p, 0])] = False
+        incand[tz2 + int(pairs[p, 1])] = False
+
+
+@njit(cache=True)
+def loaded_contacts(rec, nc):
+    """Number of the nc contact records that carry a positive normal force."""
+    n = 0
+    for c in range(nc):
+        if rec[c, C_FORCE] > 0.0:
+            n += 1
+    return n
