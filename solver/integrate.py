@@ -223,7 +223,7 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
         status, step, max_act = verlet_coupled(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                                float(speed), float(speed_ramp), float(torque), float(torque_ramp),
                                                dt, n_steps, out_every, 0.0, 0.0, theta2, 0.0, theta2, 0.0, phi, dphi,
-                                               phi_quiet, phi_quiet * omega_tooth, float(delta_max), *o)
+                                               phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
     else:
         status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                        float(speed), float(speed_ramp), float(torque), float(torque_ramp),

@@ -148,6 +148,19 @@ def test_coupled_model_closes_the_double_contact_gap(body):
     assert np.sqrt(np.mean(c1**2)) < np.sqrt(np.mean(p1**2)) + 2e-8
 
 
+def test_coupled_step_above_the_stability_bound_is_caught(paper_solid_model):
+    """Twice the critical step of the coupled pair: the guard stops the run and names why."""
+    from solver.integrate import DivergenceError, simulate, stable_time_step
+    m = with_body_springs(paper_solid_model, K_BODY)
+    dt, _w = stable_time_step(m, 50.0)          # half the critical step
+    ok = simulate(m, 100.0, 0.002, 50.0, 0.002, 0.002, dt=dt)
+    assert ok.status == 0
+    with pytest.raises(DivergenceError) as e:
+        simulate(m, 100.0, 0.002, 50.0, 0.002, 0.004, dt=4 * dt, raise_on_failure=True)
+    msg = str(e.value)
+    assert ("non-finite" in msg or "penetration" in msg or "energy growth" in msg) and "t = " in msg
+
+
 def test_scipy_peer_refuses_a_coupled_model(paper_solid_model):
     from solver.reference import simulate_scipy
     with pytest.raises(ValueError, match="coupling"):

@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .explicit import OK, NONFINITE, PENETRATION, _dissipation_power, driver_acc_left, driver_motion, load_torque
+from .explicit import ENERGY, OK, NONFINITE, PENETRATION, _dissipation_power, driver_acc_left, driver_motion, load_torque
 from .active import clear_candidates, freeze_quiet_teeth, loaded_contacts
 from .laws import contact_energy, spring_energy
 from .layout import C_BODY, C_DELTA, C_FORCE, I_CPL, I_HUB, I_P, I_TOT, K_BODY, K_CON, M1, N_K, RB, TOOTH0
@@ -76,13 +76,14 @@ def _energies_coupled(w1, v1, w2, wh2, th1, r1, th2, h2, phi, dphi, act, nact, k
 
 @njit(cache=True)
 def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
-                   r1, v1, theta2, w2, h2, wh2, phi, dphi, phi_quiet, dphi_quiet, delta_max,
+                   r1, v1, theta2, w2, h2, wh2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol,
                    o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
     """Integrate n_steps of size dt [s] from t = 0 (see the module docstring).
 
     Initial state: driver rim r1 [rad] and speed v1, driven rim theta2 and w2, driven hub h2
     and wh2, phi and dphi (updated in place). Outputs as `explicit.verlet`, with TE and
-    theta2 at the hubs. Returns (status, step reached, max active teeth).
+    theta2 at the hubs; the same guards (energy growth beyond ``energy_tol`` as in `verlet`).
+    Returns (status, step reached, max active teeth).
     """
     ntooth = phi.shape[0]
     tz2 = int(gp[1, TOOTH0])
@@ -132,6 +133,7 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
     ah2 = (tl - mb2) / ih2
     react = ih1 * acc1 + mb1
     ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+    e0 = ke + pe
     work = 0.0
     diss = 0.0
     p_in_old = react * w1 + tl * wh2
@@ -234,6 +236,8 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
             fmax = 0.0
             if not (math.isfinite(theta2) and math.isfinite(h2) and math.isfinite(ke + pe)):
                 status = NONFINITE
+            elif status == OK and ke + pe - e0 + diss - work > energy_tol * max(abs(work), ke + pe, diss):
+                status = ENERGY
         if status != OK:
             break
     return status, step, max_act
