@@ -20,16 +20,12 @@ import math
 import numpy as np
 from numba import njit
 
-from .active import clear_candidates, freeze_quiet_teeth, loaded_contacts
 from .laws import contact_energy, signed_pow, spring_energy
 from .layout import (C_CON, C_DDELTA, C_DELTA, C_FORCE, C_PHI, C_TOOTH1, C_TOOTH2, I_CPL, I_P,
                      I_TOT, K_CON, M1, N_C, N_K, RB, TOOTH0)
 from .mesh import generalized_forces, mesh_contacts
-
-OK = 0
-NONFINITE = 1
-PENETRATION = 2
-ENERGY = 3
+from .stepping import (OK, PENETRATION, checked_status, clear_candidates, freeze_quiet_teeth,
+                       loaded_contacts, record_output)
 
 
 @njit(cache=True)
@@ -260,21 +256,10 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
         if step % out_every == 0:
             o += 1
             ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
-            o_time[o] = t
-            o_te[o] = rb1 * th1 + rb2 * theta2
-            o_fmax[o] = fmax
-            o_nc[o] = loaded_contacts(rec, nc)
-            o_react[o] = react
-            o_ke[o] = ke
-            o_pe[o] = pe
-            o_work[o] = work
-            o_diss[o] = diss
-            o_theta2[o] = theta2
+            record_output(o, t, rb1 * th1 + rb2 * theta2, fmax, loaded_contacts(rec, nc), react, ke, pe, work, diss, theta2,
+                          o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
             fmax = 0.0
-            if not (math.isfinite(theta2) and math.isfinite(w2) and math.isfinite(ke + pe)):
-                status = NONFINITE
-            elif status == OK and ke + pe - e0 + diss - work > energy_tol * max(abs(work), ke + pe, diss):
-                status = ENERGY
+            status = checked_status(status, math.isfinite(theta2) and math.isfinite(w2) and math.isfinite(ke + pe), ke, pe, e0, work, diss, energy_tol)
         if status != OK:
             break
     return status, step, max_act

@@ -21,11 +21,12 @@ import math
 import numpy as np
 from numba import njit
 
-from .explicit import ENERGY, OK, NONFINITE, PENETRATION, _dissipation_power, driver_acc_left, driver_motion, load_torque
-from .active import clear_candidates, freeze_quiet_teeth, loaded_contacts
+from .explicit import _dissipation_power, driver_acc_left, driver_motion, load_torque
 from .laws import contact_energy, spring_energy
 from .layout import C_BODY, C_DELTA, C_FORCE, I_CPL, I_HUB, I_P, I_TOT, K_BODY, K_CON, M1, N_K, RB, TOOTH0
 from .mesh import generalized_forces, mesh_contacts
+from .stepping import (OK, PENETRATION, checked_status, clear_candidates, freeze_quiet_teeth,
+                       loaded_contacts, record_output)
 
 
 @njit(cache=True)
@@ -223,21 +224,10 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
         if step % out_every == 0:
             o += 1
             ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
-            o_time[o] = t
-            o_te[o] = rb1 * th1 + rb2 * h2
-            o_fmax[o] = fmax
-            o_nc[o] = loaded_contacts(rec, nc)
-            o_react[o] = react
-            o_ke[o] = ke
-            o_pe[o] = pe
-            o_work[o] = work
-            o_diss[o] = diss
-            o_theta2[o] = h2
+            record_output(o, t, rb1 * th1 + rb2 * h2, fmax, loaded_contacts(rec, nc), react, ke, pe, work, diss, h2,
+                          o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
             fmax = 0.0
-            if not (math.isfinite(theta2) and math.isfinite(h2) and math.isfinite(ke + pe)):
-                status = NONFINITE
-            elif status == OK and ke + pe - e0 + diss - work > energy_tol * max(abs(work), ke + pe, diss):
-                status = ENERGY
+            status = checked_status(status, math.isfinite(theta2) and math.isfinite(h2) and math.isfinite(ke + pe), ke, pe, e0, work, diss, energy_tol)
         if status != OK:
             break
     return status, step, max_act

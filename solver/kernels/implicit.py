@@ -29,14 +29,14 @@ import math
 import numpy as np
 from numba import njit
 
-from .explicit import (ENERGY, NONFINITE, OK, PENETRATION, _dissipation_power, _energies,
-                       driver_motion, driver_speed, load_torque)
-from .active import clear_candidates, freeze_quiet_teeth, loaded_contacts
+from .explicit import _dissipation_power, _energies, driver_motion, driver_speed, load_torque
 from .laws import contact_damping_tangents, spring_damping_tangent
 from .layout import (C_CON, C_DDELTA, C_DELTA, C_FORCE, C_G2, C_GA, C_GB, C_KT, C_PHI, C_TOOTH1,
                      C_TOOTH2, I_CPL, I_P, I_TOT, M2, M3, MAX_CONTACTS, N_C, R_BND, RB, TOOTH0)
 from .mesh import generalized_forces, mesh_contacts, tooth_spring_tangent
 from .statics import solve_dense
+from .stepping import (NONFINITE, OK, PENETRATION, checked_status, clear_candidates,
+                       freeze_quiet_teeth, loaded_contacts, record_output)
 
 NEWTON = 4
 
@@ -334,25 +334,12 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
         if step % out_every == 0:
             o += 1
             ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
-            o_time[o] = t
-            o_te[o] = rb1 * th1 + rb2 * theta2
-            o_fmax[o] = fmax
-            o_nc[o] = loaded_contacts(rec, nc)
-            o_react[o] = react
-            o_ke[o] = ke
-            o_pe[o] = pe
-            o_work[o] = work
-            o_diss[o] = diss
-            o_theta2[o] = theta2
+            record_output(o, t, rb1 * th1 + rb2 * theta2, fmax, loaded_contacts(rec, nc), react, ke, pe, work, diss, theta2,
+                          o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
             o_newton[o] = itmax
             fmax = 0.0
             itmax = 0
-            if not (math.isfinite(theta2) and math.isfinite(w2) and math.isfinite(ke + pe)):
-                status = NONFINITE
-            elif status == OK:
-                growth = ke + pe - e0 + diss - work
-                if growth > energy_tol * max(abs(work), ke + pe, diss):
-                    status = ENERGY
+            status = checked_status(status, math.isfinite(theta2) and math.isfinite(w2) and math.isfinite(ke + pe), ke, pe, e0, work, diss, energy_tol)
         if status != OK:
             break
     return status, step, max_act, total_it

@@ -1,4 +1,7 @@
-"""The active-tooth set shared by the time integrators (numba).
+"""Pieces shared by the time-stepping loops (explicit, coupled explicit, implicit; numba):
+status codes, the active-tooth set, output records and the output-time guards.
+
+Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy growth.
 
 Teeth away from the mesh are left out of the integration, rigid to their hub; a tooth joins
 the set when the pre-search names it a candidate and leaves it once it is outside the
@@ -9,6 +12,11 @@ candidates and at rest (rotation below ``phi_quiet`` [rad], rate below ``dphi_qu
 from numba import njit
 
 from .layout import C_FORCE
+
+OK = 0
+NONFINITE = 1
+PENETRATION = 2
+ENERGY = 3
 
 
 @njit(cache=True)
@@ -50,3 +58,33 @@ def loaded_contacts(rec, nc):
         if rec[c, C_FORCE] > 0.0:
             n += 1
     return n
+
+
+@njit(cache=True)
+def record_output(o, t, te, fmax, n_loaded, react, ke, pe, work, diss, theta2,
+                  o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
+    """Write output record o: time [s], TE [m], largest contact force over the interval [N],
+    loaded contacts, driver torque [N m], kinetic, potential, input and dissipated energy [J],
+    driven hub angle [rad]."""
+    o_time[o] = t
+    o_te[o] = te
+    o_fmax[o] = fmax
+    o_nc[o] = n_loaded
+    o_react[o] = react
+    o_ke[o] = ke
+    o_pe[o] = pe
+    o_work[o] = work
+    o_diss[o] = diss
+    o_theta2[o] = theta2
+
+
+@njit(cache=True)
+def checked_status(status, finite, ke, pe, e0, work, diss, energy_tol):
+    """Status after the checks at an output instant: NONFINITE when the state is not finite,
+    ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
+    [J] above energy_tol times the energy scale, else ``status`` unchanged."""
+    if not finite:
+        return NONFINITE
+    if status == OK and ke + pe - e0 + diss - work > energy_tol * max(abs(work), ke + pe, diss):
+        return ENERGY
+    return status
