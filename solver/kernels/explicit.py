@@ -175,16 +175,8 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
     fmax = 0.0
     o = 0
-    o_time[0] = 0.0
-    o_te[0] = rb1 * th1 + rb2 * theta2
-    o_fmax[0] = 0.0
-    o_nc[0] = nc
-    o_react[0] = react
-    o_ke[0] = ke
-    o_pe[0] = pe
-    o_work[0] = 0.0
-    o_diss[0] = 0.0
-    o_theta2[0] = theta2
+    record_output(0, 0.0, rb1 * th1 + rb2 * theta2, 0.0, nc, react, ke, pe, 0.0, 0.0, theta2,
+                  o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
     status = OK
     step = 0
     for step in range(1, n_steps + 1):
