@@ -9,7 +9,7 @@ from study import reference as ref_mod
 from study import springs
 from study.scene import SceneError, default_scene
 
-from conftest import solid_scene
+from conftest import SMALL_PAIR, solid_scene
 
 
 @pytest.fixture(autouse=True)
@@ -21,16 +21,9 @@ def private_cache(tmp_path, monkeypatch):
 
 
 def small_scene(**kw):
-    """24 teeth, m = 3 mm (contact ratio 1.6): a coarse, fast FE body; one mesh pitch of rotation."""
-    base = {}
-    for g in (1, 2):
-        base.update({f"gear{g}.module": 3.0, f"gear{g}.teeth": 24, f"gear{g}.fillet_radius": 0.9,
-                     f"gear{g}.face_width": 20.0, f"gear{g}.body.rim_height": 4.0, f"gear{g}.body.web_height": 14.0,
-                     f"gear{g}.body.hub_height": 6.0, f"gear{g}.body.web_thickness": 20.0, f"gear{g}.body.holes": 0})
-    base.update({"pair.backlash": 0.1, "quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.25,
-                 "quasi_static.torque": 100.0})
-    base.update(kw)
-    return default_scene().replace(**base)
+    """The small 24-tooth pair of conftest (contact ratio 1.6), one mesh pitch of rotation."""
+    return default_scene().replace(**{**SMALL_PAIR, "quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.25,
+                                      "quasi_static.torque": 100.0, **kw})
 
 
 LIGHT = {"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,

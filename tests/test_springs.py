@@ -13,6 +13,8 @@ from solver.weber import pitch_point_depth, weber_deflection
 from study import springs
 from study.scene import default_scene
 
+from conftest import SMALL_PAIR
+
 
 @pytest.fixture(autouse=True)
 def private_cache(tmp_path, monkeypatch):
@@ -23,16 +25,9 @@ def private_cache(tmp_path, monkeypatch):
 
 
 def small_scene(**kw):
-    """24 teeth, m = 3 mm: a coarse, fast FE body (about 1 s)."""
-    base = {}
-    for g in (1, 2):
-        base.update({f"gear{g}.module": 3.0, f"gear{g}.teeth": 24, f"gear{g}.fillet_radius": 0.9,
-                     f"gear{g}.face_width": 20.0, f"gear{g}.body.rim_height": 4.0, f"gear{g}.body.web_height": 14.0,
-                     f"gear{g}.body.hub_height": 6.0, f"gear{g}.body.web_thickness": 20.0, f"gear{g}.body.holes": 0})
-    base.update({"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
-                 "gear2.body.hole_circle_radius": 19.5, "pair.backlash": 0.1})
-    base.update(kw)
-    return default_scene().replace(**base)
+    """The small 24-tooth pair of conftest, the driven gear with a web of 8 mm and 4 holes."""
+    return default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+                                      "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
 
 
 def test_solid_body_gives_the_same_stiffness_to_every_tooth():
