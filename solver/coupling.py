@@ -1,4 +1,5 @@
-"""Foundation coupling of the pseudo-rigid model: a body-torsion spring per gear.
+"""Foundation coupling of the pseudo-rigid model: a body-torsion spring per gear, and the
+full version with the tooth springs coupled through the body's compliance.
 
 The per-tooth spring fitted to a bore-clamped FE body holds the wind-up of the whole body,
 which all loaded teeth share. Put into every tooth spring, it is counted once per tooth, so
@@ -23,6 +24,13 @@ stiffness is tooth 0's spring, the other teeth scale it by their pitch-point too
 Against the FE reference (Table 1, 50 N·m) this halves the STE error of a root-circle pivot.
 
 With k_body -> infinity and k_tooth = k_fe the coupled model is the plain one.
+
+The full version (`tooth_compliance_fit`): a load on one tooth also turns its neighbours
+through rim and web, and by how much depends on where the holes are. The body spring stays;
+the tooth springs become one compliance matrix C over the teeth (tooth rotation per tooth
+moment), fitted with c_body and the pivot to the FE influence coefficients at the points where
+the mesh loads the teeth together (a tooth's own contact point; neighbours at their
+simultaneous contact points). The kernels use it through `kernels.toothcoupling`.
 Units: SI.
 """
 from __future__ import annotations
@@ -70,3 +78,104 @@ def body_windup(torque: float, base_radii, k_body) -> float:
     the driver carries torque*rb1/rb2): rb1*M1/k_body1 + rb2*T/k_body2."""
     rb1, rb2 = base_radii
     return rb1 * (torque * rb1 / rb2) / k_body[0] + rb2 * torque / k_body[1]
+
+
+@dataclass(frozen=True)
+class ToothComplianceFit:
+    k_body: float            # body torsion stiffness hub -> rim [N·m/rad]
+    c_body: float            # the same as a compliance along the line of action [m/N]
+    compliance: np.ndarray   # (Z, Z) tooth rotation per tooth moment, C[a, b] [rad/(N·m)]
+    pivot_radius: float      # tooth pivot [m]
+    reach: int               # teeth up to this many pitches apart are coupled [-]
+    rms_rel_error: float     # RMS relative residual of the fitted influence coefficients [-]
+
+    @property
+    def k_own(self) -> np.ndarray:
+        """(Z,) each tooth's spring when it alone is loaded, 1/C[a, a] [N·m/rad]."""
+        return 1.0 / np.diag(self.compliance)
+
+
+def _linear_fit(sample_pair, n_pairs, LL, value):
+    """For levers fixed (LL = lever_read*lever_load [m^2]): the least-squares c_body [m/N] and
+    C of every pair [rad/(N·m)] (the model is linear in them), and the sum of squared relative
+    residuals. C_p = A_p - c_body*B_p eliminates the pairs; c_body is then one linear fit,
+    held at or below the smallest coefficient (the objective is convex in it, so the bound is
+    the constrained optimum): the body part is what every loaded pair shares, and the local
+    part never pulls a neighbour back."""
+    w = 1.0 / value**2
+    den = np.bincount(sample_pair, w * LL * LL, n_pairs)
+    A = np.bincount(sample_pair, w * value * LL, n_pairs) / den
+    B = np.bincount(sample_pair, w * LL, n_pairs) / den
+    e = 1.0 - B[sample_pair] * LL                  # d residual / d c_body
+    f = A[sample_pair] * LL - value                # residual at c_body = 0
+    c_body = min(-np.sum(w * e * f) / np.sum(w * e * e), float(value.min()))
+    r = c_body * e + f
+    return c_body, A - c_body * B, float(np.sum(w * r * r))
+
+
+def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, base_radius: float,
+                         psi_base: float, pivot_bounds: tuple) -> ToothComplianceFit:
+    """The full foundation coupling, identified from FE influence coefficients.
+
+    Samples k = 0..N-1: ``value[k]`` [m/N], the displacement along the line of action at roll
+    parameter ``u_read[k]`` of tooth ``pairs[sample_pair[k], 0]`` under a unit load at
+    ``u_load[k]`` of tooth ``pairs[sample_pair[k], 1]``, at the points the mesh loads together
+    (a tooth's own block at its contact point, neighbours at their simultaneous contact points).
+    The model of a sample is
+
+        c_body + lever(u_read) * lever(u_load) * C[a, b],
+
+    the body wind-up (a rotation about the gear centre, lever rb: the same along the line of
+    action wherever the contact) plus the teeth's rotations about the pivot (levers about the
+    pivot at radius r_Q). For a given r_Q the model is linear in c_body and the C of every
+    pair (one least-squares solve on the relative residuals); r_Q minimises that residual
+    within ``pivot_bounds`` [m] (the rim under the tooth; a bounded scalar search). Pairs not listed are not coupled (C = 0):
+    the mesh never loads them together. Raises ValueError when the fit is not a valid
+    stiffness (a window of reach + 2 neighbouring teeth not positive definite).
+    """
+    from scipy.optimize import minimize_scalar
+
+    pairs = np.asarray(pairs, int)
+    sample_pair = np.asarray(sample_pair, int)
+    u_read, u_load, value = (np.asarray(x, float) for x in (u_read, u_load, value))
+    n = value.size
+    if pairs.ndim != 2 or pairs.shape[1] != 2:
+        raise ValueError(f"pairs: need (pairs, 2) tooth indices, got shape {pairs.shape}")
+    if not (sample_pair.shape == u_read.shape == u_load.shape == (n,)) or n == 0:
+        raise ValueError("samples: sample_pair, u_read, u_load and value need the same length, at least 1")
+    if sample_pair.min() < 0 or sample_pair.max() >= len(pairs) or np.bincount(sample_pair, minlength=len(pairs)).min() == 0:
+        raise ValueError("sample_pair: every pair needs at least one sample, and only listed pairs")
+    if not np.all(value > 0):
+        raise ValueError("value: influence coefficients along the load must be positive")
+    lo, hi = pivot_bounds
+    if not 0 < lo < hi:
+        raise ValueError(f"pivot_bounds: need 0 < lower < upper, got {pivot_bounds}")
+    P = len(pairs)
+    cos_r, cos_l = np.cos(psi_base - u_read), np.cos(psi_base - u_load)
+
+    def fit(r_q):       # levers about the pivot (identify.lever), r_q [m]
+        LL = np.abs(base_radius - r_q * cos_r) * np.abs(base_radius - r_q * cos_l)
+        return _linear_fit(sample_pair, P, LL, value)
+
+    res = minimize_scalar(lambda x: fit(x * 1e-3)[2], bounds=(lo * 1e3, hi * 1e3), method="bounded",
+                          options=dict(xatol=1e-6))
+    r_q = float(res.x) * 1e-3
+    c_body, c, j = fit(r_q)
+    if not c_body > 0:
+        raise ValueError(f"value: fitted body compliance {c_body:.4g} m/N is not positive")
+    d = pairs[:, 1] - pairs[:, 0]
+    reach = int(np.minimum(d % teeth, (-d) % teeth).max())
+    C = np.zeros((teeth, teeth))
+    C[pairs[:, 0] % teeth, pairs[:, 1] % teeth] = c
+    C = 0.5 * (C + C.T)
+    if np.any(np.diag(C) <= 0):
+        raise ValueError("value: a tooth's fitted compliance is not positive")
+    w = min(reach + 2, teeth)
+    for a in range(teeth):
+        idx = (a + np.arange(w)) % teeth
+        try:
+            np.linalg.cholesky(C[np.ix_(idx, idx)])
+        except np.linalg.LinAlgError:
+            raise ValueError(f"value: the fitted compliance of teeth {a}..{a + w - 1} is not positive "
+                             "definite (not a valid stiffness)") from None
+    return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / n)))

@@ -33,6 +33,7 @@ class GearInput:
     n_c: float = 1.0
     body_stiffness: float = math.inf    # hub -> rim torsion spring, N·m/rad (inf: rigid body)
     body_damping_ratio: float = 0.02    # of critical on the body mode (as the teeth's 2 %)
+    tooth_compliance: np.ndarray | None = None  # (Z, Z) rad/(N·m): teeth coupled through the body
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,9 @@ class Model:
     teeth_inertia: tuple            # (ToothInertia, ToothInertia)
     body_inertia: tuple             # kg·m² of the bodies without teeth
     inputs: tuple = field(repr=False, default=())
+    tooth_compliance: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((0, 0)))
+    # (Z1+Z2, Z1+Z2) rad/(N·m), block-diagonal by gear, when the teeth are coupled through
+    # the bodies (`kernels.toothcoupling`); 0 x 0 for independent tooth springs
 
     @property
     def teeth(self) -> tuple:
@@ -96,6 +100,11 @@ class Model:
         return bool(np.any(self.gear_par[:, L.K_BODY] > 0))
 
     @property
+    def teeth_coupled(self) -> bool:
+        """Tooth springs coupled through a compliance matrix (k_phi then each tooth's own)."""
+        return self.tooth_compliance.shape[0] > 0
+
+    @property
     def inertia_total(self) -> tuple:
         return float(self.gear_par[0, L.I_TOT]), float(self.gear_par[1, L.I_TOT])
 
@@ -128,6 +137,9 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
         g = gear_geometry(gi.tooth, prefix=name)
         validate_body(g, gi.body, prefix=f"{name}.body")
         k = np.asarray(gi.k_phi, dtype=float)
+        if gi.tooth_compliance is not None:
+            _check_compliance(gi, g.teeth, name)
+            k = 1.0 / np.diag(gi.tooth_compliance)
         if k.shape != (g.teeth,):
             raise ValueError(f"{name}.spring.k_phi: expected {g.teeth} per-tooth values, got shape {k.shape}")
         if not np.all(np.isfinite(k)) or np.any(k <= 0):
@@ -174,5 +186,31 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
     pp[L.ALPHA] = pair.pressure_angle
     pp[L.MARGIN] = presearch_margin * max(geos[0].pitch_angle, geos[1].pitch_angle)
     lp = np.array([law.k, law.m1, law.c, law.m2, law.m3], dtype=float)
-    kphi = np.concatenate([np.asarray(gear1.k_phi, float), np.asarray(gear2.k_phi, float)])
-    return Model(gp, pp, lp, kphi, tuple(geos), pair, tuple(inert), tuple(bodies), (gear1, gear2, law, material))
+    own = [1.0 / np.diag(gi.tooth_compliance) if gi.tooth_compliance is not None else np.asarray(gi.k_phi, float)
+           for gi in (gear1, gear2)]
+    kphi = np.concatenate(own)
+    ctooth = np.zeros((0, 0))
+    if gear1.tooth_compliance is not None or gear2.tooth_compliance is not None:
+        for name, gi in (("gear1", gear1), ("gear2", gear2)):
+            if gi.n_k != 1.0:
+                raise ValueError(f"{name}.spring.n_k: coupled tooth springs are linear (n_k = 1), got {gi.n_k}")
+        # the other gear's independent springs are a diagonal block
+        blocks = [gi.tooth_compliance if gi.tooth_compliance is not None else np.diag(1.0 / k)
+                  for gi, k in zip((gear1, gear2), own)]
+        n1 = geos[0].teeth
+        ctooth = np.zeros((kphi.size, kphi.size))
+        ctooth[:n1, :n1] = blocks[0]
+        ctooth[n1:, n1:] = blocks[1]
+    return Model(gp, pp, lp, kphi, tuple(geos), pair, tuple(inert), tuple(bodies), (gear1, gear2, law, material), ctooth)
+
+
+def _check_compliance(gi: GearInput, z: int, name: str) -> None:
+    c = np.asarray(gi.tooth_compliance, float)
+    if c.shape != (z, z):
+        raise ValueError(f"{name}.tooth_compliance: expected a {z} x {z} matrix, got shape {c.shape}")
+    if not np.all(np.isfinite(c)) or np.max(np.abs(c - c.T)) > 1e-9 * np.max(np.abs(c)):
+        raise ValueError(f"{name}.tooth_compliance: must be finite and symmetric")
+    try:
+        np.linalg.cholesky(c)
+    except np.linalg.LinAlgError:
+        raise ValueError(f"{name}.tooth_compliance: must be positive definite") from None

@@ -7,7 +7,9 @@ Body-torsion coupling (``Model.coupled``): the teeth sit on a rigid rim joined t
 the body spring k_body. In statics the spring carries the whole gear torque (T on gear 2,
 T*rb1/rb2 on the driver under flank contact), so the rims stand at the hub angles less the
 constant wind-ups: the kernel solves the mesh in rim angles and the hubs' TE adds
-rb1*M1/k_body1 + rb2*T/k_body2.
+rb1*M1/k_body1 + rb2*T/k_body2. Teeth coupled through the body (``Model.teeth_coupled``,
+the compliance model) take their spring moments from the compliance matrix of the teeth
+near the mesh (`kernels.toothcoupling`).
 """
 from __future__ import annotations
 
@@ -67,8 +69,10 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     rim_angles = angles - windup1 if model.coupled else angles
     if model.coupled:
         theta2 -= windup2
+    # teeth coupled through the bodies: their springs act through the compliance matrix alone
+    kphi = np.zeros_like(model.k_phi) if model.teeth_coupled else model.k_phi
     fails = static_sweep(rim_angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
-                         model.law_par, model.k_phi, tol, max_iter, te, nc, f1, it, th2)
+                         model.law_par, kphi, model.tooth_compliance, tol, max_iter, te, nc, f1, it, th2)
     if model.coupled:
         th2 += windup2
         te[:] = rb1 * angles + rb2 * th2

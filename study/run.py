@@ -37,41 +37,54 @@ def tooth_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
     return fe_springs(scene, g)
 
 
+def coupling_fit(scene: Scene, g: int):
+    """Gear g's foundation coupling identified from its FE body: a `BodyTorsionFit`
+    ('body-torsion'), a `ToothComplianceFit` ('compliance'), or None (the plain model)."""
+    from . import coupling
+    model = scene.coupling.model
+    if model == "body-torsion":
+        return coupling.body_torsion(scene, g)
+    if model == "compliance":
+        return coupling.tooth_compliance(scene, g)
+    return None
+
+
 def coupled_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gear g's tooth springs without the body wind-up [N·m/rad] (linear, n_k = 1) and the
-    FE stiffness ratio [1] of the plain model's springs (body-torsion coupling)."""
-    from .coupling import body_torsion
-    fit = body_torsion(scene, g)
-    ratio = tooth_springs(scene, g)[1]
-    return fit.k_tooth / units.spring_stiffness_to_si(1.0), ratio
+    """Gear g's tooth springs without the body wind-up [N·mm/rad] (linear, n_k = 1; with the
+    compliance model each tooth's own spring, loaded alone) and the FE stiffness ratio [1] of
+    the plain model's springs."""
+    fit = coupling_fit(scene, g)
+    k = fit.k_tooth if scene.coupling.model == "body-torsion" else fit.k_own
+    return k / units.spring_stiffness_to_si(1.0), tooth_springs(scene, g)[1]
 
 
 def scene_springs(scene: Scene):
     """((k1, r1), (k2, r2)): per-tooth springs [N·mm/rad^n_k] and stiffness ratios of both gears."""
-    if scene.coupling.model == "body-torsion":
+    if scene.coupling.model != "none":
         return coupled_springs(scene, 1), coupled_springs(scene, 2)
     return tooth_springs(scene, 1), tooth_springs(scene, 2)
 
 
 def build_scene_model(scene: Scene, springs=None) -> Model:
     """The solver model of a scene (SI). ``springs`` = ((k1, r1), (k2, r2)) skips the FE of
-    the tooth springs (a body-torsion coupling still takes its body springs from the FE)."""
+    the tooth springs (a coupled model still takes its body springs from the FE)."""
     springs = springs or scene_springs(scene)
-    coupled = scene.coupling.model == "body-torsion"
     gears = []
     for g in (1, 2):
         gs = scene.gear(g)
-        if coupled:
-            from .coupling import body_torsion
-            fit = body_torsion(scene, g)
+        fit = coupling_fit(scene, g)
+        cmat = None
+        if fit is not None:
             k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
+            if scene.coupling.model == "compliance":
+                cmat = fit.compliance
         else:
             k_body, n_k, pivot = math.inf, gs.spring.n_k, scene.pivot_radius(g)
         gears.append(GearInput(tooth=scene.tooth_spec(g), body=scene.body_spec(g),
                                pivot_radius=pivot,
                                k_phi=units.spring_stiffness_to_si(np.asarray(springs[g - 1][0], float)),
                                n_k=n_k, c_phi=units.spring_damping_to_si(gs.spring.c_phi),
-                               n_c=gs.spring.n_c, body_stiffness=k_body))
+                               n_c=gs.spring.n_c, body_stiffness=k_body, tooth_compliance=cmat))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(c.c_con, c.m2, c.m3), c.m2, c.m3)

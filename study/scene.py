@@ -137,7 +137,9 @@ class FESection:
 class CouplingSection:
     model: str = _f("none", "", "foundation coupling between the teeth: 'none' (the paper's per-tooth springs) or "
                     "'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and identified "
-                    "from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not used)", choices=("none", "body-torsion"))
+                    "from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not used) or "
+                    "'compliance' (the same, with the tooth springs coupled through the FE compliance between the teeth: "
+                    "neighbours and hole positions)", choices=("none", "body-torsion", "compliance"))
 
 
 @dataclass(frozen=True)

@@ -115,7 +115,7 @@ def test_coupled_slow_transient_follows_coupled_statics(paper_solid_model):
     assert (st.te - plain.te).mean() == pytest.approx(body_windup(50.0, m.base_radii, K_BODY), rel=0.02)
 
 
-def _double_contact_errors(scene):
+def _double_contact_errors(scene, coupling="body-torsion"):
     """(plain-FE, coupled) STE errors [m] against the FE reference where the rigid geometry has
     two pairs in the path of contact, and the single-contact errors."""
     from study.coupling import plain_fe_springs
@@ -129,7 +129,7 @@ def _double_contact_errors(scene):
         k = plain_fe_springs(scene, g) / units.spring_stiffness_to_si(1.0)
         sp.append((k, np.ones_like(k)))
     plain = solve_static(build_scene_model(lin, tuple(sp)), angles, scene.quasi_static.torque).te - res.te
-    coupled = solve_static(build_scene_model(scene.replace(**{"coupling.model": "body-torsion"})), angles,
+    coupled = solve_static(build_scene_model(scene.replace(**{"coupling.model": coupling})), angles,
                            scene.quasi_static.torque).te - res.te
     two, one = nominal == 2, nominal == 1
     assert two.any() and one.any()
@@ -137,12 +137,13 @@ def _double_contact_errors(scene):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("coupling", ["body-torsion", "compliance"])
 @pytest.mark.parametrize("body", ["solid", "lightened"])
-def test_coupled_model_closes_the_double_contact_gap(body):
+def test_coupled_model_closes_the_double_contact_gap(body, coupling):
     """Per-tooth FE springs count the body wind-up once per loaded tooth: too stiff in double
-    contact. The body-torsion model, from the same FE body, is closer to the FE reference."""
+    contact. Both coupled models, from the same FE body, are closer to the FE reference."""
     s = small_scene(**{"fe.mesh_size": 1.2, **(LIGHT if body == "lightened" else {})})
-    p2, c2, p1, c1 = _double_contact_errors(s)
+    p2, c2, p1, c1 = _double_contact_errors(s, coupling)
     assert p2.mean() < 0                                      # plain: too stiff in double contact
     assert np.sqrt(np.mean(c2**2)) < 0.5 * np.sqrt(np.mean(p2**2))
     assert np.sqrt(np.mean(c1**2)) < np.sqrt(np.mean(p1**2)) + 2e-8

@@ -14,6 +14,7 @@ from numba import njit
 
 from .layout import C_FORCE, C_G2, C_GA, C_GB, C_KT, C_TOOTH1, C_TOOTH2, JN_HALF, K_CON, M1, RB, TOOTH0
 from .mesh import generalized_forces, mesh_contacts, tooth_spring_tangent
+from .toothcoupling import set_moment, set_stiffness
 
 
 @njit(cache=True)
@@ -64,19 +65,31 @@ def _unknowns(pairs, npair, gp, pos, lst):
 
 
 @njit(cache=True)
-def _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros):
-    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+def _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, coupled, q, r):
+    """Residual r on theta2 and the unknown teeth; a coupled model's tooth springs act
+    through the set stiffness ks (its per-tooth kphi are zero)."""
     generalized_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, q)
     r[0] = q[1]
     for a in range(nt):
         r[1 + a] = q[2 + lst[a]]
+        if coupled:
+            r[1 + a] -= set_moment(ks, lst, nt, phi, a)
+
+
+@njit(cache=True)
+def _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros, ks, coupled):
+    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+    _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, coupled, q, r)
     return nc, npair
 
 
 @njit(cache=True)
-def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_iter,
+def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, tol, max_iter,
                  te_out, nc_out, force1_out, iter_out, theta2_out):
     """Equilibrium at each driver angle theta1s[a] [rad] under the resisting torque [N m].
+
+    ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth are coupled
+    through the body (`toothcoupling`; its kphi are then zero), or a 0 x 0 array.
 
     phi (Z1+Z2) is the start guess and is updated in place. Writes TE [m], the number of
     loaded contacts, the force on each gear-1 tooth [N] (force1_out[a, k]), the Newton
@@ -91,6 +104,8 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
     rec = np.zeros((64, 15))
     pairs = np.zeros((64, 3), dtype=np.int64)
     r = np.zeros(ntooth + 1)
+    coupled = ctooth.shape[0] > 0
+    ks = np.zeros((ntooth, 2 * ntooth)) if coupled else np.zeros((0, 0))
     rb1 = gp[0, RB]
     rb2 = gp[1, RB]
     tol_abs = tol * max(abs(torque), 1e-3)
@@ -115,6 +130,8 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
                 nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
             fresh = False
             nt = _unknowns(pairs, npair, gp, pos, lst)
+            if coupled:
+                set_stiffness(ctooth, lst, nt, ks)
             for i in range(ntooth):
                 if pos[i] < 0:
                     phi[i] = 0.0
@@ -132,10 +149,7 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
                 theta2 = (sgn * (pp[JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
             # residual from the contacts just found (same state: no second search)
-            generalized_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, q)
-            r[0] = q[1]
-            for m in range(nt):
-                r[1 + m] = q[2 + lst[m]]
+            _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, coupled, q, r)
             n = nt + 1
             rn = 0.0
             for i in range(n):
@@ -156,9 +170,14 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
                 for x in range(3):
                     for y in range(3):
                         K[idx[x], idx[y]] += kt * gv[x] * gv[y]
-            for m in range(nt):
-                i = lst[m]
-                K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
+            if coupled:
+                for m in range(nt):
+                    for m2 in range(nt):
+                        K[m + 1, m2 + 1] += ks[m, m2]
+            else:
+                for m in range(nt):
+                    i = lst[m]
+                    K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
             if K[0, 0] <= 0.0:
                 K[0, 0] = 1e-9
             dx = solve_dense(K, r[:n].copy())
@@ -172,7 +191,7 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, tol, max_
                 theta2 = th_old + step * dx[0]
                 for m in range(nt):
                     phi[lst[m]] = ph_old[m] + step * dx[m + 1]
-                nc, npair = _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros)
+                nc, npair = _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros, ks, coupled)
                 rn2 = 0.0
                 for i in range(n):
                     rn2 = max(rn2, abs(r[i]))

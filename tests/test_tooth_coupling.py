@@ -1,0 +1,143 @@
+"""Teeth coupled through the body (the compliance model): the set-stiffness kernel, the
+limits, the identification, and statics in single and double contact."""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from solver.coupling import tooth_compliance_fit
+from solver.identify import lever
+from solver.kernels.toothcoupling import set_energy, set_moment, set_stiffness
+from solver.model import build_model
+from solver.statics import solve_static
+
+from conftest import SMALL_PAIR, solid_scene
+
+RNG = np.random.default_rng(7)
+
+
+def spd(n, scale=1e-3):
+    a = RNG.normal(size=(n, n))
+    return scale * (a @ a.T / n + np.eye(n))
+
+
+@pytest.mark.parametrize("jit", [True, False])
+def test_set_stiffness_inverts_the_set_block_and_gives_moments_and_energy(jit):
+    f_inv, f_mom, f_en = ((set_stiffness, set_moment, set_energy) if jit else
+                          (set_stiffness.py_func, set_moment.py_func, set_energy.py_func))
+    C = spd(9)
+    lst = np.array([7, 2, 4, 3, 0, 0, 0, 0, 0])
+    n = 4
+    ks = np.zeros((9, 18))
+    f_inv(C, lst, n, ks)
+    S = lst[:n]
+    K = np.linalg.inv(C[np.ix_(S, S)])
+    assert ks[:n, :n] == pytest.approx(K, rel=1e-10)
+    phi = RNG.normal(size=9) * 1e-4
+    m = np.array([f_mom(ks, lst, n, phi, a) for a in range(n)])
+    assert m == pytest.approx(K @ phi[S], rel=1e-10)
+    assert f_en(ks, lst, n, phi) == pytest.approx(0.5 * phi[S] @ K @ phi[S], rel=1e-10)
+
+
+def with_compliance(model, c1, c2, k_body=(math.inf, math.inf)):
+    g1, g2, law, mat = model.inputs
+    return build_model(dataclasses.replace(g1, n_k=1.0, tooth_compliance=c1, body_stiffness=k_body[0]),
+                       dataclasses.replace(g2, n_k=1.0, tooth_compliance=c2, body_stiffness=k_body[1]), law, mat)
+
+
+@pytest.fixture(scope="module")
+def linear_pair():
+    from study.run import build_scene_model
+    return build_scene_model(solid_scene(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
+
+
+def ring(z, k, coupling):
+    """Compliance [rad/(N m)] of z teeth of own spring k with the neighbours coupled by
+    ``coupling`` (fraction of the own compliance, one and two pitches apart)."""
+    C = np.eye(z) / k
+    for d, c in enumerate(coupling, start=1):
+        for a in range(z):
+            C[a, (a + d) % z] = C[(a + d) % z, a] = c / k
+    return C
+
+
+def test_diagonal_compliance_is_the_plain_linear_model(linear_pair):
+    angles = np.radians(np.arange(0.0, 16.0, 0.25))
+    plain = solve_static(linear_pair, angles, 50.0)
+    z1, z2 = linear_pair.teeth
+    k1, k2 = linear_pair.k_phi[:z1], linear_pair.k_phi[z1:]
+    m = with_compliance(linear_pair, np.diag(1 / k1), np.diag(1 / k2))
+    assert m.teeth_coupled and not m.coupled
+    assert m.k_phi == pytest.approx(linear_pair.k_phi)
+    st = solve_static(m, angles, 50.0)
+    assert st.te == pytest.approx(plain.te, abs=1e-14)
+    assert st.tooth_force == pytest.approx(plain.tooth_force, rel=1e-9, abs=1e-9)
+
+
+def test_coupling_softens_double_contact_and_leaves_single_contact():
+    """A neighbour's load turns a tooth too: where two pairs carry the load the mesh is softer;
+    where one pair carries it alone the unloaded neighbours change nothing (the small pair,
+    contact ratio 1.6)."""
+    from study.run import build_scene_model
+    small = build_scene_model(solid_scene(**{**SMALL_PAIR, "gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
+    angles = np.radians(np.arange(0.0, 15.0, 0.1))
+    z1, z2 = small.teeth
+    k = float(small.k_phi[0])
+    plain = solve_static(with_compliance(small, ring(z1, k, ()), ring(z2, k, ())), angles, 50.0)
+    coupled = solve_static(with_compliance(small, ring(z1, k, (0.3, 0.1)), ring(z2, k, (0.3, 0.1))), angles, 50.0)
+    loaded = plain.n_contacts
+    one, two = (loaded == 1) & (coupled.n_contacts == 1), loaded == 2
+    assert one.any() and two.any()
+    d = coupled.te - plain.te
+    assert np.abs(d[one]).max() < 1e-12
+    elastic = plain.te[two] - small.backlash_offset
+    assert d[two].min() > 0 and np.median(d[two] / elastic) > 0.1
+
+
+def test_compliance_of_the_body_tooth_model_is_recovered_by_the_fit():
+    """Samples made by the model itself (body part + pivot levers, three teeth coupled):
+    the fit returns c_body, the pivot and every pair's C."""
+    rb, psi_b, z = 0.047, 0.05, 6
+    c_body, r_q = 1.3e-9, 0.0465
+    C = ring(z, 4000.0, (0.1, 0.02)) * (1 + 0.05 * np.cos(2 * np.pi * np.arange(z) / 3))[:, None]
+    C = 0.5 * (C + C.T)
+    u = np.linspace(0.25, 0.45, 7)
+    pairs, sp, ur, ul, val = [], [], [], [], []
+    for a in range(z):
+        for d in (-2, -1, 0, 1, 2):
+            b = (a + d) % z
+            uu = np.column_stack([u, u]) if d == 0 else np.array([(x, y) for x in u for y in u])
+            sp.append(np.full(len(uu), len(pairs)))
+            pairs.append((a, b))
+            ur.append(uu[:, 0]); ul.append(uu[:, 1])
+            L = lever(rb, psi_b - uu[:, 0], r_q) * lever(rb, psi_b - uu[:, 1], r_q)
+            val.append(c_body + L * C[a, b])
+    cat = np.concatenate
+    fit = tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z, rb, psi_b, (0.044, 0.048))
+    assert fit.c_body == pytest.approx(c_body, rel=1e-6)
+    assert fit.pivot_radius == pytest.approx(r_q, rel=1e-5)
+    assert fit.compliance == pytest.approx(np.where(np.abs(C) > 0, C, 0.0), rel=1e-5)
+    assert fit.k_body == pytest.approx(rb**2 / c_body, rel=1e-6)
+    assert fit.reach == 2 and fit.rms_rel_error < 1e-6
+    with pytest.raises(ValueError, match="pivot_bounds"):
+        tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z, rb, psi_b, (0.048, 0.044))
+    with pytest.raises(ValueError, match="every pair"):
+        tooth_compliance_fit(np.array(pairs + [(0, 3)]), cat(sp), cat(ur), cat(ul), cat(val), z, rb, psi_b, (0.044, 0.048))
+
+
+def test_bad_compliance_matrices_are_refused(linear_pair):
+    z1, z2 = linear_pair.teeth
+    k = float(linear_pair.k_phi[0])
+    good = ring(z2, k, (0.3,))
+    with pytest.raises(ValueError, match="gear1.tooth_compliance: expected"):
+        with_compliance(linear_pair, good[:5, :5], None)
+    bad = good.copy()
+    bad[0, 1] *= 2
+    with pytest.raises(ValueError, match="gear2.tooth_compliance: must be finite and symmetric"):
+        with_compliance(linear_pair, None, bad)
+    with pytest.raises(ValueError, match="positive definite"):
+        with_compliance(linear_pair, None, ring(z2, k, (0.9, 0.9)))
+    g1, g2, law, mat = linear_pair.inputs
+    with pytest.raises(ValueError, match="n_k"):
+        build_model(dataclasses.replace(g1, n_k=1.1), dataclasses.replace(g2, n_k=1.0, tooth_compliance=good), law, mat)
