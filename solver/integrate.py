@@ -93,8 +93,11 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
         M[i, i] = gp[g, L.I_P]
         if g == 1:
             M[0, i] = M[i, 0] = gp[1, L.I_CPL]
-        K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
+        if not model.teeth_coupled:
+            K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
         C[i, i] += spring_damping_tangent(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
+    if model.teeth_coupled:     # the springs of the teeth near the mesh: (C[S, S])^-1
+        K[1:, 1:] += np.linalg.inv(model.tooth_compliance[np.ix_(teeth, teeth)])
     for c in range(nc):
         kt = rec[c, L.C_KT]
         ia = int(rec[c, L.C_TOOTH1])
@@ -218,9 +221,13 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     phi = np.zeros(model.n_teeth)
     dphi = np.zeros(model.n_teeth)
     omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
+    if model.teeth_coupled and not model.coupled:
+        raise ValueError("tooth_compliance: the dynamics of teeth coupled through the body need the body "
+                         "springs too (coupling.model = 'compliance' identifies both)")
     if model.coupled:
         from .kernels.explicit_coupled import verlet_coupled
         status, step, max_act = verlet_coupled(model.gear_par, model.pair_par, model.law_par, model.k_phi,
+                                               model.tooth_compliance,
                                                float(speed), float(speed_ramp), float(torque), float(torque_ramp),
                                                dt, n_steps, out_every, 0.0, 0.0, theta2, 0.0, theta2, 0.0, phi, dphi,
                                                phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)

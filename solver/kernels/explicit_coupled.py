@@ -15,6 +15,13 @@ I_HUB1*theta1'' + k_body1*(theta1 - r1) + c_body1*(theta1' - r1'). The body spri
 linear damping c_body (``C_BODY``, from a damping ratio on the body mode). TE is read at the
 hubs: rb1*theta1 + rb2*h2. Energy bookkeeping as in `explicit.py` plus the hub kinetic
 energy and the body springs' potential energy.
+
+Teeth coupled through the body (``ctooth``, the compliance model; 0 x 0 otherwise): the
+teeth of the pre-search candidates form the set S whose springs act through
+K_S = (C[S, S])^-1 (`toothcoupling`); the other active teeth keep their own spring
+kphi = 1/C[a, a]. When S changes, a tooth that joins it takes on the rotation and rate its
+neighbours' moments give it (phi_i += sum_b C[i, b] M_b), and a tooth that leaves gives them
+back, so that the spring moments of all teeth stay continuous through the change.
 """
 import math
 
@@ -27,6 +34,7 @@ from .layout import C_BODY, C_DELTA, C_FORCE, I_CPL, I_HUB, I_P, I_TOT, K_BODY, 
 from .mesh import generalized_forces, mesh_contacts
 from .stepping import (OK, PENETRATION, checked_status, clear_candidates, freeze_quiet_teeth,
                        loaded_contacts, record_output)
+from .toothcoupling import set_energy, set_moment, set_stiffness
 
 
 @njit(cache=True)
@@ -60,7 +68,8 @@ def _rim_accelerations(q, act, nact, gp, acc, tz2, m1, m2):
 
 
 @njit(cache=True)
-def _energies_coupled(w1, v1, w2, wh2, th1, r1, th2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2):
+def _energies_coupled(w1, v1, w2, wh2, th1, r1, th2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2,
+                      ks, slst, ns):
     ke = 0.5 * gp[0, I_HUB] * w1 * w1 + 0.5 * (gp[0, I_TOT] - gp[0, I_HUB]) * v1 * v1
     ke += 0.5 * gp[1, I_HUB] * wh2 * wh2 + 0.5 * (gp[1, I_TOT] - gp[1, I_HUB]) * w2 * w2
     pe = 0.5 * gp[0, K_BODY] * (th1 - r1) ** 2 + 0.5 * gp[1, K_BODY] * (h2 - th2) ** 2
@@ -72,11 +81,69 @@ def _energies_coupled(w1, v1, w2, wh2, th1, r1, th2, h2, phi, dphi, act, nact, k
         pe += spring_energy(phi[i], kphi[i], gp[g, N_K])
     for c in range(nc):
         pe += contact_energy(rec[c, C_DELTA], lp[K_CON], lp[M1])
+    if ns > 0:      # the set's springs through K_S instead of their own (linear) springs
+        pe += set_energy(ks, slst, ns, phi)
+        for a in range(ns):
+            i = slst[a]
+            pe -= 0.5 * kphi[i] * phi[i] * phi[i]
     return ke, pe
 
 
 @njit(cache=True)
-def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
+def _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, vpred, mo, dmo):
+    """Make newl[:nn] the coupled set (``inset`` flags the old members): teeth that join take
+    their neighbours' share of rotation and rate, teeth that leave give it back (the spring
+    moments stay continuous). Returns the new size."""
+    for a in range(nn):
+        innew[newl[a]] = True
+    same = nn == ns
+    if same:
+        for a in range(ns):
+            if not innew[slst[a]]:
+                same = False
+                break
+    if not same:
+        for a in range(ns):
+            mo[a] = set_moment(ks, slst, ns, phi, a)
+            dmo[a] = set_moment(ks, slst, ns, vpred, a)
+        for a in range(ns):                     # leaving
+            i = slst[a]
+            if not innew[i]:
+                for b in range(ns):
+                    j = slst[b]
+                    if j != i:
+                        phi[i] -= ctooth[i, j] * mo[b]
+                        dphi[i] -= ctooth[i, j] * dmo[b]
+                        vpred[i] -= ctooth[i, j] * dmo[b]
+                inset[i] = False
+        for a in range(nn):                     # joining
+            i = newl[a]
+            if not inset[i]:
+                for b in range(ns):
+                    j = slst[b]
+                    phi[i] += ctooth[i, j] * mo[b]
+                    dphi[i] += ctooth[i, j] * dmo[b]
+                    vpred[i] += ctooth[i, j] * dmo[b]
+        for a in range(nn):
+            slst[a] = newl[a]
+            inset[newl[a]] = True
+        set_stiffness(ctooth, slst, nn, ks)
+        ns = nn
+    for a in range(nn):
+        innew[newl[a]] = False
+    return ns
+
+
+@njit(cache=True)
+def _set_springs(ks, slst, ns, kphi, phi, q):
+    """Replace the own elastic spring torque of the set's teeth by the coupled one."""
+    for a in range(ns):
+        i = slst[a]
+        q[2 + i] += kphi[i] * phi[i] - set_moment(ks, slst, ns, phi, a)
+
+
+@njit(cache=True)
+def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
                    r1, v1, theta2, w2, h2, wh2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol,
                    o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
     """Integrate n_steps of size dt [s] from t = 0 (see the module docstring).
@@ -84,6 +151,7 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
     Initial state: driver rim r1 [rad] and speed v1, driven rim theta2 and w2, driven hub h2
     and wh2, phi and dphi (updated in place). Outputs as `explicit.verlet`, with TE and
     theta2 at the hubs; the same guards (energy growth beyond ``energy_tol`` as in `verlet`).
+    ``ctooth``: the tooth compliance [rad/(N m)] of teeth coupled through the body, or 0 x 0.
     Returns (status, step reached, max active teeth).
     """
     ntooth = phi.shape[0]
@@ -106,6 +174,16 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
     active = np.zeros(ntooth, dtype=np.bool_)
     act = np.zeros(ntooth, dtype=np.int64)
     incand = np.zeros(ntooth, dtype=np.bool_)
+    coupled = ctooth.shape[0] > 0
+    ms = 64 if coupled else 0               # the coupled set: the candidates' teeth
+    ks = np.zeros((ms, 2 * ms))
+    slst = np.zeros(ms, dtype=np.int64)
+    newl = np.zeros(ms, dtype=np.int64)
+    mo = np.zeros(ms)
+    dmo = np.zeros(ms)
+    inset = np.zeros(ntooth, dtype=np.bool_)
+    innew = np.zeros(ntooth, dtype=np.bool_)
+    ns = 0
     for i in range(ntooth):
         if phi[i] != 0.0 or dphi[i] != 0.0:
             active[i] = True
@@ -115,9 +193,18 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
     th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
     tl = load_torque(0.0, torque, torque_ramp)
     nc, npair = mesh_contacts(r1, theta2, phi, v1, w2, dphi, gp, pp, lp, pairs, rec)
+    nn = 0
     for p in range(npair):
-        active[int(pairs[p, 0])] = True
-        active[tz2 + int(pairs[p, 1])] = True
+        for g in range(2):
+            i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
+            active[i] = True
+            if coupled and not incand[i]:
+                incand[i] = True
+                newl[nn] = i
+                nn += 1
+    if coupled:
+        ns = _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, dphi, mo, dmo)
+        clear_candidates(incand, pairs, npair, tz2)
     nact = 0
     for i in range(ntooth):
         if active[i]:
@@ -126,6 +213,7 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
     for i in range(ntooth + 2):
         q[i] = 0.0
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, 0.0, q)
+    _set_springs(ks, slst, ns, kphi, phi, q)
     mb1 = kb1 * (th1 - r1) + cb1 * (w1 - v1)
     mb2 = kb2 * (h2 - theta2) + cb2 * (wh2 - w2)
     q[0] += mb1
@@ -133,7 +221,7 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
     a1, a2 = _rim_accelerations(q, act, nact, gp, acc, tz2, mr1, mr2)
     ah2 = (tl - mb2) / ih2
     react = ih1 * acc1 + mb1
-    ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+    ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2, ks, slst, ns)
     e0 = ke + pe
     work = 0.0
     diss = 0.0
@@ -168,9 +256,13 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
         nc, npair = mesh_contacts(r1, theta2, phi, v1p, w2p, vpred, gp, pp, lp, pairs, rec)
+        nn = 0
         for p in range(npair):
             for g in range(2):
                 i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
+                if coupled and not incand[i]:
+                    newl[nn] = i
+                    nn += 1
                 incand[i] = True
                 if not active[i]:
                     active[i] = True
@@ -178,9 +270,12 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
                     nact += 1
                     acc[i] = 0.0
                     vpred[i] = 0.0
+        if coupled:
+            ns = _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, vpred, mo, dmo)
         for i in range(ntooth + 2):
             q[i] = 0.0
         generalized_forces(rec, nc, phi, vpred, act, nact, kphi, gp, 0.0, q)
+        _set_springs(ks, slst, ns, kphi, phi, q)
         mb1 = kb1 * (th1 - r1) + cb1 * (w1 - v1p)
         mb2 = kb2 * (h2 - theta2) + cb2 * (wh2p - w2p)
         q[0] += mb1
@@ -215,7 +310,7 @@ def verlet_coupled(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt,
             max_act = nact
         if step % out_every == 0:
             o += 1
-            ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
+            ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2, ks, slst, ns)
             record_output(o, t, rb1 * th1 + rb2 * h2, fmax, loaded_contacts(rec, nc), react, ke, pe, work, diss, h2,
                           o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
             fmax = 0.0
