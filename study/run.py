@@ -16,6 +16,7 @@ import xarray as xr
 from solver import units
 from solver.implicit import choose_method, simulate_implicit
 from solver.integrate import simulate
+from solver.kernels.layout import R_PV
 from solver.model import ContactLaw, GearInput, Model, build_model
 from solver.statics import solve_static
 
@@ -159,6 +160,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         "wall_time_springs_s": t_springs,
         "coupling": scene.coupling.model,
         "body_stiffness_N_m_rad": np.array([k if math.isfinite(k) else 0.0 for k in model.body_stiffness]),
+        "pivot_radius_mm": model.gear_par[:, R_PV] * units.MM_PER_M,
+        "teeth_coupled": int(model.teeth_coupled),
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
         **results.provenance(),
     }
