@@ -104,9 +104,11 @@ class Point:
     error: str = ""         # the SceneError text of an invalid combination
 
     def key(self, outputs: Outputs) -> str:
-        """Content hash of what this point computes: same scene and outputs -> same key."""
+        """Content hash of what this point computes: same scene, outputs and code -> same key
+        (a resumed study never mixes points computed by two versions of the code)."""
+        from .results import code_fingerprint
         what = self.scene.to_toml() if self.scene is not None else json.dumps(self.values, sort_keys=True)
-        blob = json.dumps([what, list(outputs.scalars), list(outputs.curves)])
+        blob = json.dumps([what, list(outputs.scalars), list(outputs.curves), code_fingerprint()])
         return hashlib.sha256(blob.encode()).hexdigest()[:24]
 
 

@@ -18,8 +18,11 @@ Global attributes: the scene as TOML, backlash offset, mesh and hole orders, ver
 from __future__ import annotations
 
 import datetime
+import functools
+import hashlib
 import platform
 from importlib import metadata
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -39,9 +42,23 @@ def versions() -> str:
     return ", ".join(out)
 
 
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """Hash of the source of the `solver` and `study` packages (file names and contents): any
+    change to the code that computes results changes it. Computed once per process."""
+    root = Path(__file__).resolve().parent.parent
+    h = hashlib.sha256()
+    for pkg in ("solver", "study"):
+        for path in sorted((root / pkg).rglob("*.py")):
+            h.update(str(path.relative_to(root)).encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
 def provenance() -> dict:
     return {
         "software": versions(),
+        "code_fingerprint": code_fingerprint(),
         "machine": f"{platform.node()} {platform.machine()} {platform.processor() or ''} python {platform.python_version()}".strip(),
         "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "Conventions": "CF-1.8",

@@ -8,7 +8,8 @@ of `SCALARS` and the requested curves.
 as it arrives (one small file per point in ``.OUT.nc.parts/``, written atomically), and writes
 the study archive (`study.archive`) atomically at the end. Re-running the same study after an
 interruption (Ctrl-C, a killed worker or process) computes only the missing points. Points are
-keyed by a hash of their scene and outputs, so an edited study reuses the points it shares.
+keyed by a hash of their scene, outputs and the code (`results.code_fingerprint`), so an
+edited study reuses the points it shares, and a changed code computes them all again.
 
 Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)

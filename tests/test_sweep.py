@@ -173,6 +173,23 @@ def test_rerunning_a_complete_study_computes_nothing(swept, monkeypatch):
     xr.testing.assert_identical(again.dataset, res.dataset)
 
 
+def test_changed_code_recomputes_every_point(swept, tmp_path, monkeypatch):
+    """Finished points of another version of the code are never reused, neither from the
+    part files nor from a complete archive."""
+    from study import results
+    res, out = swept
+    keys = [p.key(tiny_study().outputs) for p in tiny_study().points()]
+    monkeypatch.setattr(results, "code_fingerprint", lambda: "another-version")
+    assert not set(keys) & {p.key(tiny_study().outputs) for p in tiny_study().points()}
+    calls = []
+    monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or {"status": "failed", "message": "new code",
+                                                                               "wall_time": 0.0, "scalars": {}, "curves": {}})
+    copy = tmp_path / "copy.nc"
+    copy.write_bytes(out.read_bytes())
+    again = run_sweep(tiny_study(), copy, workers=0, progress=False)
+    assert again.reused == 0 and len(calls) == 8
+
+
 def test_interrupt_and_resume_give_the_same_archive(swept, tmp_path, monkeypatch):
     res, _ = swept
     out = tmp_path / "resumed.nc"
