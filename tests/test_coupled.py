@@ -15,7 +15,7 @@ from study import springs
 from study.run import build_scene_model
 from study.scene import SceneError
 
-from conftest import solid_scene
+from conftest import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 from test_ltca import LIGHT, small_scene
 
 
@@ -83,35 +83,19 @@ K_BODY = (1.5e6, 1.0e6)    # N m/rad, about the FE values of the paper's solid b
 
 
 def test_coupled_dynamics_conserve_energy_at_second_order():
-    from solver.integrate import simulate, stable_time_step
-    m = with_body_springs(build_scene_model(solid_scene(**UNDAMPED)), K_BODY, ratio=0.0)
-    dt0, _ = stable_time_step(m, 50.0)
-    errs = []
-    for dt in (dt0, dt0 / 2):
-        r = simulate(m, 100.0, 0.01, 50.0, 0.01, 0.004, dt=dt, output_step=1e-5, phi_quiet=0.0)
-        assert r.status == 0 and np.all(r.dissipated == 0)
-        errs.append(np.max(np.abs(r.energy_error)))
-        assert errs[-1] < 1e-5 * np.max(np.abs(r.work))
-    assert 3.0 < errs[0] / errs[1] < 5.5
+    assert_energy_closes_at_second_order(with_body_springs(build_scene_model(solid_scene(**UNDAMPED)), K_BODY, ratio=0.0))
 
 
 def test_coupled_slow_transient_follows_coupled_statics(paper_solid_model):
     """At 1 rad/s the coupled dynamics settle on the coupled static STE, which is the plain
     STE plus the body wind-up: the rims really carry the teeth and the hubs the TE."""
-    from solver.integrate import simulate
-    from solver.kernels.explicit import driver_motion
     m = with_body_springs(paper_solid_model, K_BODY)
-    r = simulate(m, 1.0, 0.001, 50.0, 0.001, 0.05, output_step=1e-4)
-    assert r.status == 0
-    th1 = np.array([driver_motion(t, 1.0, 0.001)[0] for t in r.time])
-    sel = th1 > math.radians(1.5)
-    st = solve_static(m, th1[sel], 50.0)
-    diff = r.te[sel] - st.te
+    diff, r, st = slow_transient_against_statics(m)
     # ringing of the lightly damped modes after each contact change: the rims alone (without
     # the hubs) ring against the mesh, so more than the plain pair's 0.1-0.15 um (0.29 um seen)
     assert abs(diff.mean()) < 0.03e-6 and np.abs(diff).max() < 0.4e-6
     assert np.max(np.abs(r.energy_error)) < 1e-3 * r.work[-1]
-    plain = solve_static(paper_solid_model, th1[sel], 50.0)
+    plain = solve_static(paper_solid_model, st.angle, 50.0)
     assert (st.te - plain.te).mean() == pytest.approx(body_windup(50.0, m.base_radii, K_BODY), rel=0.02)
 
 

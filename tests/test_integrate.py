@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import solid_scene
+from conftest import assert_energy_closes_at_second_order, solid_scene
 from solver.integrate import DivergenceError, simulate, stable_time_step
 from solver.statics import solve_static
 from study.run import build_scene_model, run_static
@@ -24,16 +24,7 @@ def test_energy_balance_without_damping_closes_at_second_order(undamped):
     re-engagement under the C1 law delta^1.24) the order drops, as expected of any
     fixed-step scheme across a non-smooth event.
     """
-    m = undamped
-    dt0, _ = stable_time_step(m, 50.0)
-    errs = []
-    for dt in (dt0, dt0 / 2):
-        # phi_quiet = 0: no tooth is frozen, so the balance measures the integrator alone
-        r = simulate(m, 100.0, 0.01, 50.0, 0.01, 0.004, dt=dt, output_step=1e-5, phi_quiet=0.0)
-        assert r.status == 0 and np.all(r.dissipated == 0)
-        errs.append(np.max(np.abs(r.energy_error)))
-        assert errs[-1] < 1e-5 * np.max(np.abs(r.work))     # bounded: no secular drift
-    assert 3.0 < errs[0] / errs[1] < 5.5
+    assert_energy_closes_at_second_order(undamped)
 
 
 def test_convergence_order_two(undamped):

@@ -12,7 +12,7 @@ from solver.kernels.toothcoupling import set_energy, set_moment, set_stiffness
 from solver.model import build_model
 from solver.statics import solve_static
 
-from conftest import SMALL_PAIR, solid_scene
+from conftest import SMALL_PAIR, assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 
 RNG = np.random.default_rng(7)
 
@@ -163,31 +163,14 @@ def coupled_pair(scene_overrides, coupling=COUPLING, ratio=0.02):
 def test_coupled_teeth_dynamics_conserve_energy():
     """Undamped: the energy balance closes at second order in dt, set changes included (the
     joining and leaving teeth keep the spring moments continuous)."""
-    from solver.integrate import simulate, stable_time_step
-    m = coupled_pair(UNDAMPED, ratio=0.0)
-    dt0, _ = stable_time_step(m, 50.0)
-    errs = []
-    for dt in (dt0, dt0 / 2):
-        r = simulate(m, 100.0, 0.01, 50.0, 0.01, 0.004, dt=dt, output_step=1e-5, phi_quiet=0.0)
-        assert r.status == 0 and np.all(r.dissipated == 0)
-        errs.append(np.max(np.abs(r.energy_error)))
-        assert errs[-1] < 1e-5 * np.max(np.abs(r.work))
-    assert 3.0 < errs[0] / errs[1] < 5.5
+    assert_energy_closes_at_second_order(coupled_pair(UNDAMPED, ratio=0.0))
 
 
 def test_coupled_teeth_slow_transient_follows_statics():
     """At 1 rad/s the dynamics settle on the static STE of the same coupled model."""
-    from solver.integrate import simulate
-    from solver.kernels.explicit import driver_motion
-    m = coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0})
-    r = simulate(m, 1.0, 0.001, 50.0, 0.001, 0.05, output_step=1e-4)
-    assert r.status == 0
-    th1 = np.array([driver_motion(t, 1.0, 0.001)[0] for t in r.time])
-    sel = th1 > math.radians(1.5)
-    st = solve_static(m, th1[sel], 50.0)
-    diff = r.te[sel] - st.te
+    diff, _r, st = slow_transient_against_statics(coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
     assert abs(diff.mean()) < 0.03e-6 and np.abs(diff).max() < 0.4e-6     # as the body-torsion model
-    uncoupled = solve_static(coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}, ()), th1[sel], 50.0)
+    uncoupled = solve_static(coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}, ()), st.angle, 50.0)
     assert (st.te - uncoupled.te).mean() > 0.1e-6          # the coupling is really there
 
 
