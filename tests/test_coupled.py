@@ -175,6 +175,10 @@ def test_validation_workflow_writes_archive_and_figures(tmp_path):
         assert np.isnan(ds["hole_amplitude"].sel(pair="solid", model="fe-reference"))
         assert ds["hole_amplitude"].sel(pair="lightened", model="fe-reference") > 0
         assert ds["ste"].attrs["units"] == "um"
+        root = s.gear2.module * (s.gear2.teeth / 2 - s.gear2.dedendum)
+        piv = ds["compliance_pivot_radius"].values
+        assert np.all((root - s.gear2.body.rim_height <= piv) & (piv <= root))
+        assert np.all(ds["compliance_k_body"].values > 0) and np.all(ds["compliance_fit_rms"].values < 0.2)
     assert {p.name for p in out.parent.glob("*.png")} == {"ste_solid.png", "ste_lightened.png", "load_sharing_solid.png",
                                                           "load_sharing_lightened.png", "errors.png"}
 

@@ -153,10 +153,17 @@ def validation_dataset(scene, angles) -> xr.Dataset:
     nominal = np.zeros((len(PAIRS), na), dtype="int16")
     tab = {k: np.full((len(PAIRS), len(MODELS)), np.nan) for k in METRIC_DOC}
     wall = np.full((len(PAIRS), len(MODELS)), np.nan)
+    fit = {k: np.full((len(PAIRS), 2), np.nan) for k in ("k_body", "pivot", "rms")}
     offsets = []
     for p, name in enumerate(PAIRS):
         sc = pairs[name]
         s, f, nom, w, model = evaluate_pair(sc, angles)
+        if "compliance" in MODELS:
+            from study.coupling import tooth_compliance
+            for g in (1, 2):
+                tc = tooth_compliance(sc, g)
+                fit["k_body"][p, g - 1], fit["pivot"][p, g - 1], fit["rms"][p, g - 1] = (
+                    tc.k_body, tc.pivot_radius * units.MM_PER_M, tc.rms_rel_error)
         offsets.append(model.backlash_offset * units.UM_PER_M)
         m = metrics(angles, s, f, nom, sc, model)
         nominal[p] = nom
@@ -176,6 +183,11 @@ def validation_dataset(scene, angles) -> xr.Dataset:
             "wall_time": v(("pair", "model"), wall, "s", "wall time of the STE (FE compliance included for the reference)")}
     for k, (unit, doc) in METRIC_DOC.items():
         data[k] = v(("pair", "model"), tab[k], unit, doc)
+    coords["gear"] = v("gear", np.array([1, 2]), "1", "gear (1 driver, 2 driven)")
+    data["compliance_k_body"] = v(("pair", "gear"), fit["k_body"], "N m rad-1", "body torsion stiffness of the compliance model")
+    data["compliance_pivot_radius"] = v(("pair", "gear"), fit["pivot"], "mm", "tooth pivot radius of the compliance model")
+    data["compliance_fit_rms"] = v(("pair", "gear"), fit["rms"], "1",
+                                   "RMS relative residual of the compliance model's fit to the FE influence coefficients")
     attrs = {"title": "STE of the pseudo-rigid models against the FE reference", "scene": scene.to_toml(),
              "backlash_offset_um": offsets[0], "static_torque_N_m": scene.quasi_static.torque,
              "hole_order": float(scene.gear2.body.holes), "mesh_order": float(scene.gear2.teeth),
@@ -195,6 +207,11 @@ def print_table(ds: xr.Dataset) -> None:
                   f"{float(r['hole_amplitude']):7.4f} {float(r['error_mean']):+7.3f} {float(r['error_mean_single']):+7.3f} "
                   f"{float(r['error_mean_double']):+7.3f} {float(r['error_rms_single']):6.3f} {float(r['error_rms_double']):6.3f} "
                   f"{float(r['load_share_error_max']):6.3f} {float(r['wall_time']):7.2f}")
+    if "compliance_k_body" in ds:
+        for p in ds["pair"].values:
+            r = ds.sel(pair=p)
+            print(f"  compliance fit, {p:9s}: k_body {r['compliance_k_body'].values.round(-3)} N m/rad, pivot "
+                  f"{r['compliance_pivot_radius'].values.round(3)} mm, RMS residual {r['compliance_fit_rms'].values.round(4)}")
     for p in ds["pair"].values:
         ref = ds.sel(pair=p, model="fe-reference")
         for m in MODELS[1:]:
