@@ -70,8 +70,10 @@ class BodyModel:
     free: np.ndarray        # free DOF indices
     solve: object           # factorised K_ff: rhs -> displacement of the free DOFs
     material: Material
-    assembly_time: float = 0.0
-    factor_time: float = 0.0
+    assembly_time: float = 0.0   # wall seconds of the assembly (incl. basis and clamping)
+    factor_time: float = 0.0     # wall seconds of the factorisation
+    assembly_cpu: float = 0.0    # CPU seconds of the same (all threads of the process)
+    factor_cpu: float = 0.0
 
     @property
     def n_dofs(self) -> int:
@@ -85,34 +87,106 @@ def plane_stress_lame(E: float, nu: float) -> tuple[float, float]:
     return lam, mu
 
 
+def plane_stress_p2_stiffness(basis, lam: float, mu: float, thickness: np.ndarray):
+    """Stiffness matrix (COO, N x N) [N/m] of straight-sided quadratic triangles in plane stress
+    with Lame parameters ``lam`` (plane-stress lambda*), ``mu`` [Pa] and per-element
+    ``thickness`` [m], in the DOF numbering of the vector P2 ``basis`` (scikit-fem).
+
+    Closed form instead of the generic form assembly (about 4x faster on a gear body): on an
+    affine triangle the P2 gradients are linear, the integrand quadratic, so the edge-midpoint
+    rule integrates it exactly; the result equals ``skfem.asm(linear_elasticity)`` to rounding.
+    """
+    import scipy.sparse as sp
+
+    m = basis.mesh
+    t = m.t                                              # (3, nel) vertex indices
+    nel = t.shape[1]
+    x, y = m.p[0, t], m.p[1, t]
+    a2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0])     # twice the signed area
+    gl = np.empty((nel, 3, 2))                           # gradients of the barycentric coordinates
+    for k in range(3):
+        k1, k2 = (k + 1) % 3, (k + 2) % 3
+        gl[:, k, 0] = (y[k1] - y[k2]) / a2
+        gl[:, k, 1] = (x[k2] - x[k1]) / a2
+    # local vertex pair (a, b) of each element edge, in the basis' own edge order (t2f)
+    ends = m.facets[:, m.t2f]                            # (2, 3, nel) global vertices
+    loc = np.stack([[np.argmax(t == ends[s_, j][None, :], axis=0) for j in range(3)] for s_ in range(2)])
+    e = np.arange(nel)
+    xx, yy, xy = (np.zeros((nel, 6, 6)) for _ in range(3))
+    for q in range(3):                                   # midpoint of the edge opposite vertex q
+        bary = np.full((nel, 3), 0.5)
+        bary[:, q] = 0.0
+        g = np.empty((nel, 6, 2))                        # scalar P2 gradients: vertices, then edges
+        for k in range(3):
+            g[:, k] = (4 * bary[:, k] - 1)[:, None] * gl[:, k]
+        for j in range(3):
+            a, b = loc[0, j], loc[1, j]
+            g[:, 3 + j] = 4 * (bary[e, a][:, None] * gl[e, b] + bary[e, b][:, None] * gl[e, a])
+        gx, gy = g[:, :, 0], g[:, :, 1]
+        xx += gx[:, :, None] * gx[:, None, :]
+        yy += gy[:, :, None] * gy[:, None, :]
+        xy += gx[:, :, None] * gy[:, None, :]
+    w = (0.5 * np.abs(a2) * thickness / 3.0)[:, None, None]      # area/3 per point, times thickness
+    xx *= w; yy *= w; xy *= w
+    yx = xy.transpose(0, 2, 1)
+    ke = np.empty((nel, 12, 12))                         # local order: (x, y) of each scalar function
+    ke[:, 0::2, 0::2] = (lam + 2 * mu) * xx + mu * yy
+    ke[:, 1::2, 1::2] = (lam + 2 * mu) * yy + mu * xx
+    ke[:, 0::2, 1::2] = lam * xy + mu * yx
+    ke[:, 1::2, 0::2] = lam * yx + mu * xy
+    nd, fd = basis.nodal_dofs, basis.facet_dofs
+    dofs = np.empty((nel, 12), dtype=np.int64)
+    for k in range(3):
+        dofs[:, 2 * k], dofs[:, 2 * k + 1] = nd[0, t[k]], nd[1, t[k]]
+    for j in range(3):
+        dofs[:, 6 + 2 * j], dofs[:, 7 + 2 * j] = fd[0, m.t2f[j]], fd[1, m.t2f[j]]
+    rows = np.broadcast_to(dofs[:, :, None], ke.shape).ravel()
+    cols = np.broadcast_to(dofs[:, None, :], ke.shape).ravel()
+    return sp.coo_matrix((ke.ravel(), (rows, cols)), shape=(basis.N, basis.N))
+
+
+def factorise(K):
+    """Sparse LU of the symmetric positive definite K (CSC) for repeated solves.
+
+    Symmetric mode (one minimum-degree ordering of K + K^T for rows and columns, no pivoting,
+    which an SPD matrix does not need) has about half the fill of the default unsymmetric
+    COLAMD ordering: faster to factorise and to solve, half the memory.
+    """
+    from scipy.sparse.linalg import splu
+
+    return splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+
+
 def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material, order: int = 2) -> BodyModel:
     """Assemble K (thickness-weighted), clamp the bore and factorise once."""
     import time
 
     import skfem
-    from scipy.sparse.linalg import splu
     from skfem.models.elasticity import linear_elasticity
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     m = skfem.MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy())
     elem = skfem.ElementVector(skfem.ElementTriP2() if order == 2 else skfem.ElementTriP1())
     basis = skfem.Basis(m, elem)
     lam, mu = plane_stress_lame(material.youngs_modulus, material.poisson_ratio)
-    form = linear_elasticity(lam, mu)
     thickness = np.where(mesh.region == REGION_WEB, web_thickness, face_width)
-    K = None
-    for t in np.unique(thickness):
-        idx = np.nonzero(thickness == t)[0]
-        Kr = t * skfem.asm(form, skfem.Basis(m, elem, elements=idx))
-        K = Kr if K is None else K + Kr
+    if order == 2:
+        K = plane_stress_p2_stiffness(basis, lam, mu, thickness)
+    else:
+        form = linear_elasticity(lam, mu)
+        K = None
+        for t in np.unique(thickness):
+            idx = np.nonzero(thickness == t)[0]
+            Kr = t * skfem.asm(form, skfem.Basis(m, elem, elements=idx))
+            K = Kr if K is None else K + Kr
     r_tol = 1e-6 * mesh.bore_radius + 1e-9
     clamped = basis.get_dofs(lambda x: np.hypot(x[0], x[1]) < mesh.bore_radius + r_tol).all()
     free = np.setdiff1d(np.arange(basis.N), clamped)
-    Kff = K[free][:, free].tocsc()
-    t1 = time.perf_counter()
-    lu = splu(Kff, permc_spec="COLAMD")
-    t2 = time.perf_counter()
-    return BodyModel(mesh, basis, thickness, free, lu.solve, material, t1 - t0, t2 - t1)
+    Kff = K.tocsc()[:, free][free, :].tocsc()
+    t1, c1 = time.perf_counter(), time.process_time()
+    lu = factorise(Kff)
+    t2, c2 = time.perf_counter(), time.process_time()
+    return BodyModel(mesh, basis, thickness, free, lu.solve, material, t1 - t0, t2 - t1, c1 - c0, c2 - c1)
 
 
 def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) -> np.ndarray:

@@ -43,6 +43,8 @@ Units: SI (m, N, rad, N·m).
 from __future__ import annotations
 
 import math
+import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -171,12 +173,16 @@ def flank_load_vector(model: BodyModel, g: GearGeometry, case: LoadCase, u: floa
 
 
 def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth, read_teeth,
-                    patch: float, symmetric_body: bool = False, block: int = 48) -> BodyCompliance:
+                    patch: float, symmetric_body: bool = False, block: int = 48,
+                    timings: dict | None = None) -> BodyCompliance:
     """Influence coefficients [m/N] of a factorised body: unit loads at every (load tooth, u),
     displacement along the load direction read at the centreline point of every (read tooth, u).
 
-    One factorisation, right-hand sides in blocks of ``block`` (memory).
+    One factorisation, right-hand sides in blocks of ``block`` (memory). ``timings``: if given,
+    wall and CPU seconds of building the load vectors and of the solves are added to it
+    (keys ``loads_wall_s``, ``loads_cpu_s``, ``solve_wall_s``, ``solve_cpu_s``).
     """
+    clock = _Clock(timings)
     load_teeth = np.asarray(load_teeth, dtype=int)
     read_teeth = np.asarray(read_teeth, dtype=int)
     z = g.teeth
@@ -189,15 +195,36 @@ def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth
     cols = np.empty((m, len(loads)))
     for s in range(0, len(loads), block):
         chunk = loads[s:s + block]
-        F = np.column_stack([flank_load_vector(model, g, load_case(g, b % z, 0.0, ui), ui, 1.0, patch)
-                             for b, ui in chunk])
-        U = np.zeros((model.basis.N, len(chunk)))
-        U[model.free] = model.solve(np.ascontiguousarray(F[model.free]))
+        with clock("loads"):
+            F = np.column_stack([flank_load_vector(model, g, load_case(g, b % z, 0.0, ui), ui, 1.0, patch)
+                                 for b, ui in chunk])
+        with clock("solve"):
+            U = np.zeros((model.basis.N, len(chunk)))
+            U[model.free] = model.solve(np.ascontiguousarray(F[model.free]))
         R = np.asarray(P @ U)
         cols[:, s:s + len(chunk)] = dx[:, None] * R[:m] + dy[:, None] * R[m:]
     n_u = u.size
     G = cols.reshape(read_teeth.size, n_u, load_teeth.size, n_u)
     return BodyCompliance(np.asarray(u, float), read_teeth, load_teeth, G, symmetric_body, z)
+
+
+class _Clock:
+    """Adds the wall and CPU seconds of a ``with clock(name):`` block to ``timings`` (if any)."""
+
+    def __init__(self, timings: dict | None):
+        self.timings = timings
+
+    @contextmanager
+    def __call__(self, name: str):
+        if self.timings is None:
+            yield
+            return
+        w, c = time.perf_counter(), time.process_time()
+        try:
+            yield
+        finally:
+            self.timings[f"{name}_wall_s"] = self.timings.get(f"{name}_wall_s", 0.0) + time.perf_counter() - w
+            self.timings[f"{name}_cpu_s"] = self.timings.get(f"{name}_cpu_s", 0.0) + time.process_time() - c
 
 
 # ------------------------------------------------------------------ mesh kinematics
