@@ -142,8 +142,8 @@ def plane_stress_p2_stiffness(basis, lam: float, mu: float, thickness: np.ndarra
         dofs[:, 2 * k], dofs[:, 2 * k + 1] = nd[0, t[k]], nd[1, t[k]]
     for j in range(3):
         dofs[:, 6 + 2 * j], dofs[:, 7 + 2 * j] = fd[0, m.t2f[j]], fd[1, m.t2f[j]]
-    rows = np.broadcast_to(dofs[:, :, None], ke.shape).ravel()
-    cols = np.broadcast_to(dofs[:, None, :], ke.shape).ravel()
+    rows = np.repeat(dofs, 12, axis=1).ravel()
+    cols = np.tile(dofs, (1, 12)).ravel()
     return sp.coo_matrix((ke.ravel(), (rows, cols)), shape=(basis.N, basis.N))
 
 
@@ -183,7 +183,9 @@ def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: 
             K = Kr if K is None else K + Kr
     r_tol = 1e-6 * mesh.bore_radius + 1e-9
     clamped = basis.get_dofs(lambda x: np.hypot(x[0], x[1]) < mesh.bore_radius + r_tol).all()
-    free = np.setdiff1d(np.arange(basis.N), clamped)
+    keep = np.ones(basis.N, bool)
+    keep[clamped] = False
+    free = np.flatnonzero(keep)
     Kff = K.tocsc()[:, free][free, :].tocsc()
     t1, c1 = time.perf_counter(), time.process_time()
     lu = factorise(Kff)
