@@ -25,6 +25,7 @@ Units: SI in and out (m, N, Pa, N·m/rad).
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -68,7 +69,7 @@ class BodyModel:
     basis: object           # skfem Basis (vector P2)
     thickness: np.ndarray   # (m,) element thickness [m]
     free: np.ndarray        # free DOF indices
-    solve: object           # factorised K_ff: rhs -> displacement of the free DOFs
+    solve: object           # factorised K_ff: rhs -> displacement of the free DOFs (one BLAS thread)
     material: Material
     assembly_time: float = 0.0   # wall seconds of the assembly (incl. basis and clamping)
     factor_time: float = 0.0     # wall seconds of the factorisation
@@ -147,6 +148,70 @@ def plane_stress_p2_stiffness(basis, lam: float, mu: float, thickness: np.ndarra
     return sp.coo_matrix((ke.ravel(), (rows, cols)), shape=(basis.N, basis.N))
 
 
+_BLAS_THREADS: dict = {}     # library path -> [(get, set)] of its thread-count functions
+
+
+def _openblas_controls() -> list:
+    """(get_num_threads, set_num_threads) of every OpenBLAS library loaded in this process
+    (numpy's and scipy's wheels each bundle one, with prefixed symbol names); empty where they
+    cannot be found (not Linux, another BLAS). The loaded libraries are listed anew each call
+    (a millisecond), so one loaded later is not missed."""
+    import ctypes
+    import re
+
+    try:
+        with open("/proc/self/maps") as f:
+            paths = sorted(set(re.findall(r"(/\S*openblas\S*\.so\S*)", f.read())))
+    except OSError:
+        return []
+    out = []
+    for path in paths:
+        if path not in _BLAS_THREADS:
+            found = []
+            try:
+                lib = ctypes.CDLL(path)
+            except OSError:
+                lib = None
+            for prefix in ("openblas", "scipy_openblas") if lib is not None else ():
+                for suffix in ("", "64_"):
+                    get = getattr(lib, f"{prefix}_get_num_threads{suffix}", None)
+                    put = getattr(lib, f"{prefix}_set_num_threads{suffix}", None)
+                    if get is not None and put is not None:
+                        get.restype, put.argtypes = ctypes.c_int, [ctypes.c_int]
+                        found.append((get, put))
+            _BLAS_THREADS[path] = found
+        out += _BLAS_THREADS[path]
+    return out
+
+
+@contextmanager
+def one_blas_thread():
+    """Run the block in single-threaded OpenBLAS, then restore the thread counts.
+
+    SuperLU calls the dense BLAS once per supernode, thousands of small calls per factorisation
+    or block solve: with two BLAS threads on a two-core machine that is also running something
+    else, the solves of one gear body took 14 s instead of 2 s (threads waiting for each other
+    at every call), and they never ran faster than with one thread even on an idle machine.
+    """
+    controls = _openblas_controls()
+    old = [get() for get, _ in controls]
+    for _, put in controls:
+        put(1)
+    try:
+        yield
+    finally:
+        for (_, put), n in zip(controls, old):
+            put(n)
+
+
+def _solver(lu):
+    """lu.solve in single-threaded BLAS (see `one_blas_thread`)."""
+    def solve(rhs):
+        with one_blas_thread():
+            return lu.solve(rhs)
+    return solve
+
+
 def factorise(K):
     """Sparse LU of the symmetric positive definite K (CSC) for repeated solves.
 
@@ -156,7 +221,8 @@ def factorise(K):
     """
     from scipy.sparse.linalg import splu
 
-    return splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+    with one_blas_thread():
+        return splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
 
 
 def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material, order: int = 2) -> BodyModel:
@@ -190,7 +256,7 @@ def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: 
     t1, c1 = time.perf_counter(), time.process_time()
     lu = factorise(Kff)
     t2, c2 = time.perf_counter(), time.process_time()
-    return BodyModel(mesh, basis, thickness, free, lu.solve, material, t1 - t0, t2 - t1, c1 - c0, c2 - c1, lu)
+    return BodyModel(mesh, basis, thickness, free, _solver(lu), material, t1 - t0, t2 - t1, c1 - c0, c2 - c1, lu)
 
 
 def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) -> np.ndarray:
@@ -293,10 +359,11 @@ def _lower_solve(T, B: np.ndarray, block: int) -> np.ndarray:
     ``spsolve_triangular`` is about four times slower here."""
     from scipy.sparse.linalg import splu
 
-    lu = splu(T.tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
     X = np.empty_like(B)
-    for s in range(0, B.shape[1], block):
-        X[:, s:s + block] = lu.solve(np.ascontiguousarray(B[:, s:s + block]))
+    with one_blas_thread():
+        lu = splu(T.tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        for s in range(0, B.shape[1], block):
+            X[:, s:s + block] = lu.solve(np.ascontiguousarray(B[:, s:s + block]))
     return X
 
 
