@@ -189,9 +189,11 @@ def one_blas_thread():
     """Run the block in single-threaded OpenBLAS, then restore the thread counts.
 
     SuperLU calls the dense BLAS once per supernode, thousands of small calls per factorisation
-    or block solve: with two BLAS threads on a two-core machine that is also running something
-    else, the solves of one gear body took 14 s instead of 2 s (threads waiting for each other
-    at every call), and they never ran faster than with one thread even on an idle machine.
+    or block solve: with two BLAS threads on a two-core machine that was also running something
+    else, the reach-restricted solves of the paper reference took 14-15 s instead of 2.2-2.6 s
+    (threads waiting for each other at every call); the factorisation took the same time with
+    one thread or two. The setting is process-wide: other threads of the process run
+    single-threaded BLAS meanwhile.
     """
     controls = _openblas_controls()
     old = [get() for get, _ in controls]
