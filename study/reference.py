@@ -29,7 +29,8 @@ from .springs import _settings, cache_dir, contact_patch, reference_torque
 LTCA_VERSION = "2"          # bump when the influence coefficients' definition changes
 PROFILE_POINTS = 8          # roll-parameter grid points along each flank (STE within 0.01 um of 16)
 _memory: dict[str, BodyCompliance] = {}
-_bodies: dict = {}          # the last factorised body, reused by the next request for it
+_bodies: dict = {}          # the last BODY_SLOTS factorised bodies (least recently used first)
+BODY_SLOTS = 2              # one per gear: a reference and then the coupling of both gears reuse them
 
 
 def static_angles(scene: Scene, step_deg: float | None = None) -> np.ndarray:
@@ -88,17 +89,24 @@ def body_compliance_cached(scene: Scene, g: int, teeth: list, spread: int, n_u: 
             return c, info
         except (OSError, KeyError, ValueError):
             pass  # unreadable cache entry: recompute
-    t0 = time.perf_counter()
-    bkey = json.dumps(st, sort_keys=True, default=float)
-    model = _bodies.get(bkey)
+    t0, c0 = time.perf_counter(), time.process_time()
+    stages = {}              # wall and CPU seconds of each stage (CPU: all threads of the process)
+    # the body model depends on geometry, material and mesh size only (not on the load or pivot)
+    bkey = json.dumps({k: v for k, v in st.items() if k not in ("force", "pivot")}, sort_keys=True, default=float)
+    model = _bodies.pop(bkey, None)
     if model is None:
+        while len(_bodies) >= BODY_SLOTS:       # factorisations are large (~0.5 GB): keep a few
+            _bodies.pop(next(iter(_bodies)))
         mesh = mesh_body(geo, body, size, prefix=f"gear{g}.body")
+        stages.update(mesh_wall_s=time.perf_counter() - t0, mesh_cpu_s=time.process_time() - c0)
         model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, scene.material_spec())
-        _bodies.clear()          # keep one factorisation in memory (they are large)
-        _bodies[bkey] = model
+        stages.update(assembly_wall_s=model.assembly_time, assembly_cpu_s=model.assembly_cpu,
+                      factor_wall_s=model.factor_time, factor_cpu_s=model.factor_cpu)
+    _bodies[bkey] = model                       # most recently used last
     patch = contact_patch(scene, g, st["force"], size)
-    c = body_compliance(model, geo, u, load, read, patch, symmetric_body=symmetric)
-    info.update(cached=False, wall_time_s=time.perf_counter() - t0, dofs=int(model.n_dofs))
+    c = body_compliance(model, geo, u, load, read, patch, symmetric_body=symmetric, timings=stages)
+    info.update(cached=False, wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0,
+                dofs=int(model.n_dofs), stages=stages)
     _memory[key] = c
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -125,19 +133,20 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     model = build_scene_model(scene, springs=((np.full(n1, scene.gear1.spring.k_phi), np.ones(n1)),
                                               (np.full(n2, scene.gear2.spring.k_phi), np.ones(n2))))
     info = {}
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     if rigid:
         comp = (None, None)
     else:
         t1, t2, spread = teeth_in_mesh(model, angles)
+        info.update(wall_time_teeth_s=time.perf_counter() - t0, cpu_time_teeth_s=time.process_time() - c0)
         c1, i1 = body_compliance_cached(scene, 1, t1, spread, n_u)
         c2, i2 = body_compliance_cached(scene, 2, t2, spread, n_u)
         comp = (c1, c2)
         info.update(gear1=i1, gear2=i2)
-    info["wall_time_compliance_s"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    info.update(wall_time_compliance_s=time.perf_counter() - t0, cpu_time_compliance_s=time.process_time() - c0)
+    t0, c0 = time.perf_counter(), time.process_time()
     res = ltca_sweep(model, comp, angles, qs.torque)
-    info["wall_time_contact_s"] = time.perf_counter() - t0
+    info.update(wall_time_contact_s=time.perf_counter() - t0, cpu_time_contact_s=time.process_time() - c0)
     return res, model, info
 
 

@@ -142,3 +142,52 @@ def test_patch_load_equals_the_quadrature_of_a_uniform_traction():
     nd = model.basis.nodal_dofs
     total = np.array([f[nd[0]].sum() + f[model.basis.facet_dofs[0]].sum(), f[nd[1]].sum() + f[model.basis.facet_dofs[1]].sum()])
     assert np.allclose(total, 10.0 * d, rtol=1e-12)
+
+
+def test_closed_form_stiffness_equals_the_generic_form_assembly():
+    """The closed-form P2 plane-stress matrix (edge-midpoint rule, exact on straight triangles)
+    is scikit-fem's linear_elasticity assembly region by region, to rounding, and K is symmetric
+    with the three rigid-body motions in its null space."""
+    from skfem.models.elasticity import linear_elasticity
+    mesh = mesh_annulus(A, C, B, 3e-3)
+    m = skfem.MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy())
+    basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP2()))
+    lam, mu = fe.plane_stress_lame(STEEL.youngs_modulus, STEEL.poisson_ratio)
+    thickness = np.where(mesh.region == REGION_WEB, T_WEB, T_RIM)
+    K = fe.plane_stress_p2_stiffness(basis, lam, mu, thickness).tocsr()
+    ref = sum(t * skfem.asm(linear_elasticity(lam, mu), skfem.Basis(m, basis.elem, elements=np.flatnonzero(thickness == t)))
+              for t in (T_WEB, T_RIM))
+    assert abs(K - ref).max() < 1e-12 * abs(ref).max()
+    assert abs(K - K.T).max() < 1e-12 * abs(K).max()
+    x, y = basis.doflocs
+    nd = np.zeros(basis.N, int)
+    nd[basis.nodal_dofs[1]] = nd[basis.facet_dofs[1]] = 1            # y-component DOFs
+    for rigid in (nd == 0, nd == 1, np.where(nd == 0, -y, x)):      # shift x, shift y, rotation
+        assert np.abs(K @ rigid.astype(float)).max() < 1e-9 * abs(K).max() * B
+
+
+def test_influence_equals_one_solve_per_load():
+    """fe.influence (all loads at once, triangular solves restricted to the DOFs the loads and
+    reads reach) gives R K^-1 f for every load f exactly as a solve per load does, loads on
+    clamped DOFs included (they carry no displacement either way)."""
+    import scipy.sparse as sp
+    mesh = mesh_annulus(A, C, B, 2e-3)
+    model = fe.assemble(mesh, T_RIM, T_WEB, STEEL)
+    rng = np.random.default_rng(7)
+    N = model.basis.N
+    F = sp.random(N, 9, density=4e-3, random_state=rng, format="lil")      # scattered loads
+    F[model.basis.nodal_dofs[0, 0], 0] = 1.0                               # a node on the bore
+    F = F.tocsc()
+    pts = np.array([[0.025, 0.0], [0.0, -0.029], [-0.015, 0.012], [0.021, 0.021]]).T
+    P = model.basis.probes(pts).tocsr()
+    R = sp.vstack([P, 0.6 * P[:4] - 0.8 * P[4:]])                          # reads along x, y, a direction
+    G = fe.influence(model, R, F, block=4)
+    ref = np.column_stack([R @ fe.solve_load(model, F[:, j].toarray().ravel()) for j in range(F.shape[1])])
+    assert np.abs(G - ref).max() < 1e-10 * np.abs(ref).max()
+    # a body without its factor object falls back to plain block solves: the same numbers
+    import dataclasses
+    plain = fe.influence(dataclasses.replace(model, factor=None, _triangles=None), R, F)
+    assert np.abs(plain - ref).max() < 1e-10 * np.abs(ref).max()
+    # Maxwell-Betti: reading where the other loads gives the transposed coefficient
+    Gs = fe.influence(model, F.T, F)
+    assert np.abs(Gs - Gs.T).max() < 1e-10 * np.abs(Gs).max()

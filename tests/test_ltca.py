@@ -143,3 +143,24 @@ def test_reference_archive_and_errors(tmp_path):
         assert np.allclose(total, 100.0 / rb2, rtol=1e-9)  # torque balance at every angle
     with pytest.raises(SceneError, match="quasi_static.torque"):
         ref_mod.reference(s.replace(**{"quasi_static.torque": 0.0}))
+
+
+def test_factorised_bodies_are_reused_for_other_load_sets(monkeypatch):
+    """Both gears' factorised bodies stay in memory: new load/read sets on either gear (as the
+    body-torsion identification asks after a reference) mesh nothing again, and the shared
+    coefficients are the same numbers."""
+    import solver.mesh
+    calls = []
+    real = solver.mesh.mesh_body
+    monkeypatch.setattr(solver.mesh, "mesh_body", lambda *a, **k: calls.append(k.get("prefix")) or real(*a, **k))
+    s = small_scene(**LIGHT, **{"fe.mesh_size": 1.8})
+    c1, i1 = ref_mod.body_compliance_cached(s, 1, [0], 1, n_u=4)
+    c2, _ = ref_mod.body_compliance_cached(s, 2, [0, 1], 1, n_u=4)
+    c1b, i1b = ref_mod.body_compliance_cached(s, 1, [0], 2, n_u=4)
+    c2b, _ = ref_mod.body_compliance_cached(s, 2, [0, 1, 2], 1, n_u=4)
+    assert calls == ["gear1.body", "gear2.body"]
+    assert "mesh_wall_s" in i1["stages"] and "mesh_wall_s" not in i1b["stages"] and not i1b["cached"]
+    assert np.allclose(c1b.block(1, 0), c1.block(1, 0), rtol=1e-12, atol=0)
+    assert np.allclose(c2b.block(1, 0), c2.block(1, 0), rtol=1e-12, atol=0)
+    rel = np.abs(c2.block(0, 0) / c1.block(0, 0) - 1).max()
+    assert rel > 0.05, rel          # the holed body is another body
