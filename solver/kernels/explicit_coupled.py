@@ -175,7 +175,7 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
     act = np.zeros(ntooth, dtype=np.int64)
     incand = np.zeros(ntooth, dtype=np.bool_)
     coupled = ctooth.shape[0] > 0
-    ms = 64 if coupled else 0               # the coupled set: the candidates' teeth
+    ms = 2 * pairs.shape[0] if coupled else 0   # the coupled set: at most both teeth of every candidate pair
     ks = np.zeros((ms, 2 * ms))
     slst = np.zeros(ms, dtype=np.int64)
     newl = np.zeros(ms, dtype=np.int64)
