@@ -82,6 +82,8 @@ def body_windup(torque: float, base_radii, k_body) -> float:
 
 @dataclass(frozen=True)
 class ToothComplianceFit:
+    """The compliance model of one gear body (`tooth_compliance_fit`)."""
+
     k_body: float            # body torsion stiffness hub -> rim [N·m/rad]
     c_body: float            # the same as a compliance along the line of action [m/N]
     compliance: np.ndarray   # (Z, Z) tooth rotation per tooth moment, C[a, b] [rad/(N·m)]
@@ -129,9 +131,10 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
     action wherever the contact) plus the teeth's rotations about the pivot (levers about the
     pivot at radius r_Q). For a given r_Q the model is linear in c_body and the C of every
     pair (one least-squares solve on the relative residuals); r_Q minimises that residual
-    within ``pivot_bounds`` [m] (the rim under the tooth; a bounded scalar search). Pairs not listed are not coupled (C = 0):
-    the mesh never loads them together. Raises ValueError when the fit is not a valid
-    stiffness (a window of reach + 2 neighbouring teeth not positive definite).
+    within ``pivot_bounds`` [m] (the rim under the tooth; a bounded scalar search). Pairs not
+    listed are not coupled (C = 0): the mesh never loads them together. Raises ValueError
+    when the fit is not a valid stiffness (a window of reach + 2 neighbouring teeth not
+    positive definite).
     """
     from scipy.optimize import minimize_scalar
 
