@@ -141,9 +141,9 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     q = np.zeros(ntooth + 2)
     acc = np.zeros(ntooth)
     vpred = np.zeros(ntooth)
-    active = np.zeros(ntooth, dtype=np.bool_)
+    active = np.zeros(ntooth, dtype=np.int64)
     act = np.zeros(ntooth, dtype=np.int64)
-    incand = np.zeros(ntooth, dtype=np.bool_)
+    incand = np.zeros(ntooth, dtype=np.int64)
     for i in range(ntooth):
         if phi[i] != 0.0 or dphi[i] != 0.0:
             active[i] = True
