@@ -77,13 +77,6 @@ def _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r):
 
 
 @njit(cache=True)
-def _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros, ks):
-    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
-    _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r)
-    return nc, npair
-
-
-@njit(cache=True)
 def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, tol, max_iter,
                  te_out, nc_out, force1_out, iter_out, theta2_out):
     """Equilibrium at each driver angle theta1s[a] [rad] under the resisting torque [N m].
@@ -195,7 +188,10 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
                 theta2 = th_old + step * dx[0]
                 for m in range(nt):
                     phi[lst[m]] = ph_old[m] + step * dx[m + 1]
-                nc, npair = _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros, ks)
+                # (written out, not a helper kernel: a kernel around mesh_contacts costs its own
+                # optimisation of the whole contact search at compile time)
+                nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+                _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r)
                 rn2 = 0.0
                 for i in range(n):
                     rn2 = max(rn2, abs(r[i]))
