@@ -51,20 +51,6 @@ def solve_dense(a, b):
 
 
 @njit(cache=True)
-def _unknowns(pairs, npair, gp, pos, lst):
-    """Teeth of the candidate pairs, numbered 1.. in pos (0 is theta2). Returns their count."""
-    n = 0
-    for i in range(npair):
-        for g in range(2):
-            t = int(pairs[i, g]) + int(gp[g, TOOTH0])
-            if pos[t] < 0:
-                n += 1
-                pos[t] = n
-                lst[n - 1] = t
-    return n
-
-
-@njit(cache=True)
 def _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r):
     """Residual r on theta2 and the unknown teeth; a coupled model's tooth springs act
     through the set stiffness ks (its per-tooth kphi are zero; ks is None otherwise)."""
@@ -126,7 +112,15 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
             if not fresh:
                 nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
             fresh = False
-            nt = _unknowns(pairs, npair, gp, pos, lst)
+            # the unknowns: the teeth of the candidate pairs, numbered 1.. in pos (0 is theta2)
+            nt = np.int64(0)
+            for i in range(npair):
+                for g in range(2):
+                    t = int(pairs[i, g]) + int(gp[g, TOOTH0])
+                    if pos[t] < 0:
+                        nt += 1
+                        pos[t] = nt
+                        lst[nt - 1] = t
             if ctooth is not None:
                 set_stiffness(ctooth, lst, nt, ks)
             for i in range(ntooth):
