@@ -74,6 +74,8 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
     Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF. With
     ``damping`` also the damping tangent at rest, (M, K, C, dof_teeth): spring dampers and
     contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1).
+    The damping laws run as plain Python here (``.py_func``, a few dozen calls): compiling
+    them would add to the first run's compile time for nothing.
     """
     rec, pairs = new_contact_buffer()
     zeros = np.zeros(model.n_teeth)
@@ -95,7 +97,7 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
             M[0, i] = M[i, 0] = gp[1, L.I_CPL]
         if not model.teeth_coupled:
             K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
-        C[i, i] += spring_damping_tangent(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
+        C[i, i] += spring_damping_tangent.py_func(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
     if model.teeth_coupled:     # the springs of the teeth near the mesh: (C[S, S])^-1
         K[1:, 1:] += np.linalg.inv(model.tooth_compliance[np.ix_(teeth, teeth)])
     for c in range(nc):
@@ -105,7 +107,7 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
         idx = [0, pos[ia], pos[ib]]
         g = np.array([rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB]])
         K[np.ix_(idx, idx)] += kt * np.outer(g, g)
-        _kd, cd = contact_damping_tangents(rec[c, L.C_DELTA], 0.0, max(rec[c, L.C_FORCE], 1e-300),
+        _kd, cd = contact_damping_tangents.py_func(rec[c, L.C_DELTA], 0.0, max(rec[c, L.C_FORCE], 1e-300),
                                            lp[L.C_CON], lp[L.M2], lp[L.M3])
         C[np.ix_(idx, idx)] += cd * np.outer(g, g)
     if damping:

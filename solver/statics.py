@@ -71,8 +71,9 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
         theta2 -= windup2
     # teeth coupled through the bodies: their springs act through the compliance matrix alone
     kphi = np.zeros_like(model.k_phi) if model.teeth_coupled else model.k_phi
+    ctooth = model.tooth_compliance if model.teeth_coupled else None    # None: the plain kernel
     fails = static_sweep(rim_angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
-                         model.law_par, kphi, model.tooth_compliance, tol, max_iter, te, nc, f1, it, th2)
+                         model.law_par, kphi, ctooth, tol, max_iter, te, nc, f1, it, th2)
     if model.coupled:
         th2 += windup2
         te[:] = rb1 * angles + rb2 * th2

@@ -75,3 +75,63 @@ def test_generalized_forces_are_minus_the_energy_gradient(paper_solid_model):
         p0[i] -= h
         fd = -(_potential(m, th1, th2, p1) - _potential(m, th1, th2, p0)) / (2 * h)
         assert q[2 + i] == pytest.approx(fd, rel=1e-5, abs=1e-6)
+
+
+def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
+    """The compiled static sweep (plain model: ctooth None, the coupled code pruned) gives
+    what its source gives when run as plain Python."""
+    from solver.kernels.statics import static_sweep
+    m = paper_solid_model
+    angles = np.radians(np.arange(0.0, 3.0, 0.5))
+    theta2 = float(m.theta2_for_te(angles[0], m.backlash_offset))
+    out = []
+    for f in (static_sweep, static_sweep.py_func):
+        n = angles.size
+        res = (np.zeros(n), np.zeros(n, dtype=np.int64), np.zeros((n, m.teeth[0])), np.zeros(n, dtype=np.int64), np.zeros(n))
+        phi = np.zeros(m.n_teeth)
+        fails = f(angles, 50.0, theta2, phi, m.gear_par, m.pair_par, m.law_par, m.k_phi, None, 1e-10, 60, *res)
+        assert fails == 0
+        out.append((*res, phi))
+    for a, b in zip(*out):
+        np.testing.assert_array_equal(a, b)
+
+
+FIRST_RUN = r'''
+import numpy as np
+from study.scene import default_scene
+from study.run import build_scene_model
+from solver.statics import solve_static
+from solver.integrate import simulate
+from solver.kernels import contact, explicit, laws, mesh, statics, stepping, toothcoupling
+m = build_scene_model(default_scene().replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}))
+solve_static(m, np.radians([0.0, 0.1, 0.2]), 50.0)
+simulate(m, 100.0, 1e-4, 50.0, 1e-4, 1e-4)
+for mod in (contact, explicit, laws, mesh, statics, stepping, toothcoupling):
+    for name, f in vars(mod).items():
+        if getattr(f, "__module__", None) == mod.__name__ and hasattr(f, "overloads"):
+            for sig in f.overloads:
+                print(name, len(f.overloads), "|".join(map(str, sig)))
+'''
+
+
+def test_first_run_compiles_each_kernel_once_and_no_coupled_code():
+    """Compile time: a fresh process (empty numba cache) running the plain statics and
+    dynamics compiles each kernel for one argument list only: no second version for a
+    literal-0 argument (numba specialises callees on Literal[int](0)), and none of the
+    coupled-teeth kernels (pruned from the plain static sweep)."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(root))
+        out = subprocess.run([sys.executable, "-c", FIRST_RUN], cwd=root, env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    names = {ln.split()[0] for ln in lines}
+    assert {"static_sweep", "verlet", "mesh_contacts", "pair_contacts", "record_output"} <= names
+    assert not [ln for ln in lines if "Literal" in ln]
+    assert not [ln for ln in lines if int(ln.split()[1]) > 1]
+    assert "set_stiffness" not in names and "set_moment" not in names

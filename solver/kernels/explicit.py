@@ -141,13 +141,13 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     q = np.zeros(ntooth + 2)
     acc = np.zeros(ntooth)
     vpred = np.zeros(ntooth)
-    active = np.zeros(ntooth, dtype=np.bool_)
+    active = np.zeros(ntooth, dtype=np.int64)
     act = np.zeros(ntooth, dtype=np.int64)
-    incand = np.zeros(ntooth, dtype=np.bool_)
+    incand = np.zeros(ntooth, dtype=np.int64)
     for i in range(ntooth):
         if phi[i] != 0.0 or dphi[i] != 0.0:
             active[i] = True
-    max_act = 0
+    max_act = np.int64(0)
 
     t = 0.0
     th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
@@ -156,7 +156,9 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     for p in range(npair):
         active[int(pairs[p, 0])] = True
         active[tz2 + int(pairs[p, 1])] = True
-    nact = 0
+    # counters start as np.int64(0), not a literal 0: numba would otherwise compile each callee
+    # once more for the argument type Literal[int](0)
+    nact = np.int64(0)
     for i in range(ntooth):
         if active[i]:
             act[nact] = i
@@ -174,10 +176,10 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     p_in_old = react * w1 + load_torque(0.0, torque, torque_ramp) * w2
     p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
     fmax = 0.0
-    o = 0
-    record_output(0, 0.0, rb1 * th1 + rb2 * theta2, 0.0, nc, react, ke, pe, 0.0, 0.0, theta2,
+    o = np.int64(0)
+    record_output(o, 0.0, rb1 * th1 + rb2 * theta2, 0.0, nc, react, ke, pe, 0.0, 0.0, theta2,
                   o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
-    status = OK
+    status = np.int64(OK)
     step = 0
     for step in range(1, n_steps + 1):
         # half kick (the driver coupling of gear-1 teeth as its exact speed increment), drift

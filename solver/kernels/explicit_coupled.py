@@ -171,9 +171,9 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
     q = np.zeros(ntooth + 2)
     acc = np.zeros(ntooth)
     vpred = np.zeros(ntooth)
-    active = np.zeros(ntooth, dtype=np.bool_)
+    active = np.zeros(ntooth, dtype=np.int64)
     act = np.zeros(ntooth, dtype=np.int64)
-    incand = np.zeros(ntooth, dtype=np.bool_)
+    incand = np.zeros(ntooth, dtype=np.int64)
     coupled = ctooth.shape[0] > 0
     ms = 2 * pairs.shape[0] if coupled else 0   # the coupled set: at most both teeth of every candidate pair
     ks = np.zeros((ms, 2 * ms))
@@ -181,19 +181,19 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
     newl = np.zeros(ms, dtype=np.int64)
     mo = np.zeros(ms)
     dmo = np.zeros(ms)
-    inset = np.zeros(ntooth, dtype=np.bool_)
-    innew = np.zeros(ntooth, dtype=np.bool_)
-    ns = 0
+    inset = np.zeros(ntooth, dtype=np.int64)
+    innew = np.zeros(ntooth, dtype=np.int64)
+    ns = np.int64(0)
     for i in range(ntooth):
         if phi[i] != 0.0 or dphi[i] != 0.0:
             active[i] = True
-    max_act = 0
+    max_act = np.int64(0)
 
     t = 0.0
     th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
     tl = load_torque(0.0, torque, torque_ramp)
     nc, npair = mesh_contacts(r1, theta2, phi, v1, w2, dphi, gp, pp, lp, pairs, rec)
-    nn = 0
+    nn = np.int64(0)
     for p in range(npair):
         for g in range(2):
             i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
@@ -205,7 +205,7 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
     if coupled:
         ns = _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, dphi, mo, dmo)
         clear_candidates(incand, pairs, npair, tz2)
-    nact = 0
+    nact = np.int64(0)     # not a literal 0: numba would compile the callees once more for it
     for i in range(ntooth):
         if active[i]:
             act[nact] = i
@@ -228,10 +228,10 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
     p_in_old = react * w1 + tl * wh2
     p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2) + cb1 * (w1 - v1) ** 2 + cb2 * (wh2 - w2) ** 2
     fmax = 0.0
-    o = 0
-    record_output(0, 0.0, rb1 * th1 + rb2 * h2, 0.0, nc, react, ke, pe, 0.0, 0.0, h2,
+    o = np.int64(0)
+    record_output(o, 0.0, rb1 * th1 + rb2 * h2, 0.0, nc, react, ke, pe, 0.0, 0.0, h2,
                   o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
-    status = OK
+    status = np.int64(OK)
     step = 0
     for step in range(1, n_steps + 1):
         t = step * dt
@@ -256,7 +256,7 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
         nc, npair = mesh_contacts(r1, theta2, phi, v1p, w2p, vpred, gp, pp, lp, pairs, rec)
-        nn = 0
+        nn = np.int64(0)
         for p in range(npair):
             for g in range(2):
                 i = int(pairs[p, g]) + (tz2 if g == 1 else 0)

@@ -159,15 +159,15 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
     acc = np.zeros(ntooth)
     xt = np.zeros(ntooth)        # Newmark predictors of phi and dphi
     vt = np.zeros(ntooth)
-    active = np.zeros(ntooth, dtype=np.bool_)
+    active = np.zeros(ntooth, dtype=np.int64)
     act = np.zeros(ntooth, dtype=np.int64)
-    incand = np.zeros(ntooth, dtype=np.bool_)
+    incand = np.zeros(ntooth, dtype=np.int64)
     A = np.zeros((2 * MAX_CONTACTS + 1, 2 * MAX_CONTACTS + 1))
     r = np.zeros(ntooth + 1)
     dx = np.zeros(ntooth + 1)
     loc = np.zeros(ntooth, dtype=np.int64)
     cl = np.zeros(2 * MAX_CONTACTS, dtype=np.int64)
-    nact = 0
+    nact = np.int64(0)     # not a literal 0: numba would compile the callees once more for it
     for i in range(ntooth):
         if phi[i] != 0.0 or dphi[i] != 0.0:
             active[i] = True
@@ -203,7 +203,8 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
     diss = 0.0
     p_in_old = react * w1 + tl * w2
     p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
-    record_output(0, 0.0, rb1 * th1 + rb2 * theta2, 0.0, nc, react, ke, pe, 0.0, 0.0, theta2,
+    o = np.int64(0)
+    record_output(o, 0.0, rb1 * th1 + rb2 * theta2, 0.0, nc, react, ke, pe, 0.0, 0.0, theta2,
                   o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
     o_newton[0] = 0
     fmax = 0.0
@@ -211,8 +212,7 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
     total_it = 0
     a1_prev = acc1
     max_act = nact
-    o = 0
-    status = OK
+    status = np.int64(OK)
     step = 0
     for step in range(1, n_steps + 1):
         t_old = (step - 1) * dt

@@ -164,7 +164,7 @@ def pair_contacts(k, j, side, theta1, theta2, phi, w1, w2, dphi, gp, pp, lp, rec
 def mesh_contacts(theta1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec):
     """All contacts of the mesh at this state. Returns (n_contacts, n_pairs); pairs holds the candidates."""
     npair = candidate_pairs(theta1, theta2, gp, pp, pairs)
-    nc = 0
+    nc = np.int64(0)    # not a literal 0: numba would compile pair_contacts once more for Literal[int](0)
     for i in range(npair):
         nc = pair_contacts(pairs[i, 0], pairs[i, 1], pairs[i, 2], theta1, theta2, phi, w1, w2, dphi,
                            gp, pp, lp, rec, nc)

@@ -51,36 +51,15 @@ def solve_dense(a, b):
 
 
 @njit(cache=True)
-def _unknowns(pairs, npair, gp, pos, lst):
-    """Teeth of the candidate pairs, numbered 1.. in pos (0 is theta2). Returns their count."""
-    n = 0
-    for i in range(npair):
-        for g in range(2):
-            t = int(pairs[i, g]) + int(gp[g, TOOTH0])
-            if pos[t] < 0:
-                n += 1
-                pos[t] = n
-                lst[n - 1] = t
-    return n
-
-
-@njit(cache=True)
-def _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, coupled, q, r):
+def _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r):
     """Residual r on theta2 and the unknown teeth; a coupled model's tooth springs act
-    through the set stiffness ks (its per-tooth kphi are zero)."""
+    through the set stiffness ks (its per-tooth kphi are zero; ks is None otherwise)."""
     generalized_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, q)
     r[0] = q[1]
     for a in range(nt):
         r[1 + a] = q[2 + lst[a]]
-        if coupled:
+        if ks is not None:
             r[1 + a] -= set_moment(ks, lst, nt, phi, a)
-
-
-@njit(cache=True)
-def _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros, ks, coupled):
-    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
-    _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, coupled, q, r)
-    return nc, npair
 
 
 @njit(cache=True)
@@ -89,7 +68,9 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
     """Equilibrium at each driver angle theta1s[a] [rad] under the resisting torque [N m].
 
     ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth are coupled
-    through the body (`toothcoupling`; its kphi are then zero), or a 0 x 0 array.
+    through the body (`toothcoupling`; its kphi are then zero), or None. The coupled code
+    sits under ``if ctooth is not None`` (and ``ks``) so that numba prunes it from the
+    plain model's compiled version.
 
     phi (Z1+Z2) is the start guess and is updated in place. Writes TE [m], the number of
     loaded contacts, the force on each gear-1 tooth [N] (force1_out[a, k]), the Newton
@@ -99,21 +80,23 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
     ntooth = phi.shape[0]
     zeros = np.zeros(ntooth)
     q = np.zeros(ntooth + 2)
-    pos = -np.ones(ntooth, dtype=np.int64)
+    pos = np.zeros(ntooth, dtype=np.int64)     # set to -1 at each iteration
     lst = np.zeros(ntooth, dtype=np.int64)
     rec = np.zeros((64, 15))
     pairs = np.zeros((64, 3), dtype=np.int64)
     r = np.zeros(ntooth + 1)
-    coupled = ctooth.shape[0] > 0
-    ks = np.zeros((ntooth, 2 * ntooth)) if coupled else np.zeros((0, 0))
+    if ctooth is None:
+        ks = None
+    else:
+        ks = np.zeros((ntooth, 2 * ntooth))
     rb1 = gp[0, RB]
     rb2 = gp[1, RB]
     tol_abs = tol * max(abs(torque), 1e-3)
     sgn = 1.0 if torque >= 0.0 else -1.0
     theta2 = theta2_start
     failures = 0
-    nc = 0
-    npair = 0
+    nc = np.int64(0)        # not a literal 0: numba would compile the callees once more for it
+    npair = np.int64(0)
     for a in range(theta1s.shape[0]):
         theta1 = theta1s[a]
         if a > 0:
@@ -129,8 +112,16 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
             if not fresh:
                 nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
             fresh = False
-            nt = _unknowns(pairs, npair, gp, pos, lst)
-            if coupled:
+            # the unknowns: the teeth of the candidate pairs, numbered 1.. in pos (0 is theta2)
+            nt = np.int64(0)
+            for i in range(npair):
+                for g in range(2):
+                    t = int(pairs[i, g]) + int(gp[g, TOOTH0])
+                    if pos[t] < 0:
+                        nt += 1
+                        pos[t] = nt
+                        lst[nt - 1] = t
+            if ctooth is not None:
                 set_stiffness(ctooth, lst, nt, ks)
             for i in range(ntooth):
                 if pos[i] < 0:
@@ -149,7 +140,7 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
                 theta2 = (sgn * (pp[JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
             # residual from the contacts just found (same state: no second search)
-            _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, coupled, q, r)
+            _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r)
             n = nt + 1
             rn = 0.0
             for i in range(n):
@@ -170,7 +161,7 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
                 for x in range(3):
                     for y in range(3):
                         K[idx[x], idx[y]] += kt * gv[x] * gv[y]
-            if coupled:
+            if ctooth is not None:
                 for m in range(nt):
                     for m2 in range(nt):
                         K[m + 1, m2 + 1] += ks[m, m2]
@@ -191,7 +182,10 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
                 theta2 = th_old + step * dx[0]
                 for m in range(nt):
                     phi[lst[m]] = ph_old[m] + step * dx[m + 1]
-                nc, npair = _residual(theta1, theta2, phi, gp, pp, lp, kphi, torque, pairs, rec, lst, nt, q, r, zeros, ks, coupled)
+                # (written out, not a helper kernel: a kernel around mesh_contacts costs its own
+                # optimisation of the whole contact search at compile time)
+                nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+                _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r)
                 rn2 = 0.0
                 for i in range(n):
                     rn2 = max(rn2, abs(r[i]))

@@ -7,7 +7,9 @@ Teeth away from the mesh are left out of the integration, rigid to their hub; a 
 the set when the pre-search names it a candidate and leaves it once it is outside the
 candidates and at rest (rotation below ``phi_quiet`` [rad], rate below ``dphi_quiet``
 [rad/s]). Arrays: ``act`` the active tooth indices (first ``nact`` valid), ``active`` and
-``incand`` per-tooth flags, ``q`` the generalised forces (hubs first, then the teeth).
+``incand`` per-tooth 0/1 flags, ``q`` the generalised forces (hubs first, then the teeth).
+The flags are int64 arrays, not bool: numba then reuses the int64 allocation it compiles
+anyway instead of compiling np.zeros once more for bool.
 """
 from numba import njit
 
