@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .integrate import ENERGY_TOL, DynamicResult, stable_time_step, status_message
+from .integrate import ENERGY_TOL, DynamicResult, run_loads, stable_time_step, status_message
 from .kernels import layout as L
 from .kernels.implicit import hht
 from .model import Model
@@ -45,7 +45,7 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
                       alpha: float = 0.0, newton_tol: float = 1e-13, max_iter: int = 12,
                       delta_max: float | None = None, raise_on_failure: bool = False,
                       phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL,
-                      all_teeth: bool = False) -> ImplicitResult:
+                      all_teeth: bool = False, load_table=None) -> ImplicitResult:
     """Integrate from rest with HHT-alpha; loads, outputs and guards as `integrate.simulate`.
 
     ``dt`` [s] defaults to four times the explicit stability step; it is rounded down so that
@@ -67,6 +67,7 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
                          "(coupling.model); use the explicit integrator for a coupled model")
     if max_iter < 1:
         raise ValueError(f"max_iter: must be at least 1, got {max_iter}")
+    table, torque, side = run_loads(load_table, torque)
     omega_max = float("nan")
     if dt is None or dt <= 0:
         dt, omega_max = stable_time_step(model, torque)
@@ -79,7 +80,7 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
         delta_max = 0.1 * model.geometry[0].spec.module
     o = [np.zeros(n_out) for _ in range(10)]
     o_newton = np.zeros(n_out, dtype=np.int64)
-    theta2 = float(model.theta2_for_te(0.0, (1.0 if torque >= 0 else -1.0) * model.backlash_offset))
+    theta2 = float(model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset))
     phi = np.full(model.n_teeth, 1e-300) if all_teeth else np.zeros(model.n_teeth)
     dphi = np.zeros(model.n_teeth)
     if all_teeth:
@@ -87,7 +88,7 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
     omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
     status, step, max_act, total = hht(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                        float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                       dt, n_steps, out_every, float(alpha), theta2, 0.0, phi, dphi,
+                                       table, dt, n_steps, out_every, float(alpha), theta2, 0.0, phi, dphi,
                                        phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol),
                                        float(newton_tol), int(max_iter), *o, o_newton)
     n = min(n_out, step // out_every + 1)

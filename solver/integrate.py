@@ -189,10 +189,43 @@ def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[
     return safety * dt_crit, w
 
 
+def load_profile(table) -> np.ndarray:
+    """A resisting-torque profile as the kernels take it: (n, 2) [time s, torque N·m], times
+    from 0, strictly increasing; ``None`` or an empty table -> (0, 2) (the ramp)."""
+    if table is None:
+        return np.zeros((0, 2))
+    a = np.array(table, dtype=float)
+    if a.size == 0:
+        return np.zeros((0, 2))
+    if a.ndim != 2 or a.shape[1] != 2 or a.shape[0] < 2:
+        raise ValueError(f"load_table: need rows of (time s, torque N·m), at least two, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError("load_table: times and torques must be finite")
+    if a[0, 0] < 0 or np.any(np.diff(a[:, 0]) <= 0):
+        raise ValueError("load_table: times must start at or after 0 s and increase strictly")
+    if a[0, 0] > 0:
+        a = np.vstack([[0.0, 0.0], a])          # from rest: the load starts from zero
+    if a[0, 1] != 0:
+        raise ValueError(f"load_table: the run starts from rest, so the torque at t = 0 must be 0, got {a[0, 1]} N·m")
+    return a
+
+
+def run_loads(load_table, torque: float) -> tuple[np.ndarray, float, float]:
+    """(profile for the kernels, torque for the step estimate [N·m], torque whose sign picks
+    the initial flank side [N·m]) of a run with ramp target ``torque`` or a profile: with a
+    profile, its largest torque in magnitude and its first nonzero torque."""
+    table = load_profile(load_table)
+    if not table.shape[0]:
+        return table, torque, torque
+    nz = np.flatnonzero(table[:, 1])
+    side = float(table[nz[0], 1]) if nz.size else 0.0
+    return table, float(table[np.argmax(np.abs(table[:, 1])), 1]), side
+
+
 def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
              duration: float, dt: float | None = None, output_step: float = 1e-5,
              safety: float = 0.5, delta_max: float | None = None, raise_on_failure: bool = False,
-             phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL) -> DynamicResult:
+             phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL, load_table=None) -> DynamicResult:
     """Integrate from rest with the driver speed ramp 0 -> speed [rad/s] over speed_ramp [s]
     and the resisting torque ramp 0 -> torque [N·m] over torque_ramp [s], for duration [s].
 
@@ -202,6 +235,9 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     ``phi_quiet`` [rad]: a tooth outside the mesh window is frozen once its rotation is below
     this (1e-9 rad moves the flank by about 3e-6 um) and its rate below phi_quiet times its
     natural frequency.
+    ``load_table``: a resisting-torque profile (rows of time [s], torque [N·m], from 0 N·m at
+    t = 0; `load_profile`) instead of the ramp to ``torque``; the step estimate then uses the
+    profile's largest torque in magnitude, and the initial flank side its first nonzero torque.
     ``energy_tol`` [-]: the run stops ("energy growth") when the energy balance shows more
     energy in the pair than the work put in, by more than this fraction of the larger of the
     work and the stored energy: the signature of an unstable step.
@@ -209,6 +245,7 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp), ("output_step", output_step)):
         if not (v > 0 and math.isfinite(v)):
             raise ValueError(f"{name}: must be positive, got {v}")
+    table, torque, side = run_loads(load_table, torque)
     omega_max = float("nan")
     if dt is None or dt <= 0:
         dt, omega_max = stable_time_step(model, torque, safety)
@@ -219,7 +256,7 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     if delta_max is None:
         delta_max = 0.1 * model.geometry[0].spec.module
     o = [np.zeros(n_out) for _ in range(10)]
-    theta2 = float(model.theta2_for_te(0.0, (1.0 if torque >= 0 else -1.0) * model.backlash_offset))
+    theta2 = float(model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset))
     phi = np.zeros(model.n_teeth)
     dphi = np.zeros(model.n_teeth)
     omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
@@ -231,12 +268,12 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
         status, step, max_act = verlet_coupled(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                                model.tooth_compliance,
                                                float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                               dt, n_steps, out_every, 0.0, 0.0, theta2, 0.0, theta2, 0.0, phi, dphi,
+                                               table, dt, n_steps, out_every, 0.0, 0.0, theta2, 0.0, theta2, 0.0, phi, dphi,
                                                phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
     else:
         status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                        float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                       dt, n_steps, out_every, theta2, 0.0, phi, dphi,
+                                       table, dt, n_steps, out_every, theta2, 0.0, phi, dphi,
                                        phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)

@@ -500,7 +500,7 @@ def simulate_explicit_all_teeth(model: Model, speed: float, speed_ramp: float, t
     delta_max = 0.1 * model.geometry[0].spec.module
     status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                    float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                   dt, n_steps, out_every, theta2, 0.0, phi, dphi, 0.0, 0.0, delta_max, 0.05, *o)
+                                   np.zeros((0, 2)), dt, n_steps, out_every, theta2, 0.0, phi, dphi, 0.0, 0.0, delta_max, 0.05, *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
     msg = "ok" if status == 0 else f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"

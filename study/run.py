@@ -15,7 +15,7 @@ import xarray as xr
 
 from solver import units
 from solver.implicit import choose_method, simulate_implicit
-from solver.integrate import simulate
+from solver.integrate import run_loads, simulate
 from solver.kernels.layout import R_PV
 from solver.model import ContactLaw, GearInput, Model, build_model
 from solver.statics import solve_static
@@ -119,17 +119,31 @@ def run_static(scene: Scene, model: Model):
     return StaticResult(angles, te, th2, nc, np.full((angles.size, model.teeth[0]), np.nan), it, qs.torque, np.full(model.n_teeth, np.nan))
 
 
+def load_table(scene: Scene) -> np.ndarray | None:
+    """The resisting-torque profile [time s, torque N·m] of a scene whose load changes during
+    the run (dynamic.torque_change_time > 0): ramp to dynamic.torque, hold, then linear to
+    dynamic.torque_after; None for the plain ramp."""
+    d = scene.dynamic
+    if d.torque_change_time <= 0:
+        return None
+    t1 = d.torque_change_time
+    return np.array([[0.0, 0.0], [d.ramp_time, d.torque], [t1, d.torque],
+                     [t1 + d.torque_change_duration, d.torque_after]])
+
+
 def run_dynamic(scene: Scene, model: Model):
     """DTE run with the scene's integrator: dynamic.method 'explicit', 'implicit' or 'auto'
     (chosen from the stability step; see `solver.implicit.choose_method`). The result carries
     ``choice`` (the MethodChoice) for the archive."""
     d = scene.dynamic
-    choice = choose_method(model, d.torque, d.duration, d.method, d.time_step or None, d.alpha)
+    table = load_table(scene)
+    step_torque = d.torque if table is None else run_loads(table, d.torque)[1]
+    choice = choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
     args = (model, d.speed, d.ramp_time, d.torque, d.ramp_time, d.duration)
     if choice.method == "implicit":
-        res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha)
+        res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha, load_table=table)
     else:
-        res = simulate(*args, dt=choice.dt, output_step=d.output_step)
+        res = simulate(*args, dt=choice.dt, output_step=d.output_step, load_table=table)
     if math.isfinite(choice.omega_max):
         res.omega_max = choice.omega_max
     res.choice = choice

@@ -122,6 +122,9 @@ class DynamicSection:
     speed: float = _f(100.0, "rad/s", "final driver speed")
     torque: float = _f(50.0, "N*m", "final resisting torque on gear 2")
     ramp_time: float = _f(0.01, "s", "speed and torque ramp time", 0, lo_open=True)
+    torque_change_time: float = _f(0.0, "s", "time at which the resisting torque starts to move, linearly, from dynamic.torque to dynamic.torque_after (a load step or a reversal during the run); 0 = never", 0.0)
+    torque_change_duration: float = _f(1e-3, "s", "duration of that change", 0, lo_open=True)
+    torque_after: float = _f(0.0, "N*m", "resisting torque on gear 2 after the change")
     duration: float = _f(0.2, "s", "simulated time", 0, lo_open=True)
     time_step: float = _f(0.0, "s", "integration step; 0 = from the scene's highest natural frequency", 0.0)
     output_step: float = _f(1e-5, "s", "sampling interval of the stored DTE", 0, lo_open=True)
@@ -283,6 +286,9 @@ def check_scene(scene: Scene) -> None:
         raise SceneError("dynamic.output_step", f"longer than dynamic.duration ({d.duration} s)")
     if d.time_step > d.output_step:
         raise SceneError("dynamic.time_step", f"must not exceed dynamic.output_step ({d.output_step} s)")
+    if d.torque_change_time > 0 and not d.ramp_time < d.torque_change_time < d.duration:
+        raise SceneError("dynamic.torque_change_time", f"must lie after the ramp ({d.ramp_time} s) and before the end "
+                         f"of the run ({d.duration} s), got {d.torque_change_time} s")
     if d.spectrum_start >= d.duration:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
 

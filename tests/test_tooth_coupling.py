@@ -201,7 +201,7 @@ def test_coupled_kernel_matches_its_plain_python_run():
         o = [np.zeros(301) for _ in range(10)]
         phi, dphi = np.zeros(m.n_teeth), np.zeros(m.n_teeth)
         # at 300 rad/s from the start the mesh turns a pitch in 0.3 ms: the set changes
-        res = f(m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance, 300.0, 1e-9, 50.0, 1e-9,
+        res = f(m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance, 300.0, 1e-9, 50.0, 1e-9, np.zeros((0, 2)),
                 dt, 300, 1, 0.0, 300.0, th2, -300.0, th2, -300.0, phi, dphi, 0.0, 0.0, 1e-4, 0.5, *o)
         runs.append((res, o, phi))
     (r1, o1, p1), (r2, o2, p2) = runs

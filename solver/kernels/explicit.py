@@ -44,11 +44,22 @@ def driver_acc_left(t, speed, ramp):
 
 
 @njit(cache=True)
-def load_torque(t, torque, ramp):
-    """Resisting torque on gear 2 [N m], ramped from zero."""
-    if t < ramp:
-        return torque * t / ramp
-    return torque
+def load_torque(t, torque, ramp, table):
+    """Resisting torque on gear 2 [N m] at time t [s]: ramped from zero to ``torque`` over
+    ``ramp`` [s], or, when ``table`` (n x 2: time [s], torque [N m], times increasing) has
+    rows, linear between its points and held at its ends."""
+    n = table.shape[0]
+    if n == 0:
+        if t < ramp:
+            return torque * t / ramp
+        return torque
+    if t <= table[0, 0]:
+        return table[0, 1]
+    for k in range(1, n):
+        if t <= table[k, 0]:
+            t0 = table[k - 1, 0]
+            return table[k - 1, 1] + (table[k, 1] - table[k - 1, 1]) * (t - t0) / (table[k, 0] - t0)
+    return table[n - 1, 1]
 
 
 @njit(cache=True)
@@ -120,13 +131,14 @@ def _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2):
 
 
 @njit(cache=True)
-def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
+def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, load_table, dt, n_steps, out_every,
            theta2, w2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol,
            o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
     """Integrate n_steps of size dt [s] from t = 0; write every out_every-th state.
 
     theta2 [rad], w2 [rad/s], phi, dphi (Z1+Z2) are the initial state (phi, dphi updated in
-    place). Outputs: time [s], TE [m], max contact force over the interval [N], loaded
+    place). The resisting torque follows `load_torque` (ramp to ``torque`` over ``torque_ramp``
+    [s], or the profile ``load_table``, n x 2, when it has rows). Outputs: time [s], TE [m], max contact force over the interval [N], loaded
     contacts, driver reaction torque [N m], kinetic, potential, input and dissipated energy
     [J], theta2 [rad]. The run stops (status 3) when the energy balance shows a growth
     work - (kinetic + potential - initial) - dissipated < -energy_tol * (energy scale), checked
@@ -165,7 +177,7 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
             nact += 1
     for i in range(ntooth + 2):
         q[i] = 0.0
-    generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, load_torque(0.0, torque, torque_ramp), q)
+    generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, load_torque(0.0, torque, torque_ramp, load_table), q)
     a2, s1, r1 = _accelerations(q, act, nact, gp, acc, tz2)
     react = s1 * acc1 + r1
     cr1 = gp[0, I_CPL] / gp[0, I_P]
@@ -173,7 +185,7 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
     e0 = ke + pe
     work = 0.0
     diss = 0.0
-    p_in_old = react * w1 + load_torque(0.0, torque, torque_ramp) * w2
+    p_in_old = react * w1 + load_torque(0.0, torque, torque_ramp, load_table) * w2
     p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
     fmax = 0.0
     o = np.int64(0)
@@ -196,7 +208,7 @@ def verlet(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps
             phi[i] += dt * dphi[i]
         theta2 += dt * w2h
         th1, w1, acc1 = driver_motion(t, speed, speed_ramp)
-        tl = load_torque(t, torque, torque_ramp)
+        tl = load_torque(t, torque, torque_ramp, load_table)
         # predicted velocities for the damping terms
         w2p = w2h + 0.5 * dt * a2
         for a in range(nact):

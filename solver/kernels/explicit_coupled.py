@@ -143,7 +143,7 @@ def _set_springs(ks, slst, ns, kphi, phi, q):
 
 
 @njit(cache=True)
-def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every,
+def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_ramp, load_table, dt, n_steps, out_every,
                    r1, v1, theta2, w2, h2, wh2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol,
                    o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
     """Integrate n_steps of size dt [s] from t = 0 (see the module docstring).
@@ -191,7 +191,7 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
 
     t = 0.0
     th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
-    tl = load_torque(0.0, torque, torque_ramp)
+    tl = load_torque(0.0, torque, torque_ramp, load_table)
     nc, npair = mesh_contacts(r1, theta2, phi, v1, w2, dphi, gp, pp, lp, pairs, rec)
     nn = np.int64(0)
     for p in range(npair):
@@ -247,7 +247,7 @@ def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_r
         theta2 += dt * w2h
         h2 += dt * wh2h
         th1, w1, acc1 = driver_motion(t, speed, speed_ramp)
-        tl = load_torque(t, torque, torque_ramp)
+        tl = load_torque(t, torque, torque_ramp, load_table)
         # predicted velocities for the damping terms
         v1p = v1h + 0.5 * dt * a1
         w2p = w2h + 0.5 * dt * a2

@@ -133,7 +133,7 @@ def _newton_step(rec, nc, phi, dphi, act, nact, kphi, gp, lp, tz2, cm, ck, cc, r
 
 
 @njit(cache=True)
-def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, out_every, alpha,
+def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, load_table, dt, n_steps, out_every, alpha,
         theta2, w2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol, newton_tol, max_iter,
         o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2, o_newton):
     """Integrate n_steps of size dt [s] from t = 0 with HHT-alpha; write every out_every-th state.
@@ -176,7 +176,7 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
     th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
     nc, npair = mesh_contacts(th1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec)
     nact = _activate(pairs, npair, tz2, active, act, nact, incand)
-    tl = load_torque(0.0, torque, torque_ramp)
+    tl = load_torque(0.0, torque, torque_ramp, load_table)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     # initial accelerations: the explicit arrowhead solve, plus the driver coupling
     s = gp[1, I_TOT]
@@ -230,10 +230,10 @@ def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, dt, n_steps, o
                 if i < tz2:
                     acc[i] -= gp[0, I_CPL] / gp[0, I_P] * (a1m - a1_prev)
                     react -= gp[0, I_CPL] ** 2 / gp[0, I_P] * (a1m - a1_prev)
-            p_in_old = react * driver_speed(t_old, speed, speed_ramp) + load_torque(t_old, torque, torque_ramp) * w2
+            p_in_old = react * driver_speed(t_old, speed, speed_ramp) + load_torque(t_old, torque, torque_ramp, load_table) * w2
             a1_prev = a1m
         th1, w1, _a1 = driver_motion(t, speed, speed_ramp)
-        tl = load_torque(t, torque, torque_ramp)
+        tl = load_torque(t, torque, torque_ramp, load_table)
         # Newmark predictors; start Newton from a_{n+1} = a_n
         th2t = theta2 + dt * w2 + dt * dt * (0.5 - beta) * a2
         w2t = w2 + dt * (1.0 - gamma) * a2
