@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate
 
-from .integrate import DivergenceError, DynamicResult
+from .integrate import DivergenceError, DynamicResult, run_loads
 from .kernels import layout as L
 from .model import Model
 
@@ -122,13 +122,15 @@ class PairEquations:
     DOFs x = [theta2, phi_0 .. phi_{N-1}] (gear-1 teeth first), velocities v likewise.
     """
 
-    def __init__(self, model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float):
+    def __init__(self, model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
+                 load_table: np.ndarray | None = None):
         if model.coupled:
             raise ValueError("coupling.model: the scipy peer has no body-torsion coupling; use the explicit integrator")
         gp = model.gear_par
         self.model = model
         self.speed, self.speed_ramp = float(speed), float(speed_ramp)
         self.torque, self.torque_ramp = float(torque), float(torque_ramp)
+        self.load_table = np.zeros((0, 2)) if load_table is None else np.asarray(load_table, float)
         self.z1, self.z2 = model.teeth
         self.nt = self.z1 + self.z2
         self.n = 1 + self.nt
@@ -247,6 +249,8 @@ class PairEquations:
 
     def state(self, t, x, v):
         th1, w1, a1 = driver_motion(t, self.speed, self.speed_ramp)
+        if self.load_table.shape[0]:       # piecewise linear, held at the ends
+            return th1, w1, a1, float(np.interp(t, self.load_table[:, 0], self.load_table[:, 1]))
         return th1, w1, a1, load_torque(t, self.torque, self.torque_ramp)
 
     def forces(self, t, x, v):
@@ -373,7 +377,8 @@ class ScipyResult(DynamicResult):
 def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
                    duration: float, method: str = "LSODA", rtol: float = 1e-6, atol: float | None = None,
                    output_step: float = 1e-5, max_step: float | None = None, delta_max: float | None = None,
-                   raise_on_failure: bool = False, max_wall_time: float | None = None) -> ScipyResult:
+                   raise_on_failure: bool = False, max_wall_time: float | None = None,
+                   load_table=None) -> ScipyResult:
     """Integrate the pair from rest with a `scipy.integrate` ODE solver (all teeth free).
 
     Same loads as `solver.integrate.simulate`: driver speed ramp 0 -> speed [rad/s] over
@@ -386,7 +391,8 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
     (default a tenth of the module) bounds the penetration.
     A failure of the solver or a guard gives status != 0 and a message (or raises
     `DivergenceError` with ``raise_on_failure``). ``max_wall_time`` [s] stops a run that takes
-    longer (status 5, "wall-time limit").
+    longer (status 5, "wall-time limit"). ``load_table``: a torque profile instead of the
+    torque ramp, as in `solver.integrate.simulate`.
     """
     if method not in METHODS:
         raise ValueError(f"method: must be one of {', '.join(METHODS)}, got {method!r}")
@@ -394,7 +400,8 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
                     ("output_step", output_step), ("rtol", rtol)):
         if not (v > 0 and math.isfinite(v)):
             raise ValueError(f"{name}: must be positive, got {v}")
-    eq = PairEquations(model, speed, speed_ramp, torque, torque_ramp)
+    table, _step_torque, side = run_loads(load_table, torque)
+    eq = PairEquations(model, speed, speed_ramp, torque, torque_ramp, table)
     n = eq.n
     if atol is None:
         atol = rtol * 1e-6
@@ -403,10 +410,11 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
     if delta_max is None:
         delta_max = 0.1 * model.geometry[0].spec.module
     y = np.zeros(2 * n + 2)
-    y[0] = model.theta2_for_te(0.0, (1.0 if torque >= 0 else -1.0) * model.backlash_offset)
+    y[0] = model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset)
     n_out = int(math.floor(duration / output_step + 1e-9)) + 1
     t_out = np.arange(n_out) * output_step
-    breaks = sorted({0.0, duration, *(b for b in (speed_ramp, torque_ramp) if 0 < b < duration)})
+    kinks = (speed_ramp, *table[:, 0]) if table.shape[0] else (speed_ramp, torque_ramp)
+    breaks = sorted({0.0, duration, *(float(b) for b in kinks if 0 < b < duration)})
     kw = {"rtol": rtol, "atol": atol_vec}
     if max_step is not None:
         kw["max_step"] = max_step
@@ -479,13 +487,14 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
 
 def simulate_explicit_all_teeth(model: Model, speed: float, speed_ramp: float, torque: float,
                                 torque_ramp: float, duration: float, dt: float,
-                                output_step: float = 1e-5) -> DynamicResult:
+                                output_step: float = 1e-5, load_table=None) -> DynamicResult:
     """The explicit Verlet kernel on the same model as the scipy peer: every tooth free.
 
     `solver.integrate.simulate` freezes idle teeth rigid to their hub (its active set); here
     all teeth start active (phi = 1e-300 rad, numerically zero) and none is ever frozen, so
     the two solvers integrate identical equations and can be compared step against
-    tolerance. ``dt`` [s] is rounded down to divide ``output_step`` [s].
+    tolerance. ``dt`` [s] is rounded down to divide ``output_step`` [s]; ``load_table`` as in
+    `solver.integrate.simulate`.
     """
     from .kernels.explicit import verlet
     from .integrate import STATUS_TEXT
@@ -494,13 +503,14 @@ def simulate_explicit_all_teeth(model: Model, speed: float, speed_ramp: float, t
     n_steps = int(round(duration / dt))
     n_out = n_steps // out_every + 1
     o = [np.zeros(n_out) for _ in range(10)]
-    theta2 = float(model.theta2_for_te(0.0, (1.0 if torque >= 0 else -1.0) * model.backlash_offset))
+    table, _step_torque, side = run_loads(load_table, torque)
+    theta2 = float(model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset))
     phi = np.full(model.n_teeth, 1e-300)
     dphi = np.zeros(model.n_teeth)
     delta_max = 0.1 * model.geometry[0].spec.module
     status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
                                    float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                   np.zeros((0, 2)), dt, n_steps, out_every, theta2, 0.0, phi, dphi, 0.0, 0.0, delta_max, 0.05, *o)
+                                   table, dt, n_steps, out_every, theta2, 0.0, phi, dphi, 0.0, 0.0, delta_max, 0.05, *o)
     n = min(n_out, step // out_every + 1)
     t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
     msg = "ok" if status == 0 else f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"

@@ -13,7 +13,9 @@ the ramps ending at half of it):
   / 100: hub and teeth lighter alike), holes leaving a 0.5 mm ligament to the rim, a 1 mm web,
   1 hole, 24 holes, driver at 1000 rad/s, mesh frequency at the torsional resonance, zero
   torque (rattle in the backlash), reversed torque (-50 N·m: the load drives, coast flanks in
-  contact), tenfold overload (deep penetration, corner contact).
+  contact), a torque reversal during the run (+50 -> -50 N·m from 60 to 80 % of the run: the
+  mesh crosses the backlash and hits the coast flanks), tenfold overload (deep penetration,
+  corner contact).
 Lightened bodies take FE springs (cached on disk; ``--mesh-size`` mm, coarse by default).
 Methods: explicit (at its stability step), implicit HHT alpha = 0 and alpha = -0.1 (at four
 times that step), and the scipy peer LSODA (rtol 1e-4, every tooth free, stopped after
@@ -37,7 +39,7 @@ from solver.integrate import linearized_system, simulate
 from solver.reference import simulate_scipy
 from solver.statics import solve_static
 from study import results
-from study.run import build_scene_model
+from study.run import build_scene_model, load_table
 from study.scene import load_scene
 
 DEFAULT_OUT = "results/stability/stability.nc"
@@ -68,6 +70,7 @@ def suite(scene) -> list[tuple[str, dict]]:
         ("torsional resonance", {"dynamic.speed": None}),          # set from the model below
         ("zero torque", {"dynamic.torque": 0.0}),
         ("reversed torque", {"dynamic.torque": -abs(d.torque)}),
+        ("torque reversal", {"dynamic.torque_change_time": None}),   # set from the duration below
         ("overload x10", {"dynamic.torque": 10 * d.torque}),
     ]
 
@@ -107,14 +110,16 @@ def run_one(model, scene, method: str, duration: float, scipy_wall: float):
     d = scene.dynamic
     ramp = duration / 2
     loads = (d.speed, ramp, d.torque, ramp, duration)
+    table = load_table(scene)          # the torque-reversal scene; None: the ramp
     if method == "LSODA":
         return simulate_scipy(model, *loads, method="LSODA", rtol=1e-4, output_step=d.output_step,
-                              max_wall_time=scipy_wall), float("nan")
+                              max_wall_time=scipy_wall, load_table=table), float("nan")
     choice = choose_method(model, d.torque, duration, "explicit" if method == "explicit" else "implicit")
     if method == "explicit":
-        return simulate(model, *loads, dt=choice.dt, output_step=d.output_step), choice.dt
+        return simulate(model, *loads, dt=choice.dt, output_step=d.output_step, load_table=table), choice.dt
     alpha = 0.0 if method.endswith("=0") else -0.1
-    return simulate_implicit(model, *loads, dt=choice.dt, output_step=d.output_step, alpha=alpha), choice.dt
+    return simulate_implicit(model, *loads, dt=choice.dt, output_step=d.output_step, alpha=alpha,
+                             load_table=table), choice.dt
 
 
 def run_suite(scene, duration: float = 0.002, methods=METHODS, scipy_wall: float = 20.0, names=None,
@@ -138,6 +143,10 @@ def run_suite(scene, duration: float = 0.002, methods=METHODS, scipy_wall: float
             sc = scene.replace(**{"fe.mesh_size": mesh_size, "dynamic.duration": max(duration, scene.dynamic.output_step),
                                   **{k: v for k, v in over.items() if v is not None}})
             model = build_scene_model(sc)
+            if "dynamic.torque_change_time" in over and over["dynamic.torque_change_time"] is None:
+                sc = sc.replace(**{"dynamic.ramp_time": duration / 2, "dynamic.torque_change_time": 0.6 * duration,
+                                   "dynamic.torque_change_duration": 0.2 * duration,
+                                   "dynamic.torque_after": -sc.dynamic.torque})
             if "dynamic.speed" in over and over["dynamic.speed"] is None:
                 w = torsional_frequency(model, sc.dynamic.torque)
                 sc = sc.replace(**{"dynamic.speed": w / model.teeth[0]})      # mesh frequency = w
