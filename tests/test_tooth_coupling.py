@@ -209,3 +209,42 @@ def test_coupled_kernel_matches_its_plain_python_run():
     for x, y in zip(o1, o2):
         assert x == pytest.approx(y, rel=1e-12, abs=1e-18)
     assert p1 == pytest.approx(p2, rel=1e-12, abs=1e-18)
+
+
+@pytest.mark.parametrize("jit", [True, False])
+def test_set_changes_keep_the_spring_moments(jit):
+    """A tooth that joins the coupled set unloaded (from rest, as from the frozen set) takes
+    the rotation its neighbours give it and changes no moment; a tooth that leaves keeps its
+    moment on its own spring."""
+    from solver.kernels.explicit_coupled import _update_set
+    f = _update_set if jit else _update_set.py_func
+    z = 9
+    C = ring(z, 800.0, (0.15, 0.05))
+    k_own = 1.0 / np.diag(C)
+    phi = RNG.normal(size=z) * 1e-4
+    dphi = RNG.normal(size=z) * 1e-2
+    vpred = dphi.copy()
+    ks = np.zeros((8, 16))
+    slst = np.zeros(8, dtype=np.int64)
+    inset = np.zeros(z, dtype=np.int64)
+    innew = np.zeros(z, dtype=np.int64)
+    mo, dmo = np.zeros(8), np.zeros(8)
+
+    def moments(ns):
+        return {int(slst[a]): set_moment(ks, slst, ns, phi, a) for a in range(ns)}
+
+    ns = f(C, ks, slst, 0, np.array([3, 4, 5]), 3, inset, innew, phi, dphi, vpred, mo, dmo)
+    before = moments(ns)
+    phi[6] = dphi[6] = vpred[6] = 0.0
+    ns = f(C, ks, slst, ns, np.array([3, 4, 5, 6]), 4, inset, innew, phi, dphi, vpred, mo, dmo)   # 6 joins
+    after = moments(ns)
+    for i in (3, 4, 5):
+        assert after[i] == pytest.approx(before[i], rel=1e-10)
+    assert after[6] == pytest.approx(0.0, abs=1e-12 * abs(before[4]))
+    assert phi[6] == pytest.approx(sum(C[6, b] * before[b] for b in (3, 4, 5)), rel=1e-12)
+    m3 = after[3]
+    ns = f(C, ks, slst, ns, np.array([4, 5, 6]), 3, inset, innew, phi, dphi, vpred, mo, dmo)      # 3 leaves
+    assert k_own[3] * phi[3] == pytest.approx(m3, rel=1e-10)
+    assert ns == 3 and sorted(slst[:ns]) == [4, 5, 6]
+    assert list(np.flatnonzero(inset)) == [4, 5, 6] and not innew.any()
+    assert vpred == pytest.approx(dphi)            # rates adjusted alike

@@ -21,7 +21,9 @@ teeth of the pre-search candidates form the set S whose springs act through
 K_S = (C[S, S])^-1 (`toothcoupling`); the other active teeth keep their own spring
 kphi = 1/C[a, a]. When S changes, a tooth that joins it takes on the rotation and rate its
 neighbours' moments give it (phi_i += sum_b C[i, b] M_b), and a tooth that leaves gives them
-back, so that the spring moments of all teeth stay continuous through the change.
+back. A tooth that joins unloaded (from rest, as teeth come from the frozen set) so changes
+no spring moment, and a tooth that leaves keeps its own; the remaining teeth's moments move
+by the coupling of the leaving tooth's moment, small since it has just left the mesh.
 """
 import math
 
@@ -92,8 +94,8 @@ def _energies_coupled(w1, v1, w2, wh2, th1, r1, th2, h2, phi, dphi, act, nact, k
 @njit(cache=True)
 def _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, vpred, mo, dmo):
     """Make newl[:nn] the coupled set (``inset`` flags the old members): teeth that join take
-    their neighbours' share of rotation and rate, teeth that leave give it back (the spring
-    moments stay continuous). Returns the new size."""
+    their neighbours' share of rotation and rate, teeth that leave give it back (see the
+    module docstring for what stays continuous). Returns the new size."""
     for a in range(nn):
         innew[newl[a]] = True
     same = nn == ns
