@@ -5,6 +5,7 @@ example when no scene is given, writes the archive and prints a summary.
 """
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
@@ -38,9 +39,11 @@ def tooth_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
     return fe_springs(scene, g)
 
 
+@functools.lru_cache(maxsize=16)
 def coupling_fit(scene: Scene, g: int):
     """Gear g's foundation coupling identified from its FE body: a `BodyTorsionFit`
-    ('body-torsion'), a `ToothComplianceFit` ('compliance'), or None (the plain model)."""
+    ('body-torsion'), a `ToothComplianceFit` ('compliance'), or None (the plain model).
+    Kept per scene: a run asks for it for the springs and again for the model."""
     from . import coupling
     model = scene.coupling.model
     if model == "body-torsion":
