@@ -24,6 +24,23 @@ def solid_scene(**overrides):
     return default_scene().replace(**{**SOLID, **overrides})
 
 
+@pytest.fixture
+def private_fe_cache(tmp_path, monkeypatch):
+    """FE results of the test go to a fresh disk cache, and no in-memory cache (influence
+    coefficients, factorised bodies, spring maps, coupling fits) leaks in or out."""
+    from study import reference, run, springs
+
+    def clear():
+        reference._memory.clear()
+        reference._bodies.clear()
+        springs._memory.clear()
+        run.coupling_fit.cache_clear()
+    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
+    clear()
+    yield
+    clear()
+
+
 @pytest.fixture(scope="session")
 def paper_solid_scene():
     return solid_scene()

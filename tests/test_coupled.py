@@ -11,7 +11,6 @@ from solver.ltca import mesh_points
 from solver.model import build_model
 from solver.statics import solve_static
 from study import reference as ref_mod
-from study import springs
 from study.run import build_scene_model
 from study.scene import SceneError
 
@@ -19,12 +18,7 @@ from conftest import assert_energy_closes_at_second_order, slow_transient_agains
 from test_ltca import LIGHT, small_scene
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
-    ref_mod._memory.clear(); ref_mod._bodies.clear(); springs._memory.clear()
-    yield
-    ref_mod._memory.clear(); ref_mod._bodies.clear(); springs._memory.clear()
+pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
 
 def with_body_springs(model, k_body, ratio=0.02):

@@ -6,18 +6,12 @@ import pytest
 
 from solver.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
 from study import reference as ref_mod
-from study import springs
 from study.scene import SceneError, default_scene
 
 from conftest import SMALL_PAIR, solid_scene
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
-    ref_mod._memory.clear(); ref_mod._bodies.clear(); springs._memory.clear()
-    yield
-    ref_mod._memory.clear(); ref_mod._bodies.clear(); springs._memory.clear()
+pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
 
 def small_scene(**kw):

@@ -16,12 +16,7 @@ from study.scene import default_scene
 from conftest import SMALL_PAIR
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
-    springs._memory.clear()
-    yield
-    springs._memory.clear()
+pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
 
 def small_scene(**kw):
