@@ -8,9 +8,10 @@ and load patch as the FE tooth springs), then splits the body wind-up off the to
 "body-torsion"``.
 
 `tooth_compliance(scene, g)`, the full version (``coupling.model = "compliance"``): the
-pitch-point compliance between every pair of teeth of the body (a solid body: one load, read
-round the whole gear), split into the body wind-up and the coupled tooth springs
-(`solver.coupling.tooth_compliance_fit`).
+influence coefficients of every tooth with itself and its neighbours along the profiles (a
+lightened body: every tooth loaded; a solid body: one, the rest by symmetry), read at the
+contact points the mesh loads together (`mesh_samples`), fitted as body wind-up plus coupled
+tooth springs (`solver.coupling.tooth_compliance_fit`).
 """
 from __future__ import annotations
 
@@ -52,13 +53,11 @@ def mesh_samples(scene: Scene, g: int, n_angles: int = 25) -> dict[int, np.ndarr
     offset d (load tooth - read tooth), the (u_read, u_load) of the contacts that coexist over
     one mesh pitch of the rigid geometry (d = 0: each contact with itself)."""
     from solver.ltca import mesh_points
-    from .run import build_scene_model
-    plain = scene.replace(**{"coupling.model": "none"})
-    z1, z2 = scene.gear1.teeth, scene.gear2.teeth
-    model = build_scene_model(plain, springs=((np.ones(z1), np.ones(z1)), (np.ones(z2), np.ones(z2))))
+    from .run import geometry_model
+    model = geometry_model(scene)
     z = model.teeth[g - 1]
     out: dict[int, list] = {}
-    for th in np.linspace(0.0, 2 * math.pi / z1, n_angles, endpoint=False):
+    for th in np.linspace(0.0, 2 * math.pi / model.teeth[0], n_angles, endpoint=False):
         mp = mesh_points(model, float(th))
         t, u = (mp.tooth1, mp.u1) if g == 1 else (mp.tooth2, mp.u2)
         for i in range(t.size):

@@ -123,15 +123,13 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
 
     ``rigid``: rigid bodies, only the contact law deforms (the closed-form check);
     ``n_u``: profile points per flank of the influence coefficients."""
-    from .run import build_scene_model
+    from .run import geometry_model
 
     qs = scene.quasi_static
     if not qs.torque > 0:
         raise SceneError("quasi_static.torque", f"the FE reference needs a positive (drive-side) torque, got {qs.torque}")
     angles = static_angles(scene) if angles is None else np.asarray(angles, float)
-    n1, n2 = scene.gear1.teeth, scene.gear2.teeth
-    model = build_scene_model(scene, springs=((np.full(n1, scene.gear1.spring.k_phi), np.ones(n1)),
-                                              (np.full(n2, scene.gear2.spring.k_phi), np.ones(n2))))
+    model = geometry_model(scene)        # the LTCA takes its compliance from the FE, not springs
     info = {}
     t0, c0 = time.perf_counter(), time.process_time()
     if rigid:

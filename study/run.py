@@ -95,6 +95,16 @@ def build_scene_model(scene: Scene, springs=None) -> Model:
     return build_model(gears[0], gears[1], law, scene.material_spec())
 
 
+def geometry_model(scene: Scene) -> Model:
+    """The pair's geometry, inertia and contact law without any FE: plain uniform springs of
+    the scene's k_phi and no foundation coupling. For what needs the kinematics and the
+    contact law only (the mesh positions, the FE reference), not the tooth springs."""
+    plain = scene.replace(**{"coupling.model": "none"})
+    z1, z2 = scene.gear1.teeth, scene.gear2.teeth
+    return build_scene_model(plain, springs=((np.full(z1, scene.gear1.spring.k_phi), np.ones(z1)),
+                                             (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2))))
+
+
 def static_angles(scene: Scene) -> np.ndarray:
     """Driver angles [rad] of the quasi-static analysis."""
     qs = scene.quasi_static
@@ -140,7 +150,7 @@ def run_dynamic(scene: Scene, model: Model):
     ``choice`` (the MethodChoice) for the archive."""
     d = scene.dynamic
     table = load_table(scene)
-    step_torque = d.torque if table is None else run_loads(table, d.torque)[1]
+    step_torque = run_loads(table, d.torque)[1]
     choice = choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
     args = (model, d.speed, d.ramp_time, d.torque, d.ramp_time, d.duration)
     if choice.method == "implicit":
