@@ -132,7 +132,7 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
                 presearch_margin: float = 0.5) -> Model:
     """Flat-array model of the pair. ``presearch_margin`` widens the pre-search window by
     that fraction of the angular pitch beyond the flank ends (tip-corner contact)."""
-    geos, inert, bodies = [], [], []
+    geos, inert, bodies, own = [], [], [], []
     for name, gi in (("gear1", gear1), ("gear2", gear2)):
         g = gear_geometry(gi.tooth, prefix=name)
         validate_body(g, gi.body, prefix=f"{name}.body")
@@ -144,6 +144,7 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
             raise ValueError(f"{name}.spring.k_phi: expected {g.teeth} per-tooth values, got shape {k.shape}")
         if not np.all(np.isfinite(k)) or np.any(k <= 0):
             raise ValueError(f"{name}.spring.k_phi: per-tooth stiffness must be finite and positive")
+        own.append(k)                   # each tooth's own spring (1/C[a, a] with a compliance matrix)
         geos.append(g)
         inert.append(tooth_inertia(g, material.density, gi.pivot_radius))
         bodies.append(body_inertia(g, gi.body, material.density)[1])
@@ -186,8 +187,6 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
     pp[L.ALPHA] = pair.pressure_angle
     pp[L.MARGIN] = presearch_margin * max(geos[0].pitch_angle, geos[1].pitch_angle)
     lp = np.array([law.k, law.m1, law.c, law.m2, law.m3], dtype=float)
-    own = [1.0 / np.diag(gi.tooth_compliance) if gi.tooth_compliance is not None else np.asarray(gi.k_phi, float)
-           for gi in (gear1, gear2)]
     kphi = np.concatenate(own)
     ctooth = np.zeros((0, 0))
     if gear1.tooth_compliance is not None or gear2.tooth_compliance is not None:
