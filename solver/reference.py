@@ -318,13 +318,12 @@ class PairEquations:
         dy[2 * n + 1] = self.dissipation_power(v[1:], cons)
         return dy
 
-    def jac(self, t, y):
-        """Analytic Jacobian of `rhs` (without the geometric stiffness F dG/dq)."""
+    def tangents(self, phi, dphi, cons, spring_floor: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """(dQ/dx [N·m/rad], dQ/dv [N·m·s/rad]) over x = [theta2, phi]: the springs' tangents
+        and k_t G G^T, c_t G G^T of each contact (without the geometric stiffness F dG/dq).
+        ``spring_floor`` [-]: that fraction of k_phi added to every spring tangent (a static
+        solve regularises unloaded teeth with it: the tangent of n_k > 1 vanishes at 0)."""
         n = self.n
-        x, v = y[:n], y[n:2 * n]
-        th1, w1, a1, _tl = self.state(t, x, v)
-        phi, dphi = x[1:], v[1:]
-        cons = self.contacts(th1, x[0], phi, w1, v[0], dphi)
         dqdx = np.zeros((n, n))
         dqdv = np.zeros((n, n))
         a = np.abs(phi)
@@ -332,8 +331,8 @@ class PairEquations:
         ad = np.abs(dphi)
         ct = np.where(self.nc == 1.0, self.cphi, self.nc * self.cphi * np.where(ad > 0, ad, 0.0) ** (self.nc - 1.0))
         idx = np.arange(1, n)
-        dqdx[idx, idx] -= kt
-        dqdv[idx, idx] -= ct
+        dqdx[idx, idx] = -(kt + spring_floor * self.kphi)
+        dqdv[idx, idx] = -ct
         for c in cons:
             dofs = (1 + c.ia, 0, 1 + c.ib)
             g = (c.g[1], c.g[2], c.g[3])
@@ -341,6 +340,16 @@ class PairEquations:
                 for s in range(3):
                     dqdx[dofs[r], dofs[s]] -= c.kt * g[r] * g[s]
                     dqdv[dofs[r], dofs[s]] -= c.ct * g[r] * g[s]
+        return dqdx, dqdv
+
+    def jac(self, t, y):
+        """Analytic Jacobian of `rhs` (without the geometric stiffness F dG/dq)."""
+        n = self.n
+        x, v = y[:n], y[n:2 * n]
+        th1, w1, a1, _tl = self.state(t, x, v)
+        phi, dphi = x[1:], v[1:]
+        cons = self.contacts(th1, x[0], phi, w1, v[0], dphi)
+        dqdx, dqdv = self.tangents(phi, dphi, cons)
         J = np.zeros((2 * n + 2, 2 * n + 2))
         J[:n, n:2 * n] = np.eye(n)
         J[n:2 * n, :n] = self._minv_columns(dqdx)

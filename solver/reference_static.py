@@ -42,18 +42,7 @@ def _jacobian(eq: PairEquations, theta1: float, x: np.ndarray, zeros: np.ndarray
     """d residual / dx [N m/rad]: spring tangents plus k_t G G^T of each contact (negated)."""
     phi = x[1:]
     cons = eq.contacts(theta1, x[0], phi, 0.0, 0.0, zeros)
-    a = np.abs(phi)
-    kt = np.where(eq.nk == 1.0, eq.kphi, eq.nk * eq.kphi * np.where(a > 0, a, 0.0) ** (eq.nk - 1.0))
-    jac = np.zeros((eq.n, eq.n))
-    idx = np.arange(1, eq.n)
-    jac[idx, idx] = -(kt + 1e-9 * eq.kphi)
-    for c in cons:
-        dofs = (1 + c.ia, 0, 1 + c.ib)
-        g = (c.g[1], c.g[2], c.g[3])
-        for r in range(3):
-            for s in range(3):
-                jac[dofs[r], dofs[s]] -= c.kt * g[r] * g[s]
-    return jac
+    return eq.tangents(phi, zeros, cons, spring_floor=1e-9)[0]
 
 
 def static_te_root(model: Model, angles, torque: float, tol: float = 1e-12) -> StaticResult:
