@@ -24,8 +24,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="solid pair only, fewer repeats")
     args = ap.parse_args(argv)
     os.environ.setdefault("LIGHTGEAR_CACHE", str(common.ROOT / ".lightgear-cache"))
-    from solver.integrate import simulate, stable_time_step
-    from solver.statics import solve_static
+    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.statics import solve_static
     from study.run import build_scene_model, static_angles
 
     rows = []

@@ -14,11 +14,11 @@ from pathlib import Path
 
 ONE = r'''
 import json, resource, time
-from solver import fe
+from solver.fe import body as fe
 from solver.geometry import gear_geometry
-from solver.mesh import mesh_body
+from solver.fe.mesh import mesh_body
 from study.scene import default_scene
-from study.springs import contact_patch, reference_torque
+from study.inputs.springs import contact_patch, reference_torque
 size_mm = {size}
 s = default_scene()
 g = gear_geometry(s.tooth_spec(2)); body = s.body_spec(2)

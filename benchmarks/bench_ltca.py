@@ -33,7 +33,7 @@ w_start, c_start = time.perf_counter(), time.process_time()
 import json, os, resource
 import numpy as np
 from study.scene import default_scene
-from study.reference import reference, static_angles
+from study.verify.fe_reference import reference, static_angles
 s = default_scene()
 if {solid}:
     s = s.replace(**{{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}})

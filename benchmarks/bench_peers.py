@@ -1,12 +1,12 @@
 """lightgear against the tools an engineer would use instead, on the same scenes and equations.
 
 Scenes: the Table 1 pair with a solid driven gear, and as published (lightened driven gear,
-per-tooth FE springs from study.springs, cached on disk).
+per-tooth FE springs from study.inputs.springs, cached on disk).
 * Quasi-static STE, 120 deg at 0.1 deg (1201 angles): lightgear's numba Newton sweep against
-  a scipy.optimize.root loop over the same equations (solver.reference_static, every tooth
+  a scipy.optimize.root loop over the same equations (solver.peers.scipy_statics, every tooth
   free), timed on the first ROOT_ANGLES angles and scaled per angle.
 * Dynamic: the slow peers run a short window (100 rad/s and 50 N m reached in 0.5 ms, 1.5 ms
-  simulated): the plain numpy + scipy solve_ivp implementation (solver.reference, LSODA and
+  simulated): the plain numpy + scipy solve_ivp implementation (solver.peers.scipy_dynamics, LSODA and
   Radau with analytic Jacobian) over a ladder of tolerances, and the same model in Exudyn
   (benchmarks/peers/exudyn_pair.py, its velocity Verlet and RK44 at lightgear's step, and RK44
   at a quarter of it: the check that both codes agree on TE).
@@ -31,8 +31,8 @@ ROOT_ANGLES = 60          # 6 deg: more than one mesh cycle (5.37 deg)
 
 
 def static_rows(kind, m, sc, rep):
-    from solver.reference_static import static_te_root
-    from solver.statics import solve_static
+    from solver.peers.scipy_statics import static_te_root
+    from solver.mbs.statics import solve_static
     from study.run import static_angles
     ang = static_angles(sc)
     tq = sc.quasi_static.torque
@@ -52,8 +52,8 @@ def static_rows(kind, m, sc, rep):
 def dynamic_rows(kind, m, rep, quick):
     import exudyn
     from peers.exudyn_pair import simulate_exudyn
-    from solver.integrate import simulate, stable_time_step
-    from solver.reference import simulate_explicit_all_teeth, simulate_scipy
+    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
     win = SHORT_DYNAMIC
     T = win[-1]
     dt, _w = stable_time_step(m, win[2])

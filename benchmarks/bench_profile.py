@@ -16,8 +16,8 @@ import common  # noqa: I001  (first: pins BLAS to one thread before numpy loads)
 import numpy as np
 from numba import njit
 
-from solver.kernels.explicit import _accelerations, _dissipation_power, _energies
-from solver.kernels.mesh import generalized_forces, mesh_contacts
+from solver.mbs.kernels.explicit import _accelerations, _dissipation_power, _energies
+from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 
 COLUMNS = ("part", "active_teeth", "ns_per_call", "note")
 N_CALLS = 200_000
@@ -61,16 +61,16 @@ def per_call(fn, *args) -> float:
 
 
 def main(argv=None) -> int:
-    from solver.integrate import simulate, stable_time_step
-    from solver.kernels import layout as L
-    from solver.kernels.mesh import new_contact_buffer
-    from solver.statics import solve_static
+    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.kernels import layout as L
+    from solver.mbs.kernels.gearmesh import new_contact_buffer
+    from solver.mbs.statics import solve_static
     m = common.model("solid")
     gp, pp, lp = m.gear_par, m.pair_par, m.law_par
     tz2 = int(gp[1, L.TOOTH0])
     theta1 = np.radians(2.0)
     st = solve_static(m, np.array([theta1]), 50.0)
-    from solver.integrate import _phi_at
+    from solver.mbs.dynamics import _phi_at
     phi = _phi_at(m, theta1, 50.0, st.te[0])
     dphi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()

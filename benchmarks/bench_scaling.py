@@ -42,8 +42,8 @@ def z_model(z: int):
 
 
 def point(series, value, m, speed=100.0, phi_quiet=1e-9, all_teeth=False, note=""):
-    from solver.integrate import simulate, stable_time_step
-    from solver.reference import simulate_explicit_all_teeth
+    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.peers.scipy_dynamics import simulate_explicit_all_teeth
     dt, _w = stable_time_step(m, TORQUE)
     if all_teeth:
         fn = lambda: simulate_explicit_all_teeth(m, speed, RAMP, TORQUE, RAMP, DUR, dt=dt)  # noqa: E731
@@ -65,7 +65,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer points")
     args = ap.parse_args(argv)
-    from solver.kernels import layout as L
+    from solver.mbs.kernels import layout as L
     rows = []
     zs = (20, 67, 200) if args.quick else (20, 30, 50, 67, 100, 150, 200)
     for z in zs:

@@ -27,8 +27,8 @@ c0, t0 = time.process_time(), time.perf_counter()
 import numpy as np
 from study.scene import default_scene
 from study.run import build_scene_model
-from solver.statics import solve_static
-from solver.integrate import simulate
+from solver.mbs.statics import solve_static
+from solver.mbs.dynamics import simulate
 m = build_scene_model(default_scene().replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}))
 c1, t1 = time.process_time(), time.perf_counter()
 solve_static(m, np.radians(np.arange(0.0, 1.0, 0.1)), 50.0)
@@ -58,9 +58,9 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     rep = 3 if args.quick else 5
     rows = []
-    from solver.integrate import simulate, stable_time_step
-    from solver.reference import simulate_scipy
-    from solver.statics import solve_static
+    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.peers.scipy_dynamics import simulate_scipy
+    from solver.mbs.statics import solve_static
     from study.run import static_angles
 
     # --- compile and cache start (subprocesses, so nothing is warm here)
@@ -105,7 +105,7 @@ def main(argv=None) -> int:
             rows.append(dict(case=case, method=f"lightgear explicit ({label})", **tim, error_um=err,
                              note=f"target < 1 s; dt {dy.dt * 1e6:.3g} us, {dy.steps} steps, up to {dy.max_active_teeth} "
                                   f"active teeth; {tim['cpu_min_s'] / dur:.2f} x real time; error vs dt/8 (default set)"))
-        from solver.reference import simulate_explicit_all_teeth
+        from solver.peers.scipy_dynamics import simulate_explicit_all_teeth
         tim, da = best_of(lambda: simulate_explicit_all_teeth(m, speed, sramp, tq, tramp, dur, dt=dt), 1)
         act = simulate(m, speed, sramp, tq, tramp, dur, dt=dt)
         rows.append(dict(case=case, method="lightgear explicit, all teeth active", **tim,
@@ -120,7 +120,7 @@ def main(argv=None) -> int:
     m = common.model("solid")
     dt, _w = stable_time_step(m, 50.0)
     win = SHORT_DYNAMIC
-    from solver.reference import simulate_explicit_all_teeth
+    from solver.peers.scipy_dynamics import simulate_explicit_all_teeth
     ref = simulate(m, *win, dt=dt / 8)
     ref_all = simulate_explicit_all_teeth(m, *win, dt=dt / 8)
     tim, dy = best_of(lambda: simulate(m, *win, dt=dt), rep, warmup=True)

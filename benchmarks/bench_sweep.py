@@ -29,8 +29,8 @@ sys.path.insert(0, str(ROOT))  # this checkout, not another installed copy
 
 import numpy as np  # noqa: E402
 
-from study.grid import loads_study  # noqa: E402
-from study.sweep import SCALARS, dask_client, run_point, run_sweep  # noqa: E402
+from study.sweep.grid import loads_study  # noqa: E402
+from study.sweep.engine import SCALARS, dask_client, run_point, run_sweep  # noqa: E402
 
 DYNAMIC = tuple(k for k in SCALARS if not k.startswith("ste"))
 SOLID = '"gear2.body.holes" = 0\n"gear2.body.web_thickness" = 17.0\n'
@@ -102,8 +102,8 @@ def scaling(tmp: Path) -> list[dict]:
 
 MEMORY = '''
 import sys; sys.path.insert(0, {root!r})
-from study.grid import loads_study
-from study.sweep import run_sweep
+from study.sweep.grid import loads_study
+from study.sweep.engine import run_sweep
 text = """title = "memory"
 [scene]
 {cheap}
@@ -146,7 +146,7 @@ def sensitivity(tmp: Path, full: bool) -> list[dict]:
         return [dict(figure="standard sensitivity study (measured)", value=(time.perf_counter() - t0) / 60, unit="min",
                      target="", note=f"{res.computed} points on 2 workers; {load()}")]
     # distinct FE bodies: spring maps are cached by body (hole sizes ignored without holes)
-    from study.springs import _key, _settings
+    from study.inputs.springs import _key, _settings
     bodies = {}
     for p in st.points():
         if p.scene.is_lightened(2):

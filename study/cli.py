@@ -12,12 +12,12 @@ import sys
 # name -> (module, one-line help)
 COMMANDS = {
     "run": ("study.run", "run a scene (default: the paper example) and write its archive"),
-    "stiffness": ("study.springs", "per-tooth FE stiffness map of a scene's gears (no solve)"),
-    "sweep": ("study.sweep", "run a parametric study (scene + grid) with dask into one NetCDF archive"),
-    "fit-contact": ("study.fit_contact", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
-    "render": ("study.figures", "plots and renders (PNG) of a run or sweep archive"),
-    "precision": ("study.precision", "work-precision study: TE error against wall time for every solver of a scene"),
-    "reference": ("study.reference", "FE reference STE and load sharing (loaded-tooth-contact analysis)"),
+    "stiffness": ("study.inputs.springs", "per-tooth FE stiffness map of a scene's gears (no solve)"),
+    "sweep": ("study.sweep.engine", "run a parametric study (scene + grid) with dask into one NetCDF archive"),
+    "fit-contact": ("study.inputs.contact_fit", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
+    "render": ("study.report.figures", "plots and renders (PNG) of a run or sweep archive"),
+    "precision": ("study.verify.precision", "work-precision study: TE error against wall time for every solver of a scene"),
+    "reference": ("study.verify.fe_reference", "FE reference STE and load sharing (loaded-tooth-contact analysis)"),
 }
 
 

@@ -15,27 +15,27 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.implicit import choose_method, simulate_implicit
-from solver.integrate import run_loads, simulate
-from solver.kernels.layout import R_PV
-from solver.model import ContactLaw, GearInput, Model, build_model
-from solver.statics import solve_static
+from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.dynamics import run_loads, simulate
+from solver.mbs.kernels.layout import R_PV
+from solver.mbs.model import ContactLaw, GearInput, Model, build_model
+from solver.mbs.statics import solve_static
 
-from . import results
-from .scene import Scene, load_scene
+from study.report import results
+from study.scene import Scene, load_scene
 
 
 def tooth_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
     """Per-tooth k_phi [N·mm/rad^n_k] and FE stiffness ratio [1] of gear g.
 
     A solid gear needs no FE: every tooth gets the scene's k_phi. A lightened gear's springs
-    come from the FE body model (`study.springs`), unless its spring.stiffness is 'uniform'.
+    come from the FE body model (`study.inputs.springs`), unless its spring.stiffness is 'uniform'.
     """
     gs = scene.gear(g)
     z = gs.teeth
     if not scene.is_lightened(g) or gs.spring.stiffness == "uniform":
         return np.full(z, gs.spring.k_phi), np.ones(z)
-    from .springs import tooth_springs as fe_springs
+    from study.inputs.springs import tooth_springs as fe_springs
     return fe_springs(scene, g)
 
 
@@ -44,7 +44,7 @@ def coupling_fit(scene: Scene, g: int):
     """Gear g's foundation coupling identified from its FE body: a `BodyTorsionFit`
     ('body-torsion'), a `ToothComplianceFit` ('compliance'), or None (the plain model).
     Kept per scene: a run asks for it for the springs and again for the model."""
-    from . import coupling
+    from study.inputs import coupling
     model = scene.coupling.model
     if model == "body-torsion":
         return coupling.body_torsion(scene, g)
@@ -119,8 +119,8 @@ def run_static(scene: Scene, model: Model):
     if qs.method == "static":
         return solve_static(model, angles, qs.torque, raise_on_failure=False)
     # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles
-    from solver.kernels.explicit import driver_motion
-    from solver.statics import StaticResult
+    from solver.mbs.kernels.explicit import driver_motion
+    from solver.mbs.statics import StaticResult
     dt_out = math.radians(qs.angle_step) / qs.speed / 4
     t_end = qs.ramp_time / 2 + angles[-1] / qs.speed + 2 * dt_out
     dyn = simulate(model, qs.speed, qs.ramp_time, qs.torque, qs.ramp_time, t_end, output_step=dt_out)
@@ -146,7 +146,7 @@ def load_table(scene: Scene) -> np.ndarray | None:
 
 def run_dynamic(scene: Scene, model: Model):
     """DTE run with the scene's integrator: dynamic.method 'explicit', 'implicit' or 'auto'
-    (chosen from the stability step; see `solver.implicit.choose_method`). The result carries
+    (chosen from the stability step; see `solver.mbs.implicit.choose_method`). The result carries
     ``choice`` (the MethodChoice) for the archive."""
     d = scene.dynamic
     table = load_table(scene)
@@ -270,7 +270,7 @@ def main(args) -> int:
     results.write_netcdf(ds, args.output)
     print_summary(ds, args.output, time.perf_counter() - t0)
     if args.figures:
-        from .figures import make_figures
+        from study.report.figures import make_figures
         for path in make_figures(ds, Path(args.output).parent):
             print(f"  figure: {path}")
     return 0

@@ -28,7 +28,9 @@ def solid_scene(**overrides):
 def private_fe_cache(tmp_path, monkeypatch):
     """FE results of the test go to a fresh disk cache, and no in-memory cache (influence
     coefficients, factorised bodies, spring maps, coupling fits) leaks in or out."""
-    from study import reference, run, springs
+    from study import run
+    from study.verify import fe_reference as reference
+    from study.inputs import springs
 
     def clear():
         reference._memory.clear()
@@ -57,7 +59,7 @@ def assert_energy_closes_at_second_order(model, torque=50.0):
     integrator alone): the energy residual stays bounded (no secular drift) and falls about
     4x per halved step."""
     import numpy as np
-    from solver.integrate import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate, stable_time_step
     dt0, _ = stable_time_step(model, torque)
     errs = []
     for dt in (dt0, dt0 / 2):
@@ -73,9 +75,9 @@ def slow_transient_against_statics(model, torque=50.0):
     angles past 1.5 deg: (TE difference [m], the run, the static result)."""
     import math
     import numpy as np
-    from solver.integrate import simulate
-    from solver.kernels.explicit import driver_motion
-    from solver.statics import solve_static
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.kernels.explicit import driver_motion
+    from solver.mbs.statics import solve_static
     r = simulate(model, 1.0, 0.001, torque, 0.001, 0.05, output_step=1e-4)
     assert r.status == 0
     th1 = np.array([driver_motion(t, 1.0, 0.001)[0] for t in r.time])

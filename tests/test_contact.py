@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from matplotlib.path import Path
 
-from solver.kernels import layout as L
-from solver.kernels.contact import flank_flank, point_flank
-from solver.kernels.mesh import mesh_contacts, new_contact_buffer
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.contact import flank_flank, point_flank
+from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
 
 
 def _tooth_world(g, center, axis, phi=0.0, pivot_radius=None):

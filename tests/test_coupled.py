@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from solver.coupling import body_torsion_fit, body_windup
-from solver.ltca import mesh_points
-from solver.model import build_model
-from solver.statics import solve_static
-from study import reference as ref_mod
+from solver.identify.coupling import body_torsion_fit, body_windup
+from solver.fe.ltca import mesh_points
+from solver.mbs.model import build_model
+from solver.mbs.statics import solve_static
+from study.verify import fe_reference as ref_mod
 from study.run import build_scene_model
 from study.scene import SceneError
 
@@ -96,7 +96,7 @@ def test_coupled_slow_transient_follows_coupled_statics(paper_solid_model):
 def _double_contact_errors(scene, coupling="body-torsion"):
     """(plain-FE, coupled) STE errors [m] against the FE reference where the rigid geometry has
     two pairs in the path of contact, and the single-contact errors."""
-    from study.coupling import plain_fe_springs
+    from study.inputs.coupling import plain_fe_springs
     from solver import units
     angles = np.radians(np.arange(0.0, scene.quasi_static.rotation, 0.25))
     res, model, _ = ref_mod.reference(scene, angles)
@@ -129,7 +129,7 @@ def test_coupled_model_closes_the_double_contact_gap(body, coupling):
 
 def test_coupled_step_above_the_stability_bound_is_caught(paper_solid_model):
     """Twice the critical step of the coupled pair: the guard stops the run and names why."""
-    from solver.integrate import DivergenceError, simulate, stable_time_step
+    from solver.mbs.dynamics import DivergenceError, simulate, stable_time_step
     m = with_body_springs(paper_solid_model, K_BODY)
     dt, _w = stable_time_step(m, 50.0)          # half the critical step
     ok = simulate(m, 100.0, 0.002, 50.0, 0.002, 0.002, dt=dt)
@@ -141,13 +141,13 @@ def test_coupled_step_above_the_stability_bound_is_caught(paper_solid_model):
 
 
 def test_scipy_peer_refuses_a_coupled_model(paper_solid_model):
-    from solver.reference import simulate_scipy
+    from solver.peers.scipy_dynamics import simulate_scipy
     with pytest.raises(ValueError, match="coupling"):
         simulate_scipy(with_body_springs(paper_solid_model, K_BODY), 100.0, 0.01, 50.0, 0.01, 1e-4)
 
 
 def test_implicit_integrator_refuses_and_auto_picks_explicit_for_a_coupled_model(paper_solid_model):
-    from solver.implicit import choose_method, simulate_implicit
+    from solver.mbs.implicit import choose_method, simulate_implicit
     coupled = with_body_springs(paper_solid_model, (1.5e6, 0.9e6))
     with pytest.raises(ValueError, match="dynamic.method"):
         simulate_implicit(coupled, 100.0, 0.002, 50.0, 0.002, 0.001, dt=1e-6)

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 import skfem
 
-from solver import fe
+from solver.fe import body as fe
 from solver.geometry import Material, gear_geometry
-from solver.mesh import REGION_WEB, mesh_annulus, mesh_body
+from solver.fe.mesh import REGION_WEB, mesh_annulus, mesh_body
 
 STEEL = Material(206e9, 0.3, 7850.0)
 A, C, B = 0.010, 0.020, 0.030       # bore, web/rim split, outer radius [m]

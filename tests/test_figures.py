@@ -9,8 +9,9 @@ import pytest
 import xarray as xr
 from matplotlib.image import imread
 
-from study import plots, render
-from study.figures import make_figures
+from study.report import plots
+from study.report import render
+from study.report.figures import make_figures
 from study.run import run_scene
 from study.scene import default_scene
 
@@ -151,7 +152,7 @@ def test_sweep_view_facets_the_other_dimensions():
 
 def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
     from study.cli import main
-    from study.results import write_netcdf
+    from study.report.results import write_netcdf
     ds, _, _ = tiny
     path = tmp_path / "run.nc"
     write_netcdf(ds, path)

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from conftest import solid_scene
-from solver.implicit import choose_method, simulate_implicit
-from solver.integrate import DivergenceError, highest_frequency, linearized_system, simulate, stable_time_step
-from solver.kernels.laws import contact_damping_tangents, contact_force, contact_tangent, spring_damping_tangent, spring_torque
+from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.dynamics import DivergenceError, highest_frequency, linearized_system, simulate, stable_time_step
+from solver.mbs.kernels.laws import contact_damping_tangents, contact_force, contact_tangent, spring_damping_tangent, spring_torque
 from study.run import build_scene_model, run_scene
 from study.scene import SceneError
 
@@ -128,7 +128,7 @@ def test_explicit_step_bound_matches_the_eigenvalues(undamped):
                  raise_on_failure=True)
     # the highest mode is bounded by a tooth on its spring plus its contact (Rayleigh)
     gp = undamped.gear_par
-    from solver.kernels import layout as L
+    from solver.mbs.kernels import layout as L
     M, K, _teeth = linearized_system(undamped, 0.0, undamped.theta2_for_te(0.0, undamped.backlash_offset + 5e-6),
                                      np.zeros(undamped.n_teeth))
     diag_max = math.sqrt(np.max(np.diag(K)[1:] / np.diag(M)[1:]))
@@ -160,7 +160,7 @@ def test_step_bound_includes_the_contact_damping():
     c*delta^1.5 overdamps the tooth-on-contact mode: Verlet is then limited by the damping,
     2/(sqrt(w² + h²) + h) with h = zeta*w, far below 2/w. The scene runs at the bound that
     includes it and is caught by the guard at the undamped bound."""
-    from solver.integrate import stability_limit
+    from solver.mbs.dynamics import stability_limit
     m = build_scene_model(solid_scene(**{"contact.k_con": 5.64e4}))
     dt_crit, w = stability_limit(m, 50.0)
     assert dt_crit < 0.1 * 2.0 / w

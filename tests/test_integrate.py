@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from conftest import assert_energy_closes_at_second_order, solid_scene
-from solver.integrate import DivergenceError, simulate, stable_time_step
-from solver.statics import solve_static
+from solver.mbs.dynamics import DivergenceError, simulate, stable_time_step
+from solver.mbs.statics import solve_static
 from study.run import build_scene_model, run_static
 
 UNDAMPED = {"gear1.spring.c_phi": 0.0, "gear2.spring.c_phi": 0.0, "contact.c_con": 0.0}

@@ -4,10 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from solver.kernels import layout as L
-from solver.kernels.laws import (contact_energy, contact_force, contact_tangent, spring_energy, spring_tangent,
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.laws import (contact_energy, contact_force, contact_tangent, spring_energy, spring_tangent,
                                  spring_torque)
-from solver.kernels.mesh import generalized_forces, mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
 
 
 def test_spring_law_against_numpy():
@@ -80,7 +80,7 @@ def test_generalized_forces_are_minus_the_energy_gradient(paper_solid_model):
 def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
     """The compiled static sweep (plain model: ctooth None, the coupled code pruned) gives
     what its source gives when run as plain Python."""
-    from solver.kernels.statics import static_sweep
+    from solver.mbs.kernels.statics import static_sweep
     m = paper_solid_model
     angles = np.radians(np.arange(0.0, 3.0, 0.5))
     theta2 = float(m.theta2_for_te(angles[0], m.backlash_offset))
@@ -100,9 +100,15 @@ FIRST_RUN = r'''
 import numpy as np
 from study.scene import default_scene
 from study.run import build_scene_model
-from solver.statics import solve_static
-from solver.integrate import simulate
-from solver.kernels import contact, explicit, laws, mesh, statics, stepping, toothcoupling
+from solver.mbs.statics import solve_static
+from solver.mbs.dynamics import simulate
+from solver.mbs.kernels import contact
+from solver.mbs.kernels import explicit
+from solver.mbs.kernels import laws
+from solver.mbs.kernels import gearmesh as mesh
+from solver.mbs.kernels import statics
+from solver.mbs.kernels import stepping
+from solver.mbs.kernels import toothcoupling
 m = build_scene_model(default_scene().replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}))
 solve_static(m, np.radians([0.0, 0.1, 0.2]), 50.0)
 simulate(m, 100.0, 1e-4, 50.0, 1e-4, 1e-4)

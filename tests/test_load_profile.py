@@ -3,9 +3,9 @@ that carries the mesh across the backlash onto the coast flanks."""
 import numpy as np
 import pytest
 
-from solver.integrate import load_profile, run_loads, simulate
-from solver.kernels.explicit import load_torque
-from solver.statics import solve_static
+from solver.mbs.dynamics import load_profile, run_loads, simulate
+from solver.mbs.kernels.explicit import load_torque
+from solver.mbs.statics import solve_static
 from study.scene import SceneError
 
 from conftest import solid_scene
@@ -63,7 +63,7 @@ def damped_pair():
 def test_torque_reversal_crosses_the_backlash_onto_the_coast_flanks(damped_pair, method):
     """+50 -> -50 N·m over 5 ms at 10 rad/s: the mesh leaves the drive flanks, crosses the
     backlash without contact and settles on the coast flanks at the static coast STE."""
-    from solver.implicit import simulate_implicit
+    from solver.mbs.implicit import simulate_implicit
     m = damped_pair
     run = simulate if method == "explicit" else simulate_implicit
     r = run(m, 10.0, 0.005, 50.0, 0.005, 0.04, load_table=TABLE)
@@ -85,7 +85,7 @@ def test_torque_reversal_crosses_the_backlash_onto_the_coast_flanks(damped_pair,
 def test_scipy_peer_follows_the_same_profile(damped_pair):
     """The numpy + scipy peer (its own interpolation of the table) against the explicit
     integrator through a load step 50 -> 20 N·m on the drive flanks (short window)."""
-    from solver.reference import simulate_explicit_all_teeth, simulate_scipy
+    from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
     table = [[0.0, 0.0], [0.0005, 50.0], [0.0008, 50.0], [0.001, 20.0]]
     ref = simulate_explicit_all_teeth(damped_pair, 100.0, 0.0005, 50.0, 0.0005, 0.0015, dt=2e-8, load_table=table)
     sp = simulate_scipy(damped_pair, 100.0, 0.0005, 50.0, 0.0005, 0.0015, method="LSODA", rtol=1e-7, load_table=table)

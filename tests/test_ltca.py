@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from solver.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
-from study import reference as ref_mod
+from solver.fe.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
+from study.verify import fe_reference as ref_mod
 from study.scene import SceneError, default_scene
 
 from conftest import SMALL_PAIR, solid_scene
@@ -143,10 +143,10 @@ def test_factorised_bodies_are_reused_for_other_load_sets(monkeypatch):
     """Both gears' factorised bodies stay in memory: new load/read sets on either gear (as the
     body-torsion identification asks after a reference) mesh nothing again, and the shared
     coefficients are the same numbers."""
-    import solver.mesh
+    import solver.fe.mesh
     calls = []
-    real = solver.mesh.mesh_body
-    monkeypatch.setattr(solver.mesh, "mesh_body", lambda *a, **k: calls.append(k.get("prefix")) or real(*a, **k))
+    real = solver.fe.mesh.mesh_body
+    monkeypatch.setattr(solver.fe.mesh, "mesh_body", lambda *a, **k: calls.append(k.get("prefix")) or real(*a, **k))
     s = small_scene(**LIGHT, **{"fe.mesh_size": 1.8})
     c1, i1 = ref_mod.body_compliance_cached(s, 1, [0], 1, n_u=4)
     c2, _ = ref_mod.body_compliance_cached(s, 2, [0, 1], 1, n_u=4)

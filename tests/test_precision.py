@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import solid_scene
-from study import precision as P
+from study.verify import precision as P
 from study.run import build_scene_model
 
 
@@ -83,7 +83,7 @@ def test_static_study_and_failed_run_kept(scene, model, tmp_path):
     assert "ZeroDivisionError" in ds2["message"].values[0] and "penetration" in ds2["message"].values[1]
     P.plot(ds, tmp_path / "wp.png")
     assert (tmp_path / "wp.png").stat().st_size > 10_000
-    from study import results
+    from study.report import results
     results.write_netcdf(ds2, tmp_path / "wp.nc")
     import xarray as xr
     back = xr.open_dataset(tmp_path / "wp.nc")

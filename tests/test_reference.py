@@ -1,11 +1,11 @@
-"""scipy peer (`solver.reference`): agrees with the numba explicit solver, between its own
+"""scipy peer (`solver.peers.scipy_dynamics`): agrees with the numba explicit solver, between its own
 methods, closes the energy balance, and reports failures by name."""
 import numpy as np
 import pytest
 
 from conftest import solid_scene
-from solver.integrate import DivergenceError, simulate
-from solver.reference import PairEquations, simulate_explicit_all_teeth, simulate_scipy
+from solver.mbs.dynamics import DivergenceError, simulate
+from solver.peers.scipy_dynamics import PairEquations, simulate_explicit_all_teeth, simulate_scipy
 from study.run import build_scene_model
 
 # a short run of the paper pair: 100 rad/s and 50 N·m reached in 2 ms, 3 ms in all

@@ -1,11 +1,11 @@
-"""scipy root-loop peer of the static solver (`solver.reference_static`): same equations,
+"""scipy root-loop peer of the static solver (`solver.peers.scipy_statics`): same equations,
 every tooth free, so it must give the same STE and contact count as `solve_static`."""
 import numpy as np
 import pytest
 
 from conftest import solid_scene
-from solver.reference_static import static_te_root
-from solver.statics import solve_static
+from solver.peers.scipy_statics import static_te_root
+from solver.mbs.statics import solve_static
 from study.run import build_scene_model
 
 

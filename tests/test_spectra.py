@@ -4,8 +4,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from study import results
-from study.spectra import amplitude_spectrum, named_orders, named_peaks, ste_order_spectrum
+from study.report import results
+from study.report.spectra import amplitude_spectrum, named_orders, named_peaks, ste_order_spectrum
 
 HANN_SCALLOP = 1 - (np.sinc(0.5) / (1 - 0.5**2))   # 15.1 %: Hann loss half-way between bins
 

@@ -5,12 +5,12 @@ import math
 import numpy as np
 import pytest
 
-from solver import fe
-from solver.energy_method import tooth_compliance
+from solver.fe import body as fe
+from solver.peers.energy_method import tooth_compliance
 from solver.geometry import gear_geometry
-from solver.iso6336 import blank_factor, single_stiffness
-from solver.weber import pitch_point_depth, weber_deflection
-from study import springs
+from solver.peers.iso6336 import blank_factor, single_stiffness
+from solver.identify.weber import pitch_point_depth, weber_deflection
+from study.inputs import springs
 from study.scene import default_scene
 
 from conftest import SMALL_PAIR
@@ -68,7 +68,7 @@ def test_spring_options_and_cache(monkeypatch, tmp_path):
     assert len(files) == 2                        # the lightened body and its solid reference
     springs._memory.clear()
     calls = []
-    monkeypatch.setattr("solver.mesh.mesh_body", lambda *a, **kw: calls.append(1))
+    monkeypatch.setattr("solver.fe.mesh.mesh_body", lambda *a, **kw: calls.append(1))
     k2, r2 = springs.tooth_springs(s, 2)          # from disk, no mesh
     assert not calls and np.array_equal(k2, k)
     # 'fe': the nonlinear spring passes through the FE point at the reference moment
@@ -147,7 +147,7 @@ def test_web_thickness_trend_follows_iso_blank_factor(table1):
 
 
 def test_identification_recovers_a_known_spring_and_reads_the_fe():
-    from solver.identify import fit_pivot, fit_power_law, lever
+    from solver.identify.pivot import fit_pivot, fit_power_law, lever
     rb, r_q, k = 0.047, 0.0445, 9.0e3
     t = np.linspace(-0.45, -0.2, 6)
     c = lever(rb, t, r_q) ** 2 / k

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from conftest import solid_scene
-from solver.kernels import layout as L
-from solver.kernels.mesh import generalized_forces, mesh_contacts, new_contact_buffer
-from solver.statics import solve_static
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
+from solver.mbs.statics import solve_static
 from study.run import build_scene_model
 
 

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 import xarray as xr
 
-import study.sweep as sweep
-from study.grid import loads_study
+import study.sweep.engine as sweep
+from study.sweep.grid import loads_study
 from study.run import run_scene, summarize
 from study.scene import SceneError, default_scene, loads_scene
-from study.sweep import STATUS, parts_folder, run_sweep
+from study.sweep.engine import STATUS, parts_folder, run_sweep
 
 # A 20-tooth solid-driver pair with small bodies, uniform springs (no FE), a few degrees of STE
 # and 10 ms of DTE: about a third of a second per point.
@@ -176,7 +176,7 @@ def test_rerunning_a_complete_study_computes_nothing(swept, monkeypatch):
 def test_changed_code_recomputes_every_point(swept, tmp_path, monkeypatch):
     """Finished points of another version of the code are never reused, neither from the
     part files nor from a complete archive."""
-    from study import results
+    from study.report import results
     res, out = swept
     keys = [p.key(tiny_study().outputs) for p in tiny_study().points()]
     monkeypatch.setattr(results, "code_fingerprint", lambda: "another-version")

@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from solver.coupling import tooth_compliance_fit
-from solver.identify import lever
-from solver.kernels.toothcoupling import set_energy, set_moment, set_stiffness
-from solver.model import build_model
-from solver.statics import solve_static
+from solver.identify.coupling import tooth_compliance_fit
+from solver.identify.pivot import lever
+from solver.mbs.kernels.toothcoupling import set_energy, set_moment, set_stiffness
+from solver.mbs.model import build_model
+from solver.mbs.statics import solve_static
 
 from conftest import SMALL_PAIR, assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 
@@ -175,7 +175,7 @@ def test_coupled_teeth_slow_transient_follows_statics():
 
 
 def test_diagonal_compliance_dynamics_is_the_body_torsion_model():
-    from solver.integrate import simulate
+    from solver.mbs.dynamics import simulate
     from study.run import build_scene_model
     m = build_scene_model(solid_scene(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
     z1, z2 = m.teeth
@@ -191,8 +191,8 @@ def test_diagonal_compliance_dynamics_is_the_body_torsion_model():
 def test_coupled_kernel_matches_its_plain_python_run():
     """The compiled coupled loop against the same loop run as plain Python, set changes
     included (300 steps through a change of the candidate teeth)."""
-    from solver.integrate import stable_time_step
-    from solver.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.dynamics import stable_time_step
+    from solver.mbs.kernels.explicit_coupled import verlet_coupled
     m = coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0})
     dt, _ = stable_time_step(m, 50.0)
     th2 = float(m.theta2_for_te(0.0, m.backlash_offset))
@@ -216,7 +216,7 @@ def test_set_changes_keep_the_spring_moments(jit):
     """A tooth that joins the coupled set unloaded (from rest, as from the frozen set) takes
     the rotation its neighbours give it and changes no moment; a tooth that leaves keeps its
     moment on its own spring."""
-    from solver.kernels.explicit_coupled import _update_set
+    from solver.mbs.kernels.explicit_coupled import _update_set
     f = _update_set if jit else _update_set.py_func
     z = 9
     C = ring(z, 800.0, (0.15, 0.05))

@@ -6,7 +6,7 @@ import pytest
 
 from solver import units
 from solver.geometry import Material
-from solver.weber import fit_contact, weber_deflection
+from solver.identify.weber import fit_contact, weber_deflection
 from study.scene import default_scene
 from solver.geometry import gear_geometry
 

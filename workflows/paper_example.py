@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from study import results
+from study.report import results
 from study.run import build_scene_model, print_summary, run_scene, run_static
 from study.scene import load_scene
 
@@ -68,7 +68,7 @@ def main(argv=None) -> int:
               f"peak-to-peak {float(ds['ste_solid'].max() - ds['ste_solid'].min()):.3f} um")
     if not args.no_figures:
         try:
-            from study.figures import make_figures
+            from study.report.figures import make_figures
         except ImportError:
             make_figures = None
         if make_figures is not None:

@@ -2,7 +2,7 @@
 lightened pair: STE, load sharing, and the error figures.
 
 Models (all at the scene's quasi-static torque, static equilibrium at every angle):
-  fe-reference  loaded-tooth-contact analysis with FE influence coefficients (`study.reference`)
+  fe-reference  loaded-tooth-contact analysis with FE influence coefficients (`study.verify.fe_reference`)
   plain         MUBOCO-PR as the scene defines it (the paper's calibrated springs)
   plain-fe      MUBOCO-PR with each tooth's spring from the same FE body (linear, k = k_fe):
                 the paper's structure with our FE, so the difference to the reference is
@@ -30,10 +30,10 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.ltca import mesh_points
-from solver.statics import solve_static
-from study import results
-from study.reference import reference, static_angles
+from solver.fe.ltca import mesh_points
+from solver.mbs.statics import solve_static
+from study.report import results
+from study.verify.fe_reference import reference, static_angles
 from study.run import build_scene_model
 from study.scene import load_scene
 
@@ -56,7 +56,7 @@ def model_scene(scene, name: str):
     if name == "compliance":
         return scene.replace(**{"coupling.model": "compliance"}), None
     if name == "plain-fe":
-        from study.coupling import plain_fe_springs
+        from study.inputs.coupling import plain_fe_springs
         lin = scene.replace(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0, "coupling.model": "none"})
         springs = []
         for g in (1, 2):
@@ -159,7 +159,7 @@ def validation_dataset(scene, angles) -> xr.Dataset:
         sc = pairs[name]
         s, f, nom, w, model = evaluate_pair(sc, angles)
         if "compliance" in MODELS:
-            from study.coupling import tooth_compliance
+            from study.inputs.coupling import tooth_compliance
             for g in (1, 2):
                 tc = tooth_compliance(sc, g)
                 fit["k_body"][p, g - 1], fit["pivot"][p, g - 1], fit["rms"][p, g - 1] = (

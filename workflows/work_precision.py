@@ -2,7 +2,7 @@
 
 For the dynamic scene (shortened window, ramps scaled) and the quasi-static scene (STE over
 one mesh cycle) it writes an archive and a log-log plot each, prints the tables and the
-cheapest method for 0.1 um and 0.01 um TE accuracy. See `study.precision` for the methods,
+cheapest method for 0.1 um and 0.01 um TE accuracy. See `study.verify.precision` for the methods,
 the references and the norms.
 
     python -m workflows.work_precision [SCENE] [-o results/work_precision/work_precision.nc]
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 
-from study import precision
+from study.verify import precision
 
 DEFAULT_OUT = "results/work_precision/work_precision.nc"
 

@@ -1,7 +1,7 @@
 """The pseudo-rigid-tooth gear pair built in Exudyn (C++ multibody code, Python front end).
 
 One `NodeGenericODE2` carries the free coordinates q = [theta2, phi_0 .. phi_{N-1}] [rad]
-(every tooth of both gears free, as in `solver.reference.PairEquations`); an
+(every tooth of both gears free, as in `solver.peers.scipy_dynamics.PairEquations`); an
 `ObjectGenericODE2` holds the constant arrowhead mass matrix of hubs and teeth (driver hub
 prescribed, so it is not a coordinate) and a force user function that returns the
 generalised forces: the torsion springs of eq. (1.2), the involute contact of eq. (1.3)
@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from solver.reference import PairEquations, driver_motion
+from solver.peers.scipy_dynamics import PairEquations, driver_motion
 
 
 def mass_matrix(eq: PairEquations) -> np.ndarray:
@@ -42,7 +42,7 @@ def simulate_exudyn(model, speed: float, speed_ramp: float, torque: float, torqu
                     duration: float, dt: float, output_step: float = 1e-5, solver: str = "VelocityVerlet"):
     """Integrate the pair from rest in Exudyn at the fixed step dt [s] with `solver`
     (an `exudyn.DynamicSolverType` name). Returns (time [s], TE [m], wall time of the solve [s]).
-    dt is rounded down to divide output_step [s] (as `solver.integrate.simulate` does), so
+    dt is rounded down to divide output_step [s] (as `solver.mbs.dynamics.simulate` does), so
     the sensor samples fall on steps.
     """
     import math

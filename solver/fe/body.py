@@ -1,0 +1,442 @@
+"""Plane-stress FE of a gear body (scikit-fem, quadratic triangles) and per-tooth stiffness.
+
+The body is clamped at the bore. Its thickness is the face width on the teeth, rim and hub and
+the web thickness t1 in the web; the stiffness matrix is the sum of the region matrices scaled
+by their thickness. One LU factorisation serves all Z load cases.
+
+Load case k: a force F on the drive (+) flank of tooth k at the pitch point, along the line of
+action (pushing the tooth toward negative polar angle, as the mating gear does), spread
+uniformly over a patch of half-width ``patch`` along the profile (a 2D point load has a
+mesh-dependent log singularity).
+
+Tooth stiffness about the pivot Q (on the tooth axis at the pivot radius): the load line
+crosses the tooth axis at C; a rigid rotation phi about Q moves C along the load by phi*lever,
+lever = distance from Q to the load line. So
+
+    k_phi = F * lever**2 / delta_C,   delta_C = u(C) . d
+
+Reading the deflection at the tooth centreline (not under the load) keeps the local contact
+flattening out of the spring: that part belongs to the contact law, whose Weber fit measures
+the flattening down to the same centreline (see `solver.identify.weber`). delta_C holds tooth bending
+and shear, the fillet/foundation deflection and the wind-up of the whole body to the bore.
+
+Units: SI in and out (m, N, Pa, N·m/rad).
+"""
+from __future__ import annotations
+
+import math
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from solver.geometry import BodySpec, GearGeometry, Material
+from solver.fe.mesh import REGION_WEB, BodyMesh
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """Pitch-point load on the + flank of one tooth (gear frame)."""
+
+    point: np.ndarray       # load point P on the flank [m]
+    direction: np.ndarray   # unit load direction d (along the line of action)
+    centre_point: np.ndarray  # C: load line on the tooth axis [m]
+    lever: float            # distance pivot -> load line [m]
+
+
+def load_case(g: GearGeometry, tooth: int, pivot_radius: float, u: float | None = None) -> LoadCase:
+    """Geometry of the load on the + flank of tooth ``tooth`` at roll parameter u (default: the
+    pitch point), with the tooth's pivot at ``pivot_radius`` [m]."""
+    u = math.tan(g.spec.pressure_angle) if u is None else float(u)
+    t = g.psi_base - u
+    rb = g.base_radius
+    p = np.array([rb * math.cos(t) - rb * u * math.sin(t), rb * math.sin(t) + rb * u * math.cos(t)])
+    d = np.array([math.sin(t), -math.cos(t)])     # -n(t): into the tooth, toward -polar angle
+    s = p[1] / math.cos(t)                        # P + s*d lies on the axis (y = 0)
+    c = p + s * d
+    q = np.array([pivot_radius, 0.0])
+    lever = abs((p[0] - q[0]) * d[1] - (p[1] - q[1]) * d[0])
+    a = tooth * g.pitch_angle
+    rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    return LoadCase(rot @ p, rot @ d, rot @ c, lever)
+
+
+@dataclass
+class BodyModel:
+    """Assembled and factorised plane-stress model of a clamped gear body."""
+
+    mesh: BodyMesh
+    basis: object           # skfem Basis (vector P2)
+    thickness: np.ndarray   # (m,) element thickness [m]
+    free: np.ndarray        # free DOF indices
+    solve: object           # factorised K_ff: rhs -> displacement of the free DOFs (one BLAS thread)
+    material: Material
+    assembly_time: float = 0.0   # wall seconds of the assembly (incl. basis and clamping)
+    factor_time: float = 0.0     # wall seconds of the factorisation
+    assembly_cpu: float = 0.0    # CPU seconds of the same (all threads of the process)
+    factor_cpu: float = 0.0
+    factor: object = None        # the SuperLU object behind ``solve`` (for `influence`)
+    _triangles: tuple | None = field(default=None, repr=False)   # (L, U^T) in CSC, made once on demand
+
+    @property
+    def n_dofs(self) -> int:
+        return self.basis.N
+
+
+def plane_stress_lame(E: float, nu: float) -> tuple[float, float]:
+    """Lame parameters (lambda*, mu) of plane stress [Pa]."""
+    mu = E / (2 * (1 + nu))
+    lam = E * nu / (1 - nu**2)   # = 2 lambda mu / (lambda + 2 mu)
+    return lam, mu
+
+
+def plane_stress_p2_stiffness(basis, lam: float, mu: float, thickness: np.ndarray):
+    """Stiffness matrix (COO, N x N) [N/m] of straight-sided quadratic triangles in plane stress
+    with Lame parameters ``lam`` (plane-stress lambda*), ``mu`` [Pa] and per-element
+    ``thickness`` [m], in the DOF numbering of the vector P2 ``basis`` (scikit-fem).
+
+    Closed form instead of the generic form assembly (about 4x faster on a gear body): on an
+    affine triangle the P2 gradients are linear, the integrand quadratic, so the edge-midpoint
+    rule integrates it exactly; the result equals ``skfem.asm(linear_elasticity)`` to rounding.
+    """
+    import scipy.sparse as sp
+
+    m = basis.mesh
+    t = m.t                                              # (3, nel) vertex indices
+    nel = t.shape[1]
+    x, y = m.p[0, t], m.p[1, t]
+    a2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0])     # twice the signed area
+    gl = np.empty((nel, 3, 2))                           # gradients of the barycentric coordinates
+    for k in range(3):
+        k1, k2 = (k + 1) % 3, (k + 2) % 3
+        gl[:, k, 0] = (y[k1] - y[k2]) / a2
+        gl[:, k, 1] = (x[k2] - x[k1]) / a2
+    # local vertex pair (a, b) of each element edge, in the basis' own edge order (t2f)
+    ends = m.facets[:, m.t2f]                            # (2, 3, nel) global vertices
+    loc = np.stack([[np.argmax(t == ends[s_, j][None, :], axis=0) for j in range(3)] for s_ in range(2)])
+    e = np.arange(nel)
+    xx, yy, xy = (np.zeros((nel, 6, 6)) for _ in range(3))
+    for q in range(3):                                   # midpoint of the edge opposite vertex q
+        bary = np.full((nel, 3), 0.5)
+        bary[:, q] = 0.0
+        g = np.empty((nel, 6, 2))                        # scalar P2 gradients: vertices, then edges
+        for k in range(3):
+            g[:, k] = (4 * bary[:, k] - 1)[:, None] * gl[:, k]
+        for j in range(3):
+            a, b = loc[0, j], loc[1, j]
+            g[:, 3 + j] = 4 * (bary[e, a][:, None] * gl[e, b] + bary[e, b][:, None] * gl[e, a])
+        gx, gy = g[:, :, 0], g[:, :, 1]
+        xx += gx[:, :, None] * gx[:, None, :]
+        yy += gy[:, :, None] * gy[:, None, :]
+        xy += gx[:, :, None] * gy[:, None, :]
+    w = (0.5 * np.abs(a2) * thickness / 3.0)[:, None, None]      # area/3 per point, times thickness
+    xx *= w; yy *= w; xy *= w
+    yx = xy.transpose(0, 2, 1)
+    ke = np.empty((nel, 12, 12))                         # local order: (x, y) of each scalar function
+    ke[:, 0::2, 0::2] = (lam + 2 * mu) * xx + mu * yy
+    ke[:, 1::2, 1::2] = (lam + 2 * mu) * yy + mu * xx
+    ke[:, 0::2, 1::2] = lam * xy + mu * yx
+    ke[:, 1::2, 0::2] = lam * yx + mu * xy
+    nd, fd = basis.nodal_dofs, basis.facet_dofs
+    dofs = np.empty((nel, 12), dtype=np.int64)
+    for k in range(3):
+        dofs[:, 2 * k], dofs[:, 2 * k + 1] = nd[0, t[k]], nd[1, t[k]]
+    for j in range(3):
+        dofs[:, 6 + 2 * j], dofs[:, 7 + 2 * j] = fd[0, m.t2f[j]], fd[1, m.t2f[j]]
+    rows = np.repeat(dofs, 12, axis=1).ravel()
+    cols = np.tile(dofs, (1, 12)).ravel()
+    return sp.coo_matrix((ke.ravel(), (rows, cols)), shape=(basis.N, basis.N))
+
+
+_BLAS_THREADS: dict = {}     # library path -> [(get, set)] of its thread-count functions
+
+
+def _openblas_controls() -> list:
+    """(get_num_threads, set_num_threads) of every OpenBLAS library loaded in this process
+    (numpy's and scipy's wheels each bundle one, with prefixed symbol names); empty where they
+    cannot be found (not Linux, another BLAS). The loaded libraries are listed anew each call
+    (a millisecond), so one loaded later is not missed."""
+    import ctypes
+    import re
+
+    try:
+        with open("/proc/self/maps") as f:
+            paths = sorted(set(re.findall(r"(/\S*openblas\S*\.so\S*)", f.read())))
+    except OSError:
+        return []
+    out = []
+    for path in paths:
+        if path not in _BLAS_THREADS:
+            found = []
+            try:
+                lib = ctypes.CDLL(path)
+            except OSError:
+                lib = None
+            for prefix in ("openblas", "scipy_openblas") if lib is not None else ():
+                for suffix in ("", "64_"):
+                    get = getattr(lib, f"{prefix}_get_num_threads{suffix}", None)
+                    put = getattr(lib, f"{prefix}_set_num_threads{suffix}", None)
+                    if get is not None and put is not None:
+                        get.restype, put.argtypes = ctypes.c_int, [ctypes.c_int]
+                        found.append((get, put))
+            _BLAS_THREADS[path] = found
+        out += _BLAS_THREADS[path]
+    return out
+
+
+@contextmanager
+def one_blas_thread():
+    """Run the block in single-threaded OpenBLAS, then restore the thread counts.
+
+    SuperLU calls the dense BLAS once per supernode, thousands of small calls per factorisation
+    or block solve: with two BLAS threads on a two-core machine that was also running something
+    else, the reach-restricted solves of the paper reference took 14-15 s instead of 2.2-2.6 s
+    (threads waiting for each other at every call); the factorisation took the same time with
+    one thread or two. The setting is process-wide: other threads of the process run
+    single-threaded BLAS meanwhile.
+    """
+    controls = _openblas_controls()
+    old = [get() for get, _ in controls]
+    for _, put in controls:
+        put(1)
+    try:
+        yield
+    finally:
+        for (_, put), n in zip(controls, old):
+            put(n)
+
+
+def _solver(lu):
+    """lu.solve in single-threaded BLAS (see `one_blas_thread`)."""
+    def solve(rhs):
+        with one_blas_thread():
+            return lu.solve(rhs)
+    return solve
+
+
+def factorise(K):
+    """Sparse LU of the symmetric positive definite K (CSC) for repeated solves.
+
+    Symmetric mode (one minimum-degree ordering of K + K^T for rows and columns, no pivoting,
+    which an SPD matrix does not need) has about half the fill of the default unsymmetric
+    COLAMD ordering: faster to factorise and to solve, half the memory.
+    """
+    from scipy.sparse.linalg import splu
+
+    with one_blas_thread():
+        return splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+
+
+def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material, order: int = 2) -> BodyModel:
+    """Assemble K (thickness-weighted), clamp the bore and factorise once."""
+    import time
+
+    import skfem
+    from skfem.models.elasticity import linear_elasticity
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    m = skfem.MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy())
+    elem = skfem.ElementVector(skfem.ElementTriP2() if order == 2 else skfem.ElementTriP1())
+    basis = skfem.Basis(m, elem)
+    lam, mu = plane_stress_lame(material.youngs_modulus, material.poisson_ratio)
+    thickness = np.where(mesh.region == REGION_WEB, web_thickness, face_width)
+    if order == 2:
+        K = plane_stress_p2_stiffness(basis, lam, mu, thickness)
+    else:
+        form = linear_elasticity(lam, mu)
+        K = None
+        for t in np.unique(thickness):
+            idx = np.nonzero(thickness == t)[0]
+            Kr = t * skfem.asm(form, skfem.Basis(m, elem, elements=idx))
+            K = Kr if K is None else K + Kr
+    r_tol = 1e-6 * mesh.bore_radius + 1e-9
+    clamped = basis.get_dofs(lambda x: np.hypot(x[0], x[1]) < mesh.bore_radius + r_tol).all()
+    keep = np.ones(basis.N, bool)
+    keep[clamped] = False
+    free = np.flatnonzero(keep)
+    Kff = K.tocsc()[:, free][free, :].tocsc()
+    t1, c1 = time.perf_counter(), time.process_time()
+    lu = factorise(Kff)
+    t2, c2 = time.perf_counter(), time.process_time()
+    return BodyModel(mesh, basis, thickness, free, _solver(lu), material, t1 - t0, t2 - t1, c1 - c0, c2 - c1, lu)
+
+
+def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) -> np.ndarray:
+    """Nodal forces of ``force`` [N] spread uniformly over the boundary within ``patch`` [m] of the
+    load point, along the load direction.
+
+    A uniform traction q on a straight quadratic edge of length L has the consistent nodal
+    loads q L/6 at each end and 2 q L/3 at the mid-side node (exact), so no quadrature is needed.
+    """
+    m = model.basis.mesh
+    p, d = case.point, case.direction
+    bf = m.boundary_facets()
+    mid = m.p[:, m.facets[:, bf]].mean(axis=1)
+    dist = np.hypot(mid[0] - p[0], mid[1] - p[1])
+    sel = bf[dist <= patch]
+    if sel.size == 0:       # patch narrower than an element: the nearest edge carries the load
+        sel = bf[[np.argmin(dist)]]
+    ends = m.facets[:, sel]                                   # (2, n) vertex indices
+    length = np.hypot(*(m.p[:, ends[1]] - m.p[:, ends[0]]))
+    q = force / length.sum()
+    f = np.zeros(model.basis.N)
+    nd = model.basis.nodal_dofs
+    for c in range(2):
+        np.add.at(f, nd[c, ends[0]], q * d[c] * length / 6)
+        np.add.at(f, nd[c, ends[1]], q * d[c] * length / 6)
+        if model.basis.facet_dofs.size:                       # P2: mid-side dofs
+            np.add.at(f, model.basis.facet_dofs[c, sel], 2 * q * d[c] * length / 3)
+        else:                                                 # P1: ends take half each
+            np.add.at(f, nd[c, ends[0]], q * d[c] * length / 3)
+            np.add.at(f, nd[c, ends[1]], q * d[c] * length / 3)
+    return f
+
+
+def solve_load(model: BodyModel, f: np.ndarray) -> np.ndarray:
+    """Displacement [m] of all DOFs for the nodal force vector f [N]."""
+    u = np.zeros(model.basis.N)
+    u[model.free] = model.solve(f[model.free])
+    return u
+
+
+def influence(model: BodyModel, R, F, block: int = 48) -> np.ndarray:
+    """R K^-1 F (m, k): the response read by the rows of R (m, N) to the loads in the columns of
+    F (N, k), through the factorisation of K (for unit loads [N] and displacement reads: m/N).
+
+    The same numbers as ``R @ solve_load(model, f)`` for every column f, computed far cheaper when
+    R and F touch few DOFs (loads on a few flanks, reads at a few points): with Pr K Pc = L U,
+
+        R K^-1 F = (U^-T (R Pc)^T)^T (L^-1 Pr F),
+
+    and both triangular solves only reach the DOFs on the paths from the loaded (read) DOFs
+    through the factors' graphs, about a tenth of a gear body. The solves are restricted to that
+    set S (exact: every other entry of the solutions is zero) and run as blocked supernodal solves
+    of the triangular submatrices. (SuperLU's own full solve reads all of U once per right-hand
+    side; this is what makes many load cases expensive.)
+    """
+    import scipy.sparse as sp
+
+    lu = model.factor
+    if lu is None:                                   # a body without its factor object: plain solves
+        U = np.zeros((model.basis.N, F.shape[1]))
+        Fd = F.toarray() if sp.issparse(F) else np.asarray(F)
+        U[model.free] = model.solve(np.ascontiguousarray(Fd[model.free]))
+        return np.asarray(R @ U)
+    if model._triangles is None:
+        model._triangles = (sp.csc_matrix(lu.L), sp.csr_matrix(lu.U).T.tocsc())
+    L, Ut = model._triangles
+    n = model.free.size
+    Ff = sp.csr_matrix(F)[model.free]                        # (n, k)
+    Rt = sp.csr_matrix(sp.csr_matrix(R)[:, model.free].T)    # (n, m)
+    # scipy's convention Pr K Pc = L U: row i of K goes to row perm_r[i], column j to perm_c[j]
+    inv_c = np.empty(n, dtype=np.int64)
+    inv_c[lu.perm_c] = np.arange(n)
+    b_f = Ff[np.argsort(lu.perm_r)]                  # Pr F
+    b_r = Rt[inv_c]                                  # (R Pc)^T
+    reach = (_reach(L, lu.perm_r[np.flatnonzero(np.diff(Ff.indptr))])
+             | _reach(Ut, lu.perm_c[np.flatnonzero(np.diff(Rt.indptr))]))
+    S = np.flatnonzero(reach)
+    y = _lower_solve(L[S][:, S], b_f[S].toarray(), block)
+    z = _lower_solve(Ut[S][:, S], b_r[S].toarray(), block)
+    return z.T @ y
+
+
+def _reach(T, sources: np.ndarray) -> np.ndarray:
+    """Boolean mask of the rows that a lower-triangular solve with T (CSC) can make nonzero from
+    right-hand sides nonzero at ``sources``: one sweep in column order (T's graph only points to
+    higher indices)."""
+    mark = np.zeros(T.shape[0], bool)
+    mark[sources] = True
+    ptr, idx = T.indptr, T.indices
+    for j in range(T.shape[0]):
+        if mark[j]:
+            mark[idx[ptr[j]:ptr[j + 1]]] = True
+    return mark
+
+
+def _lower_solve(T, B: np.ndarray, block: int) -> np.ndarray:
+    """T^-1 B for a sparse lower-triangular T (CSC). SuperLU of a triangular matrix in its own
+    order is T itself (no fill, no pivoting: a few hundredths of a second) and its solve works on
+    supernodes with dense kernels over a block of right-hand sides; scipy's
+    ``spsolve_triangular`` is about four times slower here."""
+    from scipy.sparse.linalg import splu
+
+    X = np.empty_like(B)
+    with one_blas_thread():
+        lu = splu(T.tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        for s in range(0, B.shape[1], block):
+            X[:, s:s + block] = lu.solve(np.ascontiguousarray(B[:, s:s + block]))
+    return X
+
+
+def point_displacement(model: BodyModel, u: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Displacement (2,) [m] at point x (2,) [m]."""
+    P = model.basis.probes(np.asarray(x, float).reshape(2, 1))
+    return np.asarray(P @ u).ravel()
+
+
+def tooth_stiffness(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, force: float,
+                    patch: float) -> tuple[np.ndarray, np.ndarray]:
+    """Torsion stiffness k_phi [N·m/rad] of the listed teeth and their displacement fields.
+
+    All load cases go through the one factorisation as a block of right-hand sides.
+    Returns (k (n,), u (N_dofs, n)).
+    """
+    teeth = [int(i) for i in teeth]
+    cases = [load_case(g, i, pivot_radius) for i in teeth]
+    F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
+    U = np.zeros((model.basis.N, len(teeth)))
+    U[model.free] = model.solve(np.ascontiguousarray(F[model.free]))
+    P = model.basis.probes(np.column_stack([c.centre_point for c in cases]))  # rows: x of all points, then y
+    n = len(teeth)
+    uc = np.asarray(P @ U)
+    k = np.empty(n)
+    for j, c in enumerate(cases):
+        delta = uc[j, j] * c.direction[0] + uc[n + j, j] * c.direction[1]
+        if not delta > 0:
+            raise RuntimeError(f"tooth {teeth[j]}: non-positive deflection {delta:.3g} m at the tooth centreline")
+        k[j] = force * c.lever**2 / delta
+    return k, U
+
+
+def von_mises(model: BodyModel, u: np.ndarray) -> np.ndarray:
+    """Element-mean von Mises stress [Pa] (plane stress) of displacement u."""
+    from skfem.helpers import sym_grad
+
+    basis = model.basis
+    w = basis.interpolate(u)
+    eps = sym_grad(w)                     # (2, 2, nelem, nqp)
+    lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
+    tr = eps[0, 0] + eps[1, 1]
+    sxx = lam * tr + 2 * mu * eps[0, 0]
+    syy = lam * tr + 2 * mu * eps[1, 1]
+    sxy = 2 * mu * eps[0, 1]
+    vm = np.sqrt(sxx**2 - sxx * syy + syy**2 + 3 * sxy**2)
+    return vm.mean(axis=1)
+
+
+@dataclass(frozen=True)
+class BodyField:
+    """FE mesh and the response to one tooth load, for renders. SI units."""
+
+    points: np.ndarray        # (n, 2) vertex coordinates [m]
+    triangles: np.ndarray     # (m, 3)
+    thickness: np.ndarray     # (m,) element thickness [m]
+    web: np.ndarray           # (m,) True in the web
+    displacement: np.ndarray  # (n, 2) vertex displacement [m]
+    von_mises: np.ndarray     # (m,) element-mean von Mises stress [Pa]
+    tooth: int                # loaded tooth
+    load_N: float             # load [N]
+    load_point: np.ndarray    # (2,) [m]
+    load_direction: np.ndarray  # (2,)
+
+
+def body_field(model: BodyModel, g: GearGeometry, u: np.ndarray, tooth: int, force: float, pivot_radius: float) -> BodyField:
+    """Pack the vertex displacement and element stress of one load case."""
+    nv = model.mesh.points.shape[0]
+    # vertex DOFs of the vector P2 basis: nodal_dofs[c, vertex]
+    nd = model.basis.nodal_dofs
+    disp = np.column_stack([u[nd[0, :nv]], u[nd[1, :nv]]])
+    case = load_case(g, tooth, pivot_radius)
+    return BodyField(model.mesh.points, model.mesh.triangles, model.thickness, model.mesh.region == REGION_WEB,
+                     disp, von_mises(model, u), tooth, force, case.point, case.direction)

@@ -1,0 +1,399 @@
+"""Loaded-tooth-contact analysis (LTCA) with FE influence coefficients: the STE reference.
+
+Each gear body is the plane-stress FE model of `solver.fe.body` (clamped at the bore, thickness
+field, one factorisation). Its *bulk compliance* is the matrix of influence coefficients
+between candidate contact points on the + (drive) flanks of the teeth near the mesh:
+
+    G[(a, ua), (b, ub)] = d(a, ua) . u(C(a, ua))  under a unit load at (b, ub)      [m/N]
+
+a, b tooth indices, ua, ub roll parameters on a grid along the profile, d the load direction
+(along the line of action, into the tooth) and C the point where the load line crosses the
+tooth axis. Every load acts on the whole body, so the coupling between teeth through the rim
+and web (the "foundation") is in the off-diagonal blocks. Loads are spread over the Hertz
+half-width as in `solver.fe.body` (a 2D point load is log-singular), with the patch ends at their
+exact positions on the flank so that G is smooth in the roll parameter. Reading at the centreline C,
+as `solver.fe.body.tooth_stiffness` does, keeps the local flattening out of G: that part comes from
+the contact law ``F = k_con*delta**m1`` in series, exactly as in the pseudo-rigid model, so the
+two differ only in how the bodies deform. G is symmetric by Maxwell-Betti up to the small
+local difference between the load point and C; the symmetric part is used.
+
+Rotational symmetry: a solid body needs only the columns of one tooth
+(G[(a, .), (b, .)] = G[(a - b, .), (0, .)]); a lightened body's compliance depends on the hole
+positions, so its columns are computed for every tooth that meets the mesh.
+
+Per driver angle theta1 the candidate tooth pairs and their rigid roll parameters come from
+the pre-search of the pseudo-rigid model (same frames and indices). In the path of contact the
+perfect involutes touch with zero initial separation; beyond the tip of either gear the tip
+corner meets the mating flank (extended contact) with the separation of the rigid corner from
+that flank. Unknowns: the local contact approaches delta_i >= 0 (F_i = k_con*delta_i**m1) and
+the rigid mesh approach w along the line of action; equations (active set A):
+
+    sum_j (G1 + G2)_ij F_j + delta_i = w - e_i    (i in A),     sum_i F_i * rb2 = T2,
+
+inactive pairs keep a gap w - e_i - sum_j G_ij F_j <= 0. Solved by Newton on the active set,
+adding the most violated gap and dropping negative forces until both conditions hold.
+TE = rb1*theta1 + rb2*theta2 of the hubs = jn/2 + w (rigid teeth in drive contact read the
+backlash offset jn/2), the same convention and zero as the pseudo-rigid model.
+
+Approximation: corner contacts are loaded along the line of action at the tip-corner roll
+(their true normal turns by a few degrees); their moment arm is taken as the base radius.
+
+Units: SI (m, N, rad, N·m).
+"""
+from __future__ import annotations
+
+import math
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.fe.body import BodyModel, LoadCase, load_case
+from solver.geometry import GearGeometry
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.contact import point_flank, tip_corner
+from solver.mbs.kernels.gearmesh import candidate_pairs
+from solver.mbs.model import Model
+
+
+# ------------------------------------------------------------------ influence coefficients
+
+@dataclass(frozen=True)
+class BodyCompliance:
+    """Bulk influence coefficients of one gear body between + flank points [m/N].
+
+    ``g[ia, i, ib, j]``: read on tooth ``read_teeth[ia]`` at roll ``u[i]`` under a unit load on
+    tooth ``load_teeth[ib]`` at roll ``u[j]``. ``symmetric_body``: the body is rotationally
+    symmetric, ``load_teeth == [0]`` and ``read_teeth`` are offsets -R..R from the loaded tooth.
+    """
+
+    u: np.ndarray            # (n_u,) roll parameters of the grid [-]
+    read_teeth: np.ndarray   # (n_r,) tooth indices (or offsets)
+    load_teeth: np.ndarray   # (n_l,)
+    g: np.ndarray            # (n_r, n_u, n_l, n_u) [m/N]
+    symmetric_body: bool
+    teeth: int               # number of teeth of the gear
+
+    def block(self, a: int, b: int) -> np.ndarray:
+        """(n_u, n_u) compliance block: read on tooth a, load on tooth b (absolute indices)."""
+        if self.symmetric_body:
+            off = (a - b + self.teeth // 2) % self.teeth - self.teeth // 2
+            ia = np.flatnonzero(self.read_teeth == off)
+            if ia.size == 0:
+                return np.zeros((self.u.size, self.u.size))   # farther than any computed offset
+            return self.g[ia[0], :, 0, :]
+        ia = np.flatnonzero(self.read_teeth == a % self.teeth)
+        ib = np.flatnonzero(self.load_teeth == b % self.teeth)
+        if ia.size == 0 or ib.size == 0:
+            raise KeyError(f"compliance of tooth pair ({a}, {b}) was not computed")
+        return self.g[ia[0], :, ib[0], :]
+
+    def matrix(self, teeth, rolls) -> np.ndarray:
+        """Symmetric compliance [m/N] between points (teeth[i], rolls[i]) by cubic interpolation."""
+        n = len(teeth)
+        w = [lagrange_weights(self.u, r) for r in rolls]
+        out = np.empty((n, n))
+        for i in range(n):
+            for j in range(n):
+                bl = self.block(int(teeth[i]), int(teeth[j]))
+                (ii, wi), (jj, wj) = w[i], w[j]
+                out[i, j] = wi @ bl[np.ix_(ii, jj)] @ wj
+        return 0.5 * (out + out.T)
+
+
+def lagrange_weights(grid: np.ndarray, x: float):
+    """Indices and weights of cubic Lagrange interpolation on a uniform grid (clamped to it)."""
+    n = grid.size
+    h = (grid[-1] - grid[0]) / (n - 1)
+    x = min(max(float(x), grid[0]), grid[-1])
+    k = int(min(max(math.floor((x - grid[0]) / h) - 1, 0), n - 4))
+    idx = np.arange(k, k + 4)
+    xs = grid[idx]
+    w = np.ones(4)
+    for i in range(4):
+        for j in range(4):
+            if i != j:
+                w[i] *= (x - xs[j]) / (xs[i] - xs[j])
+    return idx, w
+
+
+def profile_grid(g: GearGeometry, n_u: int, u_start: float | None = None) -> np.ndarray:
+    """Roll-parameter grid [-] along the + flank from ``u_start`` (default: the form circle)
+    to the tip."""
+    lo = g.u_form if u_start is None else max(g.u_form, u_start)
+    return np.linspace(lo, g.u_tip, n_u)
+
+
+def flank_load_vector(model: BodyModel, g: GearGeometry, case: LoadCase, u: float, force: float,
+                      patch: float, samples: int = 33) -> np.ndarray:
+    """Nodal forces [N] of ``force`` spread uniformly over the flank within ``patch`` [m] (arc
+    length) either side of roll ``u``, along the load direction of ``case``.
+
+    Unlike `solver.fe.body.load_vector`, which loads whole boundary edges, the patch ends sit at
+    their exact positions on the involute (``samples`` points, each distributed by the quadratic
+    edge shape functions of the facet it lies on), so the load and its resultant move
+    continuously with u: the influence coefficients are smooth in u and can be interpolated.
+    """
+    m = model.basis.mesh
+    rb = g.base_radius
+    s0 = 0.5 * rb * u * u                       # involute arc length from the base circle
+    s = s0 + patch * ((np.arange(samples) + 0.5) / samples * 2.0 - 1.0)
+    s = np.clip(s, 0.5 * rb * g.u_form**2, 0.5 * rb * g.u_tip**2)
+    ui = np.sqrt(2.0 * s / rb)
+    x, y = g.flank_point(ui, 1)
+    a = math.atan2(case.point[1], case.point[0]) - math.atan2(*g.flank_point(u, 1)[::-1])
+    c, sn = math.cos(a), math.sin(a)
+    pts = np.stack([c * x - sn * y, sn * x + c * y])             # (2, samples) on tooth's flank
+    bf = m.boundary_facets()
+    e0 = m.p[:, m.facets[0, bf]]
+    e1 = m.p[:, m.facets[1, bf]]
+    mid = 0.5 * (e0 + e1)
+    near = np.argsort(np.hypot(mid[0] - case.point[0], mid[1] - case.point[1]))[:max(8, samples)]
+    f = np.zeros(model.basis.N)
+    nd = model.basis.nodal_dofs
+    q = force / samples
+    for k in range(samples):
+        p = pts[:, k]
+        d0, d1 = e0[:, near], e1[:, near]
+        L2 = ((d1 - d0) ** 2).sum(axis=0)
+        t = np.clip(((p[:, None] - d0) * (d1 - d0)).sum(axis=0) / L2, 0.0, 1.0)
+        dist = np.hypot(*(d0 + t * (d1 - d0) - p[:, None]))
+        j = int(np.argmin(dist))
+        tj = t[j]
+        fac = near[j]
+        n0, n1 = m.facets[0, bf[fac]], m.facets[1, bf[fac]]
+        w0, w1, wm = (1 - tj) * (1 - 2 * tj), tj * (2 * tj - 1), 4 * tj * (1 - tj)
+        for comp in range(2):
+            qc = q * case.direction[comp]
+            f[nd[comp, n0]] += qc * w0
+            f[nd[comp, n1]] += qc * w1
+            f[model.basis.facet_dofs[comp, bf[fac]]] += qc * wm
+    return f
+
+
+def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth, read_teeth,
+                    patch: float, symmetric_body: bool = False, block: int = 48,
+                    timings: dict | None = None) -> BodyCompliance:
+    """Influence coefficients [m/N] of a factorised body: unit loads at every (load tooth, u),
+    displacement along the load direction read at the centreline point of every (read tooth, u).
+
+    One factorisation; all load cases at once through `solver.fe.body.influence` (triangular solves
+    restricted to the DOFs the loads and reads reach), right-hand sides in blocks of ``block``.
+    ``timings``: if given, wall and CPU seconds of building the load vectors and of the solves
+    are added to it (keys ``loads_wall_s``, ``loads_cpu_s``, ``solve_wall_s``, ``solve_cpu_s``).
+    """
+    import scipy.sparse as sp
+
+    from solver.fe.body import influence
+
+    clock = _Clock(timings)
+    load_teeth = np.asarray(load_teeth, dtype=int)
+    read_teeth = np.asarray(read_teeth, dtype=int)
+    z = g.teeth
+    with clock("loads"):
+        read_cases = [load_case(g, int(a) % z, 0.0, ui) for a in read_teeth for ui in u]
+        P = model.basis.probes(np.column_stack([c.centre_point for c in read_cases])).tocsr()   # (2 m, N)
+        m = len(read_cases)
+        dx = np.array([c.direction[0] for c in read_cases])
+        dy = np.array([c.direction[1] for c in read_cases])
+        R = sp.diags(dx) @ P[:m] + sp.diags(dy) @ P[m:]        # displacement along d at C
+        cols = []
+        for b in load_teeth:
+            for ui in u:
+                f = flank_load_vector(model, g, load_case(g, int(b) % z, 0.0, ui), ui, 1.0, patch)
+                nz = np.flatnonzero(f)
+                cols.append((nz, f[nz]))
+        F = sp.csc_matrix((np.concatenate([c[1] for c in cols]), np.concatenate([c[0] for c in cols]),
+                           np.cumsum([0] + [c[0].size for c in cols])), shape=(model.basis.N, len(cols)))
+    with clock("solve"):
+        G = influence(model, R, F, block)
+    n_u = u.size
+    G = G.reshape(read_teeth.size, n_u, load_teeth.size, n_u)
+    return BodyCompliance(np.asarray(u, float), read_teeth, load_teeth, G, symmetric_body, z)
+
+
+class _Clock:
+    """Adds the wall and CPU seconds of a ``with clock(name):`` block to ``timings`` (if any)."""
+
+    def __init__(self, timings: dict | None):
+        self.timings = timings
+
+    @contextmanager
+    def __call__(self, name: str):
+        if self.timings is None:
+            yield
+            return
+        w, c = time.perf_counter(), time.process_time()
+        try:
+            yield
+        finally:
+            self.timings[f"{name}_wall_s"] = self.timings.get(f"{name}_wall_s", 0.0) + time.perf_counter() - w
+            self.timings[f"{name}_cpu_s"] = self.timings.get(f"{name}_cpu_s", 0.0) + time.process_time() - c
+
+
+# ------------------------------------------------------------------ mesh kinematics
+
+@dataclass(frozen=True)
+class MeshPoints:
+    """Candidate contacts at one driver angle (rigid geometry, drive flanks)."""
+
+    tooth1: np.ndarray      # gear-1 tooth index
+    tooth2: np.ndarray      # gear-2 tooth index
+    u1: np.ndarray          # roll parameter of the gear-1 load point [-]
+    u2: np.ndarray          # roll parameter of the gear-2 load point [-]
+    gap: np.ndarray         # initial separation e at rigid drive contact [m] (0 in the path of contact)
+    kind: np.ndarray        # 1 flank-flank, 2 gear-1 tip corner, 3 gear-2 tip corner
+
+
+def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoints:
+    """Candidate drive-side contacts at driver angle theta1 [rad] with the rigid bodies at the
+    zero-load drive contact (TE = jn/2); pairs separated by more than ``max_gap`` [m] are left out."""
+    gp, pp = model.gear_par, model.pair_par
+    jn2 = float(pp[L.JN_HALF])
+    theta2 = float(model.theta2_for_te(theta1, jn2))
+    pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
+    n = candidate_pairs(theta1, theta2, gp, pp, pairs)
+    alpha = pp[L.ALPHA]
+    rb1, rb2 = gp[0, L.RB], gp[1, L.RB]
+    line = model.pair.center_distance * math.sin(alpha)
+    rows = []
+    for k, j, side in pairs[:n]:
+        if side != 1:
+            continue
+        ax1 = theta1 + gp[0, L.GAMMA0] + k * gp[0, L.PITCH]
+        ax2 = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
+        u1 = (ax1 + gp[0, L.PSI_B] + alpha + math.pi) % (2 * math.pi) - math.pi
+        u2 = (line - rb1 * u1) / rb2
+        b1 = ax1 + gp[0, L.PSI_B]
+        b2 = ax2 + gp[1, L.PSI_B]
+        if u1 <= gp[0, L.U_HI] and u2 <= gp[1, L.U_HI]:
+            if u1 >= gp[0, L.U_LO] and u2 >= gp[1, L.U_LO]:
+                rows.append((k, j, u1, u2, 0.0, 1))
+        elif u1 > gp[0, L.U_HI]:
+            qx, qy = tip_corner(gp[0, L.CX], gp[0, L.CY], rb1, b1, 1.0, gp[0, L.U_HI])
+            d, uf, _, _ = point_flank(qx, qy, gp[1, L.CX], gp[1, L.CY], rb2, b2, 1.0)
+            if gp[1, L.U_LO] <= uf <= gp[1, L.U_HI] and -d < max_gap:
+                rows.append((k, j, gp[0, L.U_HI], uf, -d, 2))
+        else:
+            qx, qy = tip_corner(gp[1, L.CX], gp[1, L.CY], rb2, b2, 1.0, gp[1, L.U_HI])
+            d, uf, _, _ = point_flank(qx, qy, gp[0, L.CX], gp[0, L.CY], rb1, b1, 1.0)
+            if gp[0, L.U_LO] <= uf <= gp[0, L.U_HI] and -d < max_gap:
+                rows.append((k, j, uf, gp[1, L.U_HI], -d, 3))
+    a = np.array(rows, dtype=float).reshape(-1, 6)
+    return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], np.maximum(a[:, 4], 0.0),
+                      a[:, 5].astype(int))
+
+
+# ------------------------------------------------------------------ contact problem
+
+class LTCAError(RuntimeError):
+    """The contact problem at some angle has no solution (no candidate contact, no convergence)."""
+
+
+def solve_contact(G: np.ndarray, gap: np.ndarray, load: float, k_con: float, m1: float,
+                  tol: float = 1e-9, max_iter: int = 60) -> tuple[np.ndarray, float]:
+    """Contact forces F (n,) [N] >= 0 and mesh approach w [m] with sum(F) = load [N] and
+
+        G F + (F/k_con)**(1/m1) = w - gap   where F > 0,     G F <= w - gap  where F = 0.
+
+    G (n, n) symmetric positive semi-definite [m/N]; the local law F = k_con*delta**m1 [N/m^m1].
+    Active-set Newton in the local approaches delta (F = k_con*delta**m1 is smooth at 0 for m1 >= 1).
+    """
+    n = gap.size
+    if n == 0:
+        raise LTCAError("no candidate contact")
+    if load <= 0:
+        return np.zeros(n), float(gap.min())
+    active = np.zeros(n, bool)
+    active[np.argmin(gap)] = True
+    d = np.zeros(n)
+    d0 = (load / k_con) ** (1.0 / m1)
+    d[active] = d0
+    w = d0 + float(gap.min())
+    for _ in range(4 * n + 4):
+        A = np.flatnonzero(active)
+        for it in range(max_iter):
+            dA = np.maximum(d[A], 0.0)
+            F = k_con * dA**m1
+            dF = k_con * m1 * np.maximum(dA, 1e-30) ** (m1 - 1.0)
+            r = np.concatenate([G[np.ix_(A, A)] @ F + dA - w + gap[A], [F.sum() - load]])
+            J = np.zeros((A.size + 1, A.size + 1))
+            J[:A.size, :A.size] = G[np.ix_(A, A)] * dF[None, :] + np.eye(A.size)
+            J[:A.size, A.size] = -1.0
+            J[A.size, :A.size] = dF
+            step = np.linalg.solve(J, -r)
+            d[A] = dA + step[:A.size]
+            w += step[A.size]
+            if np.max(np.abs(step[:A.size])) < tol * d0 and abs(step[A.size]) < tol * d0:
+                break
+        else:
+            raise LTCAError("Newton did not converge on the active set")
+        F = np.where(active, k_con * np.maximum(d, 0.0) ** m1, 0.0)
+        neg = active & (d < -tol * d0)
+        if neg.any():
+            i = np.flatnonzero(neg)[np.argmin(d[neg])]
+            active[i] = False
+            d[i] = 0.0
+            continue
+        viol = w - gap - G @ F
+        viol[active] = -np.inf
+        if viol.max() > tol * d0:
+            i = int(np.argmax(viol))
+            active[i] = True
+            d[i] = 0.0
+            continue
+        return np.where(active, k_con * np.maximum(d, 0.0) ** m1, 0.0), float(w)
+    raise LTCAError("active set did not settle")
+
+
+@dataclass
+class LTCAResult:
+    """STE reference and load sharing over driver angles."""
+
+    angle: np.ndarray          # driver rotation [rad]
+    te: np.ndarray             # transmission error rb1*theta1 + rb2*theta2 [m]
+    approach: np.ndarray       # mesh approach w = TE - jn/2 [m]
+    n_contacts: np.ndarray     # loaded contacts [-]
+    tooth_force: np.ndarray    # (angle, gear-1 tooth) normal force [N]
+    extended: np.ndarray       # (angle,) force carried by tip-corner (extended) contacts [N]
+    torque: float              # resisting torque on gear 2 [N·m]
+    backlash_offset: float     # jn/2 [m]
+
+
+def ltca_sweep(model: Model, compliance: tuple, angles, torque: float, k_con: float | None = None,
+               m1: float | None = None) -> LTCAResult:
+    """Solve the loaded contact at every driver angle [rad] under ``torque`` [N·m] on gear 2.
+
+    ``compliance`` = (BodyCompliance of gear 1, of gear 2), or (None, None) for rigid bodies
+    (only the contact law deforms). The contact law defaults to the model's.
+    """
+    k_con = float(model.law_par[L.K_CON]) if k_con is None else k_con
+    m1 = float(model.law_par[L.M1]) if m1 is None else m1
+    angles = np.asarray(angles, float)
+    rb2 = model.base_radii[1]
+    load = abs(torque) / rb2
+    z1 = model.teeth[0]
+    n = angles.size
+    te = np.empty(n); w_out = np.empty(n); nc = np.zeros(n, int); ext = np.zeros(n)
+    f1 = np.zeros((n, z1))
+    jn2 = model.backlash_offset
+    for a, th in enumerate(angles):
+        mp = mesh_points(model, float(th))
+        if mp.gap.size == 0:
+            raise LTCAError(f"no candidate contact at {math.degrees(th):.3f} deg")
+        G = np.zeros((mp.gap.size, mp.gap.size))
+        if compliance[0] is not None:
+            G += compliance[0].matrix(mp.tooth1, mp.u1)
+        if compliance[1] is not None:
+            G += compliance[1].matrix(mp.tooth2, mp.u2)
+        try:
+            F, w = solve_contact(G, mp.gap, load, k_con, m1)
+        except LTCAError as e:
+            raise LTCAError(f"{e} at {math.degrees(th):.3f} deg") from None
+        te[a] = jn2 + w
+        w_out[a] = w
+        nc[a] = int(np.count_nonzero(F > 0))
+        np.add.at(f1[a], mp.tooth1 % z1, F)
+        ext[a] = F[mp.kind != 1].sum()
+    return LTCAResult(angles, te, w_out, nc, f1, ext, float(torque), jn2)

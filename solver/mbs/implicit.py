@@ -1,0 +1,141 @@
+"""Implicit time integration (HHT-alpha, Newton on the analytic tangent) and the choice of
+integrator and step for a scene.
+
+`simulate_implicit` has the arguments and the `DynamicResult` contract of
+`solver.mbs.dynamics.simulate`, plus the HHT parameter alpha (0: trapezoidal rule, no numerical
+damping; down to -1/3: more damping of the high frequencies) and the Newton controls. Its
+result also carries the Newton counts and the numerical dissipation of the scheme.
+
+`choose_method` picks explicit or implicit and the step from the scene's highest natural
+frequency: explicit at its stability step when that step is affordable, implicit otherwise.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.mbs.dynamics import ENERGY_TOL, DynamicResult, run_loads, stable_time_step, status_message
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.implicit import hht
+from solver.mbs.model import Model
+
+
+@dataclass
+class ImplicitResult(DynamicResult):
+    """`DynamicResult` of the HHT-alpha integrator plus its Newton counts.
+
+    ``newton_max``: most Newton iterations in one step of each output interval [-];
+    ``newton_total``: Newton iterations over the run [-].
+    """
+    alpha: float = 0.0
+    newton_max: np.ndarray | None = None
+    newton_total: int = 0
+
+    @property
+    def numerical_dissipation(self) -> np.ndarray:
+        """Energy removed by the scheme itself [J]: work - (kinetic + potential - initial)
+        - dissipated. Zero to O(dt^2) for alpha = 0; positive for alpha < 0."""
+        return self.energy_error
+
+
+def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
+                      duration: float, dt: float | None = None, output_step: float = 1e-5,
+                      alpha: float = 0.0, newton_tol: float = 1e-13, max_iter: int = 12,
+                      delta_max: float | None = None, raise_on_failure: bool = False,
+                      phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL,
+                      all_teeth: bool = False, load_table=None) -> ImplicitResult:
+    """Integrate from rest with HHT-alpha; loads, outputs and guards as `integrate.simulate`.
+
+    ``dt`` [s] defaults to four times the explicit stability step; it is rounded down so that
+    output_step [s] is a whole number of steps (then the end of a ramp that is a multiple of
+    output_step falls on a step boundary). ``alpha`` in [-1/3, 0]. ``newton_tol`` [m]: Newton
+    stops when its last correction moves no flank point by more than this; ``max_iter``
+    Newton iterations per step before the run stops with "Newton failure".
+    ``all_teeth``: integrate every tooth from the start and never freeze one (the model of
+    the scipy peer `solver.peers.scipy_dynamics`, for like-for-like error figures).
+    """
+    for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp),
+                    ("output_step", output_step), ("newton_tol", newton_tol)):
+        if not (v > 0 and math.isfinite(v)):
+            raise ValueError(f"{name}: must be positive, got {v}")
+    if not -1.0 / 3.0 <= alpha <= 0.0:
+        raise ValueError(f"alpha: must lie in [-1/3, 0] (HHT), got {alpha}")
+    if model.coupled:
+        raise ValueError("dynamic.method: the implicit integrator has no body-torsion coupling "
+                         "(coupling.model); use the explicit integrator for a coupled model")
+    if max_iter < 1:
+        raise ValueError(f"max_iter: must be at least 1, got {max_iter}")
+    table, torque, side = run_loads(load_table, torque)
+    omega_max = float("nan")
+    if dt is None or dt <= 0:
+        dt, omega_max = stable_time_step(model, torque)
+        dt *= 4.0
+    out_every = max(1, int(math.ceil(output_step / dt - 1e-9)))
+    dt = output_step / out_every
+    n_steps = int(round(duration / dt))
+    n_out = n_steps // out_every + 1
+    if delta_max is None:
+        delta_max = 0.1 * model.geometry[0].spec.module
+    o = [np.zeros(n_out) for _ in range(10)]
+    o_newton = np.zeros(n_out, dtype=np.int64)
+    theta2 = float(model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset))
+    phi = np.full(model.n_teeth, 1e-300) if all_teeth else np.zeros(model.n_teeth)
+    dphi = np.zeros(model.n_teeth)
+    if all_teeth:
+        phi_quiet = 0.0
+    omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
+    status, step, max_act, total = hht(model.gear_par, model.pair_par, model.law_par, model.k_phi,
+                                       float(speed), float(speed_ramp), float(torque), float(torque_ramp),
+                                       table, dt, n_steps, out_every, float(alpha), theta2, 0.0, phi, dphi,
+                                       phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol),
+                                       float(newton_tol), int(max_iter), *o, o_newton)
+    n = min(n_out, step // out_every + 1)
+    t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
+    msg = status_message(status, step, dt, delta_max, raise_on_failure)
+    return ImplicitResult(t, te, th2, fmax, nc.astype(int), react, ke, pe, work, diss, dt, step,
+                          int(status), msg, omega_max, int(max_act),
+                          alpha=float(alpha), newton_max=o_newton[:n], newton_total=int(total))
+
+
+@dataclass(frozen=True)
+class MethodChoice:
+    """Integrator and step for a dynamic run, and why."""
+    method: str          # 'explicit' or 'implicit'
+    dt: float            # s
+    omega_max: float     # highest natural frequency of the loaded pair [rad/s]
+    reason: str
+
+
+def choose_method(model: Model, torque: float, duration: float, method: str = "auto",
+                  dt: float | None = None, alpha: float = 0.0, max_explicit_steps: float = 2e6,
+                  implicit_factor: float = 4.0, safety: float = 0.5) -> MethodChoice:
+    """Method and step [s] for a run of ``duration`` [s] under ``torque`` [N·m].
+
+    'explicit' and 'implicit' are kept; a given ``dt`` [s] > 0 is kept. 'auto' computes the
+    explicit stability step safety*2/omega_max and takes explicit when duration/step is at
+    most ``max_explicit_steps`` (Verlet then costs less than Newton per unit of accuracy),
+    implicit at ``implicit_factor`` times that step otherwise.
+    """
+    if method not in ("explicit", "implicit", "auto"):
+        raise ValueError(f"method: must be 'explicit', 'implicit' or 'auto', got {method!r}")
+    given = dt is not None and dt > 0
+    if method != "auto" and given:
+        return MethodChoice(method, float(dt), float("nan"), "method and step given")
+    dt_stable, w = stable_time_step(model, torque, safety)
+    if method == "explicit":
+        return MethodChoice("explicit", dt_stable, w, f"explicit at {safety} x the stability step 2/omega_max")
+    if method == "implicit":
+        return MethodChoice("implicit", implicit_factor * dt_stable, w,
+                            f"implicit at {implicit_factor:g} x the explicit stability step")
+    n = duration / dt_stable
+    if model.coupled:     # only the explicit kernel carries the body-torsion DOFs
+        return MethodChoice("explicit", float(dt) if given else dt_stable, w,
+                            "auto: explicit, the only integrator of the body-torsion coupling")
+    if n <= max_explicit_steps:
+        return MethodChoice("explicit", float(dt) if given else dt_stable, w,
+                            f"auto: explicit, {n:.3g} steps at the stability step "
+                            f"({dt_stable * 1e9:.4g} ns) <= {max_explicit_steps:.3g}")
+    return MethodChoice("implicit", float(dt) if given else implicit_factor * dt_stable, w,
+                        f"auto: implicit, the explicit run would take {n:.3g} steps > {max_explicit_steps:.3g}")

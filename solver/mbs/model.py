@@ -1,0 +1,215 @@
+"""The MUBOCO-PR model of a gear pair as flat arrays for the kernels.
+
+Inputs are plain dataclasses in SI units; `build_model` derives geometry, inertia and the
+parameter arrays laid out as in `solver.mbs.kernels.layout`.
+
+Frame: gear 1 (driver) centred at the origin, gear 2 (driven) at (a, 0). Both hub angles
+are counter-clockwise positive and zero at the nominal zero-backlash conjugate position:
+tooth 0 of gear 1 points along +x into the space of gear 2 centred on the line of centres.
+Gear 1 turns counter-clockwise and drives with the "+" flanks; gear 2 turns clockwise.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from solver.geometry import (BodySpec, GearGeometry, Material, PairGeometry, ToothInertia, ToothSpec,
+                       body_inertia, gear_geometry, pair_geometry, tooth_inertia, validate_body)
+from solver.mbs.kernels import layout as L
+
+
+@dataclass(frozen=True)
+class GearInput:
+    """One gear: teeth, body, pivot and the per-tooth springs (SI)."""
+
+    tooth: ToothSpec
+    body: BodySpec
+    pivot_radius: float                 # m
+    k_phi: np.ndarray                   # per tooth, N·m/rad^n_k
+    n_k: float = 1.1
+    c_phi: float = 0.0                  # N·m·s/rad (n_c = 1) or N·m/(rad/s)^n_c
+    n_c: float = 1.0
+    body_stiffness: float = math.inf    # hub -> rim torsion spring, N·m/rad (inf: rigid body)
+    body_damping_ratio: float = 0.02    # of critical on the body mode (as the teeth's 2 %)
+    tooth_compliance: np.ndarray | None = None  # (Z, Z) rad/(N·m): teeth coupled through the body
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """Eq. (1.3) in SI: k [N/m^m1], c [N/((m/s)^m2 m^m3)]."""
+
+    k: float
+    m1: float
+    c: float = 0.0
+    m2: float = 1.0
+    m3: float = 1.5
+
+
+@dataclass
+class Model:
+    """Everything the kernels need, plus the derived geometry for reporting."""
+
+    gear_par: np.ndarray            # (2, N_GEAR_PAR)
+    pair_par: np.ndarray            # (N_PAIR_PAR,)
+    law_par: np.ndarray             # (N_LAW_PAR,)
+    k_phi: np.ndarray               # (Z1 + Z2,) N·m/rad^n_k
+    geometry: tuple                 # (GearGeometry, GearGeometry)
+    pair: PairGeometry
+    teeth_inertia: tuple            # (ToothInertia, ToothInertia)
+    body_inertia: tuple             # kg·m² of the bodies without teeth
+    inputs: tuple = field(repr=False, default=())
+    tooth_compliance: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((0, 0)))
+    # (Z1+Z2, Z1+Z2) rad/(N·m), block-diagonal by gear, when the teeth are coupled through
+    # the bodies (`kernels.toothcoupling`); 0 x 0 for independent tooth springs
+
+    @property
+    def teeth(self) -> tuple:
+        return self.geometry[0].teeth, self.geometry[1].teeth
+
+    @property
+    def n_teeth(self) -> int:
+        return sum(self.teeth)
+
+    @property
+    def base_radii(self) -> tuple:
+        return self.geometry[0].base_radius, self.geometry[1].base_radius
+
+    def te(self, theta1, theta2):
+        """Transmission error rb1*theta1 + rb2*theta2 [m]."""
+        return self.base_radii[0] * np.asarray(theta1) + self.base_radii[1] * np.asarray(theta2)
+
+    def theta2_for_te(self, theta1, te):
+        """Driven hub angle [rad] giving transmission error te [m] at driver angle theta1."""
+        return (te - self.base_radii[0] * theta1) / self.base_radii[1]
+
+    @property
+    def backlash_offset(self) -> float:
+        """TE of rigid teeth in drive contact: half the normal backlash [m]."""
+        return float(self.pair_par[L.JN_HALF])
+
+    @property
+    def body_stiffness(self) -> tuple:
+        """Hub -> rim torsion stiffness of each body [N·m/rad] (inf: rigid, the plain model)."""
+        k = self.gear_par[:, L.K_BODY]
+        return tuple(float(x) if x > 0 else math.inf for x in k)
+
+    @property
+    def coupled(self) -> bool:
+        return bool(np.any(self.gear_par[:, L.K_BODY] > 0))
+
+    @property
+    def teeth_coupled(self) -> bool:
+        """Tooth springs coupled through a compliance matrix (k_phi then each tooth's own)."""
+        return self.tooth_compliance.shape[0] > 0
+
+    @property
+    def inertia_total(self) -> tuple:
+        return float(self.gear_par[0, L.I_TOT]), float(self.gear_par[1, L.I_TOT])
+
+
+def hub_side_inertia(g: GearGeometry, body: BodySpec, density: float) -> float:
+    """Inertia [kg·m²] on the hub side of the body spring: the hub ring and half the web (the
+    web's wind-up is the spring; its inertia is split between its ends)."""
+    r_rim = g.root_radius - body.rim_height
+    r_hub = r_rim - body.web_height
+    r_bore = r_hub - body.hub_height
+    hub = 0.5 * density * math.pi * (r_hub**4 - r_bore**4) * g.spec.face_width
+    web = 0.5 * density * math.pi * (r_rim**4 - r_hub**4) * body.web_thickness
+    if body.holes:
+        mh = density * math.pi * body.hole_radius**2 * body.web_thickness
+        web -= body.holes * mh * (0.5 * body.hole_radius**2 + body.hole_circle_radius**2)
+    return hub + 0.5 * web
+
+
+def _max_pivot_distance(g: GearGeometry, pivot_radius: float) -> float:
+    x, y = g.outline(n_involute=40)
+    return float(np.max(np.hypot(x - pivot_radius, y))) * 1.001
+
+
+def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: Material,
+                presearch_margin: float = 0.5) -> Model:
+    """Flat-array model of the pair. ``presearch_margin`` widens the pre-search window by
+    that fraction of the angular pitch beyond the flank ends (tip-corner contact)."""
+    geos, inert, bodies, own = [], [], [], []
+    for name, gi in (("gear1", gear1), ("gear2", gear2)):
+        g = gear_geometry(gi.tooth, prefix=name)
+        validate_body(g, gi.body, prefix=f"{name}.body")
+        k = np.asarray(gi.k_phi, dtype=float)
+        if gi.tooth_compliance is not None:
+            _check_compliance(gi, g.teeth, name)
+            k = 1.0 / np.diag(gi.tooth_compliance)
+        if k.shape != (g.teeth,):
+            raise ValueError(f"{name}.spring.k_phi: expected {g.teeth} per-tooth values, got shape {k.shape}")
+        if not np.all(np.isfinite(k)) or np.any(k <= 0):
+            raise ValueError(f"{name}.spring.k_phi: per-tooth stiffness must be finite and positive")
+        own.append(k)                   # each tooth's own spring (1/C[a, a] with a compliance matrix)
+        geos.append(g)
+        inert.append(tooth_inertia(g, material.density, gi.pivot_radius))
+        bodies.append(body_inertia(g, gi.body, material.density)[1])
+    pair = pair_geometry(*geos)
+
+    gp = np.zeros((2, L.N_GEAR_PAR))
+    centres = ((0.0, 0.0), (pair.center_distance, 0.0))
+    gammas = (0.0, math.pi + math.pi / geos[1].teeth)
+    tooth0 = (0, geos[0].teeth)
+    for i, (g, gi, ti, ib) in enumerate(zip(geos, (gear1, gear2), inert, bodies)):
+        gp[i, L.RB] = g.base_radius
+        gp[i, L.PSI_B] = g.psi_base
+        gp[i, L.U_LO] = g.u_form
+        gp[i, L.U_HI] = g.u_tip
+        gp[i, L.R_PV] = gi.pivot_radius
+        gp[i, L.PITCH] = g.pitch_angle
+        gp[i, L.GAMMA0] = gammas[i]
+        gp[i, L.CX], gp[i, L.CY] = centres[i]
+        gp[i, L.I_P] = ti.inertia_pivot
+        gp[i, L.I_CPL] = ti.inertia_pivot + ti.mass * gi.pivot_radius * (ti.centroid_radius - gi.pivot_radius)
+        gp[i, L.I_TOT] = ib + g.teeth * ti.inertia_center
+        gp[i, L.R_BND] = _max_pivot_distance(g, gi.pivot_radius)
+        gp[i, L.N_K] = gi.n_k
+        gp[i, L.C_PHI] = gi.c_phi
+        gp[i, L.N_C] = gi.n_c
+        gp[i, L.TOOTH0] = tooth0[i]
+        gp[i, L.NZ] = g.teeth
+        if gi.body_stiffness != math.inf:
+            if not gi.body_stiffness > 0:
+                raise ValueError(f"{('gear1', 'gear2')[i]}: body torsion stiffness must be positive, got {gi.body_stiffness}")
+            gp[i, L.K_BODY] = gi.body_stiffness
+        gp[i, L.I_HUB] = hub_side_inertia(g, gi.body, material.density)
+        if gp[i, L.K_BODY] > 0:
+            # body mode: rim (with the teeth) against the hub; the driver's hub is prescribed
+            i_rim = gp[i, L.I_TOT] - gp[i, L.I_HUB]
+            i_eff = i_rim if i == 0 else i_rim * gp[i, L.I_HUB] / gp[i, L.I_TOT]
+            gp[i, L.C_BODY] = 2.0 * gi.body_damping_ratio * math.sqrt(gi.body_stiffness * i_eff)
+    pp = np.zeros(L.N_PAIR_PAR)
+    pp[L.JN_HALF] = 0.5 * pair.normal_backlash
+    pp[L.ALPHA] = pair.pressure_angle
+    pp[L.MARGIN] = presearch_margin * max(geos[0].pitch_angle, geos[1].pitch_angle)
+    lp = np.array([law.k, law.m1, law.c, law.m2, law.m3], dtype=float)
+    kphi = np.concatenate(own)
+    ctooth = np.zeros((0, 0))
+    if gear1.tooth_compliance is not None or gear2.tooth_compliance is not None:
+        for name, gi in (("gear1", gear1), ("gear2", gear2)):
+            if gi.n_k != 1.0:
+                raise ValueError(f"{name}.spring.n_k: coupled tooth springs are linear (n_k = 1), got {gi.n_k}")
+        # the other gear's independent springs are a diagonal block
+        blocks = [gi.tooth_compliance if gi.tooth_compliance is not None else np.diag(1.0 / k)
+                  for gi, k in zip((gear1, gear2), own)]
+        n1 = geos[0].teeth
+        ctooth = np.zeros((kphi.size, kphi.size))
+        ctooth[:n1, :n1] = blocks[0]
+        ctooth[n1:, n1:] = blocks[1]
+    return Model(gp, pp, lp, kphi, tuple(geos), pair, tuple(inert), tuple(bodies), (gear1, gear2, law, material), ctooth)
+
+
+def _check_compliance(gi: GearInput, z: int, name: str) -> None:
+    c = np.asarray(gi.tooth_compliance, float)
+    if c.shape != (z, z):
+        raise ValueError(f"{name}.tooth_compliance: expected a {z} x {z} matrix, got shape {c.shape}")
+    if not np.all(np.isfinite(c)) or np.max(np.abs(c - c.T)) > 1e-9 * np.max(np.abs(c)):
+        raise ValueError(f"{name}.tooth_compliance: must be finite and symmetric")
+    try:
+        np.linalg.cholesky(c)
+    except np.linalg.LinAlgError:
+        raise ValueError(f"{name}.tooth_compliance: must be positive definite") from None

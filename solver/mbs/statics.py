@@ -1,0 +1,85 @@
+"""Static transmission error: equilibrium at each driver angle (no inertia, no time).
+
+`solve_static` runs Newton with continuation over a sequence of driver angles (kernel in
+`kernels/statics.py`). Angles are driver hub rotations [rad] from the nominal position.
+
+Body-torsion coupling (``Model.coupled``): the teeth sit on a rigid rim joined to the hub by
+the body spring k_body. In statics the spring carries the whole gear torque (T on gear 2,
+T*rb1/rb2 on the driver under flank contact), so the rims stand at the hub angles less the
+constant wind-ups: the kernel solves the mesh in rim angles and the hubs' TE adds
+rb1*M1/k_body1 + rb2*T/k_body2. Teeth coupled through the body (``Model.teeth_coupled``,
+the compliance model) take their spring moments from the compliance matrix of the teeth
+near the mesh (`kernels.toothcoupling`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.mbs.kernels.statics import static_sweep
+from solver.mbs.model import Model
+
+
+class StaticSolveError(RuntimeError):
+    """Newton failed to reach equilibrium at some angles."""
+
+
+@dataclass
+class StaticResult:
+    angle: np.ndarray          # driver rotation [rad]
+    te: np.ndarray             # transmission error [m]
+    theta2: np.ndarray         # driven hub angle [rad]
+    n_contacts: np.ndarray     # loaded contacts [-]
+    tooth_force: np.ndarray    # (angle, gear-1 tooth) normal force [N]
+    iterations: np.ndarray     # Newton iterations (negative: not converged)
+    torque: float              # resisting torque [N·m]
+    phi_last: np.ndarray       # tooth rotations at the last angle [rad] (Z1 + Z2)
+
+    @property
+    def converged(self) -> np.ndarray:
+        return self.iterations > 0
+
+
+def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_iter: int = 60,
+                 phi0: np.ndarray | None = None, te0: float | None = None,
+                 raise_on_failure: bool = True) -> StaticResult:
+    """Equilibrium under ``torque`` [N·m] on gear 2 at driver angles ``angles`` [rad].
+
+    ``tol`` is relative to the torque (residual torques below tol*|torque| count as converged).
+    """
+    angles = np.ascontiguousarray(angles, dtype=float)
+    if angles.ndim != 1 or angles.size == 0:
+        raise ValueError("angles: need a non-empty 1-D array of driver angles")
+    n = angles.size
+    z1 = model.teeth[0]
+    te = np.zeros(n)
+    th2 = np.zeros(n)
+    nc = np.zeros(n, dtype=np.int64)
+    f1 = np.zeros((n, z1))
+    it = np.zeros(n, dtype=np.int64)
+    phi = np.zeros(model.n_teeth) if phi0 is None else np.array(phi0, dtype=float)
+    sgn = 1.0 if torque >= 0 else -1.0
+    te_start = sgn * model.backlash_offset if te0 is None else te0
+    theta2 = float(model.theta2_for_te(angles[0], te_start))
+    kb1, kb2 = model.body_stiffness
+    rb1, rb2 = model.base_radii
+    windup1 = torque * rb1 / rb2 / kb1          # driver rim lags its hub [rad]
+    windup2 = torque / kb2                      # driven hub lags its rim [rad]
+    rim_angles = angles - windup1 if model.coupled else angles
+    if model.coupled:
+        theta2 -= windup2
+    # teeth coupled through the bodies: their springs act through the compliance matrix alone
+    kphi = np.zeros_like(model.k_phi) if model.teeth_coupled else model.k_phi
+    ctooth = model.tooth_compliance if model.teeth_coupled else None    # None: the plain kernel
+    fails = static_sweep(rim_angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
+                         model.law_par, kphi, ctooth, tol, max_iter, te, nc, f1, it, th2)
+    if model.coupled:
+        th2 += windup2
+        te[:] = rb1 * angles + rb2 * th2
+    res = StaticResult(angles, te, th2, nc, f1, it, float(torque), phi)
+    if fails and raise_on_failure:
+        bad = np.flatnonzero(it < 0)
+        raise StaticSolveError(f"static equilibrium not reached at {fails} of {n} angles, first at "
+                               f"{np.degrees(angles[bad[0]]):.3f} deg")
+    return res

@@ -1,0 +1,88 @@
+"""Plain numpy + scipy peer of the static solver: `scipy.optimize.root` at each driver angle.
+
+What a Python user would write first: every tooth of both gears is an unknown (no active
+set), the residual is the vector of generalised forces of `reference.PairEquations` (load
+torque on gear 2, contacts by the closed forms, eq. (1.2) springs) at rest, and
+`scipy.optimize.root` (MINPACK Levenberg-Marquardt, analytic Jacobian without the geometric
+stiffness) solves it at each angle, starting from the previous angle's solution. (MINPACK's
+hybrid Powell, root's default, stalls on this residual: the 130-odd unloaded teeth make the
+Jacobian nearly singular.)
+
+Unloaded teeth sit at phi = 0 where the spring tangent n*k*|phi|^(n-1) vanishes (n > 1):
+as in `kernels/statics.py`, 1e-9 of each tooth's k_phi is added to the Jacobian's diagonal
+(the residual, and so the solution, stays exact).
+
+SI units. Entry point: `static_te_root`.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy import optimize
+
+from solver.mbs.model import Model
+from solver.peers.scipy_dynamics import PairEquations
+from solver.mbs.statics import StaticResult
+
+
+def _residual(eq: PairEquations, theta1: float, x: np.ndarray, zeros: np.ndarray):
+    """Generalised forces on [theta2, phi...] at rest [N m] and the contacts."""
+    phi = x[1:]
+    cons = eq.contacts(theta1, x[0], phi, 0.0, 0.0, zeros)
+    q = np.empty(eq.n)
+    q[0] = eq.torque
+    q[1:] = eq.spring_torques(phi, zeros)
+    for c in cons:
+        q[1 + c.ia] -= c.force * c.g[1]
+        q[0] -= c.force * c.g[2]
+        q[1 + c.ib] -= c.force * c.g[3]
+    return q, cons
+
+
+def _jacobian(eq: PairEquations, theta1: float, x: np.ndarray, zeros: np.ndarray) -> np.ndarray:
+    """d residual / dx [N m/rad]: spring tangents plus k_t G G^T of each contact (negated)."""
+    phi = x[1:]
+    cons = eq.contacts(theta1, x[0], phi, 0.0, 0.0, zeros)
+    return eq.tangents(phi, zeros, cons, spring_floor=1e-9)[0]
+
+
+def static_te_root(model: Model, angles, torque: float, tol: float = 1e-12) -> StaticResult:
+    """Equilibrium under ``torque`` [N m] on gear 2 at driver angles ``angles`` [rad], one
+    `scipy.optimize.root` call per angle (``tol`` passed to it: relative step tolerance).
+
+    Returns a `StaticResult` (iterations = residual evaluations, negative when root failed).
+    """
+    angles = np.ascontiguousarray(angles, dtype=float)
+    if angles.ndim != 1 or angles.size == 0:
+        raise ValueError("angles: need a non-empty 1-D array of driver angles")
+    eq = PairEquations(model, 0.0, 1.0, torque, 1.0)
+    zeros = np.zeros(eq.nt)
+    rb1, rb2 = model.base_radii
+    x = np.zeros(eq.n)
+    sgn = 1.0 if torque >= 0 else -1.0
+    n = angles.size
+    te = np.empty(n)
+    th2 = np.empty(n)
+    ncon = np.zeros(n, dtype=np.int64)
+    f1 = np.zeros((n, model.teeth[0]))
+    it = np.zeros(n, dtype=np.int64)
+    for a, theta1 in enumerate(angles):
+        if a == 0:
+            # start in contact: the backlash closed plus the contact-only penetration under
+            # the load (a start without contact has a zero row in the Jacobian)
+            k_con, m1 = eq.law[0], eq.law[1]
+            pen = (abs(torque) / rb2 / k_con) ** (1.0 / m1)
+            x[0] = model.theta2_for_te(theta1, sgn * (model.backlash_offset + pen))
+        else:
+            x[0] -= rb1 / rb2 * (theta1 - angles[a - 1])
+        sol = optimize.root(lambda y: _residual(eq, theta1, y, zeros)[0], x,
+                            jac=lambda y: _jacobian(eq, theta1, y, zeros), method="lm", tol=tol)
+        x = sol.x
+        _q, cons = _residual(eq, theta1, x, zeros)
+        te[a] = rb1 * theta1 + rb2 * x[0]
+        th2[a] = x[0]
+        for c in cons:
+            if c.force > 0.0:
+                ncon[a] += 1
+                f1[a, c.ia] += c.force
+        it[a] = sol.nfev if sol.success else -sol.nfev
+    return StaticResult(angles, te, th2, ncon, f1, it, float(torque), x[1:].copy())

@@ -1,0 +1,128 @@
+"""All the figures an archive supports: plots (`study.report.plots`) and renders (`study.report.render`).
+
+``make_figures(ds, outdir)`` writes PNGs into ``outdir`` and returns their paths; what the
+dataset cannot support (no STE, no DTE, no lightened body to show stress in) is skipped with one
+printed line saying why. A spectrum needs no render, and a solid gear needs no FE: renders of
+a lightened body reuse one FE solve (cached springs, one factorisation) for both images.
+
+A sweep archive (dimensions beyond a single run's) gets one sweep view per output that varies
+only over the swept dimensions.
+
+CLI: ``lightgear render ARCHIVE.nc [-o DIR]`` (default: beside the archive).
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+# dimensions of a single run archive; any other dimension is a swept parameter
+RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "ste_order", "ste_peak", "dte_peak"}
+
+
+def swept_dims(ds: xr.Dataset) -> list[str]:
+    return [d for d in ds.dims if d not in RUN_DIMS]
+
+
+def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True) -> list[Path]:
+    """Write every plot and render ``ds`` supports into ``outdir``; return the PNG paths."""
+    from study.report import plots
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    out: list[Path] = []
+
+    def name(stem):
+        return outdir / f"{prefix}{stem}.png"
+
+    def skip(what, why):
+        print(f"  skip {what}: {why}")
+
+    swept = swept_dims(ds)
+    if swept:
+        return _sweep_figures(ds, swept, name, skip)
+    if "ste" in ds:
+        out.append(plots.ste_plot(ds, name("ste")))
+    else:
+        skip("STE plot", "the archive has no quasi-static analysis (ste)")
+    if "dte" in ds:
+        out.append(plots.dte_plot(ds, name("dte")))
+    else:
+        skip("DTE plot", "the archive has no dynamic analysis (dte)")
+    if "dte_amplitude" in ds or "ste_amplitude" in ds:
+        out.append(plots.spectrum_plot(ds, name("spectrum")))
+    else:
+        skip("spectrum plot", "no spectrum in the archive (DTE record too short or not computed)")
+    if "tooth_stiffness" in ds:
+        out.append(plots.stiffness_plot(ds, name("tooth_stiffness")))
+    else:
+        skip("stiffness plot", "no tooth_stiffness in the archive")
+    if not renders:
+        skip("renders", "not asked for")
+        return out
+    if "scene" not in ds.attrs or "tooth_stiffness" not in ds:
+        skip("renders", "the archive has no scene attribute or no tooth_stiffness")
+        return out
+    out += _renders(ds, name, skip)
+    return out
+
+
+def _renders(ds, name, skip) -> list[Path]:
+    from study.report import render
+    from study.scene import loads_scene
+    sc = loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
+    lightened = [g for g in (1, 2) if sc.is_lightened(g)]
+    t0 = time.perf_counter()
+    fields = {}
+    for g in lightened:
+        k = render.tooth_stiffness(ds, g)
+        fields[g] = render.fe_fields(sc, g, [int(np.argmax(k)), int(np.argmin(k))])
+    out = [render.gear_pair_render(ds, name("gear_pair"), {g: f[0] for g, f in fields.items()}).path]
+    for g in lightened:
+        out.append(render.fe_stress_render(ds, name(f"fe_stress_gear{g}"), g, fields=fields[g]).path)
+    if not lightened:
+        skip("FE stress render", "both gears are solid (no FE body needed)")
+    print(f"  renders: {time.perf_counter() - t0:.1f} s")
+    return out
+
+
+def _sweep_figures(ds, swept, name, skip) -> list[Path]:
+    from study.report import plots
+    out = []
+    if len(swept) > 4:
+        skip("sweep views", f"{len(swept)} swept dimensions ({', '.join(swept)}): select up to four first")
+        return out
+    for var in ds.data_vars:
+        da = ds[var]
+        if da.dtype.kind not in "fiu" or not da.dims or not set(da.dims) <= set(swept) or swept[0] not in da.dims:
+            continue
+        dims = [d for d in swept if d in da.dims]
+        hue = dims[1] if len(dims) > 1 else None
+        out.append(plots.sweep_view(ds, var, dims[0], hue=hue, path=name(f"sweep_{var}")))
+    if not out:
+        skip("sweep views", f"no numeric output varies only over the swept dimensions ({', '.join(swept)})")
+    return out
+
+
+# ------------------------------------------------------------------ CLI
+
+def add_arguments(p):
+    p.add_argument("archive", help="run or sweep archive (NetCDF)")
+    p.add_argument("-o", "--output", default=None, help="directory for the PNGs (default: beside the archive)")
+    p.add_argument("--no-renders", action="store_true", help="plots only (no pyvista renders, no FE)")
+
+
+def main(args) -> int:
+    path = Path(args.archive)
+    if not path.exists():
+        print(f"lightgear render: no such archive: {path}")
+        return 2
+    with xr.open_dataset(path) as ds:
+        ds = ds.load()
+    outdir = Path(args.output) if args.output else path.parent
+    t0 = time.perf_counter()
+    for p in make_figures(ds, outdir, renders=not args.no_renders):
+        print(f"  figure: {p}")
+    print(f"  {time.perf_counter() - t0:.1f} s")
+    return 0

@@ -1,0 +1,194 @@
+"""Solver results -> labelled xarray datasets (CF-style units and long names) and NetCDF.
+
+The run archive of one scene holds:
+  ste(angle)               static transmission error [um] over driver rotation [deg]
+  ste_contacts(angle)      loaded tooth contacts [1]
+  ste_tooth_force(angle, tooth)  normal force on each driver tooth [N]
+  dte(time)                dynamic transmission error [um]
+  contact_force_max(time)  largest contact force over each output interval [N]
+  dte_contacts(time), driver_torque(time), energy_balance_error(time)
+  dte_amplitude(frequency) amplitude spectrum of DTE after the ramp [um], coordinate order
+  dte_peak_*(dte_peak)     named peaks of that spectrum (hole order N, mesh order Z, harmonics,
+                           sidebands kZ+-N, the largest unexplained ones): order, frequency, amplitude
+  ste_amplitude(ste_order) amplitude spectrum of STE over orders of the driven gear's rotation [um]
+  ste_peak_*(ste_peak)     named peaks of the STE spectrum
+  tooth_stiffness(gear, tooth), stiffness_ratio(gear, tooth)
+Global attributes: the scene as TOML, backlash offset, mesh and hole orders, versions.
+"""
+from __future__ import annotations
+
+import datetime
+import functools
+import hashlib
+import platform
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from solver import units
+
+from study.report.spectra import WINDOW, amplitude_spectrum, named_peaks, ste_order_spectrum
+
+
+def versions() -> str:
+    out = []
+    for pkg in ("lightgear", "numpy", "numba", "scipy", "xarray", "netCDF4", "dask", "scikit-fem", "gmsh"):
+        try:
+            out.append(f"{pkg} {metadata.version(pkg)}")
+        except metadata.PackageNotFoundError:
+            pass
+    return ", ".join(out)
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """Hash of the source of the `solver` and `study` packages (file names and contents): any
+    change to the code that computes results changes it. Computed once per process."""
+    root = Path(__file__).resolve().parents[2]
+    h = hashlib.sha256()
+    for pkg in ("solver", "study"):
+        for path in sorted((root / pkg).rglob("*.py")):
+            h.update(str(path.relative_to(root)).encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def provenance() -> dict:
+    return {
+        "software": versions(),
+        "code_fingerprint": code_fingerprint(),
+        "machine": f"{platform.node()} {platform.machine()} {platform.processor() or ''} python {platform.python_version()}".strip(),
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "Conventions": "CF-1.8",
+    }
+
+
+def _var(dims, data, unit, long_name, **attrs):
+    return xr.Variable(dims, data, {"units": unit, "long_name": long_name, **attrs})
+
+
+def static_variables(res, offset_m: float) -> dict:
+    angle_deg = np.degrees(res.angle)
+    coords = {"angle": _var("angle", angle_deg, "degree", "driver rotation from the nominal position")}
+    data = {
+        "ste": _var("angle", res.te * units.UM_PER_M, "um", "static transmission error rb1*theta1 + rb2*theta2",
+                    comment=f"zero at the zero-backlash conjugate position; rigid teeth in drive contact read +{offset_m * 1e6:.4f} um"),
+        "ste_contacts": _var("angle", res.n_contacts.astype("int16"), "1", "loaded tooth contacts"),
+        "ste_tooth_force": _var(("angle", "driver_tooth"), res.tooth_force, "N", "normal contact force on each driver tooth"),
+        "ste_converged": _var("angle", res.converged.astype("int8"), "1", "static equilibrium reached (1) or not (0)"),
+    }
+    coords["driver_tooth"] = _var("driver_tooth", np.arange(res.tooth_force.shape[1]), "1", "driver tooth index")
+    return coords, data
+
+
+def peak_variables(prefix: str, peaks, frequency_per_order: float | None = None) -> tuple[dict, dict]:
+    """A small table of named spectral peaks along dimension ``{prefix}_peak`` (names as coordinate)."""
+    dim = f"{prefix}_peak"
+    coords = {dim: _var(dim, np.array([p.name for p in peaks], dtype=object), "1",
+                        "peak name: N hole order, Z mesh order, kZ+-N sidebands, other k = k-th largest unexplained peak")}
+    what = prefix.upper()
+    data = {
+        f"{dim}_nominal_order": _var(dim, np.array([p.nominal for p in peaks]), "1", f"nominal order of the named {what} peak (driven-gear revolutions)"),
+        f"{dim}_order": _var(dim, np.array([p.order for p in peaks]), "1", f"order where the {what} peak was found (driven-gear revolutions)"),
+        f"{dim}_amplitude": _var(dim, np.array([p.amplitude for p in peaks]), "um", f"{what} amplitude at the peak"),
+    }
+    if frequency_per_order is not None:
+        data[f"{dim}_frequency"] = _var(dim, np.array([p.order for p in peaks]) * frequency_per_order, "Hz", f"frequency of the {what} peak")
+    return coords, data
+
+
+def ste_spectrum_variables(angle_deg, ste_um, z1: int, z2: int, hole_order: float, pad: int = 4) -> tuple[dict, dict]:
+    """STE amplitude spectrum over orders per revolution of the driven gear, and its named peaks."""
+    angle_deg = np.asarray(angle_deg, float)
+    if angle_deg.size < 16:
+        return {}, {}
+    step = float(angle_deg[1] - angle_deg[0])
+    order, amp, res = ste_order_spectrum(ste_um, step, z1, z2, pad=pad)
+    coords = {"ste_order": _var("ste_order", order, "1", "order of the driven gear's rotation (STE spectrum)")}
+    data = {"ste_amplitude": _var("ste_order", amp, "um", "one-sided amplitude spectrum of STE over driven-gear orders",
+                                  window=WINDOW, resolution_orders=res, zero_padding=pad,
+                                  record_driven_revolutions=1.0 / res,
+                                  comment="driven rotation = driver rotation * z1/z2; NaN samples interpolated")}
+    c, d = peak_variables("ste", named_peaks(order, amp, hole_order, z2, res))
+    coords.update(c); data.update(d)
+    return coords, data
+
+
+def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_order: float = 0.0,
+                      mesh_order: float | None = None) -> tuple[dict, dict, dict]:
+    coords = {"time": _var("time", res.time, "s", "time")}
+    data = {
+        "dte": _var("time", res.te * units.UM_PER_M, "um", "dynamic transmission error rb1*theta1 + rb2*theta2"),
+        "contact_force_max": _var("time", res.force_max, "N", "largest tooth contact force over the output interval"),
+        "dte_contacts": _var("time", res.n_contacts.astype("int16"), "1", "loaded tooth contacts"),
+        "driver_torque": _var("time", res.driver_torque, "N m", "torque applied by the driver"),
+        "energy_balance_error": _var("time", res.energy_error, "J", "work in - change of kinetic and potential energy - dissipated energy"),
+    }
+    attrs = {}
+    sel = res.time >= spectrum_start
+    if sel.sum() >= 16 and res.status == 0:
+        dt = float(res.time[1] - res.time[0])
+        f, a = amplitude_spectrum(res.te[sel] * units.UM_PER_M, dt)
+        f_rot = driven_speed / (2 * np.pi)
+        coords["frequency"] = _var("frequency", f, "Hz", "frequency")
+        coords["order"] = _var("frequency", f / f_rot if f_rot > 0 else np.full_like(f, np.nan), "1",
+                               "order of the driven gear's rotation")
+        data["dte_amplitude"] = _var("frequency", a, "um", "one-sided amplitude spectrum of DTE after the ramp",
+                                     window=WINDOW, resolution_Hz=1.0 / (sel.sum() * dt), start_s=float(res.time[sel][0]))
+        if f_rot > 0 and mesh_order:
+            peaks = named_peaks(f / f_rot, a, hole_order, mesh_order, 1.0 / (sel.sum() * dt) / f_rot)
+            c, v = peak_variables("dte", peaks, f_rot)
+            coords.update(c); data.update(v)
+    attrs.update(dt_s=res.dt, steps=res.steps, omega_max_rad_s=res.omega_max, dynamic_status=res.message,
+                 max_active_teeth=res.max_active_teeth)
+    return coords, data, attrs
+
+
+def stiffness_variables(k_nmm: tuple, ratio: tuple) -> tuple[dict, dict]:
+    zmax = max(len(k) for k in k_nmm)
+    K = np.full((2, zmax), np.nan)
+    R = np.full((2, zmax), np.nan)
+    for g in range(2):
+        K[g, : len(k_nmm[g])] = k_nmm[g]
+        R[g, : len(ratio[g])] = ratio[g]
+    coords = {"gear": _var("gear", np.array([1, 2]), "1", "gear (1 driver, 2 driven)"),
+              "tooth": _var("tooth", np.arange(zmax), "1", "tooth index (counter-clockwise from tooth 0)")}
+    data = {"tooth_stiffness": _var(("gear", "tooth"), K, "N mm rad-1", "torsion spring stiffness k_phi of each tooth"),
+            "stiffness_ratio": _var(("gear", "tooth"), R, "1", "tooth stiffness relative to the solid gear (FE)")}
+    return coords, data
+
+
+def write_netcdf(ds: xr.Dataset, path) -> None:
+    """Write compressed NetCDF4 atomically (temporary file, then rename).
+
+    The temporary name is unique per process and call, so concurrent writers of the same path
+    (dask workers filling the FE spring cache) never share a half-written file; the last
+    rename wins and readers only ever open complete files.
+    """
+    import os
+    import uuid
+    from pathlib import Path
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}.{uuid.uuid4().hex[:8]}")
+    enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars if ds[v].dtype.kind in "fiu"}
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def largest_peaks(ds: xr.Dataset, n: int = 5, min_order: float = 0.5):
+    """The n largest local maxima of dte_amplitude: list of (frequency Hz, order, amplitude um)."""
+    if "dte_amplitude" not in ds:
+        return []
+    a = ds["dte_amplitude"].values
+    f = ds["frequency"].values
+    o = ds["order"].values
+    idx = [i for i in range(1, a.size - 1) if a[i] >= a[i - 1] and a[i] >= a[i + 1] and o[i] >= min_order]
+    idx.sort(key=lambda i: -a[i])
+    return [(float(f[i]), float(o[i]), float(a[i])) for i in idx[:n]]

@@ -1,0 +1,343 @@
+"""Parametric sweeps: one task per study point, run in process or with dask.distributed.
+
+`run_point(scene, outputs)` runs only the analyses the outputs need and never raises: it
+returns a status (ok / diverged / invalid / failed), a message, its wall time [s], the scalars
+of `SCALARS` and the requested curves.
+
+`run_sweep(study, output)` computes the points that are not finished yet, stores each result
+as it arrives (one small file per point in ``.OUT.nc.parts/``, written atomically), and writes
+the study archive (`study.sweep.archive`) atomically at the end. Re-running the same study after an
+interruption (Ctrl-C, a killed worker or process) computes only the missing points. Points are
+keyed by a hash of their scene, outputs and the code (`results.code_fingerprint`), so an
+edited study reuses the points it shares, and a changed code computes them all again.
+
+Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
+`LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)
+that is always closed, or an existing scheduler (``scheduler="tcp://host:8786"``) whose workers
+can import this package.
+
+CLI: ``lightgear sweep STUDY.toml [-o OUT.nc] [--scheduler ADDR] [--workers N]``.
+"""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import itertools
+import json
+import logging
+import math
+import os
+import pickle
+import shutil
+import sys
+import time
+import traceback
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from study.sweep.grid import Outputs, Point, Study, check_points, load_study
+from study.scene import Scene, SceneError
+
+# name -> (units, long name); the names are those of study.run.summarize
+SCALARS = {
+    "ste_mean": ("um", "mean static transmission error"),
+    "ste_elastic_mean": ("um", "mean static transmission error less the rigid backlash offset"),
+    "ste_p2p": ("um", "peak-to-peak static transmission error"),
+    "dte_mean": ("um", "mean dynamic transmission error after the ramp"),
+    "dte_rms": ("um", "RMS of the dynamic transmission error about its mean after the ramp"),
+    "dte_p2p": ("um", "peak-to-peak dynamic transmission error after the ramp"),
+    "amp_mesh_order": ("um", "DTE amplitude at the mesh order Z2"),
+    "amp_mesh2_order": ("um", "DTE amplitude at twice the mesh order"),
+    "amp_mesh3_order": ("um", "DTE amplitude at three times the mesh order"),
+    "amp_hole_order": ("um", "DTE amplitude at the hole order N (NaN for a gear without holes)"),
+    "tooth_force_max": ("N", "largest tooth contact force of the dynamic run after the ramp"),
+}
+STATUS = ("pending", "ok", "diverged", "invalid", "failed")   # CF flag meanings, values 0..4
+WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+# ---------------------------------------------------------------- one point
+
+def analysis_of(output: str) -> str:
+    """'static' for STE outputs, 'dynamic' for the others (DTE, spectra, tooth force)."""
+    return "static" if output.startswith("ste") else "dynamic"
+
+
+def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
+    """Run one scene (a Scene, scene data or TOML text) for ``outputs``; never raises.
+
+    Returns ``{"status", "message", "wall_time" [s], "scalars": {name: value},
+    "curves": {name: (axis name, axis values, axis attrs, values, attrs)}}``; scalars of an
+    analysis that failed are NaN.
+    """
+    from study.run import run_scene, summarize
+    from study.scene import loads_scene, scene_from_dict
+
+    t0 = time.perf_counter()
+    scalars = {k: math.nan for k in outputs.scalars}
+    curves: dict = {}
+    status, message = "ok", "ok"
+    try:
+        if isinstance(scene, dict):
+            scene = scene_from_dict(scene)
+        elif isinstance(scene, str):
+            scene = loads_scene(scene)
+        ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic)
+        s = summarize(ds)
+        bad = set()          # analyses whose numbers are not to be trusted
+        problems = []
+        if outputs.static:
+            conv = ds["ste_converged"].values
+            if not conv.all():
+                bad.add("static")
+                problems.append(f"static equilibrium not reached at {int((conv == 0).sum())} of {conv.size} angles")
+        if outputs.dynamic and ds.attrs.get("dynamic_status", "ok") != "ok":
+            bad.add("dynamic")
+            problems.append(f"dynamic run stopped: {ds.attrs['dynamic_status']}")
+        if problems:
+            status, message = "diverged", "; ".join(problems)
+        for k in outputs.scalars:
+            if analysis_of(k) not in bad:
+                scalars[k] = float(s.get(k, math.nan))
+        for name in outputs.curves:
+            if name in ds and analysis_of(name) not in bad:
+                var = ds[name]
+                axis = var.dims[0]
+                curves[name] = (axis, ds[axis].values.copy(), dict(ds[axis].attrs), var.values.copy(), dict(var.attrs))
+    except SceneError as e:
+        status, message = "invalid", str(e)
+    except Exception as e:  # noqa: BLE001 - a point must never stop the sweep
+        from solver.geometry import GeometryError
+        from solver.mbs.dynamics import DivergenceError
+        if isinstance(e, DivergenceError):
+            status, message = "diverged", str(e)
+        elif isinstance(e, GeometryError):
+            status, message = "invalid", f"{e.field}: {e.reason}"
+        else:
+            status = "failed"
+            where = traceback.extract_tb(e.__traceback__)[-1]
+            message = f"{type(e).__name__}: {e} ({Path(where.filename).name}:{where.lineno})"
+    return {"status": status, "message": message, "wall_time": time.perf_counter() - t0,
+            "scalars": scalars, "curves": curves}
+
+
+def invalid_result(point: Point, outputs: Outputs) -> dict:
+    """The record of a point whose combination of values is invalid (nothing computed)."""
+    return {"status": "invalid", "message": point.error, "wall_time": 0.0,
+            "scalars": {k: math.nan for k in outputs.scalars}, "curves": {}}
+
+
+# ---------------------------------------------------------------- finished points on disk
+
+class PartStore:
+    """Finished points of a study, one pickle per point key, each written atomically."""
+
+    def __init__(self, folder: str | Path):
+        self.folder = Path(folder)
+
+    def get(self, key: str) -> dict | None:
+        try:
+            with open(self.folder / f"{key}.pkl", "rb") as f:
+                return pickle.load(f)
+        except FileNotFoundError:
+            return None
+        except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ValueError):
+            return None  # unreadable record: the point is computed again
+
+    def put(self, key: str, result: dict) -> None:
+        self.folder.mkdir(parents=True, exist_ok=True)
+        tmp = self.folder / f".{key}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp"
+        with open(tmp, "wb") as f:
+            pickle.dump(result, f, protocol=pickle.HIGHEST_PROTOCOL)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, self.folder / f"{key}.pkl")
+
+    def clear(self) -> None:
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+
+def parts_folder(output: str | Path) -> Path:
+    output = Path(output)
+    return output.with_name(f".{output.name}.parts")
+
+
+# ---------------------------------------------------------------- executors
+
+@contextlib.contextmanager
+def dask_client(scheduler: str | None = None, workers: int | None = None):
+    """A dask Client: to ``scheduler``, or to a LocalCluster started (and always closed) here."""
+    from distributed import Client, LocalCluster
+    if scheduler:
+        with Client(scheduler) as client:
+            yield client
+        return
+    n = workers or os.cpu_count() or 1
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.ERROR, env=dict(WORKER_ENV)) as cluster, Client(cluster) as client:
+        yield client
+
+
+def body_group(scene: Scene) -> str:
+    """What a point's FE spring maps depend on (gears, bodies, material, mesh, FE load torque).
+
+    Points of one group share the disk-cached maps; `interleave` keeps them apart in the queue
+    so that two workers rarely compute the same map at once.
+    """
+    data = dataclasses.asdict(scene)
+    keep = {k: data[k] for k in ("gear1", "gear2", "material", "fe")}
+    keep["torque"] = scene.quasi_static.torque
+    return json.dumps(keep, sort_keys=True, default=str)
+
+
+def interleave(todo: dict) -> dict:
+    """Reorder {key: scene} round-robin over body groups (first point of every body first)."""
+    groups: dict[str, list] = {}
+    for key, scene in todo.items():
+        groups.setdefault(body_group(scene), []).append(key)
+    order = [k for round_ in itertools.zip_longest(*groups.values()) for k in round_ if k is not None]
+    return {k: todo[k] for k in order}
+
+
+def _in_process(todo: dict, outputs: Outputs):
+    for key, scene in todo.items():
+        yield key, run_point(scene, outputs)
+
+
+def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int | None):
+    from distributed import as_completed
+    with dask_client(scheduler, workers) as client:
+        futures = {client.submit(run_point, scene, outputs, key=f"lightgear-point-{key}", pure=False): key
+                   for key, scene in todo.items()}
+        try:
+            for fut in as_completed(futures):
+                try:
+                    yield futures[fut], fut.result()
+                except Exception as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
+                    yield futures[fut], {"lost": f"{type(e).__name__}: {e}"}
+        finally:
+            client.cancel(list(futures))
+
+
+# ---------------------------------------------------------------- the sweep
+
+@dataclass
+class SweepResult:
+    dataset: xr.Dataset
+    computed: int        # points computed by this call
+    reused: int          # finished points found on disk
+    invalid: int         # invalid combinations (recorded, not computed)
+    pending: int         # points still missing (lost tasks)
+    wall_time: float     # s
+
+
+def run_sweep(study: Study, output: str | Path, workers: int | None = None, scheduler: str | None = None,
+              progress: bool = True, keep_parts: bool = False) -> SweepResult:
+    """Compute the study's missing points, store each as it arrives, write the archive atomically.
+
+    ``workers=0``: in this process; None: one dask worker per core; ``scheduler``: an existing
+    dask cluster. The part files are removed once the archive holds every point (unless
+    ``keep_parts``).
+    """
+    from tqdm import tqdm
+
+    from study.sweep.archive import study_dataset
+    from study.report.results import write_netcdf
+
+    t0 = time.perf_counter()
+    points = check_points(study)
+    out = study.outputs
+    done = _complete_archive(study, points, output)
+    if done is not None:
+        return SweepResult(done, 0, int((done["status"].values != STATUS.index("invalid")).sum()),
+                           int((done["status"].values == STATUS.index("invalid")).sum()), 0, time.perf_counter() - t0)
+    store = PartStore(parts_folder(output))
+    results, todo = {}, {}
+    n_invalid = 0
+    for p in points:
+        key = p.key(out)
+        if key in results or key in todo:
+            continue
+        if p.scene is None:
+            results[key] = invalid_result(p, out)
+            n_invalid += 1
+            continue
+        found = store.get(key)
+        if found is not None:
+            results[key] = found
+        else:
+            todo[key] = p.scene
+    reused = len(results) - n_invalid
+    lost = {}
+    todo = interleave(todo)
+    if todo:
+        run = _in_process(todo, out) if workers == 0 and not scheduler else _with_dask(todo, out, scheduler, workers)
+        with contextlib.closing(run), tqdm(total=len(todo), desc=study.title[:40], unit="point", disable=not progress,
+                                           file=sys.stderr) as bar:
+            for key, res in run:
+                if "lost" in res:
+                    lost[key] = res["lost"]
+                else:
+                    store.put(key, res)
+                    results[key] = res
+                bar.update(1)
+    ds = study_dataset(study, points, results)
+    write_netcdf(ds, output)
+    if not lost and not keep_parts:
+        store.clear()
+    return SweepResult(ds, len(todo) - len(lost), reused, n_invalid, len(lost), time.perf_counter() - t0)
+
+
+def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset | None:
+    """The archive at ``output`` when it already holds every point of this very study."""
+    from study.sweep.archive import study_key
+    if not Path(output).is_file() or parts_folder(output).exists():
+        return None
+    try:
+        with xr.open_dataset(output, engine="netcdf4") as ds:
+            if ds.attrs.get("study_key") == study_key(study, points) and not (ds["status"].values == 0).any():
+                return ds.load()
+    except (OSError, KeyError, ValueError):
+        pass
+    return None
+
+
+# ---------------------------------------------------------------- CLI
+
+def add_arguments(p):
+    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]] + [outputs])")
+    p.add_argument("-o", "--output", help="archive to write (NetCDF; default results/<study name>.nc)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="address of an existing dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--workers", type=int, default=None,
+                   help="LocalCluster workers (default: one per core); 0 runs the points in this process")
+    p.add_argument("--keep-parts", action="store_true", help="keep the per-point files after the archive is complete")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def main(args) -> int:
+    study = load_study(args.study)
+    output = args.output or f"results/{Path(args.study).stem}.nc"
+    n = int(np.prod(study.shape))
+    print(f"{study.title}: {n} points ({' x '.join(map(str, study.shape))}, {study.layout} layout) -> {output}")
+    try:
+        res = run_sweep(study, output, workers=args.workers, scheduler=args.scheduler,
+                        progress=not args.no_progress, keep_parts=args.keep_parts)
+    except KeyboardInterrupt:
+        print(f"interrupted: finished points are kept in {parts_folder(output)}; run the same command to resume",
+              file=sys.stderr)
+        return 130
+    ds = res.dataset
+    counts = {name: int((ds["status"].values == i).sum()) for i, name in enumerate(STATUS)}
+    print(f"  computed {res.computed}, reused {res.reused}, invalid combinations {res.invalid}, "
+          f"wall time {res.wall_time:.1f} s")
+    print("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v))
+    for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:
+        print(f"    {msg}")
+    if res.pending:
+        print(f"  {res.pending} points lost (worker failures): run the same command again to compute them", file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,379 @@
+"""Studies: a base scene and a grid of scene fields, validated before any work starts.
+
+A study TOML file::
+
+    title = "holes and speed"
+    scene = "my_scene.toml"          # a scene file (relative to the study file); omitted: the
+                                     # embedded paper example
+    # or, instead, an inline scene: overrides on top of `file` (default: the paper example)
+    # [scene]
+    # gear2.body.web_thickness = 10.0
+
+    [grid]                           # full factorial over every listed field (dotted scene path)
+    gear2.body.holes = [0, 3, 6]
+    "dynamic.speed" = {start = 50.0, stop = 200.0, num = 4}   # linspace, both ends included
+
+    # dimension order = key order after TOML parsing: unquoted dotted keys with a common head
+    # (gear2.body.*) are grouped into one table; quote a key ("dynamic.speed") to keep it apart
+
+    [[points]]                       # optional explicit points (then the archive has a `point`
+    gear2.body.holes = 9             # dimension: the factorial points first, then these)
+    dynamic.speed = 300.0
+
+    [outputs]
+    scalars = ["ste_p2p", "dte_rms"]            # default: all of `sweep.SCALARS`
+    curves = ["ste", "dte", "dte_amplitude"]    # default: none (only scalars are archived)
+
+Every grid value is checked alone against the scene (unknown field, wrong type, out of range:
+`SceneError` naming the dotted field). A combination that is physically invalid (holes cutting
+the rim at one radius only, say) is not an error of the study: that point is recorded as
+invalid with its message and the sweep goes on.
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import hashlib
+import itertools
+import json
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from study.scene import (Scene, SceneError, default_scene_text, field_unit, scene_fields_from_dict,
+                    scene_from_dict, set_dotted)
+
+# dimension names for the fields an engineer sweeps most; others get the dotted path with '_'
+DIM_NAMES = {
+    "gear2.body.holes": "n_holes",
+    "gear2.body.hole_radius": "hole_radius",
+    "gear2.body.hole_circle_radius": "hole_circle_radius",
+    "gear2.body.rim_height": "rim_thickness",
+    "gear2.body.web_thickness": "web_thickness",
+    "gear2.body.web_height": "web_height",
+    "dynamic.speed": "speed",
+    "dynamic.torque": "torque",
+    "quasi_static.torque": "static_torque",
+}
+
+STUDY_KEYS = ("title", "scene", "grid", "points", "outputs")
+CURVES = ("ste", "dte", "dte_amplitude")
+RANGE_KEYS = ("start", "stop", "num")
+
+
+def dim_name(path: str) -> str:
+    """Archive dimension name of a dotted scene field (``gear2.body.holes`` -> ``n_holes``)."""
+    return DIM_NAMES.get(path, path.replace(".", "_"))
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What each point computes and archives: scalar names and full curves."""
+    scalars: tuple[str, ...]
+    curves: tuple[str, ...] = ()
+
+    @property
+    def static(self) -> bool:
+        """True when a quasi-static (STE) analysis is needed."""
+        return any(x.startswith("ste") for x in self.scalars + self.curves)
+
+    @property
+    def dynamic(self) -> bool:
+        """True when a dynamic (DTE) analysis is needed."""
+        return any(not x.startswith("ste") for x in self.scalars + self.curves)
+
+
+@dataclass(frozen=True)
+class Axis:
+    path: str            # dotted scene field
+    values: tuple        # in the scene's units
+
+    @property
+    def name(self) -> str:
+        return dim_name(self.path)
+
+
+@dataclass(frozen=True)
+class Point:
+    """One point of a study: its position, its field values, and its scene (or why it is invalid)."""
+    index: tuple            # grid indices (factorial layout) or (i,) (point layout)
+    values: dict            # dotted path -> value
+    scene: Scene | None     # None when the combination is invalid
+    error: str = ""         # the SceneError text of an invalid combination
+
+    def key(self, outputs: Outputs) -> str:
+        """Content hash of what this point computes: same scene, outputs and code -> same key
+        (a resumed study never mixes points computed by two versions of the code)."""
+        from study.report.results import code_fingerprint
+        what = self.scene.to_toml() if self.scene is not None else json.dumps(self.values, sort_keys=True)
+        blob = json.dumps([what, list(outputs.scalars), list(outputs.curves), code_fingerprint()])
+        return hashlib.sha256(blob.encode()).hexdigest()[:24]
+
+
+@dataclass(frozen=True)
+class Study:
+    title: str
+    text: str                 # the study TOML as given (archived)
+    base: dict                # base scene data (TOML tables)
+    axes: tuple[Axis, ...]    # factorial grid
+    extra: tuple[dict, ...]   # explicit points: dotted path -> value
+    outputs: Outputs
+
+    @property
+    def layout(self) -> str:
+        """'grid' (one dimension per swept field) or 'point' (explicit points present)."""
+        return "point" if self.extra else "grid"
+
+    @property
+    def fields(self) -> tuple[str, ...]:
+        """Every swept dotted path, grid fields first."""
+        out = [a.path for a in self.axes]
+        for p in self.extra:
+            out += [k for k in p if k not in out]
+        return tuple(out)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        if self.layout == "grid":
+            return tuple(len(a.values) for a in self.axes)
+        n_grid = int(np.prod([len(a.values) for a in self.axes])) if self.axes else 0
+        return (n_grid + len(self.extra),)
+
+    def base_scene_toml(self) -> str:
+        """The base scene with every field spelled out (defaults included)."""
+        return scene_fields_from_dict(self.base).to_toml()
+
+    def base_value(self, path: str):
+        """Value of a dotted field in the base scene (the Scene default when the base omits it)."""
+        node = scene_fields_from_dict(self.base)
+        for p in path.split("."):
+            node = getattr(node, p)
+        return node
+
+    def points(self) -> list[Point]:
+        """All points (cheap: builds and checks each scene, runs nothing)."""
+        combos = []
+        grid = list(itertools.product(*[range(len(a.values)) for a in self.axes])) if self.axes else []
+        for idx in grid:
+            combos.append((idx, {a.path: a.values[i] for a, i in zip(self.axes, idx)}))
+        if self.layout == "point":
+            combos = [((i,), vals) for i, (_, vals) in enumerate(combos)]
+            combos += [((len(combos) + i,), dict(p)) for i, p in enumerate(self.extra)]
+        out = []
+        for idx, vals in combos:
+            data = copy.deepcopy(self.base)
+            for path, v in vals.items():
+                set_dotted(data, path, v)
+            try:
+                out.append(Point(idx, vals, scene_from_dict(data)))
+            except SceneError as e:
+                out.append(Point(idx, vals, None, str(e)))
+        return out
+
+
+# ---------------------------------------------------------------- reading and checking
+
+def _flatten(table: dict, where: str, prefix: str = "", repeat: bool = False) -> dict:
+    """Nested TOML tables -> {dotted path: leaf}; a leaf is a list, a range table or a scalar.
+
+    A path given twice (nested and quoted) is an error, unless ``repeat`` (scene overrides:
+    the later one wins).
+    """
+    out = {}
+    for k, v in table.items():
+        path = f"{prefix}.{k}" if prefix else k
+        if isinstance(v, dict) and not (set(v) & set(RANGE_KEYS)):
+            sub = _flatten(v, where, path, repeat)
+        else:
+            sub = {path: v}
+        for p in sub:
+            if p in out and not repeat:
+                raise SceneError(p, f"given twice in [{where}]")
+            out.pop(p, None)
+        out.update(sub)
+    return out
+
+
+def _field_kind(base: dict, path: str):
+    """Python type of a scene value field; SceneError when the path is unknown or a table."""
+    field_unit(path)  # raises 'no such scene field'
+    node = scene_fields_from_dict(base)
+    for p in path.split("."):
+        node = getattr(node, p)
+    if dataclasses.is_dataclass(node):
+        raise SceneError(path, "is a table of the scene, not a value")
+    return type(node)
+
+
+def _check_value(base: dict, path: str, value, where: str):
+    """Field-level check of one value (type, range) with the base scene; returns it coerced."""
+    if isinstance(value, (list, dict)):
+        raise SceneError(path, f"{where}: a value must be a number, string or boolean, got {value!r}")
+    data = copy.deepcopy(base)
+    set_dotted(data, path, value)
+    try:
+        scene = scene_fields_from_dict(data)
+    except SceneError as e:
+        raise SceneError(e.field, f"{where} value {value!r}: {e.reason}") from None
+    node = scene
+    for p in path.split("."):
+        node = getattr(node, p)
+    return node
+
+
+def _axis_values(base: dict, path: str, spec) -> tuple:
+    kind = _field_kind(base, path)
+    if isinstance(spec, dict):
+        unknown = set(spec) - set(RANGE_KEYS)
+        if unknown or not set(RANGE_KEYS) <= set(spec):
+            raise SceneError(path, f"a range is a table {{start, stop, num}}, got keys {sorted(spec)}")
+        if kind not in (int, float):
+            raise SceneError(path, f"a range needs a numeric field, this one is {kind.__name__}")
+        num = spec["num"]
+        if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            raise SceneError(path, f"range num must be a positive integer, got {num!r}")
+        for k in ("start", "stop"):
+            if isinstance(spec[k], bool) or not isinstance(spec[k], (int, float)):
+                raise SceneError(path, f"range {k} must be a number, got {spec[k]!r}")
+        vals = np.linspace(spec["start"], spec["stop"], num)
+        if kind is int:
+            if not np.allclose(vals, np.round(vals)):
+                raise SceneError(path, f"range gives non-integer values {vals.tolist()} for an integer field")
+            vals = np.round(vals).astype(int)
+        values = [v.item() for v in vals]
+    elif isinstance(spec, list):
+        values = spec
+    else:
+        raise SceneError(path, f"[grid] takes a list of values or a range table, got {spec!r}")
+    if not values:
+        raise SceneError(path, "[grid] list is empty")
+    out = tuple(_check_value(base, path, v, "[grid]") for v in values)
+    if len(set(out)) != len(out):
+        raise SceneError(path, f"[grid] repeats a value: {list(out)}")
+    return out
+
+
+def _outputs(table) -> Outputs:
+    from study.sweep.engine import SCALARS
+    if not isinstance(table, dict):
+        raise SceneError("outputs", f"must be a table, got {table!r}")
+    for k in table:
+        if k not in ("scalars", "curves"):
+            raise SceneError(f"outputs.{k}", "unknown key (expected scalars, curves)")
+    scalars = table.get("scalars", list(SCALARS))
+    curves = table.get("curves", [])
+    for name, items, known in (("scalars", scalars, tuple(SCALARS)), ("curves", curves, CURVES)):
+        if not isinstance(items, list):
+            raise SceneError(f"outputs.{name}", f"must be a list, got {items!r}")
+        for it in items:
+            if it not in known:
+                raise SceneError(f"outputs.{name}", f"unknown output {it!r} (expected one of: {', '.join(known)})")
+    if not scalars and not curves:
+        raise SceneError("outputs", "asks for nothing")
+    return Outputs(tuple(dict.fromkeys(scalars)), tuple(dict.fromkeys(curves)))
+
+
+def _base_scene(spec, folder: Path | None) -> dict:
+    def read(path) -> dict:
+        p = Path(path)
+        if not p.is_absolute() and folder is not None:
+            p = folder / p
+        if not p.is_file():
+            raise SceneError("scene", f"no such file: {p}")
+        try:
+            return tomllib.loads(p.read_text())
+        except tomllib.TOMLDecodeError as e:
+            raise SceneError("scene", f"{p} is not valid TOML: {e}") from None
+
+    if spec is None:
+        return tomllib.loads(default_scene_text())
+    if isinstance(spec, str):
+        return read(spec)
+    if isinstance(spec, dict):
+        spec = copy.deepcopy(spec)
+        file = spec.pop("file", None)
+        data = read(file) if file is not None else tomllib.loads(default_scene_text())
+        for path, v in _flatten(spec, "scene", repeat=True).items():
+            set_dotted(data, path, v)
+        return data
+    raise SceneError("scene", f"must be a file name or a table, got {spec!r}")
+
+
+def loads_study(text: str, folder: str | Path | None = None) -> Study:
+    """Parse and check a study (TOML text). ``folder`` resolves a relative scene file."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError("study", f"not valid TOML: {e}") from None
+    for k in raw:
+        if k not in STUDY_KEYS:
+            raise SceneError(k, f"unknown study key (expected one of: {', '.join(STUDY_KEYS)})")
+    base = _base_scene(raw.get("scene"), Path(folder) if folder is not None else None)
+    scene_fields_from_dict(base)  # field errors of the base scene itself
+    grid = raw.get("grid", {})
+    if not isinstance(grid, dict):
+        raise SceneError("grid", f"must be a table, got {grid!r}")
+    axes = tuple(Axis(path, _axis_values(base, path, spec)) for path, spec in _flatten(grid, "grid").items())
+    extra = raw.get("points", [])
+    if not isinstance(extra, list) or not all(isinstance(p, dict) for p in extra):
+        raise SceneError("points", "must be a list of tables (dotted field = value)")
+    points = []
+    for i, p in enumerate(extra):
+        flat = _flatten(p, f"points[{i}]")
+        for path in flat:
+            _field_kind(base, path)
+        points.append({path: _check_value(base, path, v, f"points[{i}]") for path, v in flat.items()})
+    if not axes and not points:
+        raise SceneError("grid", "the study sweeps nothing: give a [grid] table or [[points]]")
+    seen = {}
+    for path in dict.fromkeys([a.path for a in axes] + [q for pt in points for q in pt]):
+        if dim_name(path) in seen:
+            raise SceneError(path, f"its dimension name {dim_name(path)!r} clashes with {seen[dim_name(path)]}")
+        seen[dim_name(path)] = path
+    return Study(str(raw.get("title", "lightgear study")), text, base, axes, tuple(points),
+                 _outputs(raw.get("outputs", {})))
+
+
+def load_study(path: str | Path) -> Study:
+    p = Path(path)
+    if not p.is_file():
+        raise SceneError("study", f"no such file: {p}")
+    return loads_study(p.read_text(), p.parent)
+
+
+def _toml(v) -> str:
+    from study.scene import _toml_value
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k} = {_toml(x)}" for k, x in v.items()) + "}"
+    return _toml_value(v)
+
+
+def dumps_study(raw: dict) -> str:
+    """A study as TOML text from its parsed tables (dotted keys quoted, so their order stays)."""
+    out = [f"{k} = {_toml(raw[k])}" for k in ("title", "scene") if k in raw and not isinstance(raw[k], dict)]
+    for table in ("scene", "grid", "outputs"):
+        if isinstance(raw.get(table), dict):
+            out.append(f"\n[{table}]")
+            flat = _flatten(raw[table], table, repeat=table == "scene") if table != "outputs" else raw[table]
+            out += [f'"{k}" = {_toml(v)}' for k, v in flat.items()]
+    for p in raw.get("points", []):
+        out.append("\n[[points]]")
+        out += [f'"{k}" = {_toml(v)}' for k, v in _flatten(p, "points").items()]
+    return "\n".join(out) + "\n"
+
+
+def check_points(study: Study) -> list[Point]:
+    """The study's points; SceneError when no point is valid (nothing could be computed)."""
+    points = study.points()
+    if not any(p.scene is not None for p in points):
+        first = points[0].error
+        field, _, reason = first.partition(": ")
+        raise SceneError(field, f"every point of the study is invalid, e.g. {reason}")
+    return points
+
+
+__all__ = ["Study", "Axis", "Point", "Outputs", "loads_study", "load_study", "dumps_study", "check_points", "dim_name", "DIM_NAMES", "CURVES"]
