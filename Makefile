@@ -7,13 +7,17 @@ export VTK_DEFAULT_OPENGL_WINDOW ?= vtkEGLRenderWindow
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.lightgear-cache/numba
 export MPLBACKEND ?= Agg
 
-.PHONY: run test bench venv sysdeps clean
+.PHONY: run test lint bench venv sysdeps clean
 
 run: $(STAMP)
 	$(PY) -m workflows.paper_example -o results/paper_example/paper_example.nc
 
 test: $(STAMP)
+	$(VENV)/bin/ruff check --quiet .
 	$(PY) -m pytest -q
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

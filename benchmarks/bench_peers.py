@@ -31,8 +31,8 @@ ROOT_ANGLES = 60          # 6 deg: more than one mesh cycle (5.37 deg)
 
 
 def static_rows(kind, m, sc, rep):
-    from solver.peers.scipy_statics import static_te_root
     from solver.mbs.statics import solve_static
+    from solver.peers.scipy_statics import static_te_root
     from study.run import static_angles
     ang = static_angles(sc)
     tq = sc.quasi_static.torque
@@ -52,6 +52,7 @@ def static_rows(kind, m, sc, rep):
 def dynamic_rows(kind, m, rep, quick):
     import exudyn
     from peers.exudyn_pair import simulate_exudyn
+
     from solver.mbs.dynamics import simulate, stable_time_step
     from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
     win = SHORT_DYNAMIC

@@ -16,7 +16,7 @@ import common  # noqa: I001  (first: pins BLAS to one thread before numpy loads)
 import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.explicit import _accelerations, _dissipation_power, _energies
+from solver.mbs.kernels.explicit import _accelerations, _dissipation_power
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 
 COLUMNS = ("part", "active_teeth", "ns_per_call", "note")

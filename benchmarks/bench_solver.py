@@ -18,7 +18,7 @@ import time
 
 import common  # noqa: I001  (first: pins BLAS to one thread before numpy loads)
 import numpy as np
-from common import PAPER_DYNAMIC, SHORT_DYNAMIC, ROOT, best_of
+from common import PAPER_DYNAMIC, ROOT, SHORT_DYNAMIC, best_of
 
 # one process: first STE and first dynamic run with whatever numba cache NUMBA_CACHE_DIR holds
 FIRST_CALL = r'''
@@ -59,8 +59,8 @@ def main(argv=None) -> int:
     rep = 3 if args.quick else 5
     rows = []
     from solver.mbs.dynamics import simulate, stable_time_step
-    from solver.peers.scipy_dynamics import simulate_scipy
     from solver.mbs.statics import solve_static
+    from solver.peers.scipy_dynamics import simulate_scipy
     from study.run import static_angles
 
     # --- compile and cache start (subprocesses, so nothing is warm here)
@@ -120,7 +120,6 @@ def main(argv=None) -> int:
     m = common.model("solid")
     dt, _w = stable_time_step(m, 50.0)
     win = SHORT_DYNAMIC
-    from solver.peers.scipy_dynamics import simulate_explicit_all_teeth
     ref = simulate(m, *win, dt=dt / 8)
     ref_all = simulate_explicit_all_teeth(m, *win, dt=dt / 8)
     tim, dy = best_of(lambda: simulate(m, *win, dt=dt), rep, warmup=True)

@@ -29,8 +29,8 @@ sys.path.insert(0, str(ROOT))  # this checkout, not another installed copy
 
 import numpy as np  # noqa: E402
 
-from study.sweep.grid import loads_study  # noqa: E402
 from study.sweep.engine import SCALARS, dask_client, run_point, run_sweep  # noqa: E402
+from study.sweep.grid import loads_study  # noqa: E402
 
 DYNAMIC = tuple(k for k in SCALARS if not k.startswith("ste"))
 SOLID = '"gear2.body.holes" = 0\n"gear2.body.web_thickness" = 17.0\n'

@@ -15,12 +15,11 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.dynamics import run_loads, simulate
+from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.kernels.layout import R_PV
 from solver.mbs.model import ContactLaw, GearInput, Model, build_model
 from solver.mbs.statics import solve_static
-
 from study.report import results
 from study.scene import Scene, load_scene
 

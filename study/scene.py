@@ -23,8 +23,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 from solver import units
-from solver.geometry import (BodySpec, GeometryError, Material, ToothSpec, gear_geometry,
-                             pair_geometry, validate_body)
+from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
 
 
 class SceneError(ValueError):

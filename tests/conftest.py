@@ -29,8 +29,8 @@ def private_fe_cache(tmp_path, monkeypatch):
     """FE results of the test go to a fresh disk cache, and no in-memory cache (influence
     coefficients, factorised bodies, spring maps, coupling fits) leaks in or out."""
     from study import run
-    from study.verify import fe_reference as reference
     from study.inputs import springs
+    from study.verify import fe_reference as reference
 
     def clear():
         reference._memory.clear()
@@ -59,6 +59,7 @@ def assert_energy_closes_at_second_order(model, torque=50.0):
     integrator alone): the energy residual stays bounded (no secular drift) and falls about
     4x per halved step."""
     import numpy as np
+
     from solver.mbs.dynamics import simulate, stable_time_step
     dt0, _ = stable_time_step(model, torque)
     errs = []
@@ -74,7 +75,9 @@ def slow_transient_against_statics(model, torque=50.0):
     """Dynamics at 1 rad/s (1 ms ramps, 50 ms) against the static STE at the same driver
     angles past 1.5 deg: (TE difference [m], the run, the static result)."""
     import math
+
     import numpy as np
+
     from solver.mbs.dynamics import simulate
     from solver.mbs.kernels.explicit import driver_motion
     from solver.mbs.statics import solve_static

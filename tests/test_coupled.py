@@ -5,18 +5,16 @@ import math
 
 import numpy as np
 import pytest
-
-from solver.identify.coupling import body_torsion_fit, body_windup
-from solver.fe.ltca import mesh_points
-from solver.mbs.model import build_model
-from solver.mbs.statics import solve_static
-from study.verify import fe_reference as ref_mod
-from study.run import build_scene_model
-from study.scene import SceneError
-
 from conftest import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 from test_ltca import LIGHT, small_scene
 
+from solver.fe.ltca import mesh_points
+from solver.identify.coupling import body_torsion_fit, body_windup
+from solver.mbs.model import build_model
+from solver.mbs.statics import solve_static
+from study.run import build_scene_model
+from study.scene import SceneError
+from study.verify import fe_reference as ref_mod
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
@@ -96,8 +94,8 @@ def test_coupled_slow_transient_follows_coupled_statics(paper_solid_model):
 def _double_contact_errors(scene, coupling="body-torsion"):
     """(plain-FE, coupled) STE errors [m] against the FE reference where the rigid geometry has
     two pairs in the path of contact, and the single-contact errors."""
-    from study.inputs.coupling import plain_fe_springs
     from solver import units
+    from study.inputs.coupling import plain_fe_springs
     angles = np.radians(np.arange(0.0, scene.quasi_static.rotation, 0.25))
     res, model, _ = ref_mod.reference(scene, angles)
     nominal = np.array([np.count_nonzero(mesh_points(model, a).kind == 1) for a in angles])
@@ -157,6 +155,7 @@ def test_implicit_integrator_refuses_and_auto_picks_explicit_for_a_coupled_model
 
 def test_validation_workflow_writes_archive_and_figures(tmp_path):
     import xarray as xr
+
     from workflows import validation
     s = small_scene(**{"fe.mesh_size": 1.8, **LIGHT})
     path = tmp_path / "s.toml"

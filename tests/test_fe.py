@@ -6,8 +6,8 @@ import pytest
 import skfem
 
 from solver.fe import body as fe
-from solver.geometry import Material, gear_geometry
 from solver.fe.mesh import REGION_WEB, mesh_annulus, mesh_body
+from solver.geometry import Material, gear_geometry
 
 STEEL = Material(206e9, 0.3, 7850.0)
 A, C, B = 0.010, 0.020, 0.030       # bore, web/rim split, outer radius [m]

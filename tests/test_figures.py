@@ -9,8 +9,7 @@ import pytest
 import xarray as xr
 from matplotlib.image import imread
 
-from study.report import plots
-from study.report import render
+from study.report import plots, render
 from study.report.figures import make_figures
 from study.run import run_scene
 from study.scene import default_scene

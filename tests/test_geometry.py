@@ -4,8 +4,18 @@ import math
 import numpy as np
 import pytest
 
-from solver.geometry import (BodySpec, GeometryError, ToothSpec, body_inertia, gear_geometry, involute,
-                             pair_geometry, polygon_properties, tooth_inertia, validate_body)
+from solver.geometry import (
+    BodySpec,
+    GeometryError,
+    ToothSpec,
+    body_inertia,
+    gear_geometry,
+    involute,
+    pair_geometry,
+    polygon_properties,
+    tooth_inertia,
+    validate_body,
+)
 
 TABLE1 = ToothSpec(module=1.5e-3, teeth=67, pressure_angle=math.radians(20), addendum_coef=1.0,
                    dedendum_coef=1.25, fillet_radius=0.45e-3, face_width=17e-3, thinning=0.035e-3)

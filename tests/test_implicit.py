@@ -5,11 +5,17 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import solid_scene
-from solver.mbs.implicit import choose_method, simulate_implicit
+
 from solver.mbs.dynamics import DivergenceError, highest_frequency, linearized_system, simulate, stable_time_step
-from solver.mbs.kernels.laws import contact_damping_tangents, contact_force, contact_tangent, spring_damping_tangent, spring_torque
+from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.kernels.laws import (
+    contact_damping_tangents,
+    contact_force,
+    contact_tangent,
+    spring_damping_tangent,
+    spring_torque,
+)
 from study.run import build_scene_model, run_scene
 from study.scene import SceneError
 
@@ -127,8 +133,6 @@ def test_explicit_step_bound_matches_the_eigenvalues(undamped):
         simulate(undamped, 100.0, 0.01, 50.0, 0.01, 0.003, dt=1.2 * dt_b, output_step=1.2 * dt_b,
                  raise_on_failure=True)
     # the highest mode is bounded by a tooth on its spring plus its contact (Rayleigh)
-    gp = undamped.gear_par
-    from solver.mbs.kernels import layout as L
     M, K, _teeth = linearized_system(undamped, 0.0, undamped.theta2_for_te(0.0, undamped.backlash_offset + 5e-6),
                                      np.zeros(undamped.n_teeth))
     diag_max = math.sqrt(np.max(np.diag(K)[1:] / np.diag(M)[1:]))

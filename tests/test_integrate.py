@@ -3,8 +3,8 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import assert_energy_closes_at_second_order, solid_scene
+
 from solver.mbs.dynamics import DivergenceError, simulate, stable_time_step
 from solver.mbs.statics import solve_static
 from study.run import build_scene_model, run_static

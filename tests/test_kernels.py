@@ -5,9 +5,8 @@ import numpy as np
 import pytest
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.laws import (contact_energy, contact_force, contact_tangent, spring_energy, spring_tangent,
-                                 spring_torque)
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.laws import contact_energy, contact_force, contact_tangent, spring_energy, spring_tangent, spring_torque
 
 
 def test_spring_law_against_numpy():

@@ -2,13 +2,12 @@
 that carries the mesh across the backlash onto the coast flanks."""
 import numpy as np
 import pytest
+from conftest import solid_scene
 
 from solver.mbs.dynamics import load_profile, run_loads, simulate
 from solver.mbs.kernels.explicit import load_torque
 from solver.mbs.statics import solve_static
 from study.scene import SceneError
-
-from conftest import solid_scene
 
 TABLE = np.array([[0.0, 0.0], [0.005, 50.0], [0.01, 50.0], [0.015, -50.0]])
 

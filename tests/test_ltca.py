@@ -3,13 +3,11 @@ import math
 
 import numpy as np
 import pytest
-
-from solver.fe.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
-from study.verify import fe_reference as ref_mod
-from study.scene import SceneError, default_scene
-
 from conftest import SMALL_PAIR, solid_scene
 
+from solver.fe.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
+from study.scene import SceneError, default_scene
+from study.verify import fe_reference as ref_mod
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 

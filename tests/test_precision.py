@@ -5,10 +5,10 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import solid_scene
-from study.verify import precision as P
+
 from study.run import build_scene_model
+from study.verify import precision as P
 
 
 @pytest.fixture(scope="module")
@@ -94,6 +94,7 @@ def test_stability_suite_subset_ends_ok_or_named():
     """Stiff and extreme scenes (solid bodies, no FE): every run ends bounded and plausible or
     with a failure that names its cause, time and step; never a silent NaN."""
     import re
+
     from workflows import stability as S
     names = ["contact stiffness x100", "no damping", "teeth 100x lighter", "zero torque", "overload x10"]
     ds = S.run_suite(solid_scene(), duration=0.002, methods=("explicit", "implicit alpha=-0.1", "LSODA"),

@@ -2,8 +2,8 @@
 methods, closes the energy balance, and reports failures by name."""
 import numpy as np
 import pytest
-
 from conftest import solid_scene
+
 from solver.mbs.dynamics import DivergenceError, simulate
 from solver.peers.scipy_dynamics import PairEquations, simulate_explicit_all_teeth, simulate_scipy
 from study.run import build_scene_model

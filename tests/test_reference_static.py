@@ -2,10 +2,10 @@
 every tooth free, so it must give the same STE and contact count as `solve_static`."""
 import numpy as np
 import pytest
-
 from conftest import solid_scene
-from solver.peers.scipy_statics import static_te_root
+
 from solver.mbs.statics import solve_static
+from solver.peers.scipy_statics import static_te_root
 from study.run import build_scene_model
 
 

@@ -4,17 +4,15 @@ import math
 
 import numpy as np
 import pytest
-
-from solver.fe import body as fe
-from solver.peers.energy_method import tooth_compliance
-from solver.geometry import gear_geometry
-from solver.peers.iso6336 import blank_factor, single_stiffness
-from solver.identify.weber import pitch_point_depth, weber_deflection
-from study.inputs import springs
-from study.scene import default_scene
-
 from conftest import SMALL_PAIR
 
+from solver.fe import body as fe
+from solver.geometry import gear_geometry
+from solver.identify.weber import pitch_point_depth, weber_deflection
+from solver.peers.energy_method import tooth_compliance
+from solver.peers.iso6336 import blank_factor, single_stiffness
+from study.inputs import springs
+from study.scene import default_scene
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 

@@ -3,8 +3,8 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import solid_scene
+
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
 from solver.mbs.statics import solve_static

@@ -6,10 +6,10 @@ import pytest
 import xarray as xr
 
 import study.sweep.engine as sweep
-from study.sweep.grid import loads_study
 from study.run import run_scene, summarize
 from study.scene import SceneError, default_scene, loads_scene
 from study.sweep.engine import STATUS, parts_folder, run_sweep
+from study.sweep.grid import loads_study
 
 # A 20-tooth solid-driver pair with small bodies, uniform springs (no FE), a few degrees of STE
 # and 10 ms of DTE: about a third of a second per point.

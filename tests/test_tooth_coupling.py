@@ -5,14 +5,13 @@ import math
 
 import numpy as np
 import pytest
+from conftest import SMALL_PAIR, assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 
 from solver.identify.coupling import tooth_compliance_fit
 from solver.identify.pivot import lever
 from solver.mbs.kernels.toothcoupling import set_energy, set_moment, set_stiffness
 from solver.mbs.model import build_model
 from solver.mbs.statics import solve_static
-
-from conftest import SMALL_PAIR, assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 
 RNG = np.random.default_rng(7)
 

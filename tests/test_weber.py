@@ -5,10 +5,9 @@ import numpy as np
 import pytest
 
 from solver import units
-from solver.geometry import Material
+from solver.geometry import Material, gear_geometry
 from solver.identify.weber import fit_contact, weber_deflection
 from study.scene import default_scene
-from solver.geometry import gear_geometry
 
 
 def table1_fit(**kw):

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from study.sweep.grid import dumps_study, loads_study
 from study.scene import SceneError, parse_override
 from study.sweep.engine import SCALARS, STATUS, run_sweep
+from study.sweep.grid import dumps_study, loads_study
 
 STUDY = Path(__file__).resolve().parents[1] / "study" / "scenes" / "sensitivity.toml"
 DEFAULT_OUT = "results/sensitivity/sensitivity.nc"

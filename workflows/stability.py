@@ -34,10 +34,10 @@ import scipy.linalg
 import xarray as xr
 
 from solver import units
-from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.dynamics import linearized_system, simulate
-from solver.peers.scipy_dynamics import simulate_scipy
+from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.statics import solve_static
+from solver.peers.scipy_dynamics import simulate_scipy
 from study.report import results
 from study.run import build_scene_model, load_table
 from study.scene import load_scene

@@ -33,9 +33,9 @@ from solver import units
 from solver.fe.ltca import mesh_points
 from solver.mbs.statics import solve_static
 from study.report import results
-from study.verify.fe_reference import reference, static_angles
 from study.run import build_scene_model
 from study.scene import load_scene
+from study.verify.fe_reference import reference, static_angles
 
 DEFAULT_OUT = "results/validation/validation.nc"
 MODELS = ("fe-reference", "plain", "plain-fe", "coupled", "compliance")

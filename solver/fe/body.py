@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from solver.geometry import BodySpec, GearGeometry, Material
 from solver.fe.mesh import REGION_WEB, BodyMesh
+from solver.geometry import GearGeometry, Material
 
 
 @dataclass(frozen=True)

@@ -56,7 +56,6 @@ from solver.mbs.kernels.contact import point_flank, tip_corner
 from solver.mbs.kernels.gearmesh import candidate_pairs
 from solver.mbs.model import Model
 
-
 # ------------------------------------------------------------------ influence coefficients
 
 @dataclass(frozen=True)
@@ -313,7 +312,7 @@ def solve_contact(G: np.ndarray, gap: np.ndarray, load: float, k_con: float, m1:
     w = d0 + float(gap.min())
     for _ in range(4 * n + 4):
         A = np.flatnonzero(active)
-        for it in range(max_iter):
+        for _it in range(max_iter):
             dA = np.maximum(d[A], 0.0)
             F = k_con * dA**m1
             dF = k_con * m1 * np.maximum(dA, 1e-30) ** (m1 - 1.0)

@@ -16,8 +16,8 @@ import scipy.linalg
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.explicit import verlet
-from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
 from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
+from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 

@@ -15,8 +15,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from solver.geometry import (BodySpec, GearGeometry, Material, PairGeometry, ToothInertia, ToothSpec,
-                       body_inertia, gear_geometry, pair_geometry, tooth_inertia, validate_body)
+from solver.geometry import (
+    BodySpec,
+    GearGeometry,
+    Material,
+    PairGeometry,
+    ToothSpec,
+    body_inertia,
+    gear_geometry,
+    pair_geometry,
+    tooth_inertia,
+    validate_body,
+)
 from solver.mbs.kernels import layout as L
 
 

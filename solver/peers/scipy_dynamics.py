@@ -505,8 +505,8 @@ def simulate_explicit_all_teeth(model: Model, speed: float, speed_ramp: float, t
     tolerance. ``dt`` [s] is rounded down to divide ``output_step`` [s]; ``load_table`` as in
     `solver.mbs.dynamics.simulate`.
     """
-    from solver.mbs.kernels.explicit import verlet
     from solver.mbs.dynamics import STATUS_TEXT
+    from solver.mbs.kernels.explicit import verlet
     out_every = max(1, int(math.ceil(output_step / dt - 1e-9)))
     dt = output_step / out_every
     n_steps = int(round(duration / dt))

@@ -20,8 +20,8 @@ import numpy as np
 from scipy import optimize
 
 from solver.mbs.model import Model
-from solver.peers.scipy_dynamics import PairEquations
 from solver.mbs.statics import StaticResult
+from solver.peers.scipy_dynamics import PairEquations
 
 
 def _residual(eq: PairEquations, theta1: float, x: np.ndarray, zeros: np.ndarray):

@@ -4,7 +4,6 @@ from __future__ import annotations
 from solver import units
 from solver.geometry import gear_geometry
 from solver.identify.weber import fit_contact
-
 from study.scene import load_scene
 
 

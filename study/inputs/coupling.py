@@ -19,12 +19,11 @@ import math
 
 import numpy as np
 
-from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, tooth_compliance_fit
 from solver.fe.body import load_case
 from solver.geometry import gear_geometry
-
-from study.verify.fe_reference import body_compliance_cached
+from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, tooth_compliance_fit
 from study.scene import Scene
+from study.verify.fe_reference import body_compliance_cached
 
 
 def body_torsion(scene: Scene, g: int) -> BodyTorsionFit:

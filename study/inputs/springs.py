@@ -31,7 +31,6 @@ import xarray as xr
 
 from solver import units
 from solver.geometry import BodySpec, gear_geometry
-
 from study.scene import Scene, load_scene
 
 FE_VERSION = "1"   # bump when the FE model or the stiffness definition changes
@@ -222,9 +221,9 @@ def identify_spring(scene: Scene, g: int, radii: int = 7, levels=(0.25, 0.5, 1.0
     """Fit (pivot radius, k_phi, n) of gear g's tooth 0 to FE compliance at ``radii`` load points
     from the start of active profile to near the tip and at ``levels`` times the reference load."""
     from solver.fe import body as fe
+    from solver.fe.mesh import default_mesh_size, mesh_body
     from solver.geometry import pair_geometry
     from solver.identify.pivot import SpringFit, fit_pivot, fit_power_law
-    from solver.fe.mesh import default_mesh_size, mesh_body
 
     geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
     pair = pair_geometry(gear_geometry(scene.tooth_spec(1)), gear_geometry(scene.tooth_spec(2)))

@@ -21,7 +21,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 
@@ -363,7 +362,7 @@ def stiffness_plot(ds: xr.Dataset, path) -> Path:
                 c = ((b.hole_phase + h * 360.0 / b.holes) % 360.0) / pitch
                 ax.axvspan(c - half, c + half, color=C_HOLE, alpha=0.15, lw=0,
                            label=f"hole of gear {g} (angular extent)" if first else None)
-                ax.axvline(c, color=C_HOLE, ls="--", lw=0.8, label=f"hole centre" if first else None)
+                ax.axvline(c, color=C_HOLE, ls="--", lw=0.8, label="hole centre" if first else None)
                 first = False
     ax.set_xlabel("tooth index [–] (tooth k's axis at k·360°/Z from tooth 0)")
     ax.set_ylabel(f"spring stiffness k_φ [{pretty_unit(k.attrs.get('units'))}]")

@@ -28,7 +28,6 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-
 from study.report.spectra import WINDOW, amplitude_spectrum, named_peaks, ste_order_spectrum
 
 

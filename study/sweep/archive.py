@@ -21,10 +21,10 @@ import hashlib
 import numpy as np
 import xarray as xr
 
-from study.sweep.grid import Point, Study, dim_name
 from study.report.results import provenance
 from study.scene import field_doc, field_unit
 from study.sweep.engine import SCALARS, STATUS
+from study.sweep.grid import Point, Study, dim_name
 
 CF_UNITS = {"": "1", "deg": "degree", "N*m": "N m", "rad/s": "rad s-1", "kg/m^3": "kg m-3",
             "N*mm/rad^n_k": "N mm rad-n_k", "N/mm^m1": "N mm-m1"}

@@ -39,8 +39,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from study.sweep.grid import Outputs, Point, Study, check_points, load_study
 from study.scene import Scene, SceneError
+from study.sweep.grid import Outputs, Point, Study, check_points, load_study
 
 # name -> (units, long name); the names are those of study.run.summarize
 SCALARS = {
@@ -245,8 +245,8 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     """
     from tqdm import tqdm
 
-    from study.sweep.archive import study_dataset
     from study.report.results import write_netcdf
+    from study.sweep.archive import study_dataset
 
     t0 = time.perf_counter()
     points = check_points(study)

@@ -42,8 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from study.scene import (Scene, SceneError, default_scene_text, field_unit, scene_fields_from_dict,
-                    scene_from_dict, set_dotted)
+from study.scene import Scene, SceneError, default_scene_text, field_unit, scene_fields_from_dict, scene_from_dict, set_dotted
 
 # dimension names for the fields an engineer sweeps most; others get the dotted path with '_'
 DIM_NAMES = {

@@ -20,11 +20,10 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.geometry import gear_geometry
 from solver.fe.ltca import BodyCompliance, body_compliance, ltca_sweep, mesh_points, profile_grid
-
+from solver.geometry import gear_geometry
+from study.inputs.springs import _settings, cache_dir, contact_patch
 from study.scene import Scene, SceneError, load_scene
-from study.inputs.springs import _settings, cache_dir, contact_patch, reference_torque
 
 LTCA_VERSION = "2"          # bump when the influence coefficients' definition changes
 PROFILE_POINTS = 8          # roll-parameter grid points along each flank (STE within 0.01 um of 16)

@@ -37,13 +37,12 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.implicit import simulate_implicit
 from solver.mbs.dynamics import simulate, stable_time_step
+from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels.explicit import driver_motion
 from solver.mbs.model import Model
-from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy, solve_static_scipy
 from solver.mbs.statics import solve_static
-
+from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy, solve_static_scipy
 from study.report import results
 from study.scene import Scene, load_scene
 
@@ -94,7 +93,7 @@ def _timed(fn, repeats: int):
     """(result, best wall time [s]) of repeats calls; one call when it takes over 10 s."""
     best = math.inf
     out = None
-    for k in range(max(1, repeats)):
+    for _ in range(max(1, repeats)):
         t0 = time.perf_counter()
         out = fn()
         best = min(best, time.perf_counter() - t0)
@@ -441,6 +440,7 @@ def add_arguments(p):
 
 def main(args) -> int:
     from pathlib import Path
+
     from study.run import build_scene_model
     scene = load_scene(args.scene, args.overrides)
     model = build_scene_model(scene)

@@ -20,12 +20,32 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.laws import contact_energy, signed_pow, spring_energy
-from solver.mbs.kernels.layout import (C_CON, C_DDELTA, C_DELTA, C_FORCE, C_PHI, C_TOOTH1, C_TOOTH2, I_CPL, I_P,
-                     I_TOT, K_CON, M1, N_C, N_K, RB, TOOTH0)
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
-from solver.mbs.kernels.stepping import (OK, PENETRATION, checked_status, clear_candidates, freeze_quiet_teeth,
-                       loaded_contacts, record_output)
+from solver.mbs.kernels.laws import contact_energy, signed_pow, spring_energy
+from solver.mbs.kernels.layout import (
+    C_DDELTA,
+    C_DELTA,
+    C_FORCE,
+    C_PHI,
+    I_CPL,
+    I_P,
+    I_TOT,
+    K_CON,
+    M1,
+    N_C,
+    N_K,
+    RB,
+    TOOTH0,
+)
+from solver.mbs.kernels.stepping import (
+    OK,
+    PENETRATION,
+    checked_status,
+    clear_candidates,
+    freeze_quiet_teeth,
+    loaded_contacts,
+    record_output,
+)
 
 
 @njit(cache=True)

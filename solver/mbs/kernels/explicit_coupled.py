@@ -31,11 +31,18 @@ import numpy as np
 from numba import njit
 
 from solver.mbs.kernels.explicit import _dissipation_power, driver_acc_left, driver_motion, load_torque
+from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 from solver.mbs.kernels.laws import contact_energy, spring_energy
 from solver.mbs.kernels.layout import C_BODY, C_DELTA, C_FORCE, I_CPL, I_HUB, I_P, I_TOT, K_BODY, K_CON, M1, N_K, RB, TOOTH0
-from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
-from solver.mbs.kernels.stepping import (OK, PENETRATION, checked_status, clear_candidates, freeze_quiet_teeth,
-                       loaded_contacts, record_output)
+from solver.mbs.kernels.stepping import (
+    OK,
+    PENETRATION,
+    checked_status,
+    clear_candidates,
+    freeze_quiet_teeth,
+    loaded_contacts,
+    record_output,
+)
 from solver.mbs.kernels.toothcoupling import set_energy, set_moment, set_stiffness
 
 

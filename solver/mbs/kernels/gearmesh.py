@@ -17,10 +17,47 @@ from numba import njit
 
 from solver.mbs.kernels.contact import cross, flank_flank, moved_center, point_flank, tip_corner, wrap
 from solver.mbs.kernels.laws import contact_force, contact_tangent, spring_tangent, spring_torque
-from solver.mbs.kernels.layout import (ALPHA, C_DDELTA, C_DELTA, C_FORCE, C_G1, C_G2, C_GA, C_GB, C_KIND, C_KT,
-                     C_NX, C_NY, C_PX, C_PY, C_TOOTH1, C_TOOTH2, CX, CY, C_CON, C_PHI, GAMMA0,
-                     JN_HALF, K_CON, M1, M2, M3, MARGIN, MAX_CONTACTS, N_C, N_K, NZ, PITCH, PSI_B,
-                     R_BND, R_PV, RB, TOOTH0, U_HI, U_LO)
+from solver.mbs.kernels.layout import (
+    ALPHA,
+    C_CON,
+    C_DDELTA,
+    C_DELTA,
+    C_FORCE,
+    C_G1,
+    C_G2,
+    C_GA,
+    C_GB,
+    C_KIND,
+    C_KT,
+    C_NX,
+    C_NY,
+    C_PHI,
+    C_PX,
+    C_PY,
+    C_TOOTH1,
+    C_TOOTH2,
+    CX,
+    CY,
+    GAMMA0,
+    JN_HALF,
+    K_CON,
+    M1,
+    M2,
+    M3,
+    MARGIN,
+    MAX_CONTACTS,
+    N_C,
+    N_K,
+    NZ,
+    PITCH,
+    PSI_B,
+    R_BND,
+    R_PV,
+    RB,
+    TOOTH0,
+    U_HI,
+    U_LO,
+)
 
 
 @njit(cache=True)

@@ -30,13 +30,42 @@ import numpy as np
 from numba import njit
 
 from solver.mbs.kernels.explicit import _dissipation_power, _energies, driver_motion, driver_speed, load_torque
-from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
-from solver.mbs.kernels.layout import (C_CON, C_DDELTA, C_DELTA, C_FORCE, C_G2, C_GA, C_GB, C_KT, C_PHI, C_TOOTH1,
-                     C_TOOTH2, I_CPL, I_P, I_TOT, M2, M3, MAX_CONTACTS, N_C, R_BND, RB, TOOTH0)
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
+from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
+from solver.mbs.kernels.layout import (
+    C_CON,
+    C_DDELTA,
+    C_DELTA,
+    C_FORCE,
+    C_G2,
+    C_GA,
+    C_GB,
+    C_KT,
+    C_PHI,
+    C_TOOTH1,
+    C_TOOTH2,
+    I_CPL,
+    I_P,
+    I_TOT,
+    M2,
+    M3,
+    MAX_CONTACTS,
+    N_C,
+    R_BND,
+    RB,
+    TOOTH0,
+)
 from solver.mbs.kernels.statics import solve_dense
-from solver.mbs.kernels.stepping import (NONFINITE, OK, PENETRATION, checked_status, clear_candidates,
-                       freeze_quiet_teeth, loaded_contacts, record_output)
+from solver.mbs.kernels.stepping import (
+    NONFINITE,
+    OK,
+    PENETRATION,
+    checked_status,
+    clear_candidates,
+    freeze_quiet_teeth,
+    loaded_contacts,
+    record_output,
+)
 
 NEWTON = 4
 

@@ -7,13 +7,12 @@ a backtracking line search on the residual. The spring tangent n*k*|phi|^(n-1) v
 phi = 0 for n > 1, so a tiny diagonal term (1e-9 of the tooth's k_phi) regularises teeth
 that carry no load; the residual, and so the solution, is exact.
 """
-import math
 
 import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.layout import C_FORCE, C_G2, C_GA, C_GB, C_KT, C_TOOTH1, C_TOOTH2, JN_HALF, K_CON, M1, RB, TOOTH0
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
+from solver.mbs.kernels.layout import C_FORCE, C_G2, C_GA, C_GB, C_KT, C_TOOTH1, C_TOOTH2, JN_HALF, K_CON, M1, RB, TOOTH0
 from solver.mbs.kernels.toothcoupling import set_moment, set_stiffness
 
 
@@ -135,7 +134,6 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
                     converged = True
                     break
                 # no contact yet: close the gap rigidly, plus the contact-only penetration
-                te = rb1 * theta1 + rb2 * theta2
                 dpen = (abs(torque) / rb2 / lp[K_CON]) ** (1.0 / lp[M1])
                 theta2 = (sgn * (pp[JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
