@@ -26,7 +26,7 @@ def main(argv=None) -> int:
     os.environ.setdefault("LIGHTGEAR_CACHE", str(common.ROOT / ".lightgear-cache"))
     from solver.mbs.dynamics import simulate, stable_time_step
     from solver.mbs.statics import solve_static
-    from study.run import build_scene_model, static_angles
+    from study.setup import build_scene_model, static_angles
 
     rows = []
     kinds = ["solid"] if args.quick else ["solid", "lightened"]

@@ -52,7 +52,7 @@ def model(kind: str):
     """Solver model of the scene; the lightened gear's FE springs come from study.inputs.springs
     (computed once, then read from its disk cache)."""
     os.environ.setdefault("LIGHTGEAR_CACHE", str(ROOT / ".lightgear-cache"))
-    from study.run import build_scene_model
+    from study.setup import build_scene_model
     return build_scene_model(scene(kind))
 
 

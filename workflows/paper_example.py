@@ -17,8 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from study.report import results
-from study.run import build_scene_model, print_summary, run_scene, run_static
+from study.report.summary import print_summary
+from study.run import run_scene, run_static
 from study.scene import load_scene
+from study.setup import build_scene_model
 
 DEFAULT_OUT = "results/paper_example/paper_example.nc"
 

@@ -39,8 +39,8 @@ from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_scipy
 from study.report import results
-from study.run import build_scene_model, load_table
 from study.scene import load_scene
+from study.setup import build_scene_model, load_table
 
 DEFAULT_OUT = "results/stability/stability.nc"
 METHODS = ("explicit", "implicit alpha=0", "implicit alpha=-0.1", "LSODA")

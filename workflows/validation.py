@@ -33,8 +33,8 @@ from solver import units
 from solver.fe.ltca import mesh_points
 from solver.mbs.statics import solve_static
 from study.report import results
-from study.run import build_scene_model
 from study.scene import load_scene
+from study.setup import build_scene_model
 from study.verify.fe_reference import reference, static_angles
 
 DEFAULT_OUT = "results/validation/validation.nc"

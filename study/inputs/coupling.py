@@ -52,7 +52,7 @@ def mesh_samples(scene: Scene, g: int, n_angles: int = 25) -> dict[int, np.ndarr
     offset d (load tooth - read tooth), the (u_read, u_load) of the contacts that coexist over
     one mesh pitch of the rigid geometry (d = 0: each contact with itself)."""
     from solver.fe.ltca import mesh_points
-    from study.run import geometry_model
+    from study.setup import geometry_model
     model = geometry_model(scene)
     z = model.teeth[g - 1]
     out: dict[int, list] = {}

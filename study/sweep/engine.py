@@ -42,7 +42,7 @@ import xarray as xr
 from study.scene import Scene, SceneError
 from study.sweep.grid import Outputs, Point, Study, check_points, load_study
 
-# name -> (units, long name); the names are those of study.run.summarize
+# name -> (units, long name); the names are those of study.report.summary.summarize
 SCALARS = {
     "ste_mean": ("um", "mean static transmission error"),
     "ste_elastic_mean": ("um", "mean static transmission error less the rigid backlash offset"),
@@ -74,7 +74,8 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
     "curves": {name: (axis name, axis values, axis attrs, values, attrs)}}``; scalars of an
     analysis that failed are NaN.
     """
-    from study.run import run_scene, summarize
+    from study.report.summary import summarize
+    from study.run import run_scene
     from study.scene import loads_scene, scene_from_dict
 
     t0 = time.perf_counter()

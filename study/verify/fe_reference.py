@@ -122,7 +122,7 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
 
     ``rigid``: rigid bodies, only the contact law deforms (the closed-form check);
     ``n_u``: profile points per flank of the influence coefficients."""
-    from study.run import geometry_model
+    from study.setup import geometry_model
 
     qs = scene.quasi_static
     if not qs.torque > 0:

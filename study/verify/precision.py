@@ -441,7 +441,7 @@ def add_arguments(p):
 def main(args) -> int:
     from pathlib import Path
 
-    from study.run import build_scene_model
+    from study.setup import build_scene_model
     scene = load_scene(args.scene, args.overrides)
     model = build_scene_model(scene)
     base = Path(args.output)

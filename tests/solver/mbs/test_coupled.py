@@ -12,8 +12,8 @@ from solver.fe.ltca import mesh_points
 from solver.identify.coupling import body_torsion_fit, body_windup
 from solver.mbs.model import build_model
 from solver.mbs.statics import solve_static
-from study.run import build_scene_model
 from study.scene import SceneError
+from study.setup import build_scene_model
 from study.verify import fe_reference as ref_mod
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")

@@ -98,7 +98,7 @@ def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
 FIRST_RUN = r'''
 import numpy as np
 from study.scene import default_scene
-from study.run import build_scene_model
+from study.setup import build_scene_model
 from solver.mbs.statics import solve_static
 from solver.mbs.dynamics import simulate
 from solver.mbs.kernels import contact
@@ -129,7 +129,7 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code():
     import sys
     import tempfile
     from pathlib import Path
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[3]   # the repository
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(root))
         out = subprocess.run([sys.executable, "-c", FIRST_RUN], cwd=root, env=env, capture_output=True, text=True)

@@ -7,7 +7,8 @@ from conftest import assert_energy_closes_at_second_order, solid_scene
 
 from solver.mbs.dynamics import DivergenceError, simulate, stable_time_step
 from solver.mbs.statics import solve_static
-from study.run import build_scene_model, run_static
+from study.run import run_static
+from study.setup import build_scene_model
 
 UNDAMPED = {"gear1.spring.c_phi": 0.0, "gear2.spring.c_phi": 0.0, "contact.c_con": 0.0}
 

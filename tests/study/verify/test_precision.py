@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from conftest import solid_scene
 
-from study.run import build_scene_model
+from study.setup import build_scene_model
 from study.verify import precision as P
 
 

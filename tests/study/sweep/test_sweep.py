@@ -6,7 +6,8 @@ import pytest
 import xarray as xr
 
 import study.sweep.engine as sweep
-from study.run import run_scene, summarize
+from study.report.summary import summarize
+from study.run import run_scene
 from study.scene import SceneError, default_scene, loads_scene
 from study.sweep.engine import STATUS, parts_folder, run_sweep
 from study.sweep.grid import loads_study

@@ -1,0 +1,67 @@
+"""Summary scalars of a run archive and the one-screen summary `lightgear run` prints."""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import xarray as xr
+
+from study.report import results
+
+
+def summarize(ds: xr.Dataset) -> dict:
+    """Scalars a sensitivity study needs (NaN where the archive lacks the analysis)."""
+    out = {}
+    nan = float("nan")
+    off = ds.attrs.get("backlash_offset_um", 0.0)
+    if "ste" in ds:
+        ste = ds["ste"].values
+        out["ste_mean"] = float(np.nanmean(ste))
+        out["ste_elastic_mean"] = float(np.nanmean(ste) - off)
+        out["ste_p2p"] = float(np.nanmax(ste) - np.nanmin(ste))
+    if "dte" in ds:
+        t = ds["time"].values
+        sel = t >= ds.attrs.get("spectrum_start_s", 0.0)
+        dte = ds["dte"].values[sel]
+        out["dte_mean"] = float(np.mean(dte)) if dte.size else nan
+        out["dte_rms"] = float(np.sqrt(np.mean((dte - dte.mean()) ** 2))) if dte.size else nan
+        out["dte_p2p"] = float(np.ptp(dte)) if dte.size else nan
+        out["tooth_force_max"] = float(np.max(ds["contact_force_max"].values)) if dte.size else nan
+    if "dte_amplitude" in ds:
+        z = ds.attrs["mesh_order"]
+        for name, order in (("mesh", z), ("mesh2", 2 * z), ("mesh3", 3 * z), ("hole", ds.attrs["hole_order"])):
+            out[f"amp_{name}_order"] = amplitude_at_order(ds, order) if order > 0 else nan
+    for k in ("wall_time_springs_s", "wall_time_static_s", "wall_time_dynamic_s"):
+        if k in ds.attrs:
+            out[k] = float(ds.attrs[k])
+    return out
+
+
+def amplitude_at_order(ds: xr.Dataset, order: float, half_width: float = 0.5) -> float:
+    """Largest DTE amplitude [um] within +-half_width orders of ``order``."""
+    o = ds["order"].values
+    sel = np.abs(o - order) <= half_width
+    return float(ds["dte_amplitude"].values[sel].max()) if sel.any() else float("nan")
+
+
+def print_summary(ds: xr.Dataset, path, wall: float) -> None:
+    s = summarize(ds)
+    w = sys.stdout.write
+    w(f"{ds.attrs.get('title', '')}\n  archive: {path}\n")
+    w(f"  contact ratio {ds.attrs['contact_ratio']:.3f}, backlash offset {ds.attrs['backlash_offset_um']:.3f} um\n")
+    if "ste" in s or "ste_mean" in s:
+        w(f"  STE: mean {s['ste_mean']:.3f} um (elastic part {s['ste_elastic_mean']:.3f} um), "
+          f"peak-to-peak {s['ste_p2p']:.3f} um over {float(ds['angle'][-1]):.4g} deg\n")
+    if "dte_rms" in s:
+        w(f"  DTE after {ds.attrs['spectrum_start_s']:.3g} s: mean {s['dte_mean']:.3f} um, RMS {s['dte_rms']:.3f} um, "
+          f"peak-to-peak {s['dte_p2p']:.3f} um, max tooth force {s['tooth_force_max']:.1f} N "
+          f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
+        for f, o, a in results.largest_peaks(ds):
+            w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
+    for what in ("dte", "ste"):
+        if f"{what}_peak_amplitude" in ds:
+            named = [(str(n), float(a)) for n, a in zip(ds[f"{what}_peak"].values, ds[f"{what}_peak_amplitude"].values)
+                     if np.isfinite(a) and not str(n).startswith("other")]
+            w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in named) + "\n")
+    w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
+      + f", total {wall:.2f} s\n")
