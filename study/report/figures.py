@@ -1,4 +1,5 @@
-"""All the figures an archive supports: plots (`study.report.plots`) and renders (`study.report.render`).
+"""All the figures an archive supports: plots (`study.report.te_plots`, `study.report.stiffness_plot`,
+`study.report.sweep_view`) and renders (`study.report.stiffness_render`, `study.report.stress_render`).
 
 ``make_figures(ds, outdir)`` writes PNGs into ``outdir`` and returns their paths; what the
 dataset cannot support (no STE, no DTE, no lightened body to show stress in) is skipped with one
@@ -26,9 +27,23 @@ def swept_dims(ds: xr.Dataset) -> list[str]:
     return [d for d in ds.dims if d not in RUN_DIMS]
 
 
+def run_plots() -> tuple:
+    """The plots of a run archive: (variables, any of which the plot draws; file stem; plot
+    function; what is skipped and why when the archive has none of the variables). Imported
+    here, not at the top: building the command line loads no matplotlib."""
+    from study.report.stiffness_plot import stiffness_plot
+    from study.report.te_plots import dte_plot, spectrum_plot, ste_plot
+    return (
+        (("ste",), "ste", ste_plot, "STE plot", "the archive has no quasi-static analysis (ste)"),
+        (("dte",), "dte", dte_plot, "DTE plot", "the archive has no dynamic analysis (dte)"),
+        (("dte_amplitude", "ste_amplitude"), "spectrum", spectrum_plot, "spectrum plot",
+         "no spectrum in the archive (DTE record too short or not computed)"),
+        (("tooth_stiffness",), "tooth_stiffness", stiffness_plot, "stiffness plot", "no tooth_stiffness in the archive"),
+    )
+
+
 def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True) -> list[Path]:
     """Write every plot and render ``ds`` supports into ``outdir``; return the PNG paths."""
-    from study.report import plots
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     out: list[Path] = []
@@ -42,22 +57,11 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True)
     swept = swept_dims(ds)
     if swept:
         return _sweep_figures(ds, swept, name, skip)
-    if "ste" in ds:
-        out.append(plots.ste_plot(ds, name("ste")))
-    else:
-        skip("STE plot", "the archive has no quasi-static analysis (ste)")
-    if "dte" in ds:
-        out.append(plots.dte_plot(ds, name("dte")))
-    else:
-        skip("DTE plot", "the archive has no dynamic analysis (dte)")
-    if "dte_amplitude" in ds or "ste_amplitude" in ds:
-        out.append(plots.spectrum_plot(ds, name("spectrum")))
-    else:
-        skip("spectrum plot", "no spectrum in the archive (DTE record too short or not computed)")
-    if "tooth_stiffness" in ds:
-        out.append(plots.stiffness_plot(ds, name("tooth_stiffness")))
-    else:
-        skip("stiffness plot", "no tooth_stiffness in the archive")
+    for variables, stem, plot, what, why in run_plots():
+        if any(v in ds for v in variables):
+            out.append(plot(ds, name(stem)))
+        else:
+            skip(what, why)
     if not renders:
         skip("renders", "not asked for")
         return out
@@ -69,18 +73,20 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True)
 
 
 def _renders(ds, name, skip) -> list[Path]:
-    from study.report import render
+    from study.report.render_inputs import fe_fields, tooth_stiffness
+    from study.report.stiffness_render import gear_pair_render
+    from study.report.stress_render import fe_stress_render
     from study.scene import loads_scene
     sc = loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
     lightened = [g for g in (1, 2) if sc.is_lightened(g)]
     t0 = time.perf_counter()
     fields = {}
     for g in lightened:
-        k = render.tooth_stiffness(ds, g)
-        fields[g] = render.fe_fields(sc, g, [int(np.argmax(k)), int(np.argmin(k))])
-    out = [render.gear_pair_render(ds, name("gear_pair"), {g: f[0] for g, f in fields.items()}).path]
+        k = tooth_stiffness(ds, g)
+        fields[g] = fe_fields(sc, g, [int(np.argmax(k)), int(np.argmin(k))])
+    out = [gear_pair_render(ds, name("gear_pair"), {g: f[0] for g, f in fields.items()}).path]
     for g in lightened:
-        out.append(render.fe_stress_render(ds, name(f"fe_stress_gear{g}"), g, fields=fields[g]).path)
+        out.append(fe_stress_render(ds, name(f"fe_stress_gear{g}"), g, fields=fields[g]).path)
     if not lightened:
         skip("FE stress render", "both gears are solid (no FE body needed)")
     print(f"  renders: {time.perf_counter() - t0:.1f} s")
@@ -88,7 +94,7 @@ def _renders(ds, name, skip) -> list[Path]:
 
 
 def _sweep_figures(ds, swept, name, skip) -> list[Path]:
-    from study.report import plots
+    from study.report.sweep_view import sweep_view
     out = []
     if len(swept) > 4:
         skip("sweep views", f"{len(swept)} swept dimensions ({', '.join(swept)}): select up to four first")
@@ -99,7 +105,7 @@ def _sweep_figures(ds, swept, name, skip) -> list[Path]:
             continue
         dims = [d for d in swept if d in da.dims]
         hue = dims[1] if len(dims) > 1 else None
-        out.append(plots.sweep_view(ds, var, dims[0], hue=hue, path=name(f"sweep_{var}")))
+        out.append(sweep_view(ds, var, dims[0], hue=hue, path=name(f"sweep_{var}")))
     if not out:
         skip("sweep views", f"no numeric output varies only over the swept dimensions ({', '.join(swept)})")
     return out

@@ -9,8 +9,11 @@ import pytest
 import xarray as xr
 from matplotlib.image import imread
 
-from study.report import plots, render
+from study.report import render_inputs, stiffness_render, stress_render
 from study.report.figures import make_figures
+from study.report.render_geometry import extrude
+from study.report.sweep_view import sweep_view
+from study.report.te_plots import hole_mesh_angles
 from study.run import run_scene
 from study.scene import default_scene
 
@@ -69,14 +72,14 @@ def test_stiffness_map_colour_range_and_pixels_match_the_tooth_stiffness(tiny, t
     k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
     k1 = ds["tooth_stiffness"].sel(gear=1).values[:24]
     assert np.ptp(k2) > 0.005 * k2.mean()            # the holes make the driven teeth differ
-    res = render.gear_pair_render(ds, tmp_path / "pair.png")
+    res = stiffness_render.gear_pair_render(ds, tmp_path / "pair.png")
     # the colour bar spans exactly the lightened gear's stiffness; the solid driver (stiffer,
     # one value) lies outside and is drawn grey
     assert res.clim == pytest.approx((k2.min(), k2.max()), rel=1e-12)
     assert k1.min() > res.clim[1]
     assert len(res.probes) == 24
     img = _png(res.path)
-    cmap = matplotlib.colormaps[render.STIFFNESS_CMAP]
+    cmap = matplotlib.colormaps[stiffness_render.STIFFNESS_CMAP]
     err = []
     for row, col, k in res.probes:
         want = np.array(cmap((k - res.clim[0]) / (res.clim[1] - res.clim[0]))[:3])
@@ -87,17 +90,17 @@ def test_stiffness_map_colour_range_and_pixels_match_the_tooth_stiffness(tiny, t
     far = cmap(1.0)[:3], cmap(0.0)[:3]
     assert np.abs(np.array(far[0]) - np.array(far[1])).max() > 0.5
     # every tooth of both bodies got its own index (FE mesh and outline alike)
-    bodies = render.pair_bodies(ds)
+    bodies = render_inputs.pair_bodies(ds)
     for g in (1, 2):
         assert set(np.unique(bodies[g].tooth)) == set(range(-1, 24))
 
 
 def test_extruded_body_keeps_web_thinner_and_scalars_per_tooth(tiny):
     ds, _, _ = tiny
-    b = render.pair_bodies(ds)[2]
+    b = render_inputs.pair_bodies(ds)[2]
     k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
     val = np.where(b.tooth >= 0, k2[np.clip(b.tooth, 0, None)], np.nan)
-    mesh = render.extrude(b, 0.0, (0.0, 0.0), val, "k_phi")
+    mesh = extrude(b, 0.0, (0.0, 0.0), val, "k_phi")
     z = mesh.points[:, 2]
     assert z.max() == pytest.approx(17.0 / 2) and z.min() == pytest.approx(-17.0 / 2)
     assert np.any(np.isclose(np.abs(z), 8.0 / 2))           # the web's faces
@@ -108,18 +111,18 @@ def test_extruded_body_keeps_web_thinner_and_scalars_per_tooth(tiny):
 def test_stress_render_scale_spans_zero_to_the_fillet_peak(tiny, tmp_path):
     ds, _, _ = tiny
     k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
-    sc = render._scene(ds)
+    sc = render_inputs.required_scene(ds)
     teeth = [int(np.argmax(k2)), int(np.argmin(k2))]
-    fields = render.fe_fields(sc, 2, teeth)
+    fields = render_inputs.fe_fields(sc, 2, teeth)
     from solver.geometry import gear_geometry
     geo = gear_geometry(sc.tooth_spec(2))
-    peaks = [render._fillet_peak(f, geo, f.tooth) / 1e6 for f in fields]
+    peaks = [stress_render.fillet_peak(f, geo, f.tooth) / 1e6 for f in fields]
     # the loaded tooth's fillet carries far more than the body on average
     assert all(p > 5 * np.median(f.von_mises) / 1e6 for p, f in zip(peaks, fields))
-    res = render.fe_stress_render(ds, tmp_path / "stress.png", fields=fields)
+    res = stress_render.fe_stress_render(ds, tmp_path / "stress.png", fields=fields)
     assert res.clim == pytest.approx((0.0, max(peaks)))
     img = _png(res.path)[:, : _png(res.path).shape[1] // 2]          # left column: stress
-    cmap = matplotlib.colormaps[render.STRESS_CMAP]
+    cmap = matplotlib.colormaps[stress_render.STRESS_CMAP]
     hot = np.array(cmap(1.0)[:3])
     cold = np.array(cmap(0.0)[:3])
     # the hot end of the scale appears (fillet) and the cold end covers much of the body
@@ -135,7 +138,7 @@ def test_sweep_view_facets_the_other_dimensions():
         coords={"n_holes": ("n_holes", [0, 4, 6], {"units": "1", "long_name": "holes"}),
                 "speed": ("speed", [50.0, 100.0, 150.0, 200.0], {"units": "rad s-1", "long_name": "driver speed"}),
                 "web_thickness": ("web_thickness", [8.0, 12.0], {"units": "mm", "long_name": "web thickness"})})
-    fig = plots.sweep_view(ds, "dte_rms", "speed", hue="n_holes")
+    fig = sweep_view(ds, "dte_rms", "speed", hue="n_holes")
     axes = fig.axes
     assert len(axes) == 2                                    # one panel per web thickness
     lines = axes[1].get_lines()
@@ -144,9 +147,9 @@ def test_sweep_view_facets_the_other_dimensions():
     assert "[rad/s]" in axes[0].get_xlabel() or "[rad/s]" in axes[1].get_xlabel()
     assert "[µm]" in axes[0].get_ylabel()
     with pytest.raises(ValueError, match="not a dimension"):
-        plots.sweep_view(ds, "dte_rms", "angle")
+        sweep_view(ds, "dte_rms", "angle")
     with pytest.raises(KeyError, match="no variable"):
-        plots.sweep_view(ds, "ste", "speed")
+        sweep_view(ds, "ste", "speed")
 
 
 def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
@@ -167,7 +170,7 @@ def test_hole_passes_on_the_ste_axis_follow_the_gear_ratio():
         sc = base.replace(**{"gear1.teeth": z1, "gear2.teeth": z2, "gear1.body.web_height": 23.25 * z1 / 67 - 4,
                              "gear2.body.hole_circle_radius": 32.36 + 0.75 * (z2 - 67)})
         ds = xr.Dataset(attrs={"scene": sc.to_toml()})
-        np.testing.assert_allclose(plots.hole_mesh_angles(ds, 120.0), expect, atol=1e-9)
+        np.testing.assert_allclose(hole_mesh_angles(ds, 120.0), expect, atol=1e-9)
     shifted = base.replace(**{"gear2.body.hole_phase": 15.0})
     ds = xr.Dataset(attrs={"scene": shifted.to_toml()})
-    np.testing.assert_allclose(plots.hole_mesh_angles(ds, 120.0), [15.0, 75.0])
+    np.testing.assert_allclose(hole_mesh_angles(ds, 120.0), [15.0, 75.0])

@@ -1,76 +1,24 @@
-"""Plots of run and sweep archives (matplotlib, Agg backend, PNG). They read only datasets.
+"""Transmission-error plots of a run archive (matplotlib, Agg, PNG). They read only the dataset
+(and the scene TOML in its attributes).
 
 Each ``*_plot(ds, path)`` writes one PNG and returns its path; it raises ``KeyError`` naming
 the variable when the dataset lacks what the plot needs (`study.report.figures` decides what to draw).
 
-  ste_plot        STE against driver angle, single/double contact shaded, solid-gear STE,
-                  the angles where a hole centre of the driven gear passes the mesh
-  dte_plot        DTE against time, speed/torque ramp and spectrum window marked, zoom
-  spectrum_plot   DTE (and STE) amplitude spectra, log amplitude against driven-gear order,
+  ste_plot        STE [um] against driver angle [deg], single/double contact shaded, solid-gear
+                  STE, the angles where a hole centre of the driven gear passes the mesh
+  dte_plot        DTE [um] against time [s], speed/torque ramp and spectrum window marked, zoom
+  spectrum_plot   DTE (and STE) amplitude spectra [um], log amplitude against driven-gear order,
                   hole/mesh orders and sidebands labelled, unexplained peaks annotated
-  stiffness_plot  per-tooth spring stiffness against tooth index, hole positions marked
-  sweep_view      any output against one or two swept dimensions, faceted by the others
 """
 from __future__ import annotations
 
-import math
-import textwrap
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+import xarray as xr
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import xarray as xr  # noqa: E402
-
-DPI = 110
-_PRETTY_UNITS = {"um": "µm", "degree": "°", "N mm rad-1": "N·mm/rad", "N m rad-1": "N·m/rad",
-                 "N m": "N·m", "1": "–", "Hz": "Hz", "s": "s", "N": "N", "J": "J", "mm": "mm",
-                 "rad s-1": "rad/s", "MPa": "MPa"}
-C_LIGHT, C_SOLID, C_HOLE, C_SIDE, C_OTHER = "#c0392b", "#2c3e50", "#2980b9", "#27ae60", "#7d3c98"
-
-
-def pretty_unit(unit: str | None) -> str:
-    if unit is None:
-        return "–"
-    return _PRETTY_UNITS.get(unit, unit)
-
-
-def axis_label(v: xr.DataArray, name: str | None = None) -> str:
-    """'long name [unit]' of a variable or coordinate."""
-    ln = v.attrs.get("long_name", name or v.name or "")
-    return f"{ln} [{pretty_unit(v.attrs.get('units'))}]"
-
-
-def _need(ds: xr.Dataset, *names: str) -> None:
-    missing = [n for n in names if n not in ds.variables]
-    if missing:
-        raise KeyError(f"dataset lacks {', '.join(missing)}")
-
-
-def _scene(ds: xr.Dataset):
-    if "scene" not in ds.attrs:
-        return None
-    from study.scene import loads_scene
-    return loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
-
-
-def _save(fig, path) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    return path
-
-
-def _title(fig, ds, what: str, width: int | None = None) -> None:
-    """Figure title: what is shown, then the archive's title; wrapped to ``width`` characters."""
-    t = ds.attrs.get("title", "")
-    text = f"{what}\n{t}" if t else what
-    if width:
-        text = "\n".join(textwrap.fill(line, width) for line in text.split("\n"))
-    fig.suptitle(text, fontsize=12 if not width else 10)
+from study.report.plot_style import C_HOLE, C_LIGHT, C_OTHER, C_SIDE, C_SOLID, archive_scene, figure_title, need, save_figure
 
 
 def _runs(mask: np.ndarray):
@@ -104,7 +52,7 @@ def hole_mesh_angles(ds: xr.Dataset, angle_max: float) -> np.ndarray:
     """Driver angles [deg] at which a hole centre of the driven gear is on the line of centres
     (its teeth over the hole are in mesh). Gear 2 turns clockwise by theta1*z1/z2 and brings its
     teeth into mesh in increasing index order, so body angle beta meets the mesh at theta1 = beta*z2/z1."""
-    sc = _scene(ds)
+    sc = archive_scene(ds)
     if sc is None or sc.gear2.body.holes == 0:
         return np.array([])
     b = sc.gear2.body
@@ -120,7 +68,7 @@ def hole_mesh_angles(ds: xr.Dataset, angle_max: float) -> np.ndarray:
 def ste_plot(ds: xr.Dataset, path) -> Path:
     """STE against driver angle: whole range, a zoom over three mesh periods with the contact
     zones, and (with a solid-gear STE) the difference lightened - solid, the hole effect."""
-    _need(ds, "ste", "angle")
+    need(ds, "ste", "angle")
     ang = ds["angle"].values
     ste = ds["ste"].values
     contacts = ds["ste_contacts"].values if "ste_contacts" in ds else None
@@ -128,7 +76,7 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     holes = hole_mesh_angles(ds, ang[-1])
     nrow = 3 if solid is not None else 2
     fig, axes = plt.subplots(nrow, 1, figsize=(11, 3.0 * nrow + 1.2), constrained_layout=True)
-    _title(fig, ds, "Static transmission error (STE)")
+    figure_title(fig, ds, "Static transmission error (STE)")
     ax = axes[0]
     if contacts is not None:
         _shade_contacts(ax, ang, contacts)
@@ -142,7 +90,7 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     ax.legend(loc="upper right", fontsize=9, ncol=4, framealpha=0.9)
     ax.grid(alpha=0.3)
     # zoom: three mesh periods
-    sc = _scene(ds)
+    sc = archive_scene(ds)
     z1 = sc.gear1.teeth if sc else int(ds.attrs.get("mesh_order", 67))
     period = 360.0 / z1
     ax = axes[1]
@@ -174,7 +122,7 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
         ax.set_title("effect of the lightening: STE(lightened) − STE(solid)", fontsize=10)
         ax.legend(loc="upper right", fontsize=9, ncol=3, framealpha=0.9)
         ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _mark_holes(ax, angles) -> None:
@@ -187,13 +135,13 @@ def _mark_holes(ax, angles) -> None:
 
 def dte_plot(ds: xr.Dataset, path) -> Path:
     """DTE against time with the ramp and the spectrum window, and a zoom on the steady end."""
-    _need(ds, "dte", "time")
+    need(ds, "dte", "time")
     t = ds["time"].values
     dte = ds["dte"].values
     ramp = float(ds.attrs.get("ramp_time_s", 0.0))
     start = float(ds.attrs.get("spectrum_start_s", ramp))
     fig, axes = plt.subplots(2, 1, figsize=(11, 7.5), constrained_layout=True)
-    _title(fig, ds, "Dynamic transmission error (DTE)")
+    figure_title(fig, ds, "Dynamic transmission error (DTE)")
     ax = axes[0]
     ax.axvspan(t[0], ramp, color="#f9e79f", alpha=0.7, lw=0, label=f"speed and torque ramp (0–{ramp * 1e3:.3g} ms)")
     ax.axvline(start, color="0.3", ls=":", lw=1.2, label=f"spectrum from {start * 1e3:.3g} ms")
@@ -224,7 +172,7 @@ def dte_plot(ds: xr.Dataset, path) -> Path:
     ax.set_xlabel(f"time [ms] (zoom on the end: {what})")
     ax.set_ylabel("DTE [µm]")
     ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 # ------------------------------------------------------------------ spectra
@@ -291,7 +239,7 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
     z = float(ds.attrs.get("mesh_order", 0.0)) or 100.0
     nrow = int(has_dte) + int(has_ste)
     fig, axes = plt.subplots(nrow, 1, figsize=(13, 3.8 * nrow + 1.0), constrained_layout=True, squeeze=False)
-    _title(fig, ds, "Amplitude spectra against the driven gear's order (N holes, Z teeth)")
+    figure_title(fig, ds, "Amplitude spectra against the driven gear's order (N holes, Z teeth)")
     i = 0
     if has_dte:
         order = ds["order"].values
@@ -323,143 +271,6 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
                         f"zero padding x{a.get('zero_padding', 1)}")
         axes[i, 0].set_xlabel("order of the driven gear's rotation [–]")
         axes[i, 0].set_title("STE (quasi-static)", fontsize=10, loc="left")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
-# ------------------------------------------------------------------ tooth stiffness
-
-def stiffness_plot(ds: xr.Dataset, path) -> Path:
-    """Per-tooth spring stiffness against tooth index; a gear whose teeth all have the same
-    spring is stated in the legend instead of drawn (it would flatten the other's variation).
-    Hole positions shaded (angular width of the hole seen from the gear centre), and the
-    stiffness ratio to the solid gear on the right axis."""
-    _need(ds, "tooth_stiffness")
-    sc = _scene(ds)
-    k = ds["tooth_stiffness"]
-    r = ds["stiffness_ratio"] if "stiffness_ratio" in ds else None
-    fig, ax = plt.subplots(figsize=(11, 5.2), constrained_layout=True)
-    _title(fig, ds, "Tooth spring stiffness k_φ, tooth by tooth (teeth over holes vs between holes)")
-    styles = {1: ("s", C_SOLID, "gear 1 (driver)"), 2: ("o", C_LIGHT, "gear 2 (driven)")}
-    drawn = []
-    for g in ds["gear"].values:
-        kg = k.sel(gear=g).values
-        ok = np.isfinite(kg)
-        m, c, lab = styles.get(int(g), ("o", None, f"gear {g}"))
-        if np.ptp(kg[ok]) <= 1e-9 * abs(kg[ok]).max():
-            ax.plot([], [], " ", label=f"{lab}: every tooth {kg[ok][0]:.4g} N·mm/rad")
-            continue
-        ax.plot(np.flatnonzero(ok), kg[ok], marker=m, ms=5, lw=1.2, color=c, label=lab)
-        drawn.append(int(g))
-    first = True
-    if sc is not None:
-        for g in drawn or (1, 2):
-            b = sc.gear(g).body
-            if b.holes == 0:
-                continue
-            pitch = 360.0 / sc.gear(g).teeth
-            half = math.degrees(math.asin(min(1.0, b.hole_radius / b.hole_circle_radius))) / pitch
-            for h in range(b.holes):
-                c = ((b.hole_phase + h * 360.0 / b.holes) % 360.0) / pitch
-                ax.axvspan(c - half, c + half, color=C_HOLE, alpha=0.15, lw=0,
-                           label=f"hole of gear {g} (angular extent)" if first else None)
-                ax.axvline(c, color=C_HOLE, ls="--", lw=0.8, label="hole centre" if first else None)
-                first = False
-    ax.set_xlabel("tooth index [–] (tooth k's axis at k·360°/Z from tooth 0)")
-    ax.set_ylabel(f"spring stiffness k_φ [{pretty_unit(k.attrs.get('units'))}]")
-    zmax = int(np.isfinite(k.values).sum(axis=1).max())
-    ax.set_xlim(-0.5, zmax - 0.5)
-    ax.grid(alpha=0.3)
-    if r is not None and drawn:
-        g = drawn[-1]
-        sec = ax.secondary_yaxis("right", functions=_ratio_axis(k.sel(gear=g).values, r.sel(gear=g).values))
-        sec.set_ylabel(f"stiffness ratio to the solid gear [–] (gear {g})")
-    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=4, fontsize=9, frameon=False)
-    return _save(fig, path)
-
-
-def _ratio_axis(kk, rr):
-    """Forward/inverse maps k -> ratio (k = k_solid * ratio for 'fe-ratio' springs)."""
-    ok = np.isfinite(kk) & np.isfinite(rr) & (rr > 0)
-    scale = float(np.median(kk[ok] / rr[ok])) if ok.any() else 1.0
-    return (lambda x: x / scale, lambda y: y * scale)
-
-
-# ------------------------------------------------------------------ sweeps
-
-def sweep_view(ds: xr.Dataset, var: str, x: str, hue: str | None = None, col: str | None = None,
-               row: str | None = None, path=None, reduce: str | None = None):
-    """A chosen output against one swept dimension ``x`` (lines coloured by ``hue``), one
-    panel per value of ``col`` (and ``row``). Dimensions of ``var`` not named are faceted: the
-    first into ``col``, the next into ``row``; more than that is an error (reduce them first,
-    or pass ``reduce='mean'|'max'|'min'`` to collapse them). Writes ``path`` when given and
-    returns it, else returns the figure."""
-    if var not in ds:
-        raise KeyError(f"sweep_view: no variable {var!r} in the dataset (have: {', '.join(map(str, ds.data_vars))})")
-    da = ds[var]
-    named = [d for d in (x, hue, col, row) if d is not None]
-    for d in named:
-        if d not in da.dims:
-            raise ValueError(f"sweep_view: {d!r} is not a dimension of {var!r} (dims: {', '.join(da.dims)})")
-    rest = [d for d in da.dims if d not in named]
-    if reduce is not None and rest:
-        da = getattr(da, reduce)(dim=rest, keep_attrs=True)
-        rest = []
-    for d in list(rest):
-        if col is None:
-            col = d
-        elif row is None:
-            row = d
-        else:
-            continue
-        rest.remove(d)
-    if rest:
-        raise ValueError(f"sweep_view: {var!r} has more dimensions than x, hue, col and row ({', '.join(rest)}); "
-                         "select or reduce them first")
-    ncol = da.sizes[col] if col else 1
-    nrow = da.sizes[row] if row else 1
-    # wide enough for the hue legend beside the panels and a wrapped title above them
-    width = max(min(4.2 * ncol, 20) + (3.0 if hue else 1.5), 7.0)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(width, min(3.3 * nrow, 16) + 1.3),
-                             sharex=True, sharey=True, squeeze=False, constrained_layout=True)
-    xv = ds[x]
-    cmap = plt.get_cmap("viridis")
-    nh = da.sizes[hue] if hue else 1
-    for i in range(nrow):
-        for j in range(ncol):
-            ax = axes[i, j]
-            sub = da
-            parts = []
-            if row:
-                sub = sub.isel({row: i}); parts.append(_coord_text(ds, row, i))
-            if col:
-                sub = sub.isel({col: j}); parts.append(_coord_text(ds, col, j))
-            for h in range(nh):
-                line = sub.isel({hue: h}) if hue else sub
-                c = cmap(h / max(nh - 1, 1)) if hue else C_LIGHT
-                ax.plot(xv.values, line.transpose(x).values, marker="o", ms=4, color=c,
-                        label=_coord_text(ds, hue, h) if hue else None)
-            if parts:
-                ax.set_title(", ".join(parts), fontsize=9)
-            ax.grid(alpha=0.3)
-            if i == nrow - 1:
-                ax.set_xlabel(axis_label(xv, x))
-            if j == 0:   # the long name is in the title; the axis keeps the variable and its unit
-                ax.set_ylabel(f"{var} [{pretty_unit(da.attrs.get('units'))}]")
-    if hue:
-        handles, labels = axes[0, 0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="outside right center", fontsize=8, title=axis_label(ds[hue], hue))
-    _title(fig, ds, f"{var}: {da.attrs.get('long_name', var)}, against {ds[x].attrs.get('long_name', x)}",
-           width=int(8 * width))
-    if path is None:
-        return fig
-    return _save(fig, path)
-
-
-def _coord_text(ds, dim, i) -> str:
-    v = ds[dim].values[i] if dim in ds.coords else i
-    unit = pretty_unit(ds[dim].attrs.get("units")) if dim in ds.coords else ""
-    unit = "" if unit == "–" else f" {unit}"
-    try:
-        return f"{dim} = {float(v):.4g}{unit}"
-    except (TypeError, ValueError):
-        return f"{dim} = {v}"

@@ -1,0 +1,68 @@
+"""What every plot of an archive shares: the Agg backend, resolution, colours, unit labels,
+the archive's scene, titles and PNG writing.
+
+The colours: C_LIGHT the lightened pair (and mesh orders), C_SOLID the solid reference, C_HOLE
+the holes (and hole orders), C_SIDE sidebands, C_OTHER unexplained spectrum peaks.
+"""
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import xarray as xr  # noqa: E402
+
+DPI = 110
+_PRETTY_UNITS = {"um": "µm", "degree": "°", "N mm rad-1": "N·mm/rad", "N m rad-1": "N·m/rad",
+                 "N m": "N·m", "1": "–", "Hz": "Hz", "s": "s", "N": "N", "J": "J", "mm": "mm",
+                 "rad s-1": "rad/s", "MPa": "MPa"}
+C_LIGHT, C_SOLID, C_HOLE, C_SIDE, C_OTHER = "#c0392b", "#2c3e50", "#2980b9", "#27ae60", "#7d3c98"
+
+
+def pretty_unit(unit: str | None) -> str:
+    """The unit as printed on an axis (UDUNITS spelling -> symbols); '–' for none."""
+    if unit is None:
+        return "–"
+    return _PRETTY_UNITS.get(unit, unit)
+
+
+def axis_label(v: xr.DataArray, name: str | None = None) -> str:
+    """'long name [unit]' of a variable or coordinate."""
+    ln = v.attrs.get("long_name", name or v.name or "")
+    return f"{ln} [{pretty_unit(v.attrs.get('units'))}]"
+
+
+def need(ds: xr.Dataset, *names: str) -> None:
+    """Raise ``KeyError`` naming the variables a plot needs and the dataset lacks."""
+    missing = [n for n in names if n not in ds.variables]
+    if missing:
+        raise KeyError(f"dataset lacks {', '.join(missing)}")
+
+
+def archive_scene(ds: xr.Dataset):
+    """The scene stored in the archive's ``scene`` attribute (TOML), or None without one."""
+    if "scene" not in ds.attrs:
+        return None
+    from study.scene import loads_scene
+    return loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
+
+
+def save_figure(fig, path) -> Path:
+    """Write the figure as PNG at ``DPI`` (parent folders made), close it, return the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
+
+
+def figure_title(fig, ds, what: str, width: int | None = None) -> None:
+    """Figure title: what is shown, then the archive's title; wrapped to ``width`` characters."""
+    t = ds.attrs.get("title", "")
+    text = f"{what}\n{t}" if t else what
+    if width:
+        text = "\n".join(textwrap.fill(line, width) for line in text.split("\n"))
+    fig.suptitle(text, fontsize=12 if not width else 10)

@@ -1,0 +1,138 @@
+"""FE stress render (pyvista/VTK, off-screen PNG) of a lightened gear body of a run archive.
+
+  fe_stress_render    von Mises stress [MPa] and displacement [um] of a lightened body under
+                      the FE tooth load on the stiffest and on the softest tooth, one colour
+                      scale per quantity for both.
+
+It reads the archive (``tooth_stiffness`` and the scene TOML in ``ds.attrs['scene']``); the
+body's mesh and fields come from `study.report.render_inputs` (`study.inputs.springs`, cached FE).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from solver import units
+from solver.geometry import gear_geometry
+from study.report.render_canvas import RenderResult, fit_parallel, plotter, write_png
+from study.report.render_geometry import Body2D, extrude, fe_body, transform
+from study.report.render_inputs import fe_fields, required_scene, tooth_stiffness
+
+STRESS_CMAP = "turbo"
+DISPLACEMENT_CMAP = "cividis"
+
+
+def fillet_peak(f, geo, tooth: int) -> float:
+    """Largest element von Mises stress [Pa] in the root/fillet band of the loaded tooth
+    (radius within one module of the root circle, within one pitch of the tooth axis)."""
+    c = f.points[f.triangles].mean(axis=1)
+    r = np.hypot(c[:, 0], c[:, 1])
+    a = np.arctan2(c[:, 1], c[:, 0]) - tooth * geo.pitch_angle
+    a = (a + math.pi) % (2 * math.pi) - math.pi
+    m = geo.spec.module
+    sel = (np.abs(r - geo.root_radius) < m) & (np.abs(a) < geo.pitch_angle)
+    return float(f.von_mises[sel].max()) if sel.any() else float("nan")
+
+
+def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) -> RenderResult:
+    """FE response of gear g's body to the tooth load on the stiffest and on the softest tooth
+    (or ``teeth``), one row each, the loaded tooth turned to point up, the view on the teeth and
+    rim around it (with the top of the hole below it):
+
+    left, von Mises stress [MPa] on one linear scale for both rows (0 .. the larger peak fillet
+    stress; the contact spot under the load goes beyond and is clipped); right, displacement
+    magnitude [um] on the shape magnified so the largest displacement in view reads 0.5 mm,
+    undeformed outline in grey. The arrow is the load on the drive flank at the pitch circle."""
+    import pyvista as pv
+    sc = required_scene(ds)
+    geo = gear_geometry(sc.tooth_spec(g))
+    body = sc.body_spec(g)
+    k = tooth_stiffness(ds, g)
+    if teeth is None:
+        teeth = [int(np.argmax(k)), int(np.argmin(k))]
+    fields = fields or fe_fields(sc, g, teeth)
+    from study.inputs.springs import hole_offset
+    off = hole_offset(sc, g)
+    n_holes = body.holes
+    r_tip = geo.tip_radius / units.MM
+    # view: from just above the hole circle's outer edge (or mid-web) to the tip, +-3.5 pitches
+    if n_holes:
+        r_in = (body.hole_circle_radius + 0.6 * body.hole_radius) / units.MM
+    else:
+        r_in = (geo.root_radius - body.rim_height - 0.5 * body.web_height) / units.MM
+    r_in = min(r_in, (geo.root_radius - 2 * geo.spec.module) / units.MM)
+    half = 3.5 * geo.pitch_angle
+    peaks = [fillet_peak(f, geo, f.tooth) / units.MPA for f in fields]
+    lo, hi = 0.0, float(max(peaks))
+    n = len(fields)
+    vw, vh = 1000, 560
+    p = plotter(shape=(n, 2), size=(2 * vw, vh * n))
+    bar = dict(title="von Mises stress [MPa]", n_labels=5, fmt="%.0f", color="black", vertical=False,
+               width=0.7, height=0.1, position_x=0.15, position_y=0.02, title_font_size=20, label_font_size=16)
+    crops, views = [], []
+    for f in fields:
+        b = fe_body(f)
+        c = b.points[b.triangles].mean(axis=1)
+        a = (np.arctan2(c[:, 1], c[:, 0]) - f.tooth * geo.pitch_angle + math.pi) % (2 * math.pi) - math.pi
+        r = np.hypot(c[:, 0], c[:, 1])
+        # crop well outside the view (ragged cell edges stay out of the picture)
+        crops.append((b, (np.abs(a) <= 3 * half) & (r >= 0.5 * r_in)))
+        views.append((np.abs(a) <= half) & (r >= r_in))
+    u_mag = [np.hypot(*f.displacement.T) / units.UM for f in fields]              # um per vertex
+    u_cell = [um[f.triangles].mean(axis=1) for um, f in zip(u_mag, fields)]
+    u_hi = float(max(uc[v].max() for uc, v in zip(u_cell, views)))
+    magnify = 0.5 / (u_hi * units.UM / units.MM)                                   # largest -> 0.5 mm
+    ubar = dict(title=f"displacement [um] (shape magnified x{magnify:.0f})", n_labels=5, fmt="%.2f", color="black",
+                vertical=False, width=0.7, height=0.1, position_x=0.15, position_y=0.02, title_font_size=20,
+                label_font_size=16)
+    corners = np.array([[r_tip * math.sin(t), r_tip * math.cos(t)] for t in np.linspace(-half, half, 9)]
+                       + [[r_in * math.sin(t), r_in * math.cos(t)] for t in np.linspace(-half, half, 9)])
+    for j, f in enumerate(fields):
+        b, keep = crops[j]
+        rot = math.pi / 2 - f.tooth * geo.pitch_angle
+        sub = Body2D(b.points, b.triangles[keep], b.thickness[keep], b.tooth[keep])
+        last = j == n - 1
+        # stress
+        p.subplot(j, 0)
+        mesh = extrude(sub, rot, (0.0, 0.0), f.von_mises[keep] / units.MPA, "von_mises")
+        p.add_mesh(mesh, scalars="von_mises", cmap=STRESS_CMAP, clim=(lo, hi), lighting=False,
+                   show_scalar_bar=last, scalar_bar_args=bar)
+        lp = transform(np.asarray(f.load_point)[None, :] / units.MM, rot, np.zeros(2))[0]
+        d = transform(np.asarray(f.load_direction)[None, :], rot, np.zeros(2))[0]
+        L = 3 * geo.spec.module / units.MM
+        z = sc.gear(g).face_width
+        p.add_mesh(pv.Arrow(start=(lp[0] - L * d[0], lp[1] - L * d[1], z), direction=(d[0], d[1], 0), scale=L,
+                            tip_length=0.3, tip_radius=0.12, shaft_radius=0.04), color="#00b4ff", lighting=False)
+        fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.2 if last else 0.0, top_margin=0.12)
+        where = ""
+        if n_holes:
+            where = (" (over a hole" if abs(off[f.tooth]) < 0.5 * _hole_half_pitches(sc, g) else " (between holes") + \
+                f", {off[f.tooth]:+.1f} pitches from a hole centre)"
+        p.add_text(f"gear {g}: {f.load_N:.0f} N on tooth {f.tooth}{where}\n"
+                   f"k_phi {k[f.tooth]:.4g} N·mm/rad; peak fillet stress {peaks[j]:.0f} MPa",
+                   position="upper_left", font_size=10, color="black")
+        # displacement on the magnified shape, undeformed outline in grey
+        p.subplot(j, 1)
+        moved = Body2D(b.points + magnify * f.displacement / units.MM, sub.triangles, sub.thickness, sub.tooth)
+        mesh = extrude(moved, rot, (0.0, 0.0), u_cell[j][keep], "displacement")
+        p.add_mesh(mesh, scalars="displacement", cmap=DISPLACEMENT_CMAP, clim=(0.0, u_hi), lighting=False,
+                   show_scalar_bar=last, scalar_bar_args=ubar)
+        p2 = transform(sub.points, rot, np.zeros(2))
+        flat = pv.PolyData(np.column_stack([p2, np.full(len(p2), z)]),
+                           np.hstack([np.full((len(sub.triangles), 1), 3), sub.triangles]).ravel())
+        ref = flat.extract_feature_edges(boundary_edges=True, feature_edges=False, manifold_edges=False,
+                                         non_manifold_edges=False)
+        p.add_mesh(ref, color="#606060", line_width=1.0, lighting=False)
+        fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.2 if last else 0.0, top_margin=0.12)
+        p.add_text(f"tooth {f.tooth}: displacement, largest in view {u_cell[j][views[j]].max():.2f} um",
+                   position="upper_left", font_size=10, color="black")
+    return RenderResult(write_png(p, path), (lo, hi), "von_mises", "MPa")
+
+
+def _hole_half_pitches(sc, g) -> float:
+    b = sc.gear(g).body
+    if not b.holes:
+        return 0.0
+    return 2 * math.degrees(math.asin(min(1.0, b.hole_radius / b.hole_circle_radius))) / (360.0 / sc.gear(g).teeth)
