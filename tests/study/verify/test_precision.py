@@ -8,7 +8,9 @@ import pytest
 from conftest import solid_scene
 
 from study.setup import build_scene_model
-from study.verify import precision as P
+from study.verify.precision_cases import Spec
+from study.verify.precision_report import cheapest, plot
+from study.verify.precision_study import dynamic_study, run_study, static_study
 
 
 @pytest.fixture(scope="module")
@@ -25,8 +27,8 @@ def model(scene):
 def dyn(scene, model):
     """1 ms window (ramps end at 0.5 ms): explicit at 1 and 1/2 of the stability step, the
     implicit one at 1 and 4 times it (the scipy stiff solvers take minutes here: they run in
-    the workflow, their code path is tested in test_reference.py)."""
-    return P.dynamic_study(scene, model, duration=0.001, repeats=1, explicit_fractions=(1, 2),
+    the workflow, their code path is tested in tests/solver/peers/test_scipy_dynamics.py)."""
+    return dynamic_study(scene, model, duration=0.001, repeats=1, explicit_fractions=(1, 2),
                            implicit_multiples=(4, 1), alphas=(0.0,), scipy_methods=(), active_set=True)
 
 
@@ -63,7 +65,7 @@ def test_errors_fall_with_the_step_at_least_at_second_order(dyn):
 
 
 def test_static_study_and_failed_run_kept(scene, model, tmp_path):
-    ds = P.static_study(scene, model, rotation_deg=0.5, repeats=1, tols=(1e-2, 1e-8),
+    ds = static_study(scene, model, rotation_deg=0.5, repeats=1, tols=(1e-2, 1e-8),
                         explicit_fractions=(1,), implicit_multiples=(4,), alphas=(0.0,))
     e = ds["te_error"].sel(norm="linf").values
     m = ds["method"].values
@@ -72,16 +74,16 @@ def test_static_study_and_failed_run_kept(scene, model, tmp_path):
     assert ds.attrs["reference_difference_linf_um"] < 1e-6
     # the slow-ramp transient differs from the static STE by its own ringing, not by the solver
     assert np.all(e[m != "static Newton"] > 1e-3)
-    c = P.cheapest(ds, 0.01)
+    c = cheapest(ds, 0.01)
     assert c[0] == "static Newton"
     # a run whose solver raises, and one stopped by a guard, stay as NaN with their message
-    bad = [P.Spec("broken", math.nan, 1e-3, lambda: 1 / 0),
-           P.Spec("guarded", 1e-6, math.nan, lambda: (np.zeros(3), 10, 2, "penetration beyond the bound at t = 1e-06 s"))]
-    ds2 = P.run_study(bad, np.zeros(3), np.zeros(3), ("a", "b"), repeats=1)
+    bad = [Spec("broken", math.nan, 1e-3, lambda: 1 / 0),
+           Spec("guarded", 1e-6, math.nan, lambda: (np.zeros(3), 10, 2, "penetration beyond the bound at t = 1e-06 s"))]
+    ds2 = run_study(bad, np.zeros(3), np.zeros(3), ("a", "b"), repeats=1)
     assert np.all(np.isnan(ds2["te_error"].values))
     assert list(ds2["status"].values) == ["failed", "failed"]
     assert "ZeroDivisionError" in ds2["message"].values[0] and "penetration" in ds2["message"].values[1]
-    P.plot(ds, tmp_path / "wp.png")
+    plot(ds, tmp_path / "wp.png")
     assert (tmp_path / "wp.png").stat().st_size > 10_000
     from study.report import results
     results.write_netcdf(ds2, tmp_path / "wp.nc")

@@ -1,0 +1,79 @@
+"""Reading a work-precision dataset (`study.verify.precision_study`): the cheapest run for a
+target error, the text table and the log-log work-precision plot (PNG).
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+
+def cheapest(ds: xr.Dataset, target_um: float, norm: str = "linf"):
+    """(method, step [s] or rtol, wall time [s]) of the fastest ok run with error <= target_um
+    [um] in ``norm``; None when no run reaches it."""
+    e = ds["te_error"].sel(norm=norm).values
+    w = ds["wall_time"].values
+    ok = np.isfinite(e) & (e <= target_um) & np.isfinite(w)
+    if not ok.any():
+        return None
+    i = int(np.flatnonzero(ok)[np.argmin(w[ok])])
+    setting = ds["step"].values[i] if np.isfinite(ds["step"].values[i]) else ds["rtol"].values[i]
+    return str(ds["method"].values[i]), float(setting), float(w[i])
+
+
+def table(ds: xr.Dataset) -> str:
+    """The study as a text table: method, step/tolerance, errors [um], wall time [s], status."""
+    lines = [f"{ds.attrs['title']}: {ds.attrs['case']}",
+             f"  reference: {ds.attrs['reference']}; cross-check: {ds.attrs['cross_check']}; "
+             f"their difference (linf) {ds.attrs['reference_difference_linf_um']:.2g} um",
+             f"  {'method':42s} {'step/rtol':>10s} {'final um':>10s} {'l2 um':>10s} {'linf um':>10s} {'time s':>9s}  status"]
+    for i in range(ds.sizes["run"]):
+        step = ds["step"].values[i]
+        setting = f"{step * 1e6:.4g} us" if np.isfinite(step) else f"{ds['rtol'].values[i]:.0e}"
+        e = ds["te_error"].values[i]
+        st = ds["status"].values[i]
+        msg = "" if st == "ok" else f"  {ds['message'].values[i]}"
+        lines.append(f"  {ds['method'].values[i]:42s} {setting:>10s} {e[0]:10.3g} {e[1]:10.3g} {e[2]:10.3g} "
+                     f"{ds['wall_time'].values[i]:9.3g}  {st}{msg}")
+    for target in (0.1, 0.01):
+        c = cheapest(ds, target)
+        lines.append(f"  cheapest for {target:g} um (linf): " + (f"{c[0]} at {setting_label(c[0], c[1])}, {c[2]:.3g} s"
+                                                                 if c else "none of the runs"))
+    return "\n".join(lines)
+
+
+def setting_label(method: str, setting: float) -> str:
+    """'dt 0.312 us' for a fixed-step method, 'rtol 1e-06' for an adaptive one or the static solver."""
+    fixed = method.startswith(("explicit", "implicit", "slow-ramp"))
+    return f"dt {setting * 1e6:.4g} us" if fixed else f"rtol {setting:g}"
+
+
+def plot(ds: xr.Dataset, path, norm: str = "linf") -> None:
+    """Log-log work-precision diagram: TE error [um] against wall time [s], one line per method,
+    with a footer naming the machine, the versions and the reference."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(8, 6))
+    methods = list(dict.fromkeys(ds["method"].values))
+    for m in methods:
+        sel = (ds["method"].values == m)
+        e = ds["te_error"].sel(norm=norm).values[sel]
+        w = ds["wall_time"].values[sel]
+        ok = np.isfinite(e) & np.isfinite(w) & (e > 0)
+        if ok.any():
+            order = np.argsort(w[ok])
+            ax.loglog(w[ok][order], e[ok][order], "o-", label=m)
+    d = ds.attrs.get(f"reference_difference_{norm}_um", float("nan"))
+    if np.isfinite(d) and d > 0:
+        ax.axhline(d, color="k", ls=":", lw=1, label="reference vs cross-check")
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel(f"TE error, {norm} norm [um]")
+    ax.set_title(ds.attrs.get("title", "work-precision"))
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    footer = (f"{ds.attrs.get('case', '')}\nreference: {ds.attrs['reference']}; cross-check: {ds.attrs['cross_check']}\n"
+              f"{ds.attrs['machine']}; {ds.attrs.get('software', '')}; {ds.attrs['date']}")
+    fig.text(0.01, 0.005, footer, fontsize=6, va="bottom", wrap=True)
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
