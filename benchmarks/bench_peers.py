@@ -20,7 +20,6 @@ Run: python benchmarks/bench_peers.py [--quick]   (writes results/benchmarks/pee
 """
 from __future__ import annotations
 
-import argparse
 import sys
 
 import common  # noqa: I001  (first: pins BLAS to one thread before numpy loads)
@@ -133,10 +132,7 @@ def _equal_error(case, rs, lg):
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="solid scene only, shorter tolerance ladders")
-    args = ap.parse_args(argv)
-    rep = 3 if args.quick else 5
+    args, rep = common.quick_options(__doc__.splitlines()[0], "solid scene only, shorter tolerance ladders", argv)
     rows = []
     for kind in (["solid"] if args.quick else ["solid", "lightened"]):
         m = common.model(kind)

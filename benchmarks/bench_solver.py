@@ -9,7 +9,6 @@ Run: python benchmarks/bench_solver.py [--quick]   (writes results/benchmarks/so
 """
 from __future__ import annotations
 
-import argparse
 import os
 import subprocess
 import sys
@@ -53,10 +52,7 @@ def run_first_call(cache_dir: str) -> tuple[dict, float]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="fewer repeats, no lightened scene")
-    args = ap.parse_args(argv)
-    rep = 3 if args.quick else 5
+    args, rep = common.quick_options(__doc__.splitlines()[0], "fewer repeats, no lightened scene", argv)
     rows = []
     from solver.mbs.dynamics import simulate, stable_time_step
     from solver.mbs.statics import solve_static

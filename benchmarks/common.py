@@ -14,6 +14,7 @@ import os
 for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ.setdefault(_v, "1")      # one core: before numpy is imported
 
+import argparse
 import csv
 import platform
 import statistics
@@ -54,6 +55,15 @@ def model(kind: str):
     os.environ.setdefault("LIGHTGEAR_CACHE", str(ROOT / ".lightgear-cache"))
     from study.setup import build_scene_model
     return build_scene_model(scene(kind))
+
+
+def quick_options(description: str, quick_help: str, argv=None) -> tuple[argparse.Namespace, int]:
+    """Command line of a benchmark script taking ``--quick`` (what it leaves out: ``quick_help``):
+    the parsed arguments and the repeats per figure, 3 with ``--quick``, 5 without."""
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("--quick", action="store_true", help=quick_help)
+    args = ap.parse_args(argv)
+    return args, (3 if args.quick else 5)
 
 
 def best_of(fn, repeat: int = 5, warmup: bool = False):

@@ -25,6 +25,13 @@ def discover() -> dict[str, Path]:
     return {p.stem[len("bench_"):]: p for p in sorted(HERE.glob("bench_*.py"))}
 
 
+def accepts_quick(path: Path) -> bool:
+    """Whether a script takes ``--quick``: its own option, or the shared `common.quick_options`
+    (read from the source, so nothing is imported here)."""
+    text = path.read_text()
+    return "--quick" in text or "quick_options(" in text
+
+
 def main(argv=None) -> int:
     found = discover()
     ap = argparse.ArgumentParser(description="Run the lightgear benchmarks, each in its own process.")
@@ -49,7 +56,7 @@ def main(argv=None) -> int:
     for name in names:
         path = found[name]
         cmd = [sys.executable, str(path)]
-        if args.quick and "--quick" in path.read_text():
+        if args.quick and accepts_quick(path):
             cmd.append("--quick")
         print(f"=== {name} ({path.relative_to(ROOT)})", flush=True)
         t0 = time.perf_counter()
