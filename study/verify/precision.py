@@ -44,7 +44,7 @@ from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy, solve_static_scipy
 from study.report import results
-from study.scene import Scene, load_scene
+from study.scene import Scene
 
 NORMS = ("final", "l2", "linf")
 
@@ -421,48 +421,3 @@ def plot(ds: xr.Dataset, path, norm: str = "linf") -> None:
     fig.tight_layout(rect=(0, 0.1, 1, 1))
     fig.savefig(path, dpi=120)
     plt.close(fig)
-
-
-# ------------------------------------------------------------------ CLI
-
-def add_arguments(p):
-    p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
-    p.add_argument("-o", "--output", default="results/work_precision.nc",
-                   help="archive base name: writes BASE_dynamic.nc and BASE_static.nc with their plots (.png)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene field by its dotted path")
-    p.add_argument("--duration", type=float, default=0.002, help="dynamic window [s] (default 0.002)")
-    p.add_argument("--ramp-fraction", type=float, default=0.5, help="ramps end at this fraction of the window")
-    p.add_argument("--rotation", type=float, default=6.0, help="quasi-static driver rotation [deg] (default 6)")
-    p.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best is kept)")
-    p.add_argument("--only", choices=("dynamic", "static"), help="run only one of the two studies")
-
-
-def main(args) -> int:
-    from pathlib import Path
-
-    from study.setup import build_scene_model
-    scene = load_scene(args.scene, args.overrides)
-    model = build_scene_model(scene)
-    base = Path(args.output)
-    base.parent.mkdir(parents=True, exist_ok=True)
-
-    def progress(i, s, e, w, msg):
-        setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
-        print(f"  [{i + 1}] {s.method}, {setting}: linf {e[2]:.3g} um, {w:.3g} s  {'' if msg == 'ok' else msg}",
-              flush=True)
-    for kind in ("static", "dynamic"):
-        if args.only and args.only != kind:
-            continue
-        print(f"{kind} study ...", flush=True)
-        if kind == "dynamic":
-            ds = dynamic_study(scene, model, args.duration, args.ramp_fraction, args.repeats, progress)
-        else:
-            ds = static_study(scene, model, args.rotation, args.repeats, progress)
-        path = base.with_name(f"{base.stem}_{kind}.nc")
-        results.write_netcdf(ds, path)
-        plot(ds, path.with_suffix(".png"))
-        print(table(ds))
-        print(f"  archive: {path}\n  plot: {path.with_suffix('.png')}", flush=True)
-    return 0
-
