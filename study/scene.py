@@ -3,13 +3,10 @@
 A scene file has the sections of `Scene` (``material``, ``pair``, ``gear1`` and ``gear2`` with
 ``body`` and ``spring`` subtables, ``contact``, ``quasi_static``, ``dynamic``, ``fe``,
 ``coupling``). Every key is optional; a missing key takes the default declared below (the
-paper's example, Table 1, with solid bodies). The embedded default scene
-``study/scenes/paper.toml`` is the paper's example with the lightened driven gear.
-
-Each field declares its unit, description and range once (`field_unit`, `field_doc`); the
-units are engineering ones (mm, deg, N·m, rad/s, s, MPa, kg/m³). The conversion to the
-solver's SI happens in one place: `Scene.tooth_spec`, `Scene.body_spec`,
-`Scene.material_spec` and `Scene.pivot_radius`.
+paper's example, Table 1, with solid bodies; ``study/scenes/paper.toml``, the embedded
+default scene, lightens the driven gear). Each field declares its unit (mm, deg, N·m, rad/s,
+s, MPa, kg/m³), description and range once (`field_unit`, `field_doc`). The conversion to
+the solver's SI happens in `Scene.tooth_spec`, `body_spec`, `material_spec` and `pivot_radius`.
 
 Errors: `SceneError` names the dotted field and the reason, before any work starts.
 """
@@ -190,15 +187,12 @@ class Scene:
     def is_lightened(self, g: int) -> bool:
         """True when gear g's body differs from a solid disc (holes or a thinner web)."""
         gs = self.gear(g)
-        b = gs.body
-        return b.holes > 0 or (b.web_height > 0 and b.web_thickness < gs.face_width)
+        return gs.body.holes > 0 or (gs.body.web_height > 0 and gs.body.web_thickness < gs.face_width)
 
     def pivot_radius(self, g: int) -> float:
         """Tooth pivot radius [m]; the root circle when the scene gives 0."""
-        gs = self.gear(g)
-        if gs.pivot_radius > 0:
-            return gs.pivot_radius * units.MM
-        return gear_geometry(self.tooth_spec(g)).root_radius
+        r = self.gear(g).pivot_radius
+        return r * units.MM if r > 0 else gear_geometry(self.tooth_spec(g)).root_radius
 
     # ---- text ----
     def to_toml(self) -> str:
