@@ -207,6 +207,7 @@ def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int
 
 @dataclass
 class SweepResult:
+    """What `run_sweep` did: the study archive and how its points were obtained."""
     dataset: xr.Dataset
     computed: int        # points computed by this call
     reused: int          # finished points found on disk
