@@ -29,8 +29,9 @@ sys.path.insert(0, str(ROOT))  # this checkout, not another installed copy
 
 import numpy as np  # noqa: E402
 
-from study.sweep.engine import SCALARS, dask_client, run_point, run_sweep  # noqa: E402
+from study.sweep.engine import dask_client, run_point, run_sweep  # noqa: E402
 from study.sweep.grid import loads_study  # noqa: E402
+from study.sweep.outputs import SCALARS  # noqa: E402
 
 DYNAMIC = tuple(k for k in SCALARS if not k.startswith("ste"))
 SOLID = '"gear2.body.holes" = 0\n"gear2.body.web_thickness" = 17.0\n'
@@ -137,8 +138,8 @@ def memory(tmp: Path) -> list[dict]:
 
 
 def sensitivity(tmp: Path, full: bool) -> list[dict]:
-    from workflows.sensitivity_sweep import STUDY, study_text
-    st = loads_study(study_text(STUDY), STUDY.parent)
+    from workflows.sensitivity_sweep import STUDY, sensitivity_study
+    st = sensitivity_study(STUDY)
     n_points = int(np.prod(st.shape))
     if full:
         t0 = time.perf_counter()

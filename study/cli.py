@@ -1,33 +1,270 @@
-"""`lightgear` command line. Each subcommand lives in the module that does the work.
+"""`lightgear` command line: one ``arguments``/``command`` pair of functions per subcommand.
 
-A command module provides ``add_arguments(parser)`` and ``main(args) -> int``; it is imported
-only when its command runs, so ``lightgear run`` never loads gmsh or VTK.
+The commands parse arguments and print; the work is done by the Python API (`study`) and
+the modules behind it, which keep no argument parsing. Modules are imported only when their
+command runs, so ``lightgear --help`` is quick and ``lightgear run`` never loads gmsh or VTK.
+Exit codes: 0 done, 2 invalid scene or study (the message names the field) or missing
+archive, 1 sweep points lost to failed workers, 130 sweep interrupted.
 """
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
+import time
+from pathlib import Path
 
-# name -> (module, one-line help)
+
+def scene_arguments(p, output: str | None, output_help: str = "archive to write (NetCDF)") -> None:
+    """The scene file, the archive (when the command writes one) and ``--set`` overrides."""
+    p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
+    if output is not None:
+        p.add_argument("-o", "--output", default=output, help=output_help)
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene field by its dotted path, e.g. --set gear2.body.holes=3")
+
+
+# ---------------------------------------------------------------- run
+
+def run_arguments(p) -> None:
+    scene_arguments(p, "results/run.nc")
+    p.add_argument("--no-static", action="store_true", help="skip the quasi-static STE")
+    p.add_argument("--no-dynamic", action="store_true", help="skip the dynamic DTE")
+    p.add_argument("--figures", action="store_true", help="also write plots and renders beside the archive")
+
+
+def run_command(args) -> int:
+    import study
+    from study.report.summary import print_summary
+    scene = study.load_scene(args.scene, args.overrides)
+    t0 = time.perf_counter()
+    ds = study.run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None)
+    study.write(ds, args.output)
+    print_summary(ds, args.output, time.perf_counter() - t0)
+    if args.figures:
+        for path in study.render(ds, Path(args.output).parent):
+            print(f"  figure: {path}")
+    return 0
+
+
+# ---------------------------------------------------------------- stiffness
+
+def stiffness_arguments(p) -> None:
+    scene_arguments(p, "results/stiffness.nc")
+    p.add_argument("--identify", action="store_true",
+                   help="also fit (pivot radius, k_phi, n) of each gear's tooth to FE compliance along the profile")
+
+
+def stiffness_command(args) -> int:
+    import numpy as np
+
+    import study
+    from study.inputs.springs import hole_offset, identify_spring, stiffness_dataset
+    scene = study.load_scene(args.scene, args.overrides)
+    ds = stiffness_dataset(scene)
+    study.write(ds, args.output)
+    print(f"tooth stiffness map -> {args.output} ({ds.attrs['wall_time_springs_s']:.2f} s)")
+    for g in (1, 2):
+        k = ds["tooth_stiffness"].sel(gear=g).values[: scene.gear(g).teeth]
+        r = ds["stiffness_ratio"].sel(gear=g).values[: scene.gear(g).teeth]
+        lo, hi = int(np.argmin(k)), int(np.argmax(k))
+        print(f"  gear {g}: k_phi {k.min():.4g} .. {k.max():.4g} N mm/rad^n (ratio {r.min():.4f} .. {r.max():.4f})")
+        if scene.gear(g).body.holes:
+            off = hole_offset(scene, g)
+            print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
+                  f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
+        if args.identify:
+            fit, u, c = identify_spring(scene, g)
+            print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius * 1e3:.3f} mm, "
+                  f"k_phi {fit.k_phi * 1e3:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
+                  f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {u.size} load radii")
+    return 0
+
+
+# ---------------------------------------------------------------- sweep
+
+def sweep_arguments(p) -> None:
+    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]] + [outputs])")
+    p.add_argument("-o", "--output", help="archive to write (NetCDF; default results/<study name>.nc)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="address of an existing dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--workers", type=int, default=None,
+                   help="LocalCluster workers (default: one per core); 0 runs the points in this process")
+    p.add_argument("--keep-parts", action="store_true", help="keep the per-point files after the archive is complete")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def sweep_command(args) -> int:
+    import numpy as np
+
+    import study
+    from study.sweep.engine import parts_folder
+    from study.sweep.outputs import STATUS
+    st = study.load_study(args.study)
+    output = args.output or f"results/{Path(args.study).stem}.nc"
+    n = int(np.prod(st.shape))
+    print(f"{st.title}: {n} points ({' x '.join(map(str, st.shape))}, {st.layout} layout) -> {output}")
+    try:
+        res = study.run_sweep(st, output, workers=args.workers, scheduler=args.scheduler,
+                              progress=not args.no_progress, keep_parts=args.keep_parts)
+    except KeyboardInterrupt:
+        print(f"interrupted: finished points are kept in {parts_folder(output)}; run the same command to resume",
+              file=sys.stderr)
+        return 130
+    ds = res.dataset
+    counts = {name: int((ds["status"].values == i).sum()) for i, name in enumerate(STATUS)}
+    print(f"  computed {res.computed}, reused {res.reused}, invalid combinations {res.invalid}, "
+          f"wall time {res.wall_time:.1f} s")
+    print("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v))
+    for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:
+        print(f"    {msg}")
+    if res.pending:
+        print(f"  {res.pending} points lost (worker failures): run the same command again to compute them", file=sys.stderr)
+        return 1
+    return 0
+
+
+# ---------------------------------------------------------------- fit-contact
+
+def fit_contact_arguments(p) -> None:
+    scene_arguments(p, None)
+
+
+def fit_contact_command(args) -> int:
+    """Weber's contact deflection fitted to F = k_con * delta**m1, against the scene's law."""
+    import study
+    from solver import units
+    from solver.geometry import gear_geometry
+    from solver.identify.weber import fit_contact
+    scene = study.load_scene(args.scene, args.overrides)
+    g1, g2 = gear_geometry(scene.tooth_spec(1), "gear1"), gear_geometry(scene.tooth_spec(2), "gear2")
+    f_ref = scene.quasi_static.torque / g1.base_radius
+    print(f"Weber contact deflection at the pitch point, plane strain, F_ref = {f_ref:.1f} N "
+          f"(quasi_static.torque / base radius), R = {fit_contact(g1, g2, scene.material_spec(), f_ref).radius * 1e3:.3f} mm")
+    for frac, note in ((0.5, "default: depth half-way to the tooth centreline"),
+                       (1.0, "depth to the tooth centreline (where the FE tooth spring is read)")):
+        f = fit_contact(g1, g2, scene.material_spec(), f_ref, depth_fraction=frac)
+        k = f.k_con / units.contact_stiffness_to_si(1.0, f.m1)
+        print(f"  {note}:\n    k_con = {k:.4g} N/mm^m1, m1 = {f.m1:.4f} "
+              f"(depth {f.depth[0] * 1e3:.3f} mm, load {f.force_range[0]:.0f}..{f.force_range[1]:.0f} N, "
+              f"fit RMS {f.rms_log_error:.1e} in ln F)")
+    c = scene.contact
+    print(f"  scene: k_con = {c.k_con:.4g} N/mm^m1, m1 = {c.m1:.4f}")
+    return 0
+
+
+# ---------------------------------------------------------------- render
+
+def render_arguments(p) -> None:
+    p.add_argument("archive", help="run or sweep archive (NetCDF)")
+    p.add_argument("-o", "--output", default=None, help="directory for the PNGs (default: beside the archive)")
+    p.add_argument("--no-renders", action="store_true", help="plots only (no pyvista renders, no FE)")
+
+
+def render_command(args) -> int:
+    import study
+    path = Path(args.archive)
+    if not path.exists():
+        print(f"lightgear render: no such archive: {path}")
+        return 2
+    t0 = time.perf_counter()
+    for p in study.render(path, args.output, renders=not args.no_renders):
+        print(f"  figure: {p}")
+    print(f"  {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
+# ---------------------------------------------------------------- precision
+
+def precision_arguments(p, output: str = "results/work_precision.nc") -> None:
+    scene_arguments(p, output, "archive base name: writes BASE_dynamic.nc and BASE_static.nc with their plots (.png)")
+    p.add_argument("--duration", type=float, default=0.002, help="dynamic window [s] (default 0.002)")
+    p.add_argument("--ramp-fraction", type=float, default=0.5, help="ramps end at this fraction of the window")
+    p.add_argument("--rotation", type=float, default=6.0, help="quasi-static driver rotation [deg] (default 6)")
+    p.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best is kept)")
+    p.add_argument("--only", choices=("dynamic", "static"), help="run only one of the two studies")
+
+
+def precision_command(args) -> int:
+    import math
+
+    import study
+    from study.setup import build_scene_model
+    from study.verify.precision import dynamic_study, plot, setting_label, static_study, table
+    scene = study.load_scene(args.scene, args.overrides)
+    model = build_scene_model(scene)
+    base = Path(args.output)
+    base.parent.mkdir(parents=True, exist_ok=True)
+
+    def progress(i, s, e, w, msg):
+        setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
+        print(f"  [{i + 1}] {s.method}, {setting}: linf {e[2]:.3g} um, {w:.3g} s  {'' if msg == 'ok' else msg}",
+              flush=True)
+    for kind in ("static", "dynamic"):
+        if args.only and args.only != kind:
+            continue
+        print(f"{kind} study ...", flush=True)
+        if kind == "dynamic":
+            ds = dynamic_study(scene, model, args.duration, args.ramp_fraction, args.repeats, progress)
+        else:
+            ds = static_study(scene, model, args.rotation, args.repeats, progress)
+        path = base.with_name(f"{base.stem}_{kind}.nc")
+        study.write(ds, path)
+        plot(ds, path.with_suffix(".png"))
+        print(table(ds))
+        print(f"  archive: {path}\n  plot: {path.with_suffix('.png')}", flush=True)
+    return 0
+
+
+# ---------------------------------------------------------------- reference
+
+def reference_arguments(p) -> None:
+    scene_arguments(p, "results/reference.nc")
+    p.add_argument("--step", type=float, default=None, metavar="DEG",
+                   help="driver angle step [deg] (default: quasi_static.angle_step)")
+
+
+def reference_command(args) -> int:
+    import numpy as np
+
+    import study
+    from study.verify.fe_reference import reference_dataset, static_angles
+    scene = study.load_scene(args.scene, args.overrides)
+    if args.step is not None and not args.step > 0:
+        raise study.SceneError("--step", f"must be positive, got {args.step}")
+    ds = reference_dataset(scene, None if args.step is None else static_angles(scene, args.step))
+    study.write(ds, args.output)
+    ste = ds["ste"].values
+    print(f"FE reference STE -> {args.output}")
+    print(f"  mean {ste.mean():.3f} um (elastic part {ste.mean() - ds.attrs['backlash_offset_um']:.3f} um), "
+          f"peak-to-peak {np.ptp(ste):.3f} um over {float(ds['angle'][-1]):.4g} deg, {ste.size} angles")
+    print(f"  wall time: compliance {ds.attrs['wall_time_compliance_s']:.2f} s, contact {ds.attrs['wall_time_contact_s']:.2f} s, "
+          f"total {ds.attrs['wall_time_reference_s']:.2f} s")
+    return 0
+
+
+# ---------------------------------------------------------------- the parser
+
+# name -> (one-line help, arguments, command)
 COMMANDS = {
-    "run": ("study.run", "run a scene (default: the paper example) and write its archive"),
-    "stiffness": ("study.inputs.springs", "per-tooth FE stiffness map of a scene's gears (no solve)"),
-    "sweep": ("study.sweep.engine", "run a parametric study (scene + grid) with dask into one NetCDF archive"),
-    "fit-contact": ("study.inputs.contact_fit", "fit the contact law k_con*delta^m1 to Weber's contact deflection"),
-    "render": ("study.report.figures", "plots and renders (PNG) of a run or sweep archive"),
-    "precision": ("study.verify.precision", "work-precision study: TE error against wall time for every solver of a scene"),
-    "reference": ("study.verify.fe_reference", "FE reference STE and load sharing (loaded-tooth-contact analysis)"),
+    "run": ("run a scene (default: the paper example) and write its archive", run_arguments, run_command),
+    "stiffness": ("per-tooth FE stiffness map of a scene's gears (no solve)", stiffness_arguments, stiffness_command),
+    "sweep": ("run a parametric study (scene + grid) with dask into one NetCDF archive", sweep_arguments, sweep_command),
+    "fit-contact": ("fit the contact law k_con*delta^m1 to Weber's contact deflection", fit_contact_arguments,
+                    fit_contact_command),
+    "render": ("plots and renders (PNG) of a run or sweep archive", render_arguments, render_command),
+    "precision": ("work-precision study: TE error against wall time for every solver of a scene", precision_arguments,
+                  precision_command),
+    "reference": ("FE reference STE and load sharing (loaded-tooth-contact analysis)", reference_arguments,
+                  reference_command),
 }
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="lightgear", description="Transmission error of lightened spur gears (MUBOCO-PR).")
     sub = parser.add_subparsers(dest="command", required=True)
-    for name, (module, help_) in COMMANDS.items():
+    for name, (help_, arguments, command) in COMMANDS.items():
         p = sub.add_parser(name, help=help_, description=help_)
-        p.set_defaults(_module=module)
-        importlib.import_module(module).add_arguments(p)
+        p.set_defaults(_command=command)
+        arguments(p)
     return parser
 
 
@@ -35,7 +272,7 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     from study.scene import SceneError
     try:
-        return int(importlib.import_module(args._module).main(args) or 0)
+        return int(args._command(args) or 0)
     except SceneError as e:
         print(f"lightgear {args.command}: invalid scene: {e}", file=sys.stderr)
         return 2

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -19,8 +18,7 @@ from solver.mbs.kernels.layout import R_PV
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study.report import results
-from study.report.summary import print_summary
-from study.scene import Scene, load_scene
+from study.scene import Scene
 from study.setup import build_scene_model, load_table, scene_springs, static_angles
 
 
@@ -114,30 +112,3 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["dynamic_method_reason"] = dy.choice.reason
         attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")
     return xr.Dataset(data, coords=coords, attrs=attrs)
-
-
-# ------------------------------------------------------------------ CLI
-
-def add_arguments(p):
-    p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
-    p.add_argument("-o", "--output", default="results/run.nc", help="archive to write (NetCDF)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene field by its dotted path, e.g. --set gear2.body.holes=3")
-    p.add_argument("--no-static", action="store_true", help="skip the quasi-static STE")
-    p.add_argument("--no-dynamic", action="store_true", help="skip the dynamic DTE")
-    p.add_argument("--figures", action="store_true", help="also write plots and renders beside the archive")
-
-
-def main(args) -> int:
-    scene = load_scene(args.scene, args.overrides)
-    t0 = time.perf_counter()
-    ds = run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None)
-    results.write_netcdf(ds, args.output)
-    print_summary(ds, args.output, time.perf_counter() - t0)
-    if args.figures:
-        from study.report.figures import make_figures
-        for path in make_figures(ds, Path(args.output).parent):
-            print(f"  figure: {path}")
-    return 0
-
-

@@ -1,15 +1,12 @@
-"""Scenes: TOML files in engineering units, validated into typed objects.
+"""Scenes: TOML files in engineering units, validated into typed, frozen objects.
 
-A scene file has the sections of `Scene` (``material``, ``pair``, ``gear1``, ``gear2`` with
-``body`` and ``spring`` subtables, ``contact``, ``quasi_static``, ``dynamic``, ``fe``, ``coupling``,
-``outputs``). Every key is optional; missing keys take the defaults below, which are the
-paper's example (Table 1) with solid bodies. The embedded default scene
-``study/scenes/paper.toml`` is the paper's example with the lightened driven gear.
-
-Units (also in each field's metadata): lengths mm, angles deg, torque N·m, speed rad/s,
-time s, k_phi N·mm/rad^n_k, c_phi N·mm·s/rad (n_c = 1), k_con N/mm^m1,
-c_con N·s/mm per mm^m3 (m2 = 1), modulus MPa, density kg/m³.
-Conversion to the solver's SI happens once, in `Scene.pair_input` / `Scene.loads`.
+A scene file has the sections of `Scene` (``material``, ``pair``, ``gear1`` and ``gear2`` with
+``body`` and ``spring`` subtables, ``contact``, ``quasi_static``, ``dynamic``, ``fe``,
+``coupling``). Every key is optional; a missing key takes the default declared below (the
+paper's example, Table 1, with solid bodies; ``study/scenes/paper.toml``, the embedded
+default scene, lightens the driven gear). Each field declares its unit (mm, deg, N·m, rad/s,
+s, MPa, kg/m³), description and range once (`field_unit`, `field_doc`). The conversion to
+the solver's SI happens in `Scene.tooth_spec`, `body_spec`, `material_spec` and `pivot_radius`.
 
 Errors: `SceneError` names the dotted field and the reason, before any work starts.
 """
@@ -19,7 +16,7 @@ import dataclasses
 import math
 import tomllib
 import typing
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from solver import units
@@ -65,6 +62,7 @@ class BodySection:
 
 @dataclass(frozen=True)
 class SpringSection:
+    """Torsion spring of each tooth about its pivot (eq. 1.2): T = k_phi phi^n_k + c_phi dphi^n_c."""
     k_phi: float = _f(1.06e6, "N*mm/rad^n_k", "torsion spring stiffness of a tooth of the solid gear (eq. 1.2)", 0, lo_open=True)
     n_k: float = _f(1.1, "1", "stiffness exponent (>= 1: a finite tangent at zero deflection)", 1.0, 3.0)
     # Damping: 2 % of critical on the tooth's own mode (66 kHz, I_pivot 3.7e-9 kg·m², tangent
@@ -91,6 +89,8 @@ class GearSection:
 
 @dataclass(frozen=True)
 class ContactSection:
+    """Penalty contact between the flanks (eq. 1.3), for a penetration delta > 0:
+    F = k_con delta^m1 + c_con ddelta^m2 delta^m3."""
     k_con: float = _f(5.64e6, "N/mm^m1", "contact stiffness (eq. 1.3; paper: fit of Weber's deflection)", 0, lo_open=True)
     m1: float = _f(1.24, "1", "stiffness exponent (>= 1)", 1.0, 3.0)
     # Damping: 5 % of critical on the local contact mode (tangent 1.3e9 N/m at 1 um and
@@ -187,15 +187,12 @@ class Scene:
     def is_lightened(self, g: int) -> bool:
         """True when gear g's body differs from a solid disc (holes or a thinner web)."""
         gs = self.gear(g)
-        b = gs.body
-        return b.holes > 0 or (b.web_height > 0 and b.web_thickness < gs.face_width)
+        return gs.body.holes > 0 or (gs.body.web_height > 0 and gs.body.web_thickness < gs.face_width)
 
     def pivot_radius(self, g: int) -> float:
         """Tooth pivot radius [m]; the root circle when the scene gives 0."""
-        gs = self.gear(g)
-        if gs.pivot_radius > 0:
-            return gs.pivot_radius * units.MM
-        return gear_geometry(self.tooth_spec(g)).root_radius
+        r = self.gear(g).pivot_radius
+        return r * units.MM if r > 0 else gear_geometry(self.tooth_spec(g)).root_radius
 
     # ---- text ----
     def to_toml(self) -> str:
@@ -212,25 +209,17 @@ class Scene:
 # ---------------------------------------------------------------- building and checking
 
 def _coerce(value, typ, path):
-    if typ is bool:
-        if isinstance(value, bool):
-            return value
-        raise SceneError(path, f"must be true or false, got {value!r}")
-    if typ is int:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or float(value) != int(value):
-            raise SceneError(path, f"must be an integer, got {value!r}")
-        return int(value)
-    if typ is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise SceneError(path, f"must be a number, got {value!r}")
-        if not math.isfinite(value):
-            raise SceneError(path, f"must be finite, got {value!r}")
-        return float(value)
-    if typ is str:
-        if not isinstance(value, str):
-            raise SceneError(path, f"must be a string, got {value!r}")
+    """``value`` as ``typ`` (bool, int, float or str), else SceneError; a bool is no number."""
+    number = isinstance(value, int | float) and not isinstance(value, bool)
+    if (typ is bool and isinstance(value, bool)) or (typ is str and isinstance(value, str)):
         return value
-    raise TypeError(typ)
+    if typ is int and number and math.isfinite(value) and float(value) == int(value):
+        return int(value)
+    if typ is float and number and math.isfinite(value):
+        return float(value)
+    what = "finite" if typ is float and number else {bool: "true or false", int: "an integer",
+                                                     float: "a number", str: "a string"}[typ]
+    raise SceneError(path, f"must be {what}, got {value!r}")
 
 
 def _build(cls, table, path: str):
@@ -293,6 +282,7 @@ def check_scene(scene: Scene) -> None:
 
 
 def scene_from_dict(data: dict) -> Scene:
+    """A checked Scene from its tables (as parsed from TOML): field and cross-field checks."""
     scene = _build(Scene, data, "")
     check_scene(scene)
     return scene
@@ -304,55 +294,51 @@ def scene_fields_from_dict(data: dict) -> Scene:
     return _build(Scene, data, "")
 
 
-def loads_scene(text: str, source: str = "scene") -> Scene:
+def _tables(text: str, source: str) -> dict:
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise SceneError(source, f"not valid TOML: {e}") from None
-    return scene_from_dict(data)
+
+
+def loads_scene(text: str, source: str = "scene") -> Scene:
+    """A checked Scene from TOML text; ``source`` names the text in a parse error."""
+    return scene_from_dict(_tables(text, source))
 
 
 def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] = ()) -> Scene:
     """Read a scene file (default: the embedded paper example), apply ``key=value`` overrides."""
-    if path is None:
-        text = default_scene_text()
-    else:
-        p = Path(path)
-        if not p.is_file():
-            raise SceneError("scene", f"no such file: {p}")
-        text = p.read_text()
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(str(path or "scene"), f"not valid TOML: {e}") from None
+    if path is not None and not Path(path).is_file():
+        raise SceneError("scene", f"no such file: {Path(path)}")
+    data = _tables(default_scene_text() if path is None else Path(path).read_text(), str(path or "scene"))
     for item in overrides:
-        key, value = parse_override(item)
-        set_dotted(data, key, value)
+        set_dotted(data, *parse_override(item))
     return scene_from_dict(data)
 
 
 def default_scene_text() -> str:
+    """TOML text of the embedded paper example (``study/scenes/paper.toml``)."""
     return (Path(__file__).parent / "scenes" / "paper.toml").read_text()
 
 
 def default_scene() -> Scene:
+    """The embedded paper example: Table 1 with the lightened driven gear."""
     return loads_scene(default_scene_text(), "paper.toml")
 
 
 def parse_override(item: str):
     """``'gear2.body.holes=3'`` -> ('gear2.body.holes', 3); values parse as TOML, else as text."""
-    if "=" not in item:
+    key, sep, raw = item.partition("=")
+    if not sep:
         raise SceneError(item, "an override must look like key=value")
-    key, raw = item.split("=", 1)
-    key = key.strip()
     try:
-        value = tomllib.loads(f"v = {raw.strip()}")["v"]
+        return key.strip(), tomllib.loads(f"v = {raw.strip()}")["v"]
     except tomllib.TOMLDecodeError:
-        value = raw.strip()
-    return key, value
+        return key.strip(), raw.strip()
 
 
 def set_dotted(data: dict, path: str, value) -> None:
+    """Set ``value`` at a dotted path in nested tables, creating the tables on the way."""
     parts = path.split(".")
     node = data
     for i, p in enumerate(parts[:-1]):
@@ -364,46 +350,44 @@ def set_dotted(data: dict, path: str, value) -> None:
 
 
 def get_dotted(scene: Scene, path: str):
+    """The value (or table) of a scene at a dotted path: ``get_dotted(scene, "gear2.body.holes")``."""
+    scene_field(path)  # SceneError for a path that is no field
     node = scene
     for p in path.split("."):
-        if not hasattr(node, p):
-            raise SceneError(path, "no such scene field")
         node = getattr(node, p)
     return node
 
 
-def field_unit(path: str) -> str:
-    """Unit string of a scene field given by its dotted path ('' if none)."""
-    cls = Scene
-    parts = path.split(".")
-    for i, p in enumerate(parts):
-        fs = {f.name: f for f in fields(cls)}
+def scene_field(path: str) -> dataclasses.Field:
+    """The declaration (default, metadata) of a scene field or table given by its dotted path."""
+    cls, f = Scene, None
+    for p in path.split("."):
+        fs = {x.name: x for x in fields(cls)} if dataclasses.is_dataclass(cls) else {}
         if p not in fs:
             raise SceneError(path, "no such scene field")
-        f = fs[p]
-        typ = typing.get_type_hints(cls)[p]
-        if i == len(parts) - 1:
-            return f.metadata.get("unit", "") if not dataclasses.is_dataclass(typ) else ""
-        cls = typ
-    return ""
+        f, cls = fs[p], typing.get_type_hints(cls)[p]
+    return f
+
+
+def field_unit(path: str) -> str:
+    """Unit string of a scene field given by its dotted path ('' for none and for a table)."""
+    return scene_field(path).metadata.get("unit", "")
 
 
 def field_doc(path: str) -> str:
-    cls = Scene
-    parts = path.split(".")
-    for i, p in enumerate(parts):
-        fs = {f.name: f for f in fields(cls)}
-        if p not in fs:
-            raise SceneError(path, "no such scene field")
-        if i == len(parts) - 1:
-            return fs[p].metadata.get("doc", p)
-        cls = typing.get_type_hints(cls)[p]
-    return path
+    """Description of a scene field given by its dotted path (its name for a table)."""
+    f = scene_field(path)
+    return f.metadata.get("doc", f.name)
 
 
 # ---------------------------------------------------------------- TOML writer
 
-def _toml_value(v) -> str:
+def toml_value(v) -> str:
+    """A value as TOML: a scalar, a list (inline array) or a dict (inline table)."""
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + "}"
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, int):
@@ -417,15 +401,10 @@ def _toml_value(v) -> str:
 
 def dumps_toml(data: dict, prefix: str = "") -> str:
     """Minimal TOML writer for nested tables of scalars (what scenes hold)."""
-    out = [f"{k} = {_toml_value(v)}" for k, v in data.items() if not isinstance(v, dict)]
+    out = [f"{k} = {toml_value(v)}" for k, v in data.items() if not isinstance(v, dict)]
     for k, v in data.items():
         if isinstance(v, dict):
             name = f"{prefix}.{k}" if prefix else k
-            out.append(f"\n[{name}]")
-            out.append(dumps_toml(v, name))
+            out += [f"\n[{name}]", dumps_toml(v, name)]
     return "\n".join(x for x in out if x) + ("\n" if not prefix else "")
 
-
-__all__ = ["Scene", "SceneError", "load_scene", "loads_scene", "default_scene", "default_scene_text",
-           "parse_override", "set_dotted", "get_dotted", "field_unit", "field_doc", "check_scene",
-           "scene_from_dict", "scene_fields_from_dict", "dumps_toml", "replace"]

@@ -16,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from study.report import results
+import study
 from study.report.summary import print_summary
-from study.run import run_scene, run_static
-from study.scene import load_scene
+from study.run import run_static
 from study.setup import build_scene_model
 
 DEFAULT_OUT = "results/paper_example/paper_example.nc"
@@ -41,8 +40,8 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
 
     t0 = time.perf_counter()
-    scene = load_scene(args.scene, args.overrides)
-    ds = run_scene(scene)
+    scene = study.load_scene(args.scene, args.overrides)
+    ds = study.run_scene(scene)
     if "ste" in ds:
         solid = solid_variant(scene)
         st = run_static(solid, build_scene_model(solid))
@@ -57,7 +56,7 @@ def main(argv=None) -> int:
             full[:n] = tr.te * 1e6
             ds["ste_transient"] = ("angle", full, {"units": "um", "long_name": "STE from the slow-ramp transient (paper's method)"})
             ds.attrs["wall_time_transient_s"] = time.perf_counter() - t1
-    results.write_netcdf(ds, args.output)
+    study.write(ds, args.output)
     print_summary(ds, args.output, time.perf_counter() - t0)
     if "ste_transient" in ds:
         d = (ds["ste_transient"] - ds["ste"]).dropna("angle")
@@ -69,13 +68,8 @@ def main(argv=None) -> int:
         print(f"  solid driven gear: STE mean {float(ds['ste_solid'].mean()):.3f} um, "
               f"peak-to-peak {float(ds['ste_solid'].max() - ds['ste_solid'].min()):.3f} um")
     if not args.no_figures:
-        try:
-            from study.report.figures import make_figures
-        except ImportError:
-            make_figures = None
-        if make_figures is not None:
-            for path in make_figures(ds, Path(args.output).parent):
-                print(f"  figure: {path}")
+        for path in study.render(ds, Path(args.output).parent):
+            print(f"  figure: {path}")
     return 0
 
 

@@ -14,53 +14,35 @@ bodies (cached on disk: a second run with other speeds reuses them); see the REA
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from study.scene import SceneError, parse_override
-from study.sweep.engine import SCALARS, STATUS, run_sweep
-from study.sweep.grid import dumps_study, loads_study
+import study
+from study.scene import SceneError, parse_override, scene_fields_from_dict, set_dotted
+from study.sweep.outputs import SCALARS, STATUS
 
 STUDY = Path(__file__).resolve().parents[1] / "study" / "scenes" / "sensitivity.toml"
 DEFAULT_OUT = "results/sensitivity/sensitivity.nc"
 SHOWN = ("ste_p2p", "dte_rms", "dte_p2p", "amp_mesh_order", "amp_hole_order", "tooth_force_max")
 
 
-def study_text(path: str | Path = STUDY, grid: list[str] = (), overrides: list[str] = ()) -> str:
-    """The study TOML with grid axes replaced (``field=v1,v2``) and base-scene overrides."""
-    raw = tomllib.loads(Path(path).read_text())
+def sensitivity_study(path: str | Path = STUDY, grid: list[str] = (), overrides: list[str] = ()):
+    """The study of ``path`` with grid axes replaced or added (``field=v1,v2,...``; a replaced
+    axis keeps its place) and base-scene fields overridden (``key=value``) -> Study."""
+    base = study.load_study(path)
+    axes = {a.path: list(a.values) for a in base.axes}
     for item in grid:
         field, _, values = item.partition("=")
         if not values:
             raise SceneError(field or "grid", "a grid axis must look like field=v1,v2,...")
-        vals = [parse_override(f"x={v}")[1] for v in values.split(",")]
-        grid_table = raw.setdefault("grid", {})
-        if field.strip() not in grid_table:   # a quoted key is replaced in place (order kept)
-            _drop(grid_table, field.strip())
-        grid_table[field.strip()] = vals
-    if overrides:
-        scene = raw.get("scene")
-        if scene is None or isinstance(scene, str):
-            raw["scene"] = {"file": scene} if isinstance(scene, str) else {}
-        for item in overrides:
-            key, value = parse_override(item)
-            raw["scene"][key] = value
-    return dumps_study(raw)
-
-
-def _drop(table: dict, dotted: str) -> None:
-    """Remove a grid entry given either as a quoted dotted key or as nested tables."""
-    table.pop(dotted, None)
-    parts = dotted.split(".")
-    node = table
-    for p in parts[:-1]:
-        node = node.get(p)
-        if not isinstance(node, dict):
-            return
-    node.pop(parts[-1], None)
+        axes[field.strip()] = [parse_override(f"x={v}")[1] for v in values.split(",")]
+    scene = dataclasses.asdict(scene_fields_from_dict(base.base))   # every field, so nothing falls back to the paper's
+    for item in overrides:
+        set_dotted(scene, *parse_override(item))
+    return study.make_study(scene, axes, base.extra, base.outputs, base.title)
 
 
 def sensitivity_table(ds) -> list[str]:
@@ -68,7 +50,7 @@ def sensitivity_table(ds) -> list[str]:
     ok = ds["status"] == STATUS.index("ok")
     shown = [k for k in SHOWN if k in ds]
     lines = ["field            value      " + "".join(f"{k:>16s}" for k in shown),
-             "                            " + "".join(f"{'[' + SCALARS[k][0] + ']':>16s}" for k in shown)]
+             "                            " + "".join(f"{'[' + SCALARS[k].units + ']':>16s}" for k in shown)]
     dims = [d for d in ds["status"].dims if d != "point"]
     for d in dims:
         for v in ds[d].values:
@@ -94,12 +76,12 @@ def main(argv=None) -> int:
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
 
-    study = loads_study(study_text(args.study, args.grid, args.overrides), Path(args.study).parent)
-    n = int(np.prod(study.shape))
-    print(f"{study.title}\n  {n} points: " + " x ".join(f"{a.name} {len(a.values)}" for a in study.axes)
+    st = sensitivity_study(args.study, args.grid, args.overrides)
+    n = int(np.prod(st.shape))
+    print(f"{st.title}\n  {n} points: " + " x ".join(f"{a.name} {len(a.values)}" for a in st.axes)
           + f" -> {args.output}")
-    res = run_sweep(study, args.output, workers=args.workers, scheduler=args.scheduler,
-                    progress=not args.no_progress)
+    res = study.run_sweep(st, args.output, workers=args.workers, scheduler=args.scheduler,
+                          progress=not args.no_progress)
     ds = res.dataset
     counts = ", ".join(f"{name} {int((ds['status'] == i).sum())}" for i, name in enumerate(STATUS) if (ds["status"] == i).any())
     print(f"  computed {res.computed}, reused {res.reused}, invalid {res.invalid} ({counts}); "

@@ -33,13 +33,13 @@ import numpy as np
 import scipy.linalg
 import xarray as xr
 
+import study
 from solver import units
 from solver.mbs.dynamics import linearized_system, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_scipy
 from study.report import results
-from study.scene import load_scene
 from study.setup import build_scene_model, load_table
 
 DEFAULT_OUT = "results/stability/stability.nc"
@@ -224,10 +224,10 @@ def main(argv=None) -> int:
     p.add_argument("--scipy-wall", type=float, default=20.0, help="wall-time limit of a scipy run [s]")
     p.add_argument("--mesh-size", type=float, default=1.0, help="FE element size of lightened bodies [mm]")
     args = p.parse_args(argv)
-    scene = load_scene(args.scene, args.overrides)
+    scene = study.load_scene(args.scene, args.overrides)
     t0 = time.perf_counter()
     ds = run_suite(scene, args.duration, tuple(args.methods), args.scipy_wall, args.scenes, args.mesh_size)
-    results.write_netcdf(ds, args.output)
+    study.write(ds, args.output)
     print(summary(ds))
     print(f"archive: {args.output}; {time.perf_counter() - t0:.1f} s")
     return 0

@@ -12,16 +12,16 @@ from __future__ import annotations
 
 import argparse
 
-from study.verify import precision
+from study.cli import precision_arguments, precision_command
 
 DEFAULT_OUT = "results/work_precision/work_precision.nc"
 
 
 def main(argv=None) -> int:
+    """`lightgear precision` with the workflow's default archive."""
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    precision.add_arguments(p)
-    p.set_defaults(output=DEFAULT_OUT)
-    return precision.main(p.parse_args(argv))
+    precision_arguments(p, output=DEFAULT_OUT)
+    return precision_command(p.parse_args(argv))
 
 
 if __name__ == "__main__":

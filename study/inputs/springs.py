@@ -31,7 +31,7 @@ import xarray as xr
 
 from solver import units
 from solver.geometry import BodySpec, gear_geometry
-from study.scene import Scene, load_scene
+from study.scene import Scene
 
 FE_VERSION = "1"   # bump when the FE model or the stiffness definition changes
 _memory: dict[str, np.ndarray] = {}
@@ -183,38 +183,6 @@ def hole_offset(scene: Scene, g: int) -> np.ndarray:
     holes = b.hole_phase + np.arange(b.holes) * 360.0 / b.holes
     d = (tooth[:, None] - holes[None, :] + 180.0) % 360.0 - 180.0
     return d[np.arange(z), np.argmin(np.abs(d), axis=1)] / (360.0 / z)
-
-
-def add_arguments(p):
-    p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
-    p.add_argument("-o", "--output", default="results/stiffness.nc", help="archive to write (NetCDF)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene field by its dotted path")
-    p.add_argument("--identify", action="store_true",
-                   help="also fit (pivot radius, k_phi, n) of each gear's tooth to FE compliance along the profile")
-
-
-def main(args) -> int:
-    from study.report.results import write_netcdf
-    scene = load_scene(args.scene, args.overrides)
-    ds = stiffness_dataset(scene)
-    write_netcdf(ds, args.output)
-    print(f"tooth stiffness map -> {args.output} ({ds.attrs['wall_time_springs_s']:.2f} s)")
-    for g in (1, 2):
-        k = ds["tooth_stiffness"].sel(gear=g).values[: scene.gear(g).teeth]
-        r = ds["stiffness_ratio"].sel(gear=g).values[: scene.gear(g).teeth]
-        lo, hi = int(np.argmin(k)), int(np.argmax(k))
-        print(f"  gear {g}: k_phi {k.min():.4g} .. {k.max():.4g} N mm/rad^n (ratio {r.min():.4f} .. {r.max():.4f})")
-        if scene.gear(g).body.holes:
-            off = hole_offset(scene, g)
-            print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
-                  f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
-        if args.identify:
-            fit, u, c = identify_spring(scene, g)
-            print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius * 1e3:.3f} mm, "
-                  f"k_phi {fit.k_phi * 1e3:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
-                  f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {u.size} load radii")
-    return 0
 
 
 def identify_spring(scene: Scene, g: int, radii: int = 7, levels=(0.25, 0.5, 1.0)):

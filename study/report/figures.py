@@ -109,26 +109,3 @@ def _sweep_figures(ds, swept, name, skip) -> list[Path]:
     if not out:
         skip("sweep views", f"no numeric output varies only over the swept dimensions ({', '.join(swept)})")
     return out
-
-
-# ------------------------------------------------------------------ CLI
-
-def add_arguments(p):
-    p.add_argument("archive", help="run or sweep archive (NetCDF)")
-    p.add_argument("-o", "--output", default=None, help="directory for the PNGs (default: beside the archive)")
-    p.add_argument("--no-renders", action="store_true", help="plots only (no pyvista renders, no FE)")
-
-
-def main(args) -> int:
-    path = Path(args.archive)
-    if not path.exists():
-        print(f"lightgear render: no such archive: {path}")
-        return 2
-    with xr.open_dataset(path) as ds:
-        ds = ds.load()
-    outdir = Path(args.output) if args.output else path.parent
-    t0 = time.perf_counter()
-    for p in make_figures(ds, outdir, renders=not args.no_renders):
-        print(f"  figure: {p}")
-    print(f"  {time.perf_counter() - t0:.1f} s")
-    return 0

@@ -9,7 +9,7 @@ Each coordinate carries ``units``, ``long_name`` (from the scene's field metadat
   status      CF flags 0 pending, 1 ok, 2 diverged, 3 invalid, 4 failed
   message     text: 'ok', or why the point is not ok
   wall_time   s, compute time of the point
-  <scalar>    each requested scalar (`sweep.SCALARS`), NaN where not ok
+  <scalar>    each requested scalar (`outputs.SCALARS`), NaN where not ok
   <curve>     each requested curve over its own dimension (angle, time, frequency)
 Global attributes: title, the study TOML, the base scene TOML, the study key (a hash of all
 its points), software versions, machine and date (`results.provenance`).
@@ -23,8 +23,8 @@ import xarray as xr
 
 from study.report.results import provenance
 from study.scene import field_doc, field_unit
-from study.sweep.engine import SCALARS, STATUS
 from study.sweep.grid import Point, Study, dim_name
+from study.sweep.outputs import CURVES, SCALARS, STATUS
 
 CF_UNITS = {"": "1", "deg": "degree", "N*m": "N m", "rad/s": "rad s-1", "kg/m^3": "kg m-3",
             "N*mm/rad^n_k": "N mm rad-n_k", "N/mm^m1": "N mm-m1"}
@@ -70,7 +70,7 @@ def study_key(study: Study, points: list[Point]) -> str:
 
 
 def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Dataset:
-    """The labelled archive of a study from ``results`` (point key -> `sweep.run_point` dict).
+    """The labelled archive of a study from ``results`` (point key -> `engine.run_point` dict).
 
     Points without a result are 'pending'. A curve's axis comes from the first point that has
     it; a point whose axis differs (another duration or angle step, say) keeps NaN there and
@@ -112,17 +112,15 @@ def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Datase
         "wall_time": xr.Variable(dims, wall, {"units": "s", "long_name": "compute time of the point"}),
     }
     for k in out.scalars:
-        unit, long_name = SCALARS[k]
-        data[k] = xr.Variable(dims, scal[k], {"units": unit, "long_name": long_name})
+        data[k] = xr.Variable(dims, scal[k], {"units": SCALARS[k].units, "long_name": SCALARS[k].long_name})
     for name in out.curves:
         if name not in axes:
             continue  # no point produced it (all failed): nothing to label its axis with
         axis, ax_vals, ax_attrs = axes[name]
         coords[axis] = xr.Variable(axis, ax_vals, {k: v for k, v in ax_attrs.items() if k in ("units", "long_name")})
         attrs = {k: v for k, v in curve_attrs[name].items() if k in ("units", "long_name", "window", "comment")}
-        if name == "dte_amplitude":
-            attrs["comment"] = ("order of the driven gear's rotation = frequency / (speed * Z1 / Z2 / (2 pi)); "
-                                "spectrum of DTE after the ramp")
+        if CURVES[name].comment:
+            attrs["comment"] = CURVES[name].comment
         data[name] = xr.Variable(dims + (axis,), curves[name], attrs)
     attrs = {"title": study.title, "study": study.text, "base_scene": study.base_scene_toml(),
              "study_layout": study.layout, "study_key": study_key(study, points),

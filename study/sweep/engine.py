@@ -1,8 +1,8 @@
 """Parametric sweeps: one task per study point, run in process or with dask.distributed.
 
 `run_point(scene, outputs)` runs only the analyses the outputs need and never raises: it
-returns a status (ok / diverged / invalid / failed), a message, its wall time [s], the scalars
-of `SCALARS` and the requested curves.
+returns a status (ok / diverged / invalid / failed), a message, its wall time [s], the
+requested scalars and curves (`study.sweep.outputs`).
 
 `run_sweep(study, output)` computes the points that are not finished yet, stores each result
 as it arrives (one small file per point in ``.OUT.nc.parts/``, written atomically), and writes
@@ -15,8 +15,6 @@ Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a da
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)
 that is always closed, or an existing scheduler (``scheduler="tcp://host:8786"``) whose workers
 can import this package.
-
-CLI: ``lightgear sweep STUDY.toml [-o OUT.nc] [--scheduler ADDR] [--workers N]``.
 """
 from __future__ import annotations
 
@@ -36,36 +34,17 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import xarray as xr
 
 from study.scene import Scene, SceneError
-from study.sweep.grid import Outputs, Point, Study, check_points, load_study
+from study.sweep.archive import study_dataset, study_key
+from study.sweep.grid import Point, Study, check_points
+from study.sweep.outputs import STATUS, Outputs, analysis_of
 
-# name -> (units, long name); the names are those of study.report.summary.summarize
-SCALARS = {
-    "ste_mean": ("um", "mean static transmission error"),
-    "ste_elastic_mean": ("um", "mean static transmission error less the rigid backlash offset"),
-    "ste_p2p": ("um", "peak-to-peak static transmission error"),
-    "dte_mean": ("um", "mean dynamic transmission error after the ramp"),
-    "dte_rms": ("um", "RMS of the dynamic transmission error about its mean after the ramp"),
-    "dte_p2p": ("um", "peak-to-peak dynamic transmission error after the ramp"),
-    "amp_mesh_order": ("um", "DTE amplitude at the mesh order Z2"),
-    "amp_mesh2_order": ("um", "DTE amplitude at twice the mesh order"),
-    "amp_mesh3_order": ("um", "DTE amplitude at three times the mesh order"),
-    "amp_hole_order": ("um", "DTE amplitude at the hole order N (NaN for a gear without holes)"),
-    "tooth_force_max": ("N", "largest tooth contact force of the dynamic run after the ramp"),
-}
-STATUS = ("pending", "ok", "diverged", "invalid", "failed")   # CF flag meanings, values 0..4
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
 # ---------------------------------------------------------------- one point
-
-def analysis_of(output: str) -> str:
-    """'static' for STE outputs, 'dynamic' for the others (DTE, spectra, tooth force)."""
-    return "static" if output.startswith("ste") else "dynamic"
-
 
 def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
     """Run one scene (a Scene, scene data or TOML text) for ``outputs``; never raises.
@@ -228,6 +207,7 @@ def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int
 
 @dataclass
 class SweepResult:
+    """What `run_sweep` did: the study archive and how its points were obtained."""
     dataset: xr.Dataset
     computed: int        # points computed by this call
     reused: int          # finished points found on disk
@@ -247,7 +227,6 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     from tqdm import tqdm
 
     from study.report.results import write_netcdf
-    from study.sweep.archive import study_dataset
 
     t0 = time.perf_counter()
     points = check_points(study)
@@ -295,7 +274,6 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
 
 def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset | None:
     """The archive at ``output`` when it already holds every point of this very study."""
-    from study.sweep.archive import study_key
     if not Path(output).is_file() or parts_folder(output).exists():
         return None
     try:
@@ -305,40 +283,3 @@ def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset |
     except (OSError, KeyError, ValueError):
         pass
     return None
-
-
-# ---------------------------------------------------------------- CLI
-
-def add_arguments(p):
-    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]] + [outputs])")
-    p.add_argument("-o", "--output", help="archive to write (NetCDF; default results/<study name>.nc)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="address of an existing dask scheduler, e.g. tcp://host:8786")
-    p.add_argument("--workers", type=int, default=None,
-                   help="LocalCluster workers (default: one per core); 0 runs the points in this process")
-    p.add_argument("--keep-parts", action="store_true", help="keep the per-point files after the archive is complete")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
-
-
-def main(args) -> int:
-    study = load_study(args.study)
-    output = args.output or f"results/{Path(args.study).stem}.nc"
-    n = int(np.prod(study.shape))
-    print(f"{study.title}: {n} points ({' x '.join(map(str, study.shape))}, {study.layout} layout) -> {output}")
-    try:
-        res = run_sweep(study, output, workers=args.workers, scheduler=args.scheduler,
-                        progress=not args.no_progress, keep_parts=args.keep_parts)
-    except KeyboardInterrupt:
-        print(f"interrupted: finished points are kept in {parts_folder(output)}; run the same command to resume",
-              file=sys.stderr)
-        return 130
-    ds = res.dataset
-    counts = {name: int((ds["status"].values == i).sum()) for i, name in enumerate(STATUS)}
-    print(f"  computed {res.computed}, reused {res.reused}, invalid combinations {res.invalid}, "
-          f"wall time {res.wall_time:.1f} s")
-    print("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v))
-    for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:
-        print(f"    {msg}")
-    if res.pending:
-        print(f"  {res.pending} points lost (worker failures): run the same command again to compute them", file=sys.stderr)
-        return 1
-    return 0

@@ -21,8 +21,12 @@ A study TOML file::
     dynamic.speed = 300.0
 
     [outputs]
-    scalars = ["ste_p2p", "dte_rms"]            # default: all of `sweep.SCALARS`
+    scalars = ["ste_p2p", "dte_rms"]            # default: all of `outputs.SCALARS`
     curves = ["ste", "dte", "dte_amplitude"]    # default: none (only scalars are archived)
+
+`make_study` builds the same study in Python (a Scene, a grid dict, outputs) and checks it the
+same way: it writes the study's TOML text and reads it back, so the archive holds a study file
+that gives the same points.
 
 Every grid value is checked alone against the scene (unknown field, wrong type, out of range:
 `SceneError` naming the dotted field). A combination that is physically invalid (holes cutting
@@ -37,12 +41,23 @@ import hashlib
 import itertools
 import json
 import tomllib
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from study.scene import Scene, SceneError, default_scene_text, field_unit, scene_fields_from_dict, scene_from_dict, set_dotted
+from study.scene import (
+    Scene,
+    SceneError,
+    default_scene_text,
+    get_dotted,
+    scene_fields_from_dict,
+    scene_from_dict,
+    set_dotted,
+    toml_value,
+)
+from study.sweep.outputs import Outputs, outputs_from_table
 
 # dimension names for the fields an engineer sweeps most; others get the dotted path with '_'
 DIM_NAMES = {
@@ -58,30 +73,12 @@ DIM_NAMES = {
 }
 
 STUDY_KEYS = ("title", "scene", "grid", "points", "outputs")
-CURVES = ("ste", "dte", "dte_amplitude")
 RANGE_KEYS = ("start", "stop", "num")
 
 
 def dim_name(path: str) -> str:
     """Archive dimension name of a dotted scene field (``gear2.body.holes`` -> ``n_holes``)."""
     return DIM_NAMES.get(path, path.replace(".", "_"))
-
-
-@dataclass(frozen=True)
-class Outputs:
-    """What each point computes and archives: scalar names and full curves."""
-    scalars: tuple[str, ...]
-    curves: tuple[str, ...] = ()
-
-    @property
-    def static(self) -> bool:
-        """True when a quasi-static (STE) analysis is needed."""
-        return any(x.startswith("ste") for x in self.scalars + self.curves)
-
-    @property
-    def dynamic(self) -> bool:
-        """True when a dynamic (DTE) analysis is needed."""
-        return any(not x.startswith("ste") for x in self.scalars + self.curves)
 
 
 @dataclass(frozen=True)
@@ -140,16 +137,17 @@ class Study:
         n_grid = int(np.prod([len(a.values) for a in self.axes])) if self.axes else 0
         return (n_grid + len(self.extra),)
 
+    def base_scene(self) -> Scene:
+        """The base scene, checked (SceneError when only the grid's values make it valid)."""
+        return scene_from_dict(copy.deepcopy(self.base))
+
     def base_scene_toml(self) -> str:
         """The base scene with every field spelled out (defaults included)."""
         return scene_fields_from_dict(self.base).to_toml()
 
     def base_value(self, path: str):
         """Value of a dotted field in the base scene (the Scene default when the base omits it)."""
-        node = scene_fields_from_dict(self.base)
-        for p in path.split("."):
-            node = getattr(node, p)
-        return node
+        return get_dotted(scene_fields_from_dict(self.base), path)
 
     def points(self) -> list[Point]:
         """All points (cheap: builds and checks each scene, runs nothing)."""
@@ -197,10 +195,7 @@ def _flatten(table: dict, where: str, prefix: str = "", repeat: bool = False) ->
 
 def _field_kind(base: dict, path: str):
     """Python type of a scene value field; SceneError when the path is unknown or a table."""
-    field_unit(path)  # raises 'no such scene field'
-    node = scene_fields_from_dict(base)
-    for p in path.split("."):
-        node = getattr(node, p)
+    node = get_dotted(scene_fields_from_dict(base), path)
     if dataclasses.is_dataclass(node):
         raise SceneError(path, "is a table of the scene, not a value")
     return type(node)
@@ -213,13 +208,9 @@ def _check_value(base: dict, path: str, value, where: str):
     data = copy.deepcopy(base)
     set_dotted(data, path, value)
     try:
-        scene = scene_fields_from_dict(data)
+        return get_dotted(scene_fields_from_dict(data), path)
     except SceneError as e:
         raise SceneError(e.field, f"{where} value {value!r}: {e.reason}") from None
-    node = scene
-    for p in path.split("."):
-        node = getattr(node, p)
-    return node
 
 
 def _axis_values(base: dict, path: str, spec) -> tuple:
@@ -252,26 +243,6 @@ def _axis_values(base: dict, path: str, spec) -> tuple:
     if len(set(out)) != len(out):
         raise SceneError(path, f"[grid] repeats a value: {list(out)}")
     return out
-
-
-def _outputs(table) -> Outputs:
-    from study.sweep.engine import SCALARS
-    if not isinstance(table, dict):
-        raise SceneError("outputs", f"must be a table, got {table!r}")
-    for k in table:
-        if k not in ("scalars", "curves"):
-            raise SceneError(f"outputs.{k}", "unknown key (expected scalars, curves)")
-    scalars = table.get("scalars", list(SCALARS))
-    curves = table.get("curves", [])
-    for name, items, known in (("scalars", scalars, tuple(SCALARS)), ("curves", curves, CURVES)):
-        if not isinstance(items, list):
-            raise SceneError(f"outputs.{name}", f"must be a list, got {items!r}")
-        for it in items:
-            if it not in known:
-                raise SceneError(f"outputs.{name}", f"unknown output {it!r} (expected one of: {', '.join(known)})")
-    if not scalars and not curves:
-        raise SceneError("outputs", "asks for nothing")
-    return Outputs(tuple(dict.fromkeys(scalars)), tuple(dict.fromkeys(curves)))
 
 
 def _base_scene(spec, folder: Path | None) -> dict:
@@ -332,7 +303,7 @@ def loads_study(text: str, folder: str | Path | None = None) -> Study:
             raise SceneError(path, f"its dimension name {dim_name(path)!r} clashes with {seen[dim_name(path)]}")
         seen[dim_name(path)] = path
     return Study(str(raw.get("title", "lightgear study")), text, base, axes, tuple(points),
-                 _outputs(raw.get("outputs", {})))
+                 outputs_from_table(raw.get("outputs", {})))
 
 
 def load_study(path: str | Path) -> Study:
@@ -342,26 +313,17 @@ def load_study(path: str | Path) -> Study:
     return loads_study(p.read_text(), p.parent)
 
 
-def _toml(v) -> str:
-    from study.scene import _toml_value
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k} = {_toml(x)}" for k, x in v.items()) + "}"
-    return _toml_value(v)
-
-
 def dumps_study(raw: dict) -> str:
     """A study as TOML text from its parsed tables (dotted keys quoted, so their order stays)."""
-    out = [f"{k} = {_toml(raw[k])}" for k in ("title", "scene") if k in raw and not isinstance(raw[k], dict)]
+    out = [f"{k} = {toml_value(raw[k])}" for k in ("title", "scene") if k in raw and not isinstance(raw[k], dict)]
     for table in ("scene", "grid", "outputs"):
         if isinstance(raw.get(table), dict):
             out.append(f"\n[{table}]")
             flat = _flatten(raw[table], table, repeat=table == "scene") if table != "outputs" else raw[table]
-            out += [f'"{k}" = {_toml(v)}' for k, v in flat.items()]
+            out += [f'"{k}" = {toml_value(v)}' for k, v in flat.items()]
     for p in raw.get("points", []):
         out.append("\n[[points]]")
-        out += [f'"{k}" = {_toml(v)}' for k, v in _flatten(p, "points").items()]
+        out += [f'"{k}" = {toml_value(v)}' for k, v in _flatten(p, "points").items()]
     return "\n".join(out) + "\n"
 
 
@@ -375,4 +337,36 @@ def check_points(study: Study) -> list[Point]:
     return points
 
 
-__all__ = ["Study", "Axis", "Point", "Outputs", "loads_study", "load_study", "dumps_study", "check_points", "dim_name", "DIM_NAMES", "CURVES"]
+
+def _plain(value):
+    """numpy arrays and scalars as Python lists and numbers (what TOML holds)."""
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value.tolist() if hasattr(value, "tolist") else value
+
+
+def make_study(scene: Scene | Mapping | None = None, grid: Mapping | None = None, points: Iterable[Mapping] = (),
+               outputs: Outputs | Mapping | None = None, title: str = "lightgear study") -> Study:
+    """A study built in Python, checked like a study file.
+
+    scene   the base scene: a Scene, or scene tables / dotted overrides on the embedded paper
+            example (what the [scene] table of a study file holds); None: the paper example
+    grid    {dotted scene field: values}, values a list or a range {"start", "stop", "num"};
+            the dimensions follow the dict's order
+    points  explicit points, each {dotted scene field: value}
+    outputs an `Outputs`, or {"scalars": [...], "curves": [...]}; None: every scalar, no curve
+    """
+    raw: dict = {"title": title}
+    if scene is not None:
+        raw["scene"] = dataclasses.asdict(scene) if isinstance(scene, Scene) else _plain(scene)
+    raw["grid"] = _plain(grid or {})
+    raw["points"] = [_plain(p) for p in points]
+    if outputs is not None:
+        raw["outputs"] = _plain(dataclasses.asdict(outputs) if isinstance(outputs, Outputs) else outputs)
+    return loads_study(dumps_study(raw))
+
+
+__all__ = ["Study", "Axis", "Point", "Outputs", "loads_study", "load_study", "make_study", "dumps_study", "check_points",
+           "dim_name", "DIM_NAMES"]

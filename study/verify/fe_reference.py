@@ -23,7 +23,7 @@ from solver import units
 from solver.fe.ltca import BodyCompliance, body_compliance, ltca_sweep, mesh_points, profile_grid
 from solver.geometry import gear_geometry
 from study.inputs.springs import _settings, cache_dir, contact_patch
-from study.scene import Scene, SceneError, load_scene
+from study.scene import Scene, SceneError
 
 LTCA_VERSION = "2"          # bump when the influence coefficients' definition changes
 PROFILE_POINTS = 8          # roll-parameter grid points along each flank (STE within 0.01 um of 16)
@@ -176,30 +176,3 @@ def reference_dataset(scene: Scene, angles=None) -> xr.Dataset:
              "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
              **results.provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
-
-
-# ------------------------------------------------------------------ CLI
-
-def add_arguments(p):
-    p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
-    p.add_argument("-o", "--output", default="results/reference.nc", help="archive to write (NetCDF)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene field by its dotted path")
-    p.add_argument("--step", type=float, default=None, metavar="DEG",
-                   help="driver angle step [deg] (default: quasi_static.angle_step)")
-
-
-def main(args) -> int:
-    from study.report.results import write_netcdf
-    scene = load_scene(args.scene, args.overrides)
-    if args.step is not None and not args.step > 0:
-        raise SceneError("--step", f"must be positive, got {args.step}")
-    ds = reference_dataset(scene, None if args.step is None else static_angles(scene, args.step))
-    write_netcdf(ds, args.output)
-    ste = ds["ste"].values
-    print(f"FE reference STE -> {args.output}")
-    print(f"  mean {ste.mean():.3f} um (elastic part {ste.mean() - ds.attrs['backlash_offset_um']:.3f} um), "
-          f"peak-to-peak {np.ptp(ste):.3f} um over {float(ds['angle'][-1]):.4g} deg, {ste.size} angles")
-    print(f"  wall time: compliance {ds.attrs['wall_time_compliance_s']:.2f} s, contact {ds.attrs['wall_time_contact_s']:.2f} s, "
-          f"total {ds.attrs['wall_time_reference_s']:.2f} s")
-    return 0

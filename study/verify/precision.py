@@ -31,53 +31,9 @@ references), `study.verify.precision_study` (timed runs, errors -> Dataset) and
 """
 from __future__ import annotations
 
-import math
+from study.verify.precision_cases import Spec
+from study.verify.precision_report import cheapest, plot, setting_label, table
+from study.verify.precision_study import NORMS, dynamic_study, machine, run_study, static_study, te_error_norms
 
-from study.report import results
-from study.scene import load_scene
-from study.verify.precision_report import plot, setting_label, table
-from study.verify.precision_study import dynamic_study, static_study
-
-# ------------------------------------------------------------------ CLI
-
-def add_arguments(p):
-    p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
-    p.add_argument("-o", "--output", default="results/work_precision.nc",
-                   help="archive base name: writes BASE_dynamic.nc and BASE_static.nc with their plots (.png)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene field by its dotted path")
-    p.add_argument("--duration", type=float, default=0.002, help="dynamic window [s] (default 0.002)")
-    p.add_argument("--ramp-fraction", type=float, default=0.5, help="ramps end at this fraction of the window")
-    p.add_argument("--rotation", type=float, default=6.0, help="quasi-static driver rotation [deg] (default 6)")
-    p.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best is kept)")
-    p.add_argument("--only", choices=("dynamic", "static"), help="run only one of the two studies")
-
-
-def main(args) -> int:
-    from pathlib import Path
-
-    from study.setup import build_scene_model
-    scene = load_scene(args.scene, args.overrides)
-    model = build_scene_model(scene)
-    base = Path(args.output)
-    base.parent.mkdir(parents=True, exist_ok=True)
-
-    def progress(i, s, e, w, msg):
-        setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
-        print(f"  [{i + 1}] {s.method}, {setting}: linf {e[2]:.3g} um, {w:.3g} s  {'' if msg == 'ok' else msg}",
-              flush=True)
-    for kind in ("static", "dynamic"):
-        if args.only and args.only != kind:
-            continue
-        print(f"{kind} study ...", flush=True)
-        if kind == "dynamic":
-            ds = dynamic_study(scene, model, args.duration, args.ramp_fraction, args.repeats, progress)
-        else:
-            ds = static_study(scene, model, args.rotation, args.repeats, progress)
-        path = base.with_name(f"{base.stem}_{kind}.nc")
-        results.write_netcdf(ds, path)
-        plot(ds, path.with_suffix(".png"))
-        print(table(ds))
-        print(f"  archive: {path}\n  plot: {path.with_suffix('.png')}", flush=True)
-    return 0
-
+__all__ = ["NORMS", "Spec", "cheapest", "dynamic_study", "machine", "plot", "run_study", "setting_label",
+           "static_study", "table", "te_error_norms"]

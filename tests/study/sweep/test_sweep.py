@@ -1,112 +1,26 @@
-"""Parametric studies: grid checks, sweep = points run alone, resume, failures, archives, dask."""
+"""The sweep engine: a sweep equals its points run alone, resume, failures, dask, the CLI and
+the sensitivity workflow."""
 import math
 
 import numpy as np
 import pytest
 import xarray as xr
+from sweep_cases import BASE, swept_once, tiny_study
 
 import study.sweep.engine as sweep
 from study.report.summary import summarize
 from study.run import run_scene
-from study.scene import SceneError, default_scene, loads_scene
-from study.sweep.engine import STATUS, parts_folder, run_sweep
-from study.sweep.grid import loads_study
-
-# A 20-tooth solid-driver pair with small bodies, uniform springs (no FE), a few degrees of STE
-# and 10 ms of DTE: about a third of a second per point.
-BASE = """
-[scene]
-gear1.teeth = 20
-gear2.teeth = 20
-gear1.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0}
-gear2.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0, holes = 0, hole_radius = 1.5, hole_circle_radius = 8.1, web_thickness = 17.0}
-gear2.spring.stiffness = "uniform"
-quasi_static = {rotation = 6.0, angle_step = 0.5}
-dynamic = {duration = 0.01, ramp_time = 0.002}
-"""
-GRID = """
-[grid]
-gear2.body.holes = [0, 4]
-"dynamic.speed" = {start = 50.0, stop = 100.0, num = 2}
-gear2.body.web_thickness = [12.0, 17.0]
-[outputs]
-curves = ["ste", "dte_amplitude"]
-"""
-
-
-def tiny_study(grid=GRID, base=BASE, title="tiny"):
-    return loads_study(f'title = "{title}"\n' + base + grid)
+from study.scene import default_scene
+from study.sweep.engine import parts_folder, run_sweep
+from study.sweep.outputs import SCALARS, STATUS
 
 
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory):
-    out = tmp_path_factory.mktemp("sweep") / "tiny.nc"
-    res = run_sweep(tiny_study(), out, workers=0, progress=False)
-    return res, out
+    return swept_once(tmp_path_factory)
 
 
-# ---------------------------------------------------------------- validation before work
-
-@pytest.mark.parametrize("text, field, reason", [
-    ("[gear2]\nteeth = 4", "gear2.teeth", "must be >= 6"),
-    ("[gear2.body]\nholez = 3", "gear2.body.holez", "unknown key"),
-    ("[gear2.body]\nholes = 2.5", "gear2.body.holes", "must be an integer"),
-    ("[gear2.body]\nrim_height = -1.0", "gear2.body.rim_height", "must be >= 0"),
-    ("[gear2.body]\nholes = 6\nhole_radius = 12.0", "gear2.body.hole_radius", "cut the rim"),
-    ("[dynamic]\nmethod = 'rk4'", "dynamic.method", "must be one of"),
-])
-def test_scene_errors_name_the_field(text, field, reason):
-    with pytest.raises(SceneError) as e:
-        loads_scene(text)
-    assert e.value.field == field and reason in str(e.value)
-
-
-@pytest.mark.parametrize("grid, field, reason", [
-    ("[grid]\ngear2.body.holez = [1, 2]", "gear2.body.holez", "no such scene field"),
-    ("[grid]\n\"gear2.body\" = [1, 2]", "gear2.body", "is a table"),
-    ("[grid]\ngear2.body.holes = [3, 4.5]", "gear2.body.holes", "must be an integer"),
-    ("[grid]\ngear2.body.hole_radius = [1.0, -2.0]", "gear2.body.hole_radius", "must be >= 0"),
-    ("[grid]\ndynamic.method = ['explicit', 'rk4']", "dynamic.method", "must be one of"),
-    ("[grid]\ndynamic.speed = {start = 1.0, stop = 2.0}", "dynamic.speed", "range"),
-    ("[grid]\ngear2.body.holes = {start = 0, stop = 3, num = 3}", "gear2.body.holes", "non-integer"),
-    ("[grid]\ndynamic.speed = []", "dynamic.speed", "empty"),
-    ("[grid]\ndynamic.speed = [50.0, 50.0]", "dynamic.speed", "repeats"),
-    ("[grid]\ndynamic.speed = 50.0", "dynamic.speed", "list of values or a range"),
-    ("[grid]\ndynamic.speed = [1.0]\n[outputs]\ncurves = ['dtee']", "outputs.curves", "unknown output"),
-    ("[grd]\ndynamic.speed = [1.0]", "grd", "unknown study key"),
-    ("[[points]]\ndynamic.sped = 3.0", "dynamic.sped", "no such scene field"),
-    ("[[points]]\ngear2.teeth = 3", "gear2.teeth", "points[0] value 3: must be >= 6"),
-    ("[outputs]\ncurves = ['ste']", "grid", "sweeps nothing"),
-])
-def test_study_errors_name_the_field_before_any_work(grid, field, reason, monkeypatch):
-    monkeypatch.setattr(sweep, "run_point", lambda *a: pytest.fail("work started"))
-    with pytest.raises(SceneError) as e:
-        tiny_study(grid)
-    assert e.value.field == field and reason in str(e.value), str(e.value)
-
-
-def test_base_scene_from_a_file_or_a_table(tmp_path):
-    (tmp_path / "sc").mkdir()
-    (tmp_path / "sc" / "s.toml").write_text("[gear2.body]\nholes = 0\nweb_thickness = 17.0\n")
-    grid = "\n[grid]\ndynamic.speed = [50.0]\n"
-    st = loads_study('scene = "sc/s.toml"' + grid, tmp_path)
-    assert st.points()[0].scene.gear2.body.holes == 0 and st.points()[0].scene.gear2.teeth == 67
-    st = loads_study('[scene]\nfile = "sc/s.toml"\ngear2.body.web_thickness = 12.0' + grid, tmp_path)
-    assert st.points()[0].scene.gear2.body.web_thickness == 12.0
-    paper = loads_study(grid).points()[0].scene
-    assert paper == default_scene().replace(**{"dynamic.speed": 50.0})
-    with pytest.raises(SceneError, match="no such file"):
-        loads_study('scene = "nope.toml"' + grid, tmp_path)
-
-
-def test_a_study_whose_every_point_is_invalid_is_refused(tmp_path):
-    st = tiny_study("[grid]\ngear2.body.holes = [3, 4]\ngear2.body.hole_radius = [2.5, 3.0]")
-    with pytest.raises(SceneError, match="every point of the study is invalid.*holes cut the rim"):
-        run_sweep(st, tmp_path / "x.nc", workers=0, progress=False)
-    assert not (tmp_path / "x.nc").exists()
-
-
-# ---------------------------------------------------------------- the sweep and its archive
+# ---------------------------------------------------------------- the sweep
 
 def test_sweep_equals_each_point_run_alone(swept):
     res, _ = swept
@@ -122,7 +36,7 @@ def test_sweep_equals_each_point_run_alone(swept):
                 alone = run_scene(sc)
                 s = summarize(alone)
                 pt = ds.sel(n_holes=h, speed=w, web_thickness=t)
-                for k in sweep.SCALARS:
+                for k in SCALARS:
                     np.testing.assert_allclose(float(pt[k]), s.get(k, math.nan), rtol=1e-12, equal_nan=True, err_msg=k)
                 np.testing.assert_allclose(pt["ste"].values, alone["ste"].values, rtol=1e-12)
                 np.testing.assert_allclose(pt["dte_amplitude"].values, alone["dte_amplitude"].values, rtol=1e-12)
@@ -142,28 +56,6 @@ def _flat(d, prefix=""):
         p = f"{prefix}.{k}" if prefix else k
         out.update(_flat(v, p) if isinstance(v, dict) else {p: v})
     return out
-
-
-def test_archive_labels_units_and_netcdf_round_trip(swept):
-    res, out = swept
-    ds = res.dataset
-    for name, path, unit in (("n_holes", "gear2.body.holes", "1"), ("speed", "dynamic.speed", "rad s-1"),
-                             ("web_thickness", "gear2.body.web_thickness", "mm")):
-        assert ds[name].attrs["scene_field"] == path and ds[name].attrs["units"] == unit
-        assert ds[name].attrs["long_name"]
-    for name, v in ds.variables.items():
-        assert "long_name" in v.attrs, name
-        if v.dtype.kind in "fiu":
-            assert "units" in v.attrs, name
-    assert list(ds["status"].attrs["flag_meanings"].split()) == list(STATUS)
-    assert ds["dte_amplitude"].dims[-1] == "frequency" and ds["ste"].dims[-1] == "angle"
-    assert "dte" not in ds  # not asked for
-    assert loads_study(ds.attrs["study"]).shape == (2, 2, 2)
-    assert "software" in ds.attrs and "machine" in ds.attrs and "created" in ds.attrs
-    assert not parts_folder(out).exists()  # complete: the per-point files are gone
-    with xr.open_dataset(out, engine="netcdf4") as back:
-        xr.testing.assert_identical(back.load(), ds)
-        assert back["ste"].encoding.get("zlib")
 
 
 def test_rerunning_a_complete_study_computes_nothing(swept, monkeypatch):
@@ -275,19 +167,6 @@ def test_only_the_asked_analyses_run(monkeypatch):
     assert set(r["scalars"]) == {"ste_p2p"} and r["curves"] == {}
 
 
-def test_archives_of_split_studies_open_together(swept, tmp_path):
-    res, _ = swept
-    paths = []
-    for w in (50.0, 100.0):
-        grid = GRID.replace('{start = 50.0, stop = 100.0, num = 2}', f"[{w}]")
-        p = tmp_path / f"w{w:g}.nc"
-        run_sweep(tiny_study(grid), p, workers=0, progress=False)
-        paths.append(p)
-    with xr.open_mfdataset(paths, engine="netcdf4", combine="by_coords") as both:
-        both = both.load()
-    xr.testing.assert_equal(both.drop_vars("wall_time"), res.dataset.drop_vars("wall_time"))
-
-
 # ---------------------------------------------------------------- dask
 
 def test_dask_sweep_is_interruptible_closes_its_cluster_and_resumes(swept, tmp_path, monkeypatch):
@@ -343,8 +222,9 @@ def test_cli_sweep_of_the_example_study(tmp_path, capsys):
 
 
 def test_sensitivity_workflow_shrunk_to_a_tiny_grid(tmp_path, capsys):
-    from workflows.sensitivity_sweep import STUDY, main, study_text
-    full = loads_study(study_text(STUDY), STUDY.parent)
+    from study.sweep.grid import loads_study
+    from workflows.sensitivity_sweep import STUDY, main, sensitivity_study
+    full = sensitivity_study(STUDY)
     assert [a.name for a in full.axes] == ["n_holes", "hole_radius", "rim_thickness", "web_thickness", "speed"]
     assert full.axes[0].values == (0, 3, 6, 9, 12) and all(p.scene is not None for p in full.points())
     out = tmp_path / "s.nc"

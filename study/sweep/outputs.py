@@ -1,0 +1,97 @@
+"""What a study point can compute and archive, declared once: scalar and curve outputs, the
+selection a study makes (`Outputs`), and the status flags of a point.
+
+A scalar is one number per point (the names of `study.report.summary.summarize`), with its
+units and long name; a curve is a run-archive variable over its own axis, archived with the
+units and long name the run archive gives it (`study.report.results`). Each output needs one
+analysis: 'static' (quasi-static STE) or 'dynamic' (DTE run).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from study.scene import SceneError
+
+
+@dataclass(frozen=True)
+class Scalar:
+    units: str
+    long_name: str
+    analysis: str        # 'static' or 'dynamic'
+
+
+@dataclass(frozen=True)
+class Curve:
+    axis: str            # dimension of the curve in the run archive
+    analysis: str        # 'static' or 'dynamic'
+    comment: str = ""    # added to the archived variable's attributes when given
+
+
+SCALARS = {
+    "ste_mean": Scalar("um", "mean static transmission error", "static"),
+    "ste_elastic_mean": Scalar("um", "mean static transmission error less the rigid backlash offset", "static"),
+    "ste_p2p": Scalar("um", "peak-to-peak static transmission error", "static"),
+    "dte_mean": Scalar("um", "mean dynamic transmission error after the ramp", "dynamic"),
+    "dte_rms": Scalar("um", "RMS of the dynamic transmission error about its mean after the ramp", "dynamic"),
+    "dte_p2p": Scalar("um", "peak-to-peak dynamic transmission error after the ramp", "dynamic"),
+    "amp_mesh_order": Scalar("um", "DTE amplitude at the mesh order Z2", "dynamic"),
+    "amp_mesh2_order": Scalar("um", "DTE amplitude at twice the mesh order", "dynamic"),
+    "amp_mesh3_order": Scalar("um", "DTE amplitude at three times the mesh order", "dynamic"),
+    "amp_hole_order": Scalar("um", "DTE amplitude at the hole order N (NaN for a gear without holes)", "dynamic"),
+    "tooth_force_max": Scalar("N", "largest tooth contact force of the dynamic run after the ramp", "dynamic"),
+}
+
+CURVES = {
+    "ste": Curve("angle", "static"),
+    "dte": Curve("time", "dynamic"),
+    "dte_amplitude": Curve("frequency", "dynamic",
+                           "order of the driven gear's rotation = frequency / (speed * Z1 / Z2 / (2 pi)); "
+                           "spectrum of DTE after the ramp"),
+}
+
+STATUS = ("pending", "ok", "diverged", "invalid", "failed")   # CF flag meanings, values 0..4
+
+
+def analysis_of(output: str) -> str:
+    """'static' or 'dynamic': the analysis an output (scalar or curve) needs."""
+    return (SCALARS.get(output) or CURVES[output]).analysis
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What each point of a study computes and archives: scalar names and full curves."""
+    scalars: tuple[str, ...]
+    curves: tuple[str, ...] = ()
+
+    @property
+    def static(self) -> bool:
+        """True when a quasi-static (STE) analysis is needed."""
+        return any(analysis_of(x) == "static" for x in self.scalars + self.curves)
+
+    @property
+    def dynamic(self) -> bool:
+        """True when a dynamic (DTE) analysis is needed."""
+        return any(analysis_of(x) == "dynamic" for x in self.scalars + self.curves)
+
+
+def outputs_from_table(table) -> Outputs:
+    """The [outputs] table of a study ({scalars = [...], curves = [...]}) checked: unknown names
+    and an empty selection are SceneErrors. Scalars default to all of `SCALARS`, curves to none."""
+    if isinstance(table, Outputs):
+        table = {"scalars": list(table.scalars), "curves": list(table.curves)}
+    if not isinstance(table, dict):
+        raise SceneError("outputs", f"must be a table, got {table!r}")
+    for k in table:
+        if k not in ("scalars", "curves"):
+            raise SceneError(f"outputs.{k}", "unknown key (expected scalars, curves)")
+    scalars = table.get("scalars", list(SCALARS))
+    curves = table.get("curves", [])
+    for name, items, known in (("scalars", scalars, tuple(SCALARS)), ("curves", curves, tuple(CURVES))):
+        if not isinstance(items, (list, tuple)):
+            raise SceneError(f"outputs.{name}", f"must be a list, got {items!r}")
+        for it in items:
+            if it not in known:
+                raise SceneError(f"outputs.{name}", f"unknown output {it!r} (expected one of: {', '.join(known)})")
+    if not scalars and not curves:
+        raise SceneError("outputs", "asks for nothing")
+    return Outputs(tuple(dict.fromkeys(scalars)), tuple(dict.fromkeys(curves)))

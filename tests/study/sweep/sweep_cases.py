@@ -1,0 +1,40 @@
+"""The tiny study the sweep, grid and archive tests share, and its sweep run once per session."""
+from study.sweep.engine import run_sweep
+from study.sweep.grid import loads_study
+
+# A 20-tooth solid-driver pair with small bodies, uniform springs (no FE), a few degrees of STE
+# and 10 ms of DTE: about a third of a second per point.
+BASE = """
+[scene]
+gear1.teeth = 20
+gear2.teeth = 20
+gear1.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0}
+gear2.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0, holes = 0, hole_radius = 1.5, hole_circle_radius = 8.1, web_thickness = 17.0}
+gear2.spring.stiffness = "uniform"
+quasi_static = {rotation = 6.0, angle_step = 0.5}
+dynamic = {duration = 0.01, ramp_time = 0.002}
+"""
+GRID = """
+[grid]
+gear2.body.holes = [0, 4]
+"dynamic.speed" = {start = 50.0, stop = 100.0, num = 2}
+gear2.body.web_thickness = [12.0, 17.0]
+[outputs]
+curves = ["ste", "dte_amplitude"]
+"""
+
+
+def tiny_study(grid=GRID, base=BASE, title="tiny"):
+    return loads_study(f'title = "{title}"\n' + base + grid)
+
+
+_swept: dict = {}
+
+
+def swept_once(tmp_path_factory):
+    """The tiny study swept in process, once per test session -> (SweepResult, archive path).
+    Tests only read it (and copy the archive before they change anything)."""
+    if not _swept:
+        out = tmp_path_factory.mktemp("sweep") / "tiny.nc"
+        _swept["tiny"] = (run_sweep(tiny_study(), out, workers=0, progress=False), out)
+    return _swept["tiny"]
