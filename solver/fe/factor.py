@@ -5,13 +5,8 @@ DOFs the loads and reads reach. Units follow the caller (SI: N, m).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from solver.fe.body import BodyModel
-
 
 _BLAS_THREADS: dict = {}     # library path -> [(get, set)] of its thread-count functions
 
@@ -92,9 +87,10 @@ def factorise(K):
         return splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
 
 
-def influence(model: BodyModel, R, F, block: int = 48) -> np.ndarray:
+def influence(model, R, F, block: int = 48) -> np.ndarray:
     """R K^-1 F (m, k): the response read by the rows of R (m, N) to the loads in the columns of
-    F (N, k), through the factorisation of K (for unit loads [N] and displacement reads: m/N).
+    F (N, k), through the factorisation of K of the `solver.fe.body.BodyModel` ``model`` (for
+    unit loads [N] and displacement reads: m/N).
 
     The same numbers as ``R @ solve_load(model, f)`` for every column f, computed far cheaper when
     R and F touch few DOFs (loads on a few flanks, reads at a few points): with Pr K Pc = L U,

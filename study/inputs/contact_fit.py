@@ -2,8 +2,8 @@
 from __future__ import annotations
 
 from solver import units
-from solver.geometry import gear_geometry
 from solver.identify.weber import fit_contact
+from study.inputs.gearsetup import gear_setups
 from study.scene import load_scene
 
 
@@ -15,7 +15,7 @@ def add_arguments(p):
 
 def main(args) -> int:
     scene = load_scene(args.scene, args.overrides)
-    g1, g2 = gear_geometry(scene.tooth_spec(1), "gear1"), gear_geometry(scene.tooth_spec(2), "gear2")
+    g1, g2 = (setup.geometry for setup in gear_setups(scene))
     f_ref = scene.quasi_static.torque / g1.base_radius
     print(f"Weber contact deflection at the pitch point, plane strain, F_ref = {f_ref:.1f} N "
           f"(quasi_static.torque / base radius), R = {fit_contact(g1, g2, scene.material_spec(), f_ref).radius * 1e3:.3f} mm")
