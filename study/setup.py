@@ -13,6 +13,7 @@ import numpy as np
 
 from solver import units
 from solver.mbs.model import ContactLaw, GearInput, Model, build_model
+from study.inputs import coupling
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup, gear_setup, gear_setups
 from study.inputs.springs import tooth_springs
@@ -38,14 +39,15 @@ def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple |
     model = scene.coupling.model if model is None else model
     if model not in ("body-torsion", "compliance"):
         return None
-    from study.inputs import coupling
     setups = setups or gear_setups(scene)
     setup = setups[g - 1]
-    if model == "body-torsion":
-        return FE_CACHE.fit((model, g, setups[0].key, setups[1].key), lambda: coupling.body_torsion(setup))
-    # the contact points come from the pair's rigid geometry: both gears' settings are in the key
-    return FE_CACHE.fit((model, g, setups[0].key, setups[1].key),
-                        lambda: coupling.tooth_compliance(setup, coupling.mesh_samples(geometry_model(scene), g)))
+
+    def fit():
+        if model == "body-torsion":
+            return coupling.body_torsion(setup)
+        return coupling.tooth_compliance(setup, coupling.mesh_samples(geometry_model(scene), g))
+    # both gears' FE settings in the key: the compliance fit reads the pair's rigid geometry too
+    return FE_CACHE.fit((model, g, setups[0].key, setups[1].key), fit)
 
 
 def coupled_springs(scene: Scene, setup: GearSetup, setups: tuple) -> tuple[np.ndarray, np.ndarray]:

@@ -128,6 +128,7 @@ def main(args) -> int:
     scene = load_scene(args.scene, args.overrides)
     ds = stiffness_dataset(scene)
     write_netcdf(ds, args.output)
+    setups = gear_setups(scene)
     print(f"tooth stiffness map -> {args.output} ({ds.attrs['wall_time_springs_s']:.2f} s)")
     for g in (1, 2):
         k = ds["tooth_stiffness"].sel(gear=g).values[: scene.gear(g).teeth]
@@ -139,7 +140,7 @@ def main(args) -> int:
             print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
                   f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
         if args.identify:
-            fit, u, c = identify_spring(gear_setups(scene)[g - 1])
+            fit, u, c = identify_spring(setups[g - 1])
             print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius * 1e3:.3f} mm, "
                   f"k_phi {fit.k_phi * 1e3:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
                   f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {u.size} load radii")
