@@ -23,7 +23,6 @@ import math
 import time
 
 import numpy as np
-import xarray as xr
 
 from solver import units
 from study.inputs.cache import FE_CACHE
@@ -91,8 +90,10 @@ def body_fields(setup: GearSetup, teeth) -> list:
 
 # ------------------------------------------------------------------ dataset and CLI
 
-def stiffness_dataset(scene: Scene) -> xr.Dataset:
-    """tooth_stiffness (N mm rad-1) and stiffness_ratio of both gears, with hole positions."""
+def stiffness_dataset(scene: Scene):
+    """xarray Dataset: tooth_stiffness (N mm rad-1) and stiffness_ratio of both gears, with hole positions."""
+    import xarray as xr
+
     from study.report import results
     t0 = time.perf_counter()
     springs = [tooth_springs(setup) for setup in gear_setups(scene)]
