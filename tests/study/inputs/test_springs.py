@@ -14,6 +14,7 @@ from solver.peers.iso6336 import blank_factor, single_stiffness
 from study.inputs import springs
 from study.inputs.gearsetup import gear_setup
 from study.scene import default_scene
+from study.setup import solid_scene
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
@@ -25,7 +26,7 @@ def small_scene(**kw):
 
 
 def test_solid_body_gives_the_same_stiffness_to_every_tooth():
-    s = small_scene(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 20.0})
+    s = solid_scene(small_scene())
     k = springs.fe_stiffness(gear_setup(s, 2), teeth=[0, 5, 11, 17])
     assert np.ptp(k) / k.mean() < 2e-3
 
@@ -166,7 +167,7 @@ def test_identification_recovers_a_known_spring_and_reads_the_fe():
 def test_lightened_scene_runs_with_its_fe_springs_in_the_archive():
     from study.run import run_scene
     lite = small_scene(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})
-    solid = lite.replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 20.0})
+    solid = solid_scene(lite)
     ds = run_scene(lite, static=True, dynamic=False)
     k = ds["tooth_stiffness"].sel(gear=2).values
     r = ds["stiffness_ratio"].sel(gear=2).values
