@@ -15,18 +15,16 @@ from pathlib import Path
 ONE = r'''
 import json, resource, time
 from solver.fe import body as fe
-from solver.geometry import gear_geometry
 from solver.fe.mesh import mesh_body
 from study.scene import default_scene
-from study.inputs.springs import contact_patch, reference_torque
+from study.inputs.gearsetup import gear_setup
 size_mm = {size}
-s = default_scene()
-g = gear_geometry(s.tooth_spec(2)); body = s.body_spec(2)
-t0 = time.perf_counter(); mesh = mesh_body(g, body, size_mm * 1e-3); t1 = time.perf_counter()
-model = fe.assemble(mesh, g.spec.face_width, body.web_thickness, s.material_spec())
+gs = gear_setup(default_scene().replace(**{{"fe.mesh_size": size_mm}}), 2)
+g, body = gs.geometry, gs.body
+t0 = time.perf_counter(); mesh = mesh_body(g, body, gs.mesh_size); t1 = time.perf_counter()
+model = fe.assemble(mesh, g.spec.face_width, body.web_thickness, gs.material)
 t2 = time.perf_counter()
-force = reference_torque(s) / g.base_radius
-k, _ = fe.tooth_stiffness(model, g, s.pivot_radius(2), range(g.teeth), force, contact_patch(s, 2, force, size_mm * 1e-3))
+k, _ = fe.tooth_stiffness(model, g, gs.pivot_radius, range(g.teeth), gs.force, gs.patch)
 t3 = time.perf_counter()
 print(json.dumps(dict(size_mm=size_mm, elements=int(mesh.n_elements), dofs=int(model.n_dofs), mesh_s=t1 - t0,
                       assembly_s=model.assembly_time, factor_s=model.factor_time, solves_s=t3 - t2,

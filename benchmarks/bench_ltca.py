@@ -33,10 +33,11 @@ w_start, c_start = time.perf_counter(), time.process_time()
 import json, os, resource
 import numpy as np
 from study.scene import default_scene
+from study.setup import solid_scene
 from study.verify.fe_reference import reference, static_angles
 s = default_scene()
 if {solid}:
-    s = s.replace(**{{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}})
+    s = solid_scene(s)
 angles = static_angles(s, 0.5)
 case = "solid" if {solid} else "lightened"
 rows, stages = [], [dict(case=case, gear="-", stage="imports", wall_s=time.perf_counter() - w_start,

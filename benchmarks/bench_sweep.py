@@ -147,11 +147,11 @@ def sensitivity(tmp: Path, full: bool) -> list[dict]:
         return [dict(figure="standard sensitivity study (measured)", value=(time.perf_counter() - t0) / 60, unit="min",
                      target="", note=f"{res.computed} points on 2 workers; {load()}")]
     # distinct FE bodies: spring maps are cached by body (hole sizes ignored without holes)
-    from study.inputs.springs import _key, _settings
+    from study.inputs.gearsetup import gear_setup
     bodies = {}
     for p in st.points():
         if p.scene.is_lightened(2):
-            bodies[_key(_settings(p.scene, 2, p.scene.body_spec(2)))] = p.scene.gear2.body.holes > 0
+            bodies[gear_setup(p.scene, 2).key] = p.scene.gear2.body.holes > 0
     os.environ["LIGHTGEAR_CACHE"] = str(tmp / "cache")  # cold FE cache
     times, cpu = {}, {}
     for holes, label in ((6, "holed"), (0, "webbed")):

@@ -1,6 +1,6 @@
-"""Standard involute spur gears: radii, flanks, tooth outline, tooth and body inertia.
+"""Standard involute spur gears: radii, flanks, tooth outline, the body below the root circle.
 
-All lengths in m, angles in rad, masses in kg, inertias in kg·m² (see `solver.units`).
+All lengths in m, angles in rad (see `solver.units`). Masses and inertias: `solver.inertia`.
 
 Conventions
 -----------
@@ -19,7 +19,7 @@ Conventions
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -302,42 +302,6 @@ def pair_geometry(g1: GearGeometry, g2: GearGeometry) -> PairGeometry:
     return PairGeometry(a, alpha, pb, path, eps, sap, (u_sap1, u_sap2), jn)
 
 
-@dataclass(frozen=True)
-class ToothInertia:
-    """Rigid tooth above the root circle: mass [kg], centroid radius [m], inertia [kg·m²]."""
-
-    mass: float
-    centroid_radius: float
-    inertia_centroid: float      # about the centroid (axis along the gear axis)
-    pivot_radius: float
-    inertia_pivot: float         # about the pivot
-    inertia_center: float        # about the gear centre
-
-
-def polygon_properties(x, y):
-    """Area [m²], centroid (x, y) [m] and polar second moment about the origin [m⁴]."""
-    x1, y1 = np.roll(x, -1), np.roll(y, -1)
-    cr = x * y1 - x1 * y
-    area = 0.5 * cr.sum()
-    cx = ((x + x1) * cr).sum() / (6 * area)
-    cy = ((y + y1) * cr).sum() / (6 * area)
-    j0 = ((x * x + x * x1 + x1 * x1 + y * y + y * y1 + y1 * y1) * cr).sum() / 12.0
-    return area, cx, cy, j0
-
-
-def tooth_inertia(g: GearGeometry, density: float, pivot_radius: float) -> ToothInertia:
-    """Mass and inertia of one tooth (the part above the root circle) of face width b."""
-    x, y = g.tooth_polygon()
-    area, cx, cy, j0 = polygon_properties(x, y)
-    b = g.spec.face_width
-    mass = density * area * b
-    j_c = j0 - area * (cx**2 + cy**2)
-    i_c = density * b * j_c
-    i_p = i_c + mass * ((cx - pivot_radius) ** 2 + cy**2)
-    i_o = density * b * j0
-    return ToothInertia(mass, cx, i_c, pivot_radius, i_p, i_o)
-
-
 def validate_body(g: GearGeometry, body: BodySpec, prefix: str = "gear.body") -> None:
     """Raise GeometryError naming the field when the body does not fit the gear."""
     for name in ("rim_height", "web_height", "hub_height"):
@@ -371,26 +335,10 @@ def bore_radius(g: GearGeometry, body: BodySpec) -> float:
     return g.root_radius - body.rim_height - body.web_height - body.hub_height
 
 
-def body_inertia(g: GearGeometry, body: BodySpec, density: float) -> tuple[float, float]:
-    """Mass [kg] and polar inertia [kg·m²] of the body inside the root circle (no teeth)."""
-    rf = g.root_radius
-    b = g.spec.face_width
-    r_rim = rf - body.rim_height
-    r_hub = r_rim - body.web_height
-    r_bore = r_hub - body.hub_height
-
-    def ring(r_out, r_in, t):
-        m = density * math.pi * (r_out**2 - r_in**2) * t
-        return m, 0.5 * m * (r_out**2 + r_in**2)
-
-    parts = [ring(rf, r_rim, b), ring(r_rim, r_hub, body.web_thickness), ring(r_hub, r_bore, b)]
-    mass = sum(p[0] for p in parts)
-    inertia = sum(p[1] for p in parts)
-    if body.holes:
-        mh = density * math.pi * body.hole_radius**2 * body.web_thickness
-        mass -= body.holes * mh
-        inertia -= body.holes * mh * (0.5 * body.hole_radius**2 + body.hole_circle_radius**2)
-    return mass, inertia
+def solid_body(body: BodySpec, face_width: float) -> BodySpec:
+    """The same body made solid: the web as thick as the face [m], no holes (hole sizes zeroed,
+    so every solid variant of a body is the same BodySpec)."""
+    return replace(body, web_thickness=face_width, holes=0, hole_radius=0.0, hole_circle_radius=0.0, hole_phase=0.0)
 
 
 def gear_outline(g: GearGeometry, **kw):

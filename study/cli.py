@@ -59,6 +59,7 @@ def stiffness_command(args) -> int:
 
     import study
     from study.inputs.springs import hole_offset, identify_spring, stiffness_dataset
+    from study.setup import gear_setup
     scene = study.load_scene(args.scene, args.overrides)
     ds = stiffness_dataset(scene)
     study.write(ds, args.output)
@@ -73,7 +74,7 @@ def stiffness_command(args) -> int:
             print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
                   f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
         if args.identify:
-            fit, u, c = identify_spring(scene, g)
+            fit, u, c = identify_spring(gear_setup(scene, g))
             print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius * 1e3:.3f} mm, "
                   f"k_phi {fit.k_phi * 1e3:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
                   f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {u.size} load radii")
@@ -132,10 +133,10 @@ def fit_contact_command(args) -> int:
     """Weber's contact deflection fitted to F = k_con * delta**m1, against the scene's law."""
     import study
     from solver import units
-    from solver.geometry import gear_geometry
     from solver.identify.weber import fit_contact
+    from study.setup import gear_setups
     scene = study.load_scene(args.scene, args.overrides)
-    g1, g2 = gear_geometry(scene.tooth_spec(1), "gear1"), gear_geometry(scene.tooth_spec(2), "gear2")
+    g1, g2 = (setup.geometry for setup in gear_setups(scene))
     f_ref = scene.quasi_static.torque / g1.base_radius
     print(f"Weber contact deflection at the pitch point, plane strain, F_ref = {f_ref:.1f} N "
           f"(quasi_static.torque / base radius), R = {fit_contact(g1, g2, scene.material_spec(), f_ref).radius * 1e3:.3f} mm")

@@ -1,87 +1,96 @@
-"""Scene -> solver model: the tooth springs (uniform, or from the FE body), the foundation
-coupling, the contact law in SI, and the solver arguments a scene implies (static angles,
-load profile).
+"""Scene -> gear setups -> solver model: the tooth springs (uniform, or from the FE body), the
+foundation coupling, the contact law in SI, and the solver arguments a scene implies (static
+angles, load profile).
+
+The scene's gears are prepared once (`gear_setups`, `study.inputs.gearsetup`); the FE-derived
+inputs (`study.inputs`) take those setups and the model is assembled from them.
 """
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
 from solver import units
 from solver.mbs.model import ContactLaw, GearInput, Model, build_model
+from study.inputs import coupling
+from study.inputs.cache import FE_CACHE
+from study.inputs.gearsetup import GearSetup, gear_setup, gear_setups
+from study.inputs.springs import tooth_springs
 from study.scene import Scene
 
-
-def tooth_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per-tooth k_phi [N·mm/rad^n_k] and FE stiffness ratio [1] of gear g.
-
-    A solid gear needs no FE: every tooth gets the scene's k_phi. A lightened gear's springs
-    come from the FE body model (`study.inputs.springs`), unless its spring.stiffness is 'uniform'.
-    """
-    gs = scene.gear(g)
-    z = gs.teeth
-    if not scene.is_lightened(g) or gs.spring.stiffness == "uniform":
-        return np.full(z, gs.spring.k_phi), np.ones(z)
-    from study.inputs.springs import tooth_springs as fe_springs
-    return fe_springs(scene, g)
+__all__ = ["GearSetup", "gear_setup", "gear_setups", "solid_scene", "coupling_fit", "scene_springs",
+           "build_scene_model", "geometry_model", "static_angles", "load_table"]
 
 
-@functools.lru_cache(maxsize=16)
-def coupling_fit(scene: Scene, g: int):
+def solid_scene(scene: Scene, gears=(1, 2)) -> Scene:
+    """The same scene with solid bodies for ``gears``: the web as thick as the face, no holes
+    (the scene-level twin of `solver.geometry.solid_body`)."""
+    return scene.replace(**{k: v for g in gears for k, v in ((f"gear{g}.body.holes", 0),
+                                                               (f"gear{g}.body.web_thickness", scene.gear(g).face_width))})
+
+
+def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple | None = None):
     """Gear g's foundation coupling identified from its FE body: a `BodyTorsionFit`
     ('body-torsion'), a `ToothComplianceFit` ('compliance'), or None (the plain model).
-    Kept per scene: a run asks for it for the springs and again for the model."""
-    from study.inputs import coupling
-    model = scene.coupling.model
-    if model == "body-torsion":
-        return coupling.body_torsion(scene, g)
-    if model == "compliance":
-        return coupling.tooth_compliance(scene, g)
-    return None
+    ``model``: the coupling model (default: the scene's); ``setups``: the scene's gear setups
+    when already made. Kept in `FE_CACHE` by both gears' FE settings: a run asks for it for
+    the springs and again for the model."""
+    model = scene.coupling.model if model is None else model
+    if model not in ("body-torsion", "compliance"):
+        return None
+    setups = setups or gear_setups(scene)
+    setup = setups[g - 1]
+
+    def fit():
+        if model == "body-torsion":
+            return coupling.body_torsion(setup)
+        return coupling.tooth_compliance(setup, coupling.mesh_samples(geometry_model(scene), g))
+    # both gears' FE settings in the key: the compliance fit reads the pair's rigid geometry too
+    return FE_CACHE.fit((model, g, setups[0].key, setups[1].key), fit)
 
 
-def coupled_springs(scene: Scene, g: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gear g's tooth springs without the body wind-up [N·mm/rad] (linear, n_k = 1; with the
+def coupled_springs(scene: Scene, setup: GearSetup, setups: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The gear's tooth springs without the body wind-up [N·mm/rad] (linear, n_k = 1; with the
     compliance model each tooth's own spring, loaded alone) and the FE stiffness ratio [1] of
     the plain model's springs."""
-    fit = coupling_fit(scene, g)
+    fit = coupling_fit(scene, setup.gear, setups=setups)
     k = fit.k_tooth if scene.coupling.model == "body-torsion" else fit.k_own
-    return k / units.spring_stiffness_to_si(1.0), tooth_springs(scene, g)[1]
+    return k / units.spring_stiffness_to_si(1.0), tooth_springs(setup)[1]
 
 
-def scene_springs(scene: Scene):
+def scene_springs(scene: Scene, setups: tuple | None = None):
     """((k1, r1), (k2, r2)): per-tooth springs [N·mm/rad^n_k] and stiffness ratios of both gears."""
+    setups = setups or gear_setups(scene)
     if scene.coupling.model != "none":
-        return coupled_springs(scene, 1), coupled_springs(scene, 2)
-    return tooth_springs(scene, 1), tooth_springs(scene, 2)
+        return tuple(coupled_springs(scene, s, setups) for s in setups)
+    return tuple(tooth_springs(s) for s in setups)
 
 
 def build_scene_model(scene: Scene, springs=None) -> Model:
     """The solver model of a scene (SI). ``springs`` = ((k1, r1), (k2, r2)) skips the FE of
     the tooth springs (a coupled model still takes its body springs from the FE)."""
-    springs = springs or scene_springs(scene)
+    setups = gear_setups(scene)
+    springs = springs or scene_springs(scene, setups)
     gears = []
-    for g in (1, 2):
-        gs = scene.gear(g)
-        fit = coupling_fit(scene, g)
+    for setup, (k_phi, _) in zip(setups, springs):
+        sp = setup.spring
+        fit = coupling_fit(scene, setup.gear, setups=setups)
         cmat = None
         if fit is not None:
             k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
             if scene.coupling.model == "compliance":
                 cmat = fit.compliance
         else:
-            k_body, n_k, pivot = math.inf, gs.spring.n_k, scene.pivot_radius(g)
-        gears.append(GearInput(tooth=scene.tooth_spec(g), body=scene.body_spec(g),
-                               pivot_radius=pivot,
-                               k_phi=units.spring_stiffness_to_si(np.asarray(springs[g - 1][0], float)),
-                               n_k=n_k, c_phi=units.spring_damping_to_si(gs.spring.c_phi),
-                               n_c=gs.spring.n_c, body_stiffness=k_body, tooth_compliance=cmat))
+            k_body, n_k, pivot = math.inf, sp.n_k, setup.pivot_radius
+        gears.append(GearInput(tooth=setup.tooth, body=setup.body, pivot_radius=pivot,
+                               k_phi=units.spring_stiffness_to_si(np.asarray(k_phi, float)),
+                               n_k=n_k, c_phi=units.spring_damping_to_si(sp.c_phi),
+                               n_c=sp.n_c, body_stiffness=k_body, tooth_compliance=cmat))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(c.c_con, c.m2, c.m3), c.m2, c.m3)
-    return build_model(gears[0], gears[1], law, scene.material_spec())
+    return build_model(gears[0], gears[1], law, setups[0].material)
 
 
 def geometry_model(scene: Scene) -> Model:

@@ -8,8 +8,6 @@ import pytest  # noqa: E402
 
 from study.scene import default_scene  # noqa: E402
 
-SOLID = {"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}
-
 # 24 teeth, m = 3 mm, small solid bodies: a coarse, fast FE body (about 1 s)
 SMALL_PAIR = {"pair.backlash": 0.1}
 for _g in (1, 2):
@@ -21,26 +19,19 @@ for _g in (1, 2):
 
 def solid_scene(**overrides):
     """The paper pair with a solid driven gear (no FE needed), plus overrides."""
-    return default_scene().replace(**{**SOLID, **overrides})
+    from study import setup
+    return setup.solid_scene(default_scene(), gears=(2,)).replace(**overrides)
 
 
 @pytest.fixture
 def private_fe_cache(tmp_path, monkeypatch):
-    """FE results of the test go to a fresh disk cache, and no in-memory cache (influence
-    coefficients, factorised bodies, spring maps, coupling fits) leaks in or out."""
-    from study import run
-    from study.inputs import springs
-    from study.verify import fe_reference as reference
-
-    def clear():
-        reference._memory.clear()
-        reference._bodies.clear()
-        springs._memory.clear()
-        run.coupling_fit.cache_clear()
+    """FE results of the test go to a fresh disk cache, and nothing the FE cache holds in
+    memory (spring maps, influence coefficients, factorised bodies, coupling fits) leaks in or out."""
+    from study.inputs.cache import FE_CACHE
     monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
-    clear()
-    yield
-    clear()
+    FE_CACHE.clear()
+    yield FE_CACHE
+    FE_CACHE.clear()
 
 
 @pytest.fixture(scope="session")

@@ -19,14 +19,9 @@ import numpy as np
 import study
 from study.report.summary import print_summary
 from study.run import run_static
-from study.setup import build_scene_model
+from study.setup import build_scene_model, solid_scene
 
 DEFAULT_OUT = "results/paper_example/paper_example.nc"
-
-
-def solid_variant(scene):
-    """The same scene with a solid driven gear (full web, no holes)."""
-    return scene.replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": scene.gear2.face_width})
 
 
 def main(argv=None) -> int:
@@ -43,7 +38,7 @@ def main(argv=None) -> int:
     scene = study.load_scene(args.scene, args.overrides)
     ds = study.run_scene(scene)
     if "ste" in ds:
-        solid = solid_variant(scene)
+        solid = solid_scene(scene, gears=(2,))   # the same pair with a solid driven gear
         st = run_static(solid, build_scene_model(solid))
         ds["ste_solid"] = ("angle", st.te * 1e6, {"units": "um", "long_name": "static transmission error with a solid driven gear"})
         if args.transient_rotation > 0:

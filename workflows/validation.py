@@ -34,17 +34,12 @@ from solver.fe.ltca import mesh_points
 from solver.mbs.statics import solve_static
 from study.report import results
 from study.scene import load_scene
-from study.setup import build_scene_model
+from study.setup import build_scene_model, coupling_fit, gear_setup, solid_scene
 from study.verify.fe_reference import reference, static_angles
 
 DEFAULT_OUT = "results/validation/validation.nc"
 MODELS = ("fe-reference", "plain", "plain-fe", "coupled", "compliance")
 PAIRS = ("solid", "lightened")
-
-
-def solid_variant(scene):
-    """The same scene with a solid driven gear (full web, no holes)."""
-    return scene.replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": scene.gear2.face_width})
 
 
 def model_scene(scene, name: str):
@@ -60,7 +55,7 @@ def model_scene(scene, name: str):
         lin = scene.replace(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0, "coupling.model": "none"})
         springs = []
         for g in (1, 2):
-            k = plain_fe_springs(scene, g) / units.spring_stiffness_to_si(1.0)
+            k = plain_fe_springs(gear_setup(scene, g)) / units.spring_stiffness_to_si(1.0)
             springs.append((k, k / k.max()))
         return lin, tuple(springs)
     raise ValueError(f"model: unknown {name!r}")
@@ -146,7 +141,7 @@ METRIC_DOC = {
 
 
 def validation_dataset(scene, angles) -> xr.Dataset:
-    pairs = {"solid": solid_variant(scene), "lightened": scene}
+    pairs = {"solid": solid_scene(scene, gears=(2,)), "lightened": scene}     # the driven gear made solid
     na = angles.size
     ste = np.full((len(PAIRS), len(MODELS), na), np.nan)
     share = np.full_like(ste, np.nan)
@@ -159,9 +154,8 @@ def validation_dataset(scene, angles) -> xr.Dataset:
         sc = pairs[name]
         s, f, nom, w, model = evaluate_pair(sc, angles)
         if "compliance" in MODELS:
-            from study.inputs.coupling import tooth_compliance
             for g in (1, 2):
-                tc = tooth_compliance(sc, g)
+                tc = coupling_fit(sc, g, "compliance")
                 fit["k_body"][p, g - 1], fit["pivot"][p, g - 1], fit["rms"][p, g - 1] = (
                     tc.k_body, tc.pivot_radius * units.MM_PER_M, tc.rms_rel_error)
         offsets.append(model.backlash_offset * units.UM_PER_M)

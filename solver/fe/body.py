@@ -25,11 +25,11 @@ Units: SI in and out (m, N, Pa, N·m/rad).
 from __future__ import annotations
 
 import math
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from solver.fe.factor import blas1_solver, factorise
 from solver.fe.mesh import REGION_WEB, BodyMesh
 from solver.geometry import GearGeometry, Material
 
@@ -75,8 +75,8 @@ class BodyModel:
     factor_time: float = 0.0     # wall seconds of the factorisation
     assembly_cpu: float = 0.0    # CPU seconds of the same (all threads of the process)
     factor_cpu: float = 0.0
-    factor: object = None        # the SuperLU object behind ``solve`` (for `influence`)
-    _triangles: tuple | None = field(default=None, repr=False)   # (L, U^T) in CSC, made once on demand
+    factor: object = None        # the SuperLU object behind ``solve`` (for `solver.fe.factor.influence`)
+    triangles: tuple | None = field(default=None, repr=False)   # (L, U^T) in CSC, made once on demand
 
     @property
     def n_dofs(self) -> int:
@@ -148,85 +148,6 @@ def plane_stress_p2_stiffness(basis, lam: float, mu: float, thickness: np.ndarra
     return sp.coo_matrix((ke.ravel(), (rows, cols)), shape=(basis.N, basis.N))
 
 
-_BLAS_THREADS: dict = {}     # library path -> [(get, set)] of its thread-count functions
-
-
-def _openblas_controls() -> list:
-    """(get_num_threads, set_num_threads) of every OpenBLAS library loaded in this process
-    (numpy's and scipy's wheels each bundle one, with prefixed symbol names); empty where they
-    cannot be found (not Linux, another BLAS). The loaded libraries are listed anew each call
-    (a millisecond), so one loaded later is not missed."""
-    import ctypes
-    import re
-
-    try:
-        with open("/proc/self/maps") as f:
-            paths = sorted(set(re.findall(r"(/\S*openblas\S*\.so\S*)", f.read())))
-    except OSError:
-        return []
-    out = []
-    for path in paths:
-        if path not in _BLAS_THREADS:
-            found = []
-            try:
-                lib = ctypes.CDLL(path)
-            except OSError:
-                lib = None
-            for prefix in ("openblas", "scipy_openblas") if lib is not None else ():
-                for suffix in ("", "64_"):
-                    get = getattr(lib, f"{prefix}_get_num_threads{suffix}", None)
-                    put = getattr(lib, f"{prefix}_set_num_threads{suffix}", None)
-                    if get is not None and put is not None:
-                        get.restype, put.argtypes = ctypes.c_int, [ctypes.c_int]
-                        found.append((get, put))
-            _BLAS_THREADS[path] = found
-        out += _BLAS_THREADS[path]
-    return out
-
-
-@contextmanager
-def one_blas_thread():
-    """Run the block in single-threaded OpenBLAS, then restore the thread counts.
-
-    SuperLU calls the dense BLAS once per supernode, thousands of small calls per factorisation
-    or block solve: with two BLAS threads on a two-core machine that was also running something
-    else, the reach-restricted solves of the paper reference took 14-15 s instead of 2.2-2.6 s
-    (threads waiting for each other at every call); the factorisation took the same time with
-    one thread or two. The setting is process-wide: other threads of the process run
-    single-threaded BLAS meanwhile.
-    """
-    controls = _openblas_controls()
-    old = [get() for get, _ in controls]
-    for _, put in controls:
-        put(1)
-    try:
-        yield
-    finally:
-        for (_, put), n in zip(controls, old):
-            put(n)
-
-
-def _solver(lu):
-    """lu.solve in single-threaded BLAS (see `one_blas_thread`)."""
-    def solve(rhs):
-        with one_blas_thread():
-            return lu.solve(rhs)
-    return solve
-
-
-def factorise(K):
-    """Sparse LU of the symmetric positive definite K (CSC) for repeated solves.
-
-    Symmetric mode (one minimum-degree ordering of K + K^T for rows and columns, no pivoting,
-    which an SPD matrix does not need) has about half the fill of the default unsymmetric
-    COLAMD ordering: faster to factorise and to solve, half the memory.
-    """
-    from scipy.sparse.linalg import splu
-
-    with one_blas_thread():
-        return splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
-
-
 def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material, order: int = 2) -> BodyModel:
     """Assemble K (thickness-weighted), clamp the bore and factorise once."""
     import time
@@ -258,7 +179,7 @@ def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: 
     t1, c1 = time.perf_counter(), time.process_time()
     lu = factorise(Kff)
     t2, c2 = time.perf_counter(), time.process_time()
-    return BodyModel(mesh, basis, thickness, free, _solver(lu), material, t1 - t0, t2 - t1, c1 - c0, c2 - c1, lu)
+    return BodyModel(mesh, basis, thickness, free, blas1_solver(lu), material, t1 - t0, t2 - t1, c1 - c0, c2 - c1, lu)
 
 
 def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) -> np.ndarray:
@@ -297,76 +218,6 @@ def solve_load(model: BodyModel, f: np.ndarray) -> np.ndarray:
     u = np.zeros(model.basis.N)
     u[model.free] = model.solve(f[model.free])
     return u
-
-
-def influence(model: BodyModel, R, F, block: int = 48) -> np.ndarray:
-    """R K^-1 F (m, k): the response read by the rows of R (m, N) to the loads in the columns of
-    F (N, k), through the factorisation of K (for unit loads [N] and displacement reads: m/N).
-
-    The same numbers as ``R @ solve_load(model, f)`` for every column f, computed far cheaper when
-    R and F touch few DOFs (loads on a few flanks, reads at a few points): with Pr K Pc = L U,
-
-        R K^-1 F = (U^-T (R Pc)^T)^T (L^-1 Pr F),
-
-    and both triangular solves only reach the DOFs on the paths from the loaded (read) DOFs
-    through the factors' graphs, about a tenth of a gear body. The solves are restricted to that
-    set S (exact: every other entry of the solutions is zero) and run as blocked supernodal solves
-    of the triangular submatrices. (SuperLU's own full solve reads all of U once per right-hand
-    side; this is what makes many load cases expensive.)
-    """
-    import scipy.sparse as sp
-
-    lu = model.factor
-    if lu is None:                                   # a body without its factor object: plain solves
-        U = np.zeros((model.basis.N, F.shape[1]))
-        Fd = F.toarray() if sp.issparse(F) else np.asarray(F)
-        U[model.free] = model.solve(np.ascontiguousarray(Fd[model.free]))
-        return np.asarray(R @ U)
-    if model._triangles is None:
-        model._triangles = (sp.csc_matrix(lu.L), sp.csr_matrix(lu.U).T.tocsc())
-    L, Ut = model._triangles
-    n = model.free.size
-    Ff = sp.csr_matrix(F)[model.free]                        # (n, k)
-    Rt = sp.csr_matrix(sp.csr_matrix(R)[:, model.free].T)    # (n, m)
-    # scipy's convention Pr K Pc = L U: row i of K goes to row perm_r[i], column j to perm_c[j]
-    inv_c = np.empty(n, dtype=np.int64)
-    inv_c[lu.perm_c] = np.arange(n)
-    b_f = Ff[np.argsort(lu.perm_r)]                  # Pr F
-    b_r = Rt[inv_c]                                  # (R Pc)^T
-    reach = (_reach(L, lu.perm_r[np.flatnonzero(np.diff(Ff.indptr))])
-             | _reach(Ut, lu.perm_c[np.flatnonzero(np.diff(Rt.indptr))]))
-    S = np.flatnonzero(reach)
-    y = _lower_solve(L[S][:, S], b_f[S].toarray(), block)
-    z = _lower_solve(Ut[S][:, S], b_r[S].toarray(), block)
-    return z.T @ y
-
-
-def _reach(T, sources: np.ndarray) -> np.ndarray:
-    """Boolean mask of the rows that a lower-triangular solve with T (CSC) can make nonzero from
-    right-hand sides nonzero at ``sources``: one sweep in column order (T's graph only points to
-    higher indices)."""
-    mark = np.zeros(T.shape[0], bool)
-    mark[sources] = True
-    ptr, idx = T.indptr, T.indices
-    for j in range(T.shape[0]):
-        if mark[j]:
-            mark[idx[ptr[j]:ptr[j + 1]]] = True
-    return mark
-
-
-def _lower_solve(T, B: np.ndarray, block: int) -> np.ndarray:
-    """T^-1 B for a sparse lower-triangular T (CSC). SuperLU of a triangular matrix in its own
-    order is T itself (no fill, no pivoting: a few hundredths of a second) and its solve works on
-    supernodes with dense kernels over a block of right-hand sides; scipy's
-    ``spsolve_triangular`` is about four times slower here."""
-    from scipy.sparse.linalg import splu
-
-    X = np.empty_like(B)
-    with one_blas_thread():
-        lu = splu(T.tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
-        for s in range(0, B.shape[1], block):
-            X[:, s:s + block] = lu.solve(np.ascontiguousarray(B[:, s:s + block]))
-    return X
 
 
 def point_displacement(model: BodyModel, u: np.ndarray, x: np.ndarray) -> np.ndarray:

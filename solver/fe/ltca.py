@@ -177,14 +177,14 @@ def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth
     """Influence coefficients [m/N] of a factorised body: unit loads at every (load tooth, u),
     displacement along the load direction read at the centreline point of every (read tooth, u).
 
-    One factorisation; all load cases at once through `solver.fe.body.influence` (triangular solves
+    One factorisation; all load cases at once through `solver.fe.factor.influence` (triangular solves
     restricted to the DOFs the loads and reads reach), right-hand sides in blocks of ``block``.
     ``timings``: if given, wall and CPU seconds of building the load vectors and of the solves
     are added to it (keys ``loads_wall_s``, ``loads_cpu_s``, ``solve_wall_s``, ``solve_cpu_s``).
     """
     import scipy.sparse as sp
 
-    from solver.fe.body import influence
+    from solver.fe.factor import influence
 
     clock = _Clock(timings)
     load_teeth = np.asarray(load_teeth, dtype=int)

@@ -21,12 +21,11 @@ from solver.geometry import (
     Material,
     PairGeometry,
     ToothSpec,
-    body_inertia,
     gear_geometry,
     pair_geometry,
-    tooth_inertia,
     validate_body,
 )
+from solver.inertia import body_inertia, hole_inertia, tooth_inertia
 from solver.mbs.kernels import layout as L
 
 
@@ -127,9 +126,7 @@ def hub_side_inertia(g: GearGeometry, body: BodySpec, density: float) -> float:
     r_bore = r_hub - body.hub_height
     hub = 0.5 * density * math.pi * (r_hub**4 - r_bore**4) * g.spec.face_width
     web = 0.5 * density * math.pi * (r_rim**4 - r_hub**4) * body.web_thickness
-    if body.holes:
-        mh = density * math.pi * body.hole_radius**2 * body.web_thickness
-        web -= body.holes * mh * (0.5 * body.hole_radius**2 + body.hole_circle_radius**2)
+    web -= hole_inertia(body, density)[1]
     return hub + 0.5 * web
 
 

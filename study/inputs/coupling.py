@@ -1,17 +1,20 @@
 """Foundation coupling of a scene's gears, identified from the FE body (cached).
 
-`body_torsion(scene, g)` loads every tooth of gear g's FE body at the pitch point (one tooth
+`body_torsion(setup)` loads every tooth of the gear's FE body at the pitch point (one tooth
 for a solid body, by symmetry) and reads each tooth's and its neighbours' deflection along
 the line of action at the tooth centreline (`solver.fe.ltca` influence coefficients, same mesh
 and load patch as the FE tooth springs), then splits the body wind-up off the tooth springs
-(`solver.identify.coupling.body_torsion_fit`). Used by `study.run` when ``coupling.model =
-"body-torsion"``.
+(`solver.identify.coupling.body_torsion_fit`). Used by `study.setup.coupling_fit` when
+``coupling.model = "body-torsion"``.
 
-`tooth_compliance(scene, g)`, the full version (``coupling.model = "compliance"``): the
+`tooth_compliance(setup, samples)`, the full version (``coupling.model = "compliance"``): the
 influence coefficients of every tooth with itself and its neighbours along the profiles (a
 lightened body: every tooth loaded; a solid body: one, the rest by symmetry), read at the
-contact points the mesh loads together (`mesh_samples`), fitted as body wind-up plus coupled
-tooth springs (`solver.identify.coupling.tooth_compliance_fit`).
+contact points the mesh loads together (`mesh_samples` of the pair's rigid geometry), fitted as
+body wind-up plus coupled tooth springs (`solver.identify.coupling.tooth_compliance_fit`).
+
+All take a prepared `study.inputs.gearsetup.GearSetup`; the FE comes from
+`study.inputs.compliance.gear_compliance` (cached).
 """
 from __future__ import annotations
 
@@ -20,40 +23,39 @@ import math
 import numpy as np
 
 from solver.fe.body import load_case
-from solver.geometry import gear_geometry
 from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, tooth_compliance_fit
-from study.scene import Scene
-from study.verify.fe_reference import body_compliance_cached
+from solver.mbs.model import Model
+from study.inputs.compliance import PROFILE_POINTS, gear_compliance
+from study.inputs.gearsetup import GearSetup
 
 
-def body_torsion(scene: Scene, g: int) -> BodyTorsionFit:
-    """Body spring [N·m/rad] and tooth springs without the body wind-up of gear g, about the
+def body_torsion(setup: GearSetup) -> BodyTorsionFit:
+    """Body spring [N·m/rad] and tooth springs without the body wind-up of the gear, about the
     pivot of `tooth_pivot` (so `BodyTorsionFit.k_total` is the plain FE spring about it)."""
-    geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
+    geo = setup.geometry
     z = geo.teeth
     u = np.array([math.tan(geo.spec.pressure_angle)])
-    if scene.is_lightened(g):
-        c, _ = body_compliance_cached(scene, g, list(range(z)), 1, u=u)
+    if setup.lightened:
+        c, _ = gear_compliance(setup, list(range(z)), 1, u=u)
         G = c.g[:, 0, :, 0]                        # read tooth, load tooth
         a = np.arange(z)
         c_tot = G[a, a]
         c_adj = 0.5 * (G[a, (a - 1) % z] + G[a, (a + 1) % z])
     else:
-        c, _ = body_compliance_cached(scene, g, [0], 1, u=u)
+        c, _ = gear_compliance(setup, [0], 1, u=u)
         G = c.g[:, 0, 0, 0]                        # read offsets -1, 0, 1
         c_tot = np.full(z, G[1])
         c_adj = np.full(z, 0.5 * (G[0] + G[2]))
-    r_q, k_q = tooth_pivot(scene, g, float(np.mean(c_adj)))
+    r_q, k_q = tooth_pivot(setup, float(np.mean(c_adj)))
     return body_torsion_fit(c_tot, c_adj, load_case(geo, 0, r_q).lever, geo.base_radius, r_q, k_q)
 
 
-def mesh_samples(scene: Scene, g: int, n_angles: int = 25) -> dict[int, np.ndarray]:
+def mesh_samples(model: Model, g: int, n_angles: int = 25) -> dict[int, np.ndarray]:
     """Roll parameters [-] at which the mesh loads gear g's teeth together: for each index
     offset d (load tooth - read tooth), the (u_read, u_load) of the contacts that coexist over
-    one mesh pitch of the rigid geometry (d = 0: each contact with itself)."""
+    one mesh pitch of the pair's rigid geometry ``model`` (`study.setup.geometry_model`; d = 0:
+    each contact with itself)."""
     from solver.fe.ltca import mesh_points
-    from study.setup import geometry_model
-    model = geometry_model(scene)
     z = model.teeth[g - 1]
     out: dict[int, list] = {}
     for th in np.linspace(0.0, 2 * math.pi / model.teeth[0], n_angles, endpoint=False):
@@ -80,25 +82,23 @@ def bilinear_weights(grid: np.ndarray, points: np.ndarray) -> np.ndarray:
     return w
 
 
-def tooth_compliance(scene: Scene, g: int) -> ToothComplianceFit:
-    """Body spring [N·m/rad], pivot and coupled tooth compliance [rad/(N·m)] of gear g fitted
-    to its FE influence coefficients at the points the mesh loads together
-    (`solver.identify.coupling.tooth_compliance_fit`; blocks interpolated bilinearly between the
-    profile points). A lightened body: every tooth loaded at every profile point (cached on
-    disk); a solid body: one tooth, the others by symmetry."""
-    from study.verify.fe_reference import PROFILE_POINTS
-    geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
+def tooth_compliance(setup: GearSetup, samples: dict[int, np.ndarray]) -> ToothComplianceFit:
+    """Body spring [N·m/rad], pivot and coupled tooth compliance [rad/(N·m)] of the gear fitted
+    to its FE influence coefficients at the points the mesh loads together (``samples``, from
+    `mesh_samples`; `solver.identify.coupling.tooth_compliance_fit`; blocks interpolated
+    bilinearly between the profile points). A lightened body: every tooth loaded at every
+    profile point (cached on disk); a solid body: one tooth, the others by symmetry."""
+    geo = setup.geometry
     z = geo.teeth
-    samples = mesh_samples(scene, g)
     reach = max(abs(d) for d in samples)
-    if scene.is_lightened(g):
-        c, _ = body_compliance_cached(scene, g, list(range(z)), reach, PROFILE_POINTS)
+    if setup.lightened:
+        c, _ = gear_compliance(setup, list(range(z)), reach, PROFILE_POINTS)
         pos = {int(t): i for i, t in enumerate(c.read_teeth)}
 
         def block(a, d):
             return c.g[pos[a], :, pos[(a + d) % z], :]
     else:
-        c, _ = body_compliance_cached(scene, g, [0], reach, PROFILE_POINTS)
+        c, _ = gear_compliance(setup, [0], reach, PROFILE_POINTS)
 
         def block(a, d):       # read a, load a + d = read offset -d from the loaded tooth
             return c.g[reach - d, :, 0, :]
@@ -112,32 +112,30 @@ def tooth_compliance(scene: Scene, g: int) -> ToothComplianceFit:
             ul.append(uv[:, 1])
             val.append(weights[d] @ block(a, d).ravel())
     # the pivot lies in the rim under the tooth
-    bounds = (geo.root_radius - scene.body_spec(g).rim_height, geo.root_radius)
+    bounds = (geo.root_radius - setup.body.rim_height, geo.root_radius)
     cat = np.concatenate
     return tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z,
                                 geo.base_radius, geo.psi_base, bounds)
 
 
-def tooth_pivot(scene: Scene, g: int, c_body: float) -> tuple[float, float]:
-    """(pivot radius [m], spring [N·m/rad]) of gear g's tooth 0 refitted to its FE compliance
+def tooth_pivot(setup: GearSetup, c_body: float) -> tuple[float, float]:
+    """(pivot radius [m], spring [N·m/rad]) of the gear's tooth 0 refitted to its FE compliance
     along the profile less the body compliance c_body [m/N] (see `solver.identify.coupling`)."""
     from solver.identify.pivot import fit_pivot
-    from study.verify.fe_reference import PROFILE_POINTS
-    geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
-    if scene.is_lightened(g):
-        c, _ = body_compliance_cached(scene, g, [0], 0, PROFILE_POINTS)
+    geo = setup.geometry
+    if setup.lightened:
+        c, _ = gear_compliance(setup, [0], 0, PROFILE_POINTS)
         off = 0
     else:
-        c, _ = body_compliance_cached(scene, g, [0], 1, PROFILE_POINTS)
+        c, _ = gear_compliance(setup, [0], 1, PROFILE_POINTS)
         off = 1
     diag = np.array([c.g[off, i, 0, i] for i in range(c.u.size)])
     r_q, k, _err = fit_pivot(geo.base_radius, geo.psi_base - c.u, diag - c_body)
     return r_q, k
 
 
-def plain_fe_springs(scene: Scene, g: int) -> np.ndarray:
+def plain_fe_springs(setup: GearSetup) -> np.ndarray:
     """Per-tooth FE springs [N·m/rad] of the plain model about the scene's pivot, from the same
     influence coefficients (lever**2 / c_total: body wind-up included in every tooth)."""
-    geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
-    lever = load_case(geo, 0, scene.pivot_radius(g)).lever
-    return lever**2 / body_torsion(scene, g).c_total
+    lever = load_case(setup.geometry, 0, setup.pivot_radius).lever
+    return lever**2 / body_torsion(setup).c_total

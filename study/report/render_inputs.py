@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from solver.geometry import gear_geometry
 from study.report.render_geometry import fe_body, outline_body, with_teeth
 
 
@@ -27,12 +26,9 @@ def tooth_stiffness(ds: xr.Dataset, g: int) -> np.ndarray:
 
 def fe_fields(scene, g: int, teeth) -> list:
     """`solver.fe.body.BodyField` of gear g under the load on each of ``teeth`` (one FE solve)."""
-    from solver.fe import body as fe
-    from study.inputs.springs import _settings, fe_stiffness
-    geo = gear_geometry(scene.tooth_spec(g))
-    st = _settings(scene, g, scene.body_spec(g))
-    _, (model, U) = fe_stiffness(scene, g, teeth=list(teeth), keep_fields=True)
-    return [fe.body_field(model, geo, U[:, j], int(t), st["force"], st["pivot"]) for j, t in enumerate(teeth)]
+    from study.inputs.gearsetup import gear_setup
+    from study.inputs.springs import body_fields
+    return body_fields(gear_setup(scene, g), teeth)
 
 
 def pair_bodies(ds: xr.Dataset, fields: dict | None = None) -> dict:

@@ -1,18 +1,17 @@
 """FE reference STE of a scene: loaded-tooth-contact analysis with FE influence coefficients.
 
-`reference_dataset(scene)` builds both gear bodies' FE models (`solver.fe.body`, same mesh size and
-load patch as the tooth springs of `study.inputs.springs`), their bulk compliance between the drive
-flank points of the teeth that meet the mesh over the scene's quasi-static rotation
-(`solver.fe.ltca`), and solves the loaded contact at every angle of ``quasi_static`` with the
-scene's contact law in series. The compliance is cached in memory and on disk (same directory
-and key scheme as the FE springs), so a second run only solves the contact problems.
+`reference_dataset(scene)` takes both gear bodies' bulk compliance between the drive flank points
+of the teeth that meet the mesh over the scene's quasi-static rotation
+(`study.inputs.compliance.gear_compliance`: the FE body of `solver.fe.body`, same mesh size and
+load patch as the tooth springs, influence coefficients of `solver.fe.ltca`) and solves the
+loaded contact at every angle of ``quasi_static`` with the scene's contact law in series. The
+compliance is cached in memory and on disk (`study.inputs.cache`), so a second run only solves
+the contact problems.
 
 CLI: ``lightgear reference [SCENE] [-o OUT.nc] [--set k=v] [--step DEG]``.
 """
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 import time
 
@@ -20,16 +19,11 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.fe.ltca import BodyCompliance, body_compliance, ltca_sweep, mesh_points, profile_grid
-from solver.geometry import gear_geometry
-from study.inputs.springs import _settings, cache_dir, contact_patch
+from solver.fe.ltca import ltca_sweep, mesh_points
+from study.inputs.compliance import PROFILE_POINTS, gear_compliance
+from study.inputs.gearsetup import gear_setups
 from study.scene import Scene, SceneError
-
-LTCA_VERSION = "2"          # bump when the influence coefficients' definition changes
-PROFILE_POINTS = 8          # roll-parameter grid points along each flank (STE within 0.01 um of 16)
-_memory: dict[str, BodyCompliance] = {}
-_bodies: dict = {}          # the last BODY_SLOTS factorised bodies (least recently used first)
-BODY_SLOTS = 2              # one per gear: a reference and then the coupling of both gears reuse them
+from study.setup import geometry_model
 
 
 def static_angles(scene: Scene, step_deg: float | None = None) -> np.ndarray:
@@ -56,74 +50,11 @@ def teeth_in_mesh(model, angles) -> tuple[list, list, int]:
     return sorted(s1), sorted(s2), spread
 
 
-def body_compliance_cached(scene: Scene, g: int, teeth: list, spread: int, n_u: int = PROFILE_POINTS,
-                           u: np.ndarray | None = None) -> tuple[BodyCompliance, dict]:
-    """Gear g's bulk compliance (cached). A solid body: columns of tooth 0, read at offsets
-    -spread..spread; a lightened body: every tooth in ``teeth`` loaded and read. ``u``: the roll
-    grid (default: ``n_u`` points from the form circle to the tip)."""
-    from solver.fe import body as fe
-    from solver.fe.mesh import default_mesh_size, mesh_body
-
-    body = scene.body_spec(g)
-    geo = gear_geometry(scene.tooth_spec(g), f"gear{g}")
-    st = _settings(scene, g, body)
-    size = st["size"] or default_mesh_size(geo.spec.module)
-    symmetric = not scene.is_lightened(g)
-    u = profile_grid(geo, n_u) if u is None else np.asarray(u, float)
-    if symmetric:
-        load, read = [0], list(range(-spread, spread + 1))
-    else:
-        load = read = [int(t) for t in teeth]
-    key = hashlib.sha256(json.dumps({**st, "load": load, "read": read, "u": [float(x) for x in u], "ltca": LTCA_VERSION},
-                                    sort_keys=True, default=float).encode()).hexdigest()[:20]
-    info = {"mesh_size_m": size, "cached": True, "wall_time_s": 0.0, "load_cases": len(load) * u.size}
-    if key in _memory:
-        return _memory[key], info
-    path = cache_dir() / f"ltca-{key}.npz"
-    if path.exists():
-        try:
-            with np.load(path) as d:
-                c = BodyCompliance(d["u"], d["read"], d["load"], d["g"], bool(d["symmetric"]), int(d["teeth"]))
-            _memory[key] = c
-            return c, info
-        except (OSError, KeyError, ValueError):
-            pass  # unreadable cache entry: recompute
-    t0, c0 = time.perf_counter(), time.process_time()
-    stages = {}              # wall and CPU seconds of each stage (CPU: all threads of the process)
-    # the body model depends on geometry, material and mesh size only (not on the load or pivot)
-    bkey = json.dumps({k: v for k, v in st.items() if k not in ("force", "pivot")}, sort_keys=True, default=float)
-    model = _bodies.pop(bkey, None)
-    if model is None:
-        while len(_bodies) >= BODY_SLOTS:       # factorisations are large (~0.5 GB): keep a few
-            _bodies.pop(next(iter(_bodies)))
-        mesh = mesh_body(geo, body, size, prefix=f"gear{g}.body")
-        stages.update(mesh_wall_s=time.perf_counter() - t0, mesh_cpu_s=time.process_time() - c0)
-        model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, scene.material_spec())
-        stages.update(assembly_wall_s=model.assembly_time, assembly_cpu_s=model.assembly_cpu,
-                      factor_wall_s=model.factor_time, factor_cpu_s=model.factor_cpu)
-    _bodies[bkey] = model                       # most recently used last
-    patch = contact_patch(scene, g, st["force"], size)
-    c = body_compliance(model, geo, u, load, read, patch, symmetric_body=symmetric, timings=stages)
-    info.update(cached=False, wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0,
-                dofs=int(model.n_dofs), stages=stages)
-    _memory[key] = c
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.stem}.tmp.npz")
-        np.savez(tmp, u=c.u, read=c.read_teeth, load=c.load_teeth, g=c.g, symmetric=c.symmetric_body, teeth=c.teeth)
-        tmp.replace(path)
-    except OSError:
-        pass  # a read-only cache only costs recomputation
-    return c, info
-
-
 def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS):
     """(LTCAResult, model, info) of the scene at driver ``angles`` [rad] (default: quasi-static).
 
     ``rigid``: rigid bodies, only the contact law deforms (the closed-form check);
     ``n_u``: profile points per flank of the influence coefficients."""
-    from study.setup import geometry_model
-
     qs = scene.quasi_static
     if not qs.torque > 0:
         raise SceneError("quasi_static.torque", f"the FE reference needs a positive (drive-side) torque, got {qs.torque}")
@@ -136,8 +67,9 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     else:
         t1, t2, spread = teeth_in_mesh(model, angles)
         info.update(wall_time_teeth_s=time.perf_counter() - t0, cpu_time_teeth_s=time.process_time() - c0)
-        c1, i1 = body_compliance_cached(scene, 1, t1, spread, n_u)
-        c2, i2 = body_compliance_cached(scene, 2, t2, spread, n_u)
+        setup1, setup2 = gear_setups(scene)
+        c1, i1 = gear_compliance(setup1, t1, spread, n_u)
+        c2, i2 = gear_compliance(setup2, t2, spread, n_u)
         comp = (c1, c2)
         info.update(gear1=i1, gear2=i2)
     info.update(wall_time_compliance_s=time.perf_counter() - t0, cpu_time_compliance_s=time.process_time() - c0)

@@ -4,18 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from solver.geometry import (
-    BodySpec,
-    GeometryError,
-    ToothSpec,
-    body_inertia,
-    gear_geometry,
-    involute,
-    pair_geometry,
-    polygon_properties,
-    tooth_inertia,
-    validate_body,
-)
+from solver.geometry import BodySpec, GeometryError, ToothSpec, gear_geometry, involute, pair_geometry, solid_body, validate_body
+from solver.inertia import body_inertia, hole_inertia, polygon_properties, tooth_inertia
 
 TABLE1 = ToothSpec(module=1.5e-3, teeth=67, pressure_angle=math.radians(20), addendum_coef=1.0,
                    dedendum_coef=1.25, fillet_radius=0.45e-3, face_width=17e-3, thinning=0.035e-3)
@@ -100,6 +90,22 @@ def test_body_inertia_closed_form_and_holes():
     light = BodySpec(6.075e-3, 23.25e-3, 7.425e-3, 10e-3, 6, 6e-3, 32.36e-3)
     ml, il = body_inertia(g, light, 7850.0)
     assert ml < m and il < i
+
+
+def test_holes_and_the_solid_variant_of_a_body():
+    """Each hole takes out a disc of the web thickness on the hole circle (parallel axes);
+    the solid variant of a lightened body is the full disc, whatever its hole fields were."""
+    g = gear_geometry(TABLE1)
+    light = BodySpec(6.075e-3, 23.25e-3, 7.425e-3, 10e-3, 6, 6e-3, 32.36e-3, 0.3)
+    webbed = BodySpec(6.075e-3, 23.25e-3, 7.425e-3, 10e-3)
+    disc = 7850 * math.pi * 6e-3**2 * 10e-3
+    m_h, i_h = hole_inertia(light, 7850.0)
+    assert (m_h, i_h) == pytest.approx((6 * disc, 6 * disc * (0.5 * 6e-3**2 + 32.36e-3**2)), rel=1e-12)
+    assert body_inertia(g, light, 7850.0) == pytest.approx(np.subtract(body_inertia(g, webbed, 7850.0), (m_h, i_h)), rel=1e-12)
+    assert hole_inertia(webbed, 7850.0) == (0.0, 0.0)
+    solid = solid_body(light, TABLE1.face_width)
+    assert solid == BodySpec(6.075e-3, 23.25e-3, 7.425e-3, TABLE1.face_width)
+    assert body_inertia(g, solid, 7850.0) == body_inertia(g, BodySpec(6.075e-3, 23.25e-3, 7.425e-3, 17e-3), 7850.0)
 
 
 @pytest.mark.parametrize("spec, field", [

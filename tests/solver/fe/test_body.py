@@ -6,6 +6,7 @@ import pytest
 import skfem
 
 from solver.fe import body as fe
+from solver.fe.factor import influence
 from solver.fe.mesh import REGION_WEB, mesh_annulus, mesh_body
 from solver.geometry import Material, gear_geometry
 
@@ -92,7 +93,8 @@ def test_body_mesh_regions_and_holes():
     tri = p[mesh.triangles]
     e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
     area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()
-    from solver.geometry import gear_outline, polygon_properties
+    from solver.geometry import gear_outline
+    from solver.inertia import polygon_properties
     outline = polygon_properties(*gear_outline(g, n_involute=200, n_fillet=50, n_tip=20, n_root=20))[0]
     expected = outline - math.pi * body_bore**2 - 4 * math.pi * 3e-3**2
     assert area == pytest.approx(expected, rel=2e-3)
@@ -167,7 +169,7 @@ def test_closed_form_stiffness_equals_the_generic_form_assembly():
 
 
 def test_influence_equals_one_solve_per_load():
-    """fe.influence (all loads at once, triangular solves restricted to the DOFs the loads and
+    """influence (all loads at once, triangular solves restricted to the DOFs the loads and
     reads reach) gives R K^-1 f for every load f exactly as a solve per load does, loads on
     clamped DOFs included (they carry no displacement either way)."""
     import scipy.sparse as sp
@@ -181,13 +183,13 @@ def test_influence_equals_one_solve_per_load():
     pts = np.array([[0.025, 0.0], [0.0, -0.029], [-0.015, 0.012], [0.021, 0.021]]).T
     P = model.basis.probes(pts).tocsr()
     R = sp.vstack([P, 0.6 * P[:4] - 0.8 * P[4:]])                          # reads along x, y, a direction
-    G = fe.influence(model, R, F, block=4)
+    G = influence(model, R, F, block=4)
     ref = np.column_stack([R @ fe.solve_load(model, F[:, j].toarray().ravel()) for j in range(F.shape[1])])
     assert np.abs(G - ref).max() < 1e-10 * np.abs(ref).max()
     # a body without its factor object falls back to plain block solves: the same numbers
     import dataclasses
-    plain = fe.influence(dataclasses.replace(model, factor=None, _triangles=None), R, F)
+    plain = influence(dataclasses.replace(model, factor=None, triangles=None), R, F)
     assert np.abs(plain - ref).max() < 1e-10 * np.abs(ref).max()
     # Maxwell-Betti: reading where the other loads gives the transposed coefficient
-    Gs = fe.influence(model, F.T, F)
+    Gs = influence(model, F.T, F)
     assert np.abs(Gs - Gs.T).max() < 1e-10 * np.abs(Gs).max()

@@ -6,6 +6,8 @@ import pytest
 from conftest import SMALL_PAIR, solid_scene
 
 from solver.fe.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
+from study.inputs.compliance import gear_compliance
+from study.inputs.gearsetup import gear_setups
 from study.scene import SceneError, default_scene
 from study.verify import fe_reference as ref_mod
 
@@ -90,7 +92,7 @@ def test_compliance_is_symmetric_and_positive_definite():
     influence matrix nearly symmetric; its symmetric part is positive definite; the foundation
     couples neighbouring teeth (positive off-diagonal blocks, decaying with distance)."""
     s = small_scene(**LIGHT)
-    c, _ = ref_mod.body_compliance_cached(s, 2, [0, 1, 2, 3], 1, n_u=6)
+    c, _ = gear_compliance(gear_setups(s)[1], [0, 1, 2, 3], 1, n_u=6)
     n = c.g.shape[0] * c.g.shape[1]
     M = c.g.reshape(n, n)
     asym = np.abs(M - M.T).max() / np.abs(M).max()
@@ -146,10 +148,11 @@ def test_factorised_bodies_are_reused_for_other_load_sets(monkeypatch):
     real = solver.fe.mesh.mesh_body
     monkeypatch.setattr(solver.fe.mesh, "mesh_body", lambda *a, **k: calls.append(k.get("prefix")) or real(*a, **k))
     s = small_scene(**LIGHT, **{"fe.mesh_size": 1.8})
-    c1, i1 = ref_mod.body_compliance_cached(s, 1, [0], 1, n_u=4)
-    c2, _ = ref_mod.body_compliance_cached(s, 2, [0, 1], 1, n_u=4)
-    c1b, i1b = ref_mod.body_compliance_cached(s, 1, [0], 2, n_u=4)
-    c2b, _ = ref_mod.body_compliance_cached(s, 2, [0, 1, 2], 1, n_u=4)
+    g1, g2 = gear_setups(s)
+    c1, i1 = gear_compliance(g1, [0], 1, n_u=4)
+    c2, _ = gear_compliance(g2, [0, 1], 1, n_u=4)
+    c1b, i1b = gear_compliance(g1, [0], 2, n_u=4)
+    c2b, _ = gear_compliance(g2, [0, 1, 2], 1, n_u=4)
     assert calls == ["gear1.body", "gear2.body"]
     assert "mesh_wall_s" in i1["stages"] and "mesh_wall_s" not in i1b["stages"] and not i1b["cached"]
     assert np.allclose(c1b.block(1, 0), c1.block(1, 0), rtol=1e-12, atol=0)

@@ -96,13 +96,14 @@ def _double_contact_errors(scene, coupling="body-torsion"):
     two pairs in the path of contact, and the single-contact errors."""
     from solver import units
     from study.inputs.coupling import plain_fe_springs
+    from study.setup import gear_setup
     angles = np.radians(np.arange(0.0, scene.quasi_static.rotation, 0.25))
     res, model, _ = ref_mod.reference(scene, angles)
     nominal = np.array([np.count_nonzero(mesh_points(model, a).kind == 1) for a in angles])
     lin = scene.replace(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0})
     sp = []
     for g in (1, 2):
-        k = plain_fe_springs(scene, g) / units.spring_stiffness_to_si(1.0)
+        k = plain_fe_springs(gear_setup(scene, g)) / units.spring_stiffness_to_si(1.0)
         sp.append((k, np.ones_like(k)))
     plain = solve_static(build_scene_model(lin, tuple(sp)), angles, scene.quasi_static.torque).te - res.te
     coupled = solve_static(build_scene_model(scene.replace(**{"coupling.model": coupling})), angles,

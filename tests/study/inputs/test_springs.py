@@ -12,7 +12,9 @@ from solver.identify.weber import pitch_point_depth, weber_deflection
 from solver.peers.energy_method import tooth_compliance
 from solver.peers.iso6336 import blank_factor, single_stiffness
 from study.inputs import springs
+from study.inputs.gearsetup import gear_setup
 from study.scene import default_scene
+from study.setup import solid_scene
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
@@ -24,25 +26,25 @@ def small_scene(**kw):
 
 
 def test_solid_body_gives_the_same_stiffness_to_every_tooth():
-    s = small_scene(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 20.0})
-    k = springs.fe_stiffness(s, 2, teeth=[0, 5, 11, 17])
+    s = solid_scene(small_scene())
+    k = springs.fe_stiffness(gear_setup(s, 2), teeth=[0, 5, 11, 17])
     assert np.ptp(k) / k.mean() < 2e-3
 
 
 def test_map_has_the_hole_symmetry_and_rotates_with_the_holes():
     s = small_scene()
-    k = springs.fe_stiffness(s, 2)                 # 4 holes, 24 teeth: period 6 teeth
+    k = springs.fe_stiffness(gear_setup(s, 2))     # 4 holes, 24 teeth: period 6 teeth
     assert np.ptp(k) / k.mean() > 0.01            # the holes do show
     assert np.allclose(k, np.roll(k, 6), rtol=3e-3)
     # moving the holes by one tooth pitch moves the map by one tooth
-    k_rot = springs.fe_stiffness(small_scene(**{"gear2.body.hole_phase": 15.0}), 2)
+    k_rot = springs.fe_stiffness(gear_setup(small_scene(**{"gear2.body.hole_phase": 15.0}), 2))
     assert np.allclose(k_rot, np.roll(k, 1), rtol=3e-3)
 
 
 def test_ratio_converges_under_mesh_refinement():
     s = small_scene()
-    _, r0, _ = springs.fe_ratio(s, 2)
-    _, r1, _ = springs.fe_ratio(s.replace(**{"fe.mesh_size": 3.0 / 6}), 2)   # default is module / 4
+    _, r0, _ = springs.fe_ratio(gear_setup(s, 2))
+    _, r1, _ = springs.fe_ratio(gear_setup(s.replace(**{"fe.mesh_size": 3.0 / 6}), 2))   # default is module / 4
     assert np.max(np.abs(r1 / r0 - 1)) < 5e-3
 
 
@@ -51,31 +53,31 @@ def test_solid_gear_needs_no_fe(monkeypatch):
         raise AssertionError("FE called for a solid gear")
     monkeypatch.setattr(springs, "fe_stiffness", boom)
     s = small_scene()
-    k, r = springs.tooth_springs(s, 1)
+    k, r = springs.tooth_springs(gear_setup(s, 1))
     assert np.all(k == s.gear1.spring.k_phi) and np.all(r == 1.0)
-    k, r = springs.tooth_springs(s.replace(**{"gear2.spring.stiffness": "uniform"}), 2)
+    k, r = springs.tooth_springs(gear_setup(s.replace(**{"gear2.spring.stiffness": "uniform"}), 2))
     assert np.all(k == s.gear2.spring.k_phi)
 
 
-def test_spring_options_and_cache(monkeypatch, tmp_path):
+def test_spring_options_and_cache(monkeypatch, tmp_path, private_fe_cache):
     s = small_scene()
-    k, r = springs.tooth_springs(s, 2)
+    k, r = springs.tooth_springs(gear_setup(s, 2))
     assert np.allclose(k, s.gear2.spring.k_phi * r)
     assert 0.5 < r.min() < r.max() < 1.0          # thinner web and holes: softer than solid
     files = list((tmp_path / "cache" / "fe").glob("*.nc"))
     assert len(files) == 2                        # the lightened body and its solid reference
-    springs._memory.clear()
+    private_fe_cache.clear()
     calls = []
     monkeypatch.setattr("solver.fe.mesh.mesh_body", lambda *a, **kw: calls.append(1))
-    k2, r2 = springs.tooth_springs(s, 2)          # from disk, no mesh
+    k2, r2 = springs.tooth_springs(gear_setup(s, 2))   # from disk, no mesh
     assert not calls and np.array_equal(k2, k)
     # 'fe': the nonlinear spring passes through the FE point at the reference moment
     s_fe = s.replace(**{"gear2.spring.stiffness": "fe"})
-    k_nl, _ = springs.tooth_springs(s_fe, 2)
+    k_nl, _ = springs.tooth_springs(gear_setup(s_fe, 2))
     g = gear_geometry(s.tooth_spec(2))
     lever = fe.load_case(g, 0, g.root_radius).lever
     m_ref = s.quasi_static.torque / g.base_radius * lever
-    k_lin = springs.fe_stiffness(s, 2)
+    k_lin = springs.fe_stiffness(gear_setup(s, 2))
     phi_fe = m_ref / k_lin
     phi_nl = (m_ref / (k_nl * 1e-3)) ** (1 / s.gear2.spring.n_k)   # N·mm -> N·m
     assert np.allclose(phi_nl, phi_fe, rtol=1e-10)
@@ -93,7 +95,8 @@ def table1():
         s = default_scene()
         g = gear_geometry(s.tooth_spec(1))
         body = s.body_spec(1)
-        k = {t: springs.fe_stiffness(s, 1, dataclasses.replace(body, web_thickness=t * 1e-3), teeth=[0])[0]
+        setup = gear_setup(s, 1)
+        k = {t: springs.fe_stiffness(dataclasses.replace(setup, body=dataclasses.replace(body, web_thickness=t * 1e-3)), teeth=[0])[0]
              for t in (17.0, 10.0, 5.0)}
         if old is None:
             del os.environ["LIGHTGEAR_CACHE"]
@@ -153,7 +156,7 @@ def test_identification_recovers_a_known_spring_and_reads_the_fe():
     assert r_fit == pytest.approx(r_q, rel=1e-10) and k_fit == pytest.approx(k, rel=1e-10) and err < 1e-10
     phi = np.array([1e-4, 3e-4, 1e-3])
     assert fit_power_law(1060.0 * phi**1.1, phi) == pytest.approx((1060.0, 1.1), rel=1e-10)
-    fit, u, comp = springs.identify_spring(small_scene(), 1, radii=5)
+    fit, u, comp = springs.identify_spring(gear_setup(small_scene(), 1), radii=5)
     assert np.all(np.diff(comp) > 0)                     # higher load point: more compliant
     assert fit.n == pytest.approx(1.0, abs=1e-9)          # the body FE is linear
     g = gear_geometry(small_scene().tooth_spec(1))
@@ -164,7 +167,7 @@ def test_identification_recovers_a_known_spring_and_reads_the_fe():
 def test_lightened_scene_runs_with_its_fe_springs_in_the_archive():
     from study.run import run_scene
     lite = small_scene(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})
-    solid = lite.replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 20.0})
+    solid = solid_scene(lite)
     ds = run_scene(lite, static=True, dynamic=False)
     k = ds["tooth_stiffness"].sel(gear=2).values
     r = ds["stiffness_ratio"].sel(gear=2).values

@@ -1,0 +1,71 @@
+"""Mass properties of a gear: the rigid tooth (from its outline polygon) and the body below the
+root circle (rings at their thickness, less the holes). SI: kg, m, kg·m².
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.geometry import BodySpec, GearGeometry
+
+
+@dataclass(frozen=True)
+class ToothInertia:
+    """Rigid tooth above the root circle: mass [kg], centroid radius [m], inertia [kg·m²]."""
+
+    mass: float
+    centroid_radius: float
+    inertia_centroid: float      # about the centroid (axis along the gear axis)
+    pivot_radius: float
+    inertia_pivot: float         # about the pivot
+    inertia_center: float        # about the gear centre
+
+
+def polygon_properties(x, y):
+    """Area [m²], centroid (x, y) [m] and polar second moment about the origin [m⁴]."""
+    x1, y1 = np.roll(x, -1), np.roll(y, -1)
+    cr = x * y1 - x1 * y
+    area = 0.5 * cr.sum()
+    cx = ((x + x1) * cr).sum() / (6 * area)
+    cy = ((y + y1) * cr).sum() / (6 * area)
+    j0 = ((x * x + x * x1 + x1 * x1 + y * y + y * y1 + y1 * y1) * cr).sum() / 12.0
+    return area, cx, cy, j0
+
+
+def tooth_inertia(g: GearGeometry, density: float, pivot_radius: float) -> ToothInertia:
+    """Mass and inertia of one tooth (the part above the root circle) of face width b."""
+    x, y = g.tooth_polygon()
+    area, cx, cy, j0 = polygon_properties(x, y)
+    b = g.spec.face_width
+    mass = density * area * b
+    j_c = j0 - area * (cx**2 + cy**2)
+    i_c = density * b * j_c
+    i_p = i_c + mass * ((cx - pivot_radius) ** 2 + cy**2)
+    i_o = density * b * j0
+    return ToothInertia(mass, cx, i_c, pivot_radius, i_p, i_o)
+
+
+def hole_inertia(body: BodySpec, density: float) -> tuple[float, float]:
+    """Mass [kg] and polar inertia about the gear axis [kg·m²] of the web material the holes
+    take out (each hole a disc of the web thickness, moved to the hole circle); zero without holes."""
+    mh = density * math.pi * body.hole_radius**2 * body.web_thickness
+    return body.holes * mh, body.holes * mh * (0.5 * body.hole_radius**2 + body.hole_circle_radius**2)
+
+
+def body_inertia(g: GearGeometry, body: BodySpec, density: float) -> tuple[float, float]:
+    """Mass [kg] and polar inertia [kg·m²] of the body inside the root circle (no teeth)."""
+    rf = g.root_radius
+    b = g.spec.face_width
+    r_rim = rf - body.rim_height
+    r_hub = r_rim - body.web_height
+    r_bore = r_hub - body.hub_height
+
+    def ring(r_out, r_in, t):
+        m = density * math.pi * (r_out**2 - r_in**2) * t
+        return m, 0.5 * m * (r_out**2 + r_in**2)
+
+    parts = [ring(rf, r_rim, b), ring(r_rim, r_hub, body.web_thickness), ring(r_hub, r_bore, b)]
+    m_holes, i_holes = hole_inertia(body, density)
+    return sum(p[0] for p in parts) - m_holes, sum(p[1] for p in parts) - i_holes

@@ -1,0 +1,130 @@
+"""The FE cache: one object for everything the FE of a gear body produces and a run reuses.
+
+On disk, under ``$LIGHTGEAR_CACHE/fe`` (default ``./.lightgear-cache/fe``), one file per result,
+named by `FECache.key` of everything the result depends on:
+
+* ``{key}.nc``: a tooth-stiffness map (NetCDF, ``k_fe`` [N·m/rad] per tooth, the settings as a
+  JSON attribute);
+* ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.ltca.BodyCompliance`).
+
+In memory: the same results once read or computed, the last `BODY_SLOTS` factorised bodies (a
+reference and the coupling fits of both gears reuse them) and the coupling fits. `FE_CACHE` is
+the process-wide instance; `FECache.clear` forgets everything held in memory (the disk stays).
+A missing or unreadable file is recomputed; a read-only folder only costs recomputation.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+BODY_SLOTS = 2      # factorised bodies kept: one per gear (each up to ~0.5 GB)
+FIT_SLOTS = 16      # coupling fits kept (small: a few arrays of the tooth count)
+
+
+class FECache:
+    """FE results in memory and on disk, keyed by the hash of their settings."""
+
+    def __init__(self):
+        self.stiffness: dict[str, np.ndarray] = {}   # key -> tooth stiffness map [N·m/rad]
+        self.compliance: dict = {}                   # key -> BodyCompliance
+        self.bodies: dict = {}                       # body key -> factorised BodyModel (least recently used first)
+        self.fits: dict = {}                         # fit key -> coupling fit (least recently used first)
+
+    @property
+    def folder(self) -> Path:
+        """The disk folder, read from ``$LIGHTGEAR_CACHE`` at each use."""
+        return Path(os.environ.get("LIGHTGEAR_CACHE", ".lightgear-cache")) / "fe"
+
+    @staticmethod
+    def key(settings: dict) -> str:
+        """20 hex digits of the SHA-256 of the settings as sorted JSON (numbers as floats)."""
+        return hashlib.sha256(json.dumps(settings, sort_keys=True, default=float).encode()).hexdigest()[:20]
+
+    def clear(self) -> None:
+        """Forget every result held in memory (maps, compliances, factorised bodies, fits)."""
+        for held in (self.stiffness, self.compliance, self.bodies, self.fits):
+            held.clear()
+
+    def _read(self, held: dict, key: str, name: str, load):
+        """The result of ``key`` from ``held``, else loaded from the file ``name`` (None when
+        the file is missing or unreadable: it is then recomputed and overwritten)."""
+        if key not in held:
+            path = self.folder / name
+            if not path.exists():
+                return None
+            try:
+                held[key] = load(path)
+            except (OSError, KeyError, ValueError):
+                return None
+        return held[key]
+
+    # ---- tooth stiffness maps
+    def read_stiffness(self, key: str) -> np.ndarray | None:
+        """A copy of the stiffness map of ``key`` from memory or disk, or None."""
+        def load(path):
+            import xarray as xr
+            with xr.open_dataset(path) as ds:
+                return ds["k_fe"].values.copy()
+        k = self._read(self.stiffness, key, f"{key}.nc", load)
+        return None if k is None else k.copy()
+
+    def write_stiffness(self, key: str, k: np.ndarray, settings: dict) -> None:
+        import xarray as xr
+
+        from study.report.results import write_netcdf
+        self.stiffness[key] = k.copy()
+        ds = xr.Dataset({"k_fe": xr.Variable("tooth", k, {"units": "N m rad-1", "long_name": "FE tooth torsion stiffness"})},
+                        attrs={"settings": json.dumps(settings, default=float)})
+        try:
+            write_netcdf(ds, self.folder / f"{key}.nc")
+        except OSError:
+            pass
+
+    # ---- bulk compliances
+    def read_compliance(self, key: str):
+        """The `BodyCompliance` of ``key`` from memory or disk, or None."""
+        def load(path):
+            from solver.fe.ltca import BodyCompliance
+            with np.load(path) as d:
+                return BodyCompliance(d["u"], d["read"], d["load"], d["g"], bool(d["symmetric"]), int(d["teeth"]))
+        return self._read(self.compliance, key, f"ltca-{key}.npz", load)
+
+    def write_compliance(self, key: str, c) -> None:
+        self.compliance[key] = c
+        path = self.folder / f"ltca-{key}.npz"
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.stem}.tmp.npz")      # readers never see a half-written file
+            np.savez(tmp, u=c.u, read=c.read_teeth, load=c.load_teeth, g=c.g, symmetric=c.symmetric_body, teeth=c.teeth)
+            tmp.replace(path)
+        except OSError:
+            pass
+
+    # ---- factorised bodies and fits (memory only)
+    def body(self, key: str, build):
+        """The factorised body of ``key``, made by ``build()`` when it is not among the last
+        `BODY_SLOTS` used."""
+        model = self.bodies.pop(key, None)
+        if model is None:
+            while len(self.bodies) >= BODY_SLOTS:     # drop the least recently used first
+                self.bodies.pop(next(iter(self.bodies)))
+            model = build()
+        self.bodies[key] = model                      # most recently used last
+        return model
+
+    def fit(self, key, build):
+        """The coupling fit of ``key`` (any hashable), made by ``build()`` when not held."""
+        fit = self.fits.pop(key, None)
+        if fit is None:
+            while len(self.fits) >= FIT_SLOTS:
+                self.fits.pop(next(iter(self.fits)))
+            fit = build()
+        self.fits[key] = fit
+        return fit
+
+
+FE_CACHE = FECache()
