@@ -1,4 +1,6 @@
 """The tiny study the sweep, grid and archive tests share, and its sweep run once per session."""
+import pytest
+
 from study.sweep.engine import run_sweep
 from study.sweep.grid import loads_study
 
@@ -28,13 +30,11 @@ def tiny_study(grid=GRID, base=BASE, title="tiny"):
     return loads_study(f'title = "{title}"\n' + base + grid)
 
 
-_swept: dict = {}
 
 
-def swept_once(tmp_path_factory):
+@pytest.fixture(scope="session")
+def swept(tmp_path_factory):
     """The tiny study swept in process, once per test session -> (SweepResult, archive path).
     Tests only read it (and copy the archive before they change anything)."""
-    if not _swept:
-        out = tmp_path_factory.mktemp("sweep") / "tiny.nc"
-        _swept["tiny"] = (run_sweep(tiny_study(), out, workers=0, progress=False), out)
-    return _swept["tiny"]
+    out = tmp_path_factory.mktemp("sweep") / "tiny.nc"
+    return run_sweep(tiny_study(), out, workers=0, progress=False), out

@@ -1,16 +1,10 @@
 """Study archives: labels and units, the NetCDF round trip, and split studies opening as one."""
-import pytest
 import xarray as xr
-from sweep_cases import GRID, swept_once, tiny_study
+from sweep_cases import GRID, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
 
 from study.sweep.engine import parts_folder, run_sweep
 from study.sweep.grid import loads_study
 from study.sweep.outputs import STATUS
-
-
-@pytest.fixture(scope="module")
-def swept(tmp_path_factory):
-    return swept_once(tmp_path_factory)
 
 
 def test_archive_labels_units_and_netcdf_round_trip(swept):

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 import xarray as xr
-from sweep_cases import BASE, swept_once, tiny_study
+from sweep_cases import BASE, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
 
 import study.sweep.engine as sweep
 from study.report.summary import summarize
@@ -13,12 +13,6 @@ from study.run import run_scene
 from study.scene import default_scene
 from study.sweep.engine import parts_folder, run_sweep
 from study.sweep.outputs import SCALARS, STATUS
-
-
-@pytest.fixture(scope="module")
-def swept(tmp_path_factory):
-    return swept_once(tmp_path_factory)
-
 
 # ---------------------------------------------------------------- the sweep
 
