@@ -21,6 +21,7 @@ from pathlib import Path
 
 from solver import units
 from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
+from study.toml_writer import dumps_toml
 
 
 class SceneError(ValueError):
@@ -378,33 +379,3 @@ def field_doc(path: str) -> str:
     """Description of a scene field given by its dotted path (its name for a table)."""
     f = scene_field(path)
     return f.metadata.get("doc", f.name)
-
-
-# ---------------------------------------------------------------- TOML writer
-
-def toml_value(v) -> str:
-    """A value as TOML: a scalar, a list (inline array) or a dict (inline table)."""
-    if isinstance(v, list | tuple):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + "}"
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    raise TypeError(f"cannot write {type(v)} to TOML")
-
-
-def dumps_toml(data: dict, prefix: str = "") -> str:
-    """Minimal TOML writer for nested tables of scalars (what scenes hold)."""
-    out = [f"{k} = {toml_value(v)}" for k, v in data.items() if not isinstance(v, dict)]
-    for k, v in data.items():
-        if isinstance(v, dict):
-            name = f"{prefix}.{k}" if prefix else k
-            out += [f"\n[{name}]", dumps_toml(v, name)]
-    return "\n".join(x for x in out if x) + ("\n" if not prefix else "")
-

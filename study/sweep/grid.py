@@ -55,9 +55,9 @@ from study.scene import (
     scene_fields_from_dict,
     scene_from_dict,
     set_dotted,
-    toml_value,
 )
 from study.sweep.outputs import Outputs, outputs_from_table
+from study.toml_writer import toml_value
 
 # dimension names for the fields an engineer sweeps most; others get the dotted path with '_'
 DIM_NAMES = {
