@@ -58,7 +58,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     rep = 3 if args.quick else 5
     rows = []
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
     from solver.mbs.statics import solve_static
     from solver.peers.scipy_dynamics import simulate_scipy
     from study.setup import static_angles

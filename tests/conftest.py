@@ -28,7 +28,7 @@ def solid_scene(**overrides):
 def private_fe_cache(tmp_path, monkeypatch):
     """FE results of the test go to a fresh disk cache, and no in-memory cache (influence
     coefficients, factorised bodies, spring maps, coupling fits) leaks in or out."""
-    from study import run
+    from study import setup
     from study.inputs import springs
     from study.verify import fe_reference as reference
 
@@ -36,7 +36,7 @@ def private_fe_cache(tmp_path, monkeypatch):
         reference._memory.clear()
         reference._bodies.clear()
         springs._memory.clear()
-        run.coupling_fit.cache_clear()
+        setup.coupling_fit.cache_clear()
     monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
     clear()
     yield
@@ -60,7 +60,8 @@ def assert_energy_closes_at_second_order(model, torque=50.0):
     4x per halved step."""
     import numpy as np
 
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
     dt0, _ = stable_time_step(model, torque)
     errs = []
     for dt in (dt0, dt0 / 2):
@@ -79,7 +80,7 @@ def slow_transient_against_statics(model, torque=50.0):
     import numpy as np
 
     from solver.mbs.dynamics import simulate
-    from solver.mbs.kernels.explicit import driver_motion
+    from solver.mbs.kernels.mechanics import driver_motion
     from solver.mbs.statics import solve_static
     r = simulate(model, 1.0, 0.001, torque, 0.001, 0.05, output_step=1e-4)
     assert r.status == 0
