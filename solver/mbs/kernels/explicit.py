@@ -30,6 +30,7 @@ from solver.mbs.kernels.layout import (
     H_TH2,
     I_CPL,
     I_P,
+    I_TOT,
     N_STEPS,
     OUT_EVERY,
     POS,
@@ -49,17 +50,14 @@ from solver.mbs.kernels.mechanics import (
     driver_motion,
     driver_speed,
     load_torque,
-    pair_energies,
+    mesh_energies,
 )
 from solver.mbs.kernels.stepping import (
     OK,
     activate,
-    checked_status,
-    close_step,
+    end_step,
     initial_set,
-    loaded_contacts,
     record_output,
-    release_teeth,
     work_arrays,
 )
 
@@ -76,12 +74,13 @@ def verlet(mdl, ctl, hub, teeth, out):
     guards of `stepping` (energy growth beyond par[ENERGY_TOL], checked at the output
     instants). Returns (status, step reached, max active teeth, 0).
     """
-    gp, pp, lp, kphi, _ct = mdl
+    gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, table = ctl
     phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
     tz2 = int(gp[1, TOOTH0])
     dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
-    rec, pairs, q, vpred, tset, book = work_arrays(phi.shape[0])
+    ws = work_arrays(phi.shape[0])
+    rec, pairs, q, vpred, tset, book = ws
     act = tset[T_ACT]
     theta2, w2 = hub[POS, H_TH2], hub[RATE, H_TH2]
     th1, w1, acc1 = driver_motion(0.0, speed, ramp)
@@ -92,14 +91,14 @@ def verlet(mdl, ctl, hub, teeth, out):
     a2, s1, r1 = arrowhead_accelerations(q, act, nact, gp, acc)
     react = s1 * acc1 + r1
     cr1 = gp[0, I_CPL] / gp[0, I_P]
-    ke, pe = pair_energies(w1, w2, teeth, act, nact, mdl, rec, nc)
+    ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+                           teeth, act, nact, mdl, rec, nc)
     book[B_E0] = ke + pe
     book[B_P_IN] = react * w1 + tl * w2
     book[B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
     te0 = gp[0, RB] * th1 + gp[1, RB] * theta2
     o = max_act = np.int64(0)
-    record_output(out, o, 0.0, te0, theta2, react, ke, pe, nc, book)
-    status = np.int64(OK)
+    status = record_output(out, o, (0.0, te0, theta2, react, ke, pe), book, rec, nc, True, par, np.int64(OK))
     step = 0
     for step in range(1, ipar[N_STEPS] + 1):
         # half kick (the driver coupling of gear-1 teeth as its exact speed increment), drift
@@ -131,7 +130,8 @@ def verlet(mdl, ctl, hub, teeth, out):
         for a in range(n_old, nact):
             acc[act[a]] = 0.0
             vpred[act[a]] = 0.0
-        q[:] = 0.0
+        for i in range(q.shape[0]):
+            q[i] = 0.0
         generalized_forces(rec, nc, phi, vpred, act, nact, kphi, gp, tl, q)
         a2, s1, r1 = arrowhead_accelerations(q, act, nact, gp, acc)
         react = s1 * acc1 + r1
@@ -145,15 +145,15 @@ def verlet(mdl, ctl, hub, teeth, out):
         # one-sided driver torques where the speed ramp ends on this instant
         p_in_left = (s1 * driver_acc_left(t, speed, ramp) + r1) * w1 + tl * w2
         p_d = dissipation_power(vpred, act, nact, mdl, rec, nc)
-        status = close_step(book, rec, nc, p_in_left, react * w1 + tl * w2, p_d, par, status)
-        nact = release_teeth(tset, nact, teeth, q, pairs, npair, tz2, par)
+        status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * w2, p_d), par, status)
         max_act = max(max_act, nact)
         if step % ipar[OUT_EVERY] == 0:
             o += 1
-            ke, pe = pair_energies(w1, w2, teeth, act, nact, mdl, rec, nc)
+            ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+                                   teeth, act, nact, mdl, rec, nc)
             te = gp[0, RB] * th1 + gp[1, RB] * theta2
-            record_output(out, o, t, te, theta2, react, ke, pe, loaded_contacts(rec, nc), book)
-            status = checked_status(status, math.isfinite(theta2) and math.isfinite(w2), ke, pe, book, par)
+            finite = math.isfinite(theta2) and math.isfinite(w2)
+            status = record_output(out, o, (t, te, theta2, react, ke, pe), book, rec, nc, finite, par, status)
         if status != OK:
             break
     hub[POS, H_TH2], hub[RATE, H_TH2], hub[ACC, H_TH2] = theta2, w2, a2

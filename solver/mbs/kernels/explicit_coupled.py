@@ -65,12 +65,9 @@ from solver.mbs.kernels.mechanics import dissipation_power, driver_acc_left, dri
 from solver.mbs.kernels.stepping import (
     OK,
     activate,
-    checked_status,
-    close_step,
+    end_step,
     initial_set,
-    loaded_contacts,
     record_output,
-    release_teeth,
     work_arrays,
 )
 from solver.mbs.kernels.toothcoupling import coupled_set, set_energy, set_springs, update_set
@@ -214,8 +211,8 @@ def verlet_coupled(mdl, ctl, hub, teeth, out):
     book[B_P_IN] = react * w1 + tl * v[H_H2]
     book[B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl, rec, nc), gp, w1, v)
     o = max_act = np.int64(0)
-    record_output(out, o, 0.0, gp[0, RB] * th1 + gp[1, RB] * x[H_H2], x[H_H2], react, ke, pe, nc, book)
-    status = np.int64(OK)
+    row = (0.0, gp[0, RB] * th1 + gp[1, RB] * x[H_H2], x[H_H2], react, ke, pe)
+    status = record_output(out, o, row, book, rec, nc, True, par, np.int64(OK))
     step = 0
     for step in range(1, ipar[N_STEPS] + 1):
         t = step * dt
@@ -253,15 +250,14 @@ def verlet_coupled(mdl, ctl, hub, teeth, out):
         # the driver's hub inertia sees the one-sided acceleration where the ramp ends
         p_in_left = (gp[0, I_HUB] * driver_acc_left(t, speed, ramp) + mb1) * w1 + tl * v[H_H2]
         p_d = body_dissipation(dissipation_power(vpred, act, nact, mdl, rec, nc), gp, w1, vp)
-        status = close_step(book, rec, nc, p_in_left, react * w1 + tl * v[H_H2], p_d, par, status)
-        nact = release_teeth(tset, nact, teeth, q, pairs, npair, tz2, par)
+        status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * v[H_H2], p_d), par, status)
         max_act = max(max_act, nact)
         if step % ipar[OUT_EVERY] == 0:
             o += 1
             ke, pe = coupled_energies(mdl, th1, w1, hub, teeth, tset, nact, rec, nc, cset, ns)
             te = gp[0, RB] * th1 + gp[1, RB] * x[H_H2]
-            record_output(out, o, t, te, x[H_H2], react, ke, pe, loaded_contacts(rec, nc), book)
-            status = checked_status(status, math.isfinite(x[H_TH2]) and math.isfinite(x[H_H2]), ke, pe, book, par)
+            finite = math.isfinite(x[H_TH2]) and math.isfinite(x[H_H2])
+            status = record_output(out, o, (t, te, x[H_H2], react, ke, pe), book, rec, nc, finite, par, status)
         if status != OK:
             break
     return status, step, max_act, 0

@@ -84,7 +84,7 @@ from solver.mbs.kernels.mechanics import (
     driver_motion,
     driver_speed,
     load_torque,
-    pair_energies,
+    mesh_energies,
 )
 from solver.mbs.kernels.statics import solve_dense
 from solver.mbs.kernels.stepping import (
@@ -92,12 +92,9 @@ from solver.mbs.kernels.stepping import (
     NONFINITE,
     OK,
     activate,
-    checked_status,
-    close_step,
+    end_step,
     initial_set,
-    loaded_contacts,
     record_output,
-    release_teeth,
     work_arrays,
 )
 
@@ -264,7 +261,7 @@ def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
     the forces q and contacts end at the converged state. drv = (theta1 [rad], theta1'
     [rad/s], load torque [N m], driver acceleration over the step [rad/s²]).
     Returns (status, iterations, contacts, candidate pairs, active teeth)."""
-    gp, pp, lp, kphi, _ct = mdl
+    gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, _table = ctl
     rec, pairs, q, _vpred, tset, _book = ws
     coef, q_old, pred, hpred, _A, _r, dx, _loc, _cl = nw
@@ -334,7 +331,7 @@ def hht(mdl, ctl, hub, teeth, out):
     iterations in a step of each output interval). Returns (status, step reached, max active
     teeth, total Newton iterations).
     """
-    gp, pp, lp, kphi, _ct = mdl
+    gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, table = ctl
     phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
     tz2 = int(gp[1, TOOTH0])
@@ -356,15 +353,16 @@ def hht(mdl, ctl, hub, teeth, out):
             acc[act[a]] = (q[2 + act[a]] - gp[0, I_CPL] * acc1) / gp[0, I_P]
     react = driver_torque(q, act, nact, gp, acc, acc1)
     w2 = hub[RATE, H_TH2]
-    ke, pe = pair_energies(w1, w2, teeth, act, nact, mdl, rec, nc)
+    ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+                           teeth, act, nact, mdl, rec, nc)
     book[B_E0] = ke + pe
     book[B_P_IN] = react * w1 + tl * w2
     book[B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
     o = itmax = total_it = np.int64(0)
-    record_output(out, o, 0.0, gp[0, RB] * th1 + gp[1, RB] * hub[POS, H_TH2], hub[POS, H_TH2], react, ke, pe, nc, book)
+    row = (0.0, gp[0, RB] * th1 + gp[1, RB] * hub[POS, H_TH2], hub[POS, H_TH2], react, ke, pe)
+    status = record_output(out, o, row, book, rec, nc, True, par, np.int64(OK))
     a1_prev = acc1
     max_act = nact
-    status = np.int64(OK)
     step = 0
     for step in range(1, ipar[N_STEPS] + 1):
         t_old = (step - 1) * dt
@@ -387,18 +385,18 @@ def hht(mdl, ctl, hub, teeth, out):
         react = driver_torque(q, act, nact, gp, acc, a1m)
         w2 = hub[RATE, H_TH2]
         p_in = react * w1 + tl * w2
-        status = close_step(book, rec, nc, p_in, p_in, dissipation_power(dphi, act, nact, mdl, rec, nc), par, status)
-        nact = release_teeth(tset, nact, teeth, q, pairs, npair, tz2, par)
+        p_d = dissipation_power(dphi, act, nact, mdl, rec, nc)
+        status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in, p_in, p_d), par, status)
         max_act = max(max_act, nact)
         if step % ipar[OUT_EVERY] == 0:
             o += 1
             theta2 = hub[POS, H_TH2]
-            ke, pe = pair_energies(w1, w2, teeth, act, nact, mdl, rec, nc)
-            record_output(out, o, t, gp[0, RB] * th1 + gp[1, RB] * theta2, theta2, react, ke, pe,
-                          loaded_contacts(rec, nc), book)
+            ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+                                   teeth, act, nact, mdl, rec, nc)
+            row = (t, gp[0, RB] * th1 + gp[1, RB] * theta2, theta2, react, ke, pe)
+            status = record_output(out, o, row, book, rec, nc, math.isfinite(theta2) and math.isfinite(w2), par, status)
             out[o, O_NEWTON] = itmax
             itmax = 0
-            status = checked_status(status, math.isfinite(theta2) and math.isfinite(w2), ke, pe, book, par)
         if status != OK:
             break
     return status, step, max_act, total_it

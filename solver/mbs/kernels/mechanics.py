@@ -87,8 +87,9 @@ def arrowhead_accelerations(q, act, nact, gp, acc):
 def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
     """(kinetic, potential) energy [J]: ``ke`` and ``pe`` of the bodies plus the active teeth,
     their springs and the contacts. w1, w2 [rad/s]: rates of the bodies that carry the teeth
-    of gear 1 and 2; ``teeth`` rows: rotations, rates."""
-    gp, _pp, lp, kphi, _ct = mdl
+    of gear 1 and 2; ``teeth`` rows: rotations, rates. The plain pair's bodies are the rigid
+    gears: ke = I_tot1*w1²/2 + I_tot2*w2²/2, pe = 0."""
+    gp, lp, kphi = mdl[0], mdl[2], mdl[3]
     tz2 = int(gp[1, TOOTH0])
     phi = teeth[0]
     dphi = teeth[1]
@@ -104,18 +105,9 @@ def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
 
 
 @njit(cache=True)
-def pair_energies(w1, w2, teeth, act, nact, mdl, rec, nc):
-    """(kinetic, potential) energy [J] of the plain pair: rigid gears at w1, w2 [rad/s] plus
-    `mesh_energies`."""
-    gp = mdl[0]
-    ke = 0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2
-    return mesh_energies(ke, 0.0, w1, w2, teeth, act, nact, mdl, rec, nc)
-
-
-@njit(cache=True)
 def dissipation_power(dphi, act, nact, mdl, rec, nc):
     """Power [W] of the tooth-spring dampers at the rates dphi and of the contact dampers."""
-    gp, _pp, lp, _kphi, _ct = mdl
+    gp, lp = mdl[0], mdl[2]
     tz2 = int(gp[1, TOOTH0])
     p = 0.0
     for a in range(nact):

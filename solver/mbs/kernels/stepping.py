@@ -14,7 +14,7 @@ int64, not bool: numba then reuses the int64 allocation it compiles anyway inste
 compiling np.zeros once more for bool. ``q``: generalised forces (hubs first, then the teeth).
 
 Running sums of a run sit in ``book`` (`layout` B_* columns); the loops pass the powers of
-each step to `close_step`, which integrates them with the trapezoidal rule.
+each step to `end_step`, which integrates them with the trapezoidal rule.
 """
 import math
 
@@ -115,13 +115,30 @@ def activate(tset, nact, pairs, npair, tz2):
 
 
 @njit(cache=True)
-def release_teeth(tset, nact, teeth, q, pairs, npair, tz2, par):
-    """Set the quiet teeth outside the candidates exactly to rest and drop them from the set,
-    then reset the candidate flags of this step's pre-search pairs.
+def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
+    """The end of a step: guards, energy bookkeeping, and the active set.
 
-    Their rotation, rate, acceleration and generalised force become zero (rigid to the hub,
-    whose inertia already holds them). Returns the new number of active teeth.
+    Records the largest contact force of ws's contacts rec[:nc] and checks the penetration
+    bound (status PENETRATION); integrates the work [J] and the dissipated energy [J] by the
+    trapezoidal rule from the last step's powers to these, powers = (p_in_left, p_in, p_d):
+    input power p_in [W] (p_in_left its left limit at this instant, where the driver
+    acceleration jumps) and dissipation power p_d [W]; sets the quiet teeth outside the
+    candidates exactly to rest (rotation, rate, acceleration and generalised force zero: rigid
+    to the hub, whose inertia already holds them) and drops them from the set; resets the
+    candidate flags of the npair pre-search pairs (gear-2 teeth offset by tz2). Returns (status, new number of active teeth).
     """
+    rec, pairs, q, tset, book = ws[0], ws[1], ws[2], ws[4], ws[5]
+    p_in_left, p_in, p_d = powers
+    for c in range(nc):
+        if rec[c, C_FORCE] > book[B_FMAX]:
+            book[B_FMAX] = rec[c, C_FORCE]
+        if rec[c, C_DELTA] > par[DELTA_MAX]:
+            status = PENETRATION
+    dt = par[DT]
+    book[B_WORK] += 0.5 * dt * (p_in_left + book[B_P_IN])
+    book[B_DISS] += 0.5 * dt * (p_d + book[B_P_D])
+    book[B_P_IN] = p_in
+    book[B_P_D] = p_d
     act = tset[T_ACT]
     a = 0
     while a < nact:
@@ -140,49 +157,29 @@ def release_teeth(tset, nact, teeth, q, pairs, npair, tz2, par):
     for p in range(npair):
         tset[T_INCAND, int(pairs[p, 0])] = False
         tset[T_INCAND, tz2 + int(pairs[p, 1])] = False
-    return nact
+    return status, nact
 
 
 @njit(cache=True)
-def close_step(book, rec, nc, p_in_left, p_in, p_d, par, status):
-    """Guards and energy bookkeeping at the end of a step: the largest contact force, the
-    penetration bound (status PENETRATION), and the work [J] and dissipated energy [J] by the
-    trapezoidal rule from the last step's powers to these: input power p_in [W] (p_in_left its
-    left limit at this instant, where the driver acceleration jumps) and dissipation power
-    p_d [W]. Returns the status."""
-    for c in range(nc):
-        if rec[c, C_FORCE] > book[B_FMAX]:
-            book[B_FMAX] = rec[c, C_FORCE]
-        if rec[c, C_DELTA] > par[DELTA_MAX]:
-            status = PENETRATION
-    dt = par[DT]
-    book[B_WORK] += 0.5 * dt * (p_in_left + book[B_P_IN])
-    book[B_DISS] += 0.5 * dt * (p_d + book[B_P_D])
-    book[B_P_IN] = p_in
-    book[B_P_D] = p_d
-    return status
+def record_output(out, o, row, book, rec, nc, finite, par, status):
+    """Write output record o (`layout` O_* columns) and check the state; returns the status.
 
-
-@njit(cache=True)
-def loaded_contacts(rec, nc):
-    """Number of the nc contact records that carry a positive normal force."""
+    row = (time [s], TE [m], driven hub angle [rad], driver torque [N m], kinetic and
+    potential energy [J]); with the largest contact force since the last record [N] (then
+    reset), the loaded contacts of rec[:nc], and the work and dissipated energy [J] of
+    ``book``. Status NONFINITE when the state is not ``finite`` or the energies are not,
+    ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
+    [J] above par[ENERGY_TOL] times the energy scale, else ``status`` unchanged.
+    """
+    t, te, theta2, react, ke, pe = row
     n = 0
     for c in range(nc):
         if rec[c, C_FORCE] > 0.0:
             n += 1
-    return n
-
-
-@njit(cache=True)
-def record_output(out, o, t, te, theta2, react, ke, pe, n_contacts, book):
-    """Write output record o (`layout` O_* columns): time [s], TE [m], the largest contact
-    force since the last record [N] (then reset), contacts [-], driver torque [N m], kinetic
-    and potential energy [J], the work and dissipated energy of ``book`` [J], driven hub
-    angle [rad]."""
     out[o, O_TIME] = t
     out[o, O_TE] = te
     out[o, O_FMAX] = book[B_FMAX]
-    out[o, O_NC] = n_contacts
+    out[o, O_NC] = n
     out[o, O_REACT] = react
     out[o, O_KE] = ke
     out[o, O_PE] = pe
@@ -190,13 +187,6 @@ def record_output(out, o, t, te, theta2, react, ke, pe, n_contacts, book):
     out[o, O_DISS] = book[B_DISS]
     out[o, O_THETA2] = theta2
     book[B_FMAX] = 0.0
-
-
-@njit(cache=True)
-def checked_status(status, finite, ke, pe, book, par):
-    """Status after the checks at an output instant: NONFINITE when the state is not finite,
-    ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
-    [J] above par[ENERGY_TOL] times the energy scale, else ``status`` unchanged."""
     if not (finite and math.isfinite(ke + pe)):
         return NONFINITE
     work = book[B_WORK]
