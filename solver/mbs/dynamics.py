@@ -17,6 +17,7 @@ import numpy as np
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.explicit import verlet
 from solver.mbs.kernels.mechanics import driver_motion
+from solver.mbs.kernels.stepping import work_arrays
 from solver.mbs.model import Model
 from solver.mbs.stability import stable_time_step
 
@@ -144,7 +145,7 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
         teeth[L.POS] = 1e-300
     out = np.zeros((n_out, L.N_OUT))
     mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance)
-    ret = kernel(mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out)
+    ret = kernel(mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out, work_arrays(model.n_teeth))
     return ret, out[:min(n_out, ret[1] // out_every + 1)]
 
 

@@ -58,12 +58,11 @@ from solver.mbs.kernels.stepping import (
     end_step,
     initial_set,
     record_output,
-    work_arrays,
 )
 
 
 @njit(cache=True)
-def verlet(mdl, ctl, hub, teeth, out):
+def verlet(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0; write every
     ipar[OUT_EVERY]-th state to ``out`` (`layout` O_* columns).
 
@@ -72,14 +71,14 @@ def verlet(mdl, ctl, hub, teeth, out):
     (n x 2; 0 rows: the torque ramp, see `load_torque`); hub[:, H_TH2] and teeth (rows
     angle, rate, acceleration) the initial state, advanced in place. The run stops on the
     guards of `stepping` (energy growth beyond par[ENERGY_TOL], checked at the output
-    instants). Returns (status, step reached, max active teeth, 0).
+    instants). ws: the work arrays (`stepping.work_arrays`). Returns (status, step reached,
+    max active teeth, 0).
     """
     gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, table = ctl
     phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
     tz2 = int(gp[1, TOOTH0])
     dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
-    ws = work_arrays(phi.shape[0])
     rec, pairs, q, vpred, tset, book = ws
     act = tset[T_ACT]
     theta2, w2 = hub[POS, H_TH2], hub[RATE, H_TH2]
@@ -98,7 +97,7 @@ def verlet(mdl, ctl, hub, teeth, out):
     book[B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
     te0 = gp[0, RB] * th1 + gp[1, RB] * theta2
     o = max_act = np.int64(0)
-    status = record_output(out, o, (0.0, te0, theta2, react, ke, pe), book, rec, nc, True, par, np.int64(OK))
+    status = record_output(out, o, (0.0, te0, theta2, react, ke, pe), book, rec, nc, math.isfinite(te0), par, np.int64(OK))
     step = 0
     for step in range(1, ipar[N_STEPS] + 1):
         # half kick (the driver coupling of gear-1 teeth as its exact speed increment), drift

@@ -68,7 +68,6 @@ from solver.mbs.kernels.stepping import (
     end_step,
     initial_set,
     record_output,
-    work_arrays,
 )
 from solver.mbs.kernels.toothcoupling import coupled_set, set_energy, set_springs, update_set
 
@@ -175,7 +174,7 @@ def new_candidates(newl, incand, pairs, npair, tz2):
 
 
 @njit(cache=True)
-def verlet_coupled(mdl, ctl, hub, teeth, out):
+def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0 (see the module docstring);
     arguments, outputs and guards as `explicit.verlet`, with the body angles hub[:, H_*]
     (driver rim, driven rim, driven hub) and TE and theta2 at the hubs. mdl[4]: the tooth
@@ -187,7 +186,6 @@ def verlet_coupled(mdl, ctl, hub, teeth, out):
     phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
     tz2 = int(gp[1, TOOTH0])
     dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
-    ws = work_arrays(phi.shape[0])
     rec, pairs, q, vpred, tset, book = ws
     act = tset[T_ACT]
     x, v, ha = hub[POS], hub[RATE], hub[ACC]
@@ -212,7 +210,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out):
     book[B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl, rec, nc), gp, w1, v)
     o = max_act = np.int64(0)
     row = (0.0, gp[0, RB] * th1 + gp[1, RB] * x[H_H2], x[H_H2], react, ke, pe)
-    status = record_output(out, o, row, book, rec, nc, True, par, np.int64(OK))
+    status = record_output(out, o, row, book, rec, nc, math.isfinite(row[1]), par, np.int64(OK))
     step = 0
     for step in range(1, ipar[N_STEPS] + 1):
         t = step * dt

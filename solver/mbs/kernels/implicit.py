@@ -95,7 +95,6 @@ from solver.mbs.kernels.stepping import (
     end_step,
     initial_set,
     record_output,
-    work_arrays,
 )
 
 # coefficients of the scheme: nw[0]
@@ -324,7 +323,7 @@ def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
 
 
 @njit(cache=True)
-def hht(mdl, ctl, hub, teeth, out):
+def hht(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0 with HHT-alpha (par[HHT_ALPHA]
     in [-1/3, 0]); arguments, outputs and guards as `explicit.verlet`, plus Newton's
     par[NEWTON_TOL] [m] and ipar[MAX_ITER] per step, and out[:, O_NEWTON] (most Newton
@@ -336,7 +335,6 @@ def hht(mdl, ctl, hub, teeth, out):
     phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
     tz2 = int(gp[1, TOOTH0])
     dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
-    ws = work_arrays(phi.shape[0])
     rec, pairs, q, _vpred, tset, book = ws
     nw = newton_arrays(phi.shape[0], par[HHT_ALPHA], dt)
     act = tset[T_ACT]
@@ -360,7 +358,7 @@ def hht(mdl, ctl, hub, teeth, out):
     book[B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
     o = itmax = total_it = np.int64(0)
     row = (0.0, gp[0, RB] * th1 + gp[1, RB] * hub[POS, H_TH2], hub[POS, H_TH2], react, ke, pe)
-    status = record_output(out, o, row, book, rec, nc, True, par, np.int64(OK))
+    status = record_output(out, o, row, book, rec, nc, math.isfinite(row[1]), par, np.int64(OK))
     a1_prev = acc1
     max_act = nact
     step = 0

@@ -64,10 +64,11 @@ ENERGY = 3
 NEWTON = 4
 
 
-@njit(cache=True)
 def work_arrays(ntooth):
-    """(rec, pairs, q, vpred, tset, book) of a loop over ntooth teeth: contact records,
-    candidate pairs, generalised forces, predicted tooth rates, active set, running sums."""
+    """(rec, pairs, q, vpred, tset, book), the work arrays ``ws`` of a loop over ntooth teeth:
+    contact records, candidate pairs, generalised forces, predicted tooth rates, active set,
+    running sums. Plain Python (the caller allocates them: one numba function less to
+    compile)."""
     rec = np.zeros((MAX_CONTACTS, N_C_COLS))
     pairs = np.zeros((MAX_CONTACTS, 3), dtype=np.int64)
     q = np.zeros(ntooth + 2)

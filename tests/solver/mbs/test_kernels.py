@@ -137,7 +137,7 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code():
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
     names = {ln.split()[0] for ln in lines}
-    assert {"static_sweep", "verlet", "mesh_contacts", "pair_contacts", "work_arrays", "end_step", "record_output",
+    assert {"static_sweep", "verlet", "mesh_contacts", "pair_contacts", "end_step", "record_output",
             "arrowhead_accelerations", "mesh_energies", "dissipation_power"} <= names
     assert not [ln for ln in lines if "Literal" in ln]
     assert not [ln for ln in lines if int(ln.split()[1]) > 1]

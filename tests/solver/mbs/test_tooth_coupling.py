@@ -192,6 +192,7 @@ def test_coupled_kernel_matches_its_plain_python_run():
     """The compiled coupled loop against the same loop run as plain Python, set changes
     included (300 steps through a change of the candidate teeth)."""
     from solver.mbs.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.kernels.stepping import work_arrays
     from solver.mbs.stability import stable_time_step
     m = coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0})
     dt, _ = stable_time_step(m, 50.0)
@@ -209,7 +210,7 @@ def test_coupled_kernel_matches_its_plain_python_run():
         hub[L.RATE, L.H_TH2] = hub[L.RATE, L.H_H2] = -300.0
         teeth = np.zeros((3, m.n_teeth))
         mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance)
-        res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out)
+        res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out, work_arrays(m.n_teeth))
         runs.append((res, out, teeth[L.POS]))
     (r1, o1, p1), (r2, o2, p2) = runs
     assert r1 == r2 and r1[0] == 0
