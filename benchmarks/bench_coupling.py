@@ -24,7 +24,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="solid pair only, fewer repeats")
     args = ap.parse_args(argv)
     os.environ.setdefault("LIGHTGEAR_CACHE", str(common.ROOT / ".lightgear-cache"))
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
     from solver.mbs.statics import solve_static
     from study.setup import build_scene_model, static_angles
 

@@ -52,7 +52,8 @@ def dynamic_rows(kind, m, rep, quick):
     import exudyn
     from peers.exudyn_pair import simulate_exudyn
 
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
     from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
     win = SHORT_DYNAMIC
     T = win[-1]

@@ -1,7 +1,7 @@
 """Where the explicit solver's time goes: one velocity-Verlet step of the paper's dynamic case
 against its parts, each timed in a numba loop at a loaded state of the solid Table 1 pair.
 
-Parts: the contact search (pre-search + closed forms, `kernels/mesh.py mesh_contacts`), the
+Parts: the contact search (pre-search + closed forms, `kernels/gearmesh.py mesh_contacts`), the
 generalised forces, the arrowhead solve and the energy/dissipation bookkeeping, for a small
 active set (the teeth near the mesh) and for every tooth active. The whole step comes from
 `simulate` runs of 20 ms at 100 rad/s (CPU time per step, best of 3).
@@ -16,8 +16,8 @@ import common  # noqa: I001  (first: pins BLAS to one thread before numpy loads)
 import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.explicit import _accelerations, _dissipation_power
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
+from solver.mbs.kernels.mechanics import arrowhead_accelerations, dissipation_power
 
 COLUMNS = ("part", "active_teeth", "ns_per_call", "note")
 N_CALLS = 200_000
@@ -33,20 +33,20 @@ def _loop_contacts(n, th1, th2, phi, dphi, gp, pp, lp, pairs, rec):
 
 
 @njit(cache=False)
-def _loop_forces(n, rec, nc, phi, dphi, act, nact, kphi, gp, q, acc, tz2, lp):
+def _loop_forces(n, rec, nc, phi, dphi, act, nact, kphi, gp, q, acc):
     s = 0.0
-    for k in range(n):
+    for _k in range(n):
         generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, 50.0, q)
-        a2, s1, r1 = _accelerations(q, act, nact, gp, acc, tz2)
+        a2, _s1, _r1 = arrowhead_accelerations(q, act, nact, gp, acc)
         s += a2
     return s
 
 
 @njit(cache=False)
-def _loop_bookkeeping(n, dphi, act, nact, gp, rec, nc, lp, tz2):
+def _loop_bookkeeping(n, dphi, act, nact, mdl, rec, nc):
     s = 0.0
-    for k in range(n):
-        s += _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
+    for _k in range(n):
+        s += dissipation_power(dphi, act, nact, mdl, rec, nc)
     return s
 
 
@@ -61,17 +61,18 @@ def per_call(fn, *args) -> float:
 
 
 def main(argv=None) -> int:
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
     from solver.mbs.kernels import layout as L
     from solver.mbs.kernels.gearmesh import new_contact_buffer
+    from solver.mbs.stability import stable_time_step
     from solver.mbs.statics import solve_static
     m = common.model("solid")
     gp, pp, lp = m.gear_par, m.pair_par, m.law_par
+    mdl = (gp, pp, lp, m.k_phi, m.tooth_compliance)
     tz2 = int(gp[1, L.TOOTH0])
     theta1 = np.radians(2.0)
     st = solve_static(m, np.array([theta1]), 50.0)
-    from solver.mbs.dynamics import _phi_at
-    phi = _phi_at(m, theta1, 50.0, st.te[0])
+    phi = st.phi_last
     dphi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()
     nc, npair = mesh_contacts(theta1, st.theta2[0], phi, 100.0, 100.0, dphi, gp, pp, lp, pairs, rec)
@@ -83,10 +84,10 @@ def main(argv=None) -> int:
     acc = np.zeros(m.n_teeth)
     for label, act in (("near the mesh", np.array(near, dtype=np.int64)), ("all teeth", np.arange(m.n_teeth, dtype=np.int64))):
         rows.append(dict(part="forces + arrowhead solve", active_teeth=act.size,
-                         ns_per_call=per_call(_loop_forces, rec, nc, phi, dphi, act, act.size, m.k_phi, gp, q, acc, tz2, lp),
+                         ns_per_call=per_call(_loop_forces, rec, nc, phi, dphi, act, act.size, m.k_phi, gp, q, acc),
                          note=label))
         rows.append(dict(part="dissipation power (energy balance)", active_teeth=act.size,
-                         ns_per_call=per_call(_loop_bookkeeping, dphi, act, act.size, gp, rec, nc, lp, tz2), note=label))
+                         ns_per_call=per_call(_loop_bookkeeping, dphi, act, act.size, mdl, rec, nc), note=label))
     dt, _w = stable_time_step(m, 50.0)
     for pq in (1e-9, 1e-6):
         simulate(m, 100.0, 0.01, 50.0, 0.01, 1e-3, dt=dt)

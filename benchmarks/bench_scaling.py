@@ -42,7 +42,8 @@ def z_model(z: int):
 
 
 def point(series, value, m, speed=100.0, phi_quiet=1e-9, all_teeth=False, note=""):
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
     from solver.peers.scipy_dynamics import simulate_explicit_all_teeth
     dt, _w = stable_time_step(m, TORQUE)
     if all_teeth:

@@ -54,7 +54,8 @@ def run_first_call(cache_dir: str) -> tuple[dict, float]:
 def main(argv=None) -> int:
     args, rep = common.quick_options(__doc__.splitlines()[0], "fewer repeats, no lightened scene", argv)
     rows = []
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
     from solver.mbs.statics import solve_static
     from solver.peers.scipy_dynamics import simulate_scipy
     from study.setup import static_angles

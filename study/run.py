@@ -29,15 +29,11 @@ def run_static(scene: Scene, model: Model):
     if qs.method == "static":
         return solve_static(model, angles, qs.torque, raise_on_failure=False)
     # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles
-    from solver.mbs.kernels.explicit import driver_motion
+    from solver.mbs.dynamics import at_driver_angles, slow_ramp_window
     from solver.mbs.statics import StaticResult
-    dt_out = math.radians(qs.angle_step) / qs.speed / 4
-    t_end = qs.ramp_time / 2 + angles[-1] / qs.speed + 2 * dt_out
+    dt_out, t_end = slow_ramp_window(angles, math.radians(qs.angle_step), qs.speed, qs.ramp_time)
     dyn = simulate(model, qs.speed, qs.ramp_time, qs.torque, qs.ramp_time, t_end, output_step=dt_out)
-    th1 = np.array([driver_motion(t, qs.speed, qs.ramp_time)[0] for t in dyn.time])
-    te = np.interp(angles, th1, dyn.te, right=np.nan)
-    th2 = np.interp(angles, th1, dyn.theta2, right=np.nan)
-    nc = np.round(np.interp(angles, th1, dyn.n_contacts)).astype(np.int64)
+    te, th2, nc = at_driver_angles(dyn, qs.speed, qs.ramp_time, angles)
     it = np.where(np.isfinite(te), 1, -1)
     return StaticResult(angles, te, th2, nc, np.full((angles.size, model.teeth[0]), np.nan), it, qs.torque, np.full(model.n_teeth, np.nan))
 

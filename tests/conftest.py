@@ -51,7 +51,8 @@ def assert_energy_closes_at_second_order(model, torque=50.0):
     4x per halved step."""
     import numpy as np
 
-    from solver.mbs.dynamics import simulate, stable_time_step
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
     dt0, _ = stable_time_step(model, torque)
     errs = []
     for dt in (dt0, dt0 / 2):
@@ -70,7 +71,7 @@ def slow_transient_against_statics(model, torque=50.0):
     import numpy as np
 
     from solver.mbs.dynamics import simulate
-    from solver.mbs.kernels.explicit import driver_motion
+    from solver.mbs.kernels.mechanics import driver_motion
     from solver.mbs.statics import solve_static
     r = simulate(model, 1.0, 0.001, torque, 0.001, 0.05, output_step=1e-4)
     assert r.status == 0

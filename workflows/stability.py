@@ -35,8 +35,9 @@ import xarray as xr
 
 import study
 from solver import units
-from solver.mbs.dynamics import linearized_system, simulate
+from solver.mbs.dynamics import simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.stability import linearized_system
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_scipy
 from study.report import results

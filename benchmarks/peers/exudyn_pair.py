@@ -1,7 +1,7 @@
 """The pseudo-rigid-tooth gear pair built in Exudyn (C++ multibody code, Python front end).
 
 One `NodeGenericODE2` carries the free coordinates q = [theta2, phi_0 .. phi_{N-1}] [rad]
-(every tooth of both gears free, as in `solver.peers.scipy_dynamics.PairEquations`); an
+(every tooth of both gears free, as in `solver.peers.pair_equations.PairEquations`); an
 `ObjectGenericODE2` holds the constant arrowhead mass matrix of hubs and teeth (driver hub
 prescribed, so it is not a coordinate) and a force user function that returns the
 generalised forces: the torsion springs of eq. (1.2), the involute contact of eq. (1.3)
@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from solver.peers.scipy_dynamics import PairEquations, driver_motion
+from solver.peers.pair_equations import PairEquations, driver_motion
 
 
 def mass_matrix(eq: PairEquations) -> np.ndarray:

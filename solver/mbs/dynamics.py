@@ -1,10 +1,11 @@
 """Time integration of the pair under the prescribed speed ramp and the load-torque ramp.
 
 `simulate` runs the explicit velocity-Verlet kernel (`kernels/explicit.py`, or
-`kernels/explicit_coupled.py` for a body-torsion coupled model) with a fixed step. By default
-the step comes from the scene's highest natural frequency: the model is linearised at static equilibrium at several positions across one mesh cycle under the full
-load, and ``dt = safety * 2 / omega_max`` (Verlet is stable for omega*dt < 2), reduced where
-the modal damping of the loaded contacts asks for it (`stability_limit`).
+`kernels/explicit_coupled.py` for a body-torsion coupled model) with a fixed step, by default
+the stability bound of `solver.mbs.stability`. Shared by every fixed-step integrator (the
+implicit one and the peers too): the step grid (`step_grid`), the load inputs
+(`run_loads`), the kernel call (`run_kernel`), the guard messages, and the reading of a run
+at driver angles (`at_driver_angles`, the slow-ramp quasi-static transient).
 """
 from __future__ import annotations
 
@@ -12,14 +13,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.explicit import verlet
-from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
-from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
+from solver.mbs.kernels.mechanics import driver_motion
+from solver.mbs.kernels.stepping import work_arrays
 from solver.mbs.model import Model
-from solver.mbs.statics import solve_static
+from solver.mbs.stability import stable_time_step
 
 STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound", 3: "energy growth",
                4: "Newton failure"}
@@ -68,127 +68,6 @@ def status_message(status: int, step: int, dt: float, delta_max: float, raise_on
     return msg
 
 
-def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False):
-    """Mass and tangent stiffness over the free DOFs (theta2, then the teeth near the mesh).
-
-    Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF. With
-    ``damping`` also the damping tangent at rest, (M, K, C, dof_teeth): spring dampers and
-    contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1).
-    The damping laws run as plain Python here (``.py_func``, a few dozen calls): compiling
-    them would add to the first run's compile time for nothing.
-    """
-    rec, pairs = new_contact_buffer()
-    zeros = np.zeros(model.n_teeth)
-    gp = model.gear_par
-    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, model.pair_par, model.law_par, pairs, rec)
-    tz2 = int(gp[1, L.TOOTH0])
-    teeth = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
-    pos = {t: i + 1 for i, t in enumerate(teeth)}
-    n = len(teeth) + 1
-    M = np.zeros((n, n))
-    K = np.zeros((n, n))
-    C = np.zeros((n, n))
-    M[0, 0] = gp[1, L.I_TOT]
-    lp = model.law_par
-    for t, i in pos.items():
-        g = 1 if t >= tz2 else 0
-        M[i, i] = gp[g, L.I_P]
-        if g == 1:
-            M[0, i] = M[i, 0] = gp[1, L.I_CPL]
-        if not model.teeth_coupled:
-            K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
-        C[i, i] += spring_damping_tangent.py_func(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
-    if model.teeth_coupled:     # the springs of the teeth near the mesh: (C[S, S])^-1
-        K[1:, 1:] += np.linalg.inv(model.tooth_compliance[np.ix_(teeth, teeth)])
-    for c in range(nc):
-        kt = rec[c, L.C_KT]
-        ia = int(rec[c, L.C_TOOTH1])
-        ib = tz2 + int(rec[c, L.C_TOOTH2])
-        idx = [0, pos[ia], pos[ib]]
-        g = np.array([rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB]])
-        K[np.ix_(idx, idx)] += kt * np.outer(g, g)
-        _kd, cd = contact_damping_tangents.py_func(rec[c, L.C_DELTA], 0.0, max(rec[c, L.C_FORCE], 1e-300),
-                                           lp[L.C_CON], lp[L.M2], lp[L.M3])
-        C[np.ix_(idx, idx)] += cd * np.outer(g, g)
-    if damping:
-        return M, K, C, teeth
-    return M, K, teeth
-
-
-def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[float, float]:
-    """(critical Verlet step [s], highest natural frequency [rad/s]) of the loaded pair over one
-    mesh cycle.
-
-    The pair is linearised at static equilibrium under ``torque`` [N·m] (1 N·m if zero) at
-    ``positions`` driver angles across one angular pitch; the generalised eigenproblem
-    K x = w² M x gives the frequencies. Each mode i, with its modal damping ratio
-    zeta_i = x_i^T C x_i / (2 w_i) (mass-normalised x_i), limits the step to
-    2/w_i * (sqrt(1 + zeta_i²) - zeta_i): velocity Verlet with damping forces evaluated at the
-    predicted velocity is stable up to there (2/w_i undamped). A deep, damped contact (m3 > 1)
-    can make a lower but overdamped mode the limit. The equilibria come from one static sweep
-    with continuation (tooth rotations carried from angle to angle); positions where it does
-    not converge are left out.
-    """
-    angles = np.linspace(0.0, model.geometry[0].pitch_angle, positions, endpoint=False)
-    load = torque if abs(torque) > 1e-9 else 1.0
-    wmax = 0.0
-    dt_crit = math.inf
-    phi, te0, used = None, None, 0
-    for theta1 in angles:
-        st = solve_static(model, np.array([theta1]), load, phi0=phi, te0=te0, raise_on_failure=False)
-        if not st.converged[0]:
-            continue
-        phi, te0 = st.phi_last, float(st.te[0])
-        # a coupled model's mesh sits at the rim angles: the hubs less the body wind-up
-        kb1, kb2 = model.body_stiffness
-        rb1, rb2 = model.base_radii
-        rim1 = theta1 - load * rb1 / rb2 / kb1
-        rim2 = st.theta2[0] - load / kb2
-        M, K, C, _t = linearized_system(model, rim1, rim2, phi, damping=True)
-        lam, x = scipy.linalg.eigh(K, M)
-        w = np.sqrt(np.maximum(lam, 0.0))
-        h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
-        lim = 2.0 / np.maximum(np.hypot(w, h) + h, 1e-300)    # = 2/w (sqrt(1+zeta²) - zeta)
-        wmax = max(wmax, float(w.max()))
-        dt_crit = min(dt_crit, float(lim.min()))
-        used += 1
-    if used == 0:
-        raise ValueError(f"no static equilibrium under {load} N·m found to estimate the highest natural frequency")
-    return dt_crit, wmax
-
-
-def highest_frequency(model: Model, torque: float, positions: int = 12) -> float:
-    """Highest natural frequency [rad/s] of the loaded pair over one mesh cycle (see
-    `stability_limit`)."""
-    return stability_limit(model, torque, positions)[1]
-
-
-def body_frequency(model: Model) -> float:
-    """Highest natural frequency [rad/s] of the body springs alone (hub against rim and teeth);
-    the tooth modes of `highest_frequency` are usually far above it."""
-    gp = model.gear_par
-    w = 0.0
-    for g in range(2):
-        if gp[g, L.K_BODY] > 0:
-            i_rim = gp[g, L.I_TOT] - gp[g, L.I_HUB]
-            inv = 1.0 / i_rim + (1.0 / gp[g, L.I_HUB] if g == 1 else 0.0)   # the driver's hub is prescribed
-            w = max(w, math.sqrt(gp[g, L.K_BODY] * inv))
-    return w
-
-
-def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[float, float]:
-    """(dt [s], omega_max [rad/s]) for the explicit integrator: safety times the critical step
-    of `stability_limit` (2/omega_max without damping)."""
-    dt_crit, w = stability_limit(model, torque)
-    if model.coupled:   # the body modes are not in the mesh linearisation
-        wb = body_frequency(model)
-        w = max(w, wb)
-        dt_crit = min(dt_crit, 2.0 / wb)
-    if not w > 0:
-        raise ValueError("no loaded contact found to estimate the highest natural frequency")
-    return safety * dt_crit, w
-
-
 def load_profile(table) -> np.ndarray:
     """A resisting-torque profile as the kernels take it: (n, 2) [time s, torque N·m], times
     from 0, strictly increasing; ``None`` or an empty table -> (0, 2) (the ramp)."""
@@ -222,10 +101,86 @@ def run_loads(load_table, torque: float) -> tuple[np.ndarray, float, float]:
     return table, float(table[np.argmax(np.abs(table[:, 1])), 1]), side
 
 
+def step_grid(dt: float, output_step: float, duration: float) -> tuple[float, int, int, int]:
+    """(dt [s], steps per output, steps, output records) of a fixed-step run: ``dt`` rounded
+    down so that ``output_step`` [s] is a whole number of steps (a step within 1e-9 of a
+    divisor is kept: the ends of ramps that are multiples of output_step then fall on step
+    boundaries), steps to cover ``duration`` [s], records including t = 0."""
+    out_every = max(1, int(math.ceil(output_step / dt - 1e-9)))
+    dt = output_step / out_every
+    n_steps = int(round(duration / dt))
+    return dt, out_every, n_steps, n_steps // out_every + 1
+
+
+def check_positive(**values: float) -> None:
+    """Raise ValueError naming the first of ``values`` that is not positive and finite."""
+    for name, v in values.items():
+        if not (v > 0 and math.isfinite(v)):
+            raise ValueError(f"{name}: must be positive, got {v}")
+
+
+def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_teeth: bool = False):
+    """Run a stepping kernel from rest; returns (its 4 return values, output records).
+
+    loads: (speed [rad/s], speed ramp [s], torque [N·m], torque ramp [s], profile (n x 2),
+    initial flank side (sign)); grid: `step_grid`; par: the remaining control values by
+    `layout` column name (DELTA_MAX, PHI_QUIET, ENERGY_TOL, HHT_ALPHA, NEWTON_TOL, MAX_ITER).
+    ``all_teeth``: every tooth active from the start (phi = 1e-300 rad) and none frozen.
+    """
+    speed, speed_ramp, torque, torque_ramp, table, side = loads
+    dt, out_every, n_steps, n_out = grid
+    phi_quiet = 0.0 if all_teeth else par["PHI_QUIET"]
+    omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
+    p = np.zeros(L.N_PAR)
+    for name, v in dict(par, SPEED=speed, SPEED_RAMP=speed_ramp, TORQUE=torque, TORQUE_RAMP=torque_ramp, DT=dt,
+                        PHI_QUIET=phi_quiet, DPHI_QUIET=phi_quiet * omega_tooth).items():
+        if name != "MAX_ITER":
+            p[getattr(L, name)] = v
+    ip = np.zeros(L.N_IPAR, dtype=np.int64)
+    ip[[L.N_STEPS, L.OUT_EVERY, L.MAX_ITER]] = n_steps, out_every, par.get("MAX_ITER", 0)
+    hub = np.zeros((3, L.N_HUB))
+    hub[L.POS, L.H_TH2] = hub[L.POS, L.H_H2] = model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset)
+    teeth = np.zeros((3, model.n_teeth))
+    if all_teeth:
+        teeth[L.POS] = 1e-300
+    out = np.zeros((n_out, L.N_OUT))
+    mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance)
+    ret = kernel(mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out, work_arrays(model.n_teeth))
+    return ret, out[:min(n_out, ret[1] // out_every + 1)]
+
+
+def result_fields(out: np.ndarray) -> tuple:
+    """The `DynamicResult` arrays time .. dissipated of a run's output records."""
+    cols = (L.O_TIME, L.O_TE, L.O_THETA2, L.O_FMAX, L.O_NC, L.O_REACT, L.O_KE, L.O_PE, L.O_WORK, L.O_DISS)
+    fields = [out[:, c].copy() for c in cols]
+    fields[4] = fields[4].astype(int)
+    return tuple(fields)
+
+
+def at_driver_angles(res: DynamicResult, speed: float, ramp: float, angles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(TE [m], driven hub angle [rad], loaded contacts) of a run under the speed ramp
+    0 -> speed [rad/s] over ramp [s], interpolated at driver angles [rad] (TE and angle NaN
+    past the run's end): how a slow-ramp transient gives the quasi-static STE."""
+    th1 = np.array([driver_motion(t, speed, ramp)[0] for t in res.time])
+    te = np.interp(angles, th1, res.te, right=np.nan)
+    th2 = np.interp(angles, th1, res.theta2, right=np.nan)
+    nc = np.round(np.interp(angles, th1, res.n_contacts)).astype(np.int64)
+    return te, th2, nc
+
+
+def slow_ramp_window(angles, angle_step: float, speed: float, ramp: float) -> tuple[float, float]:
+    """(output step [s], duration [s]) of the slow-ramp transient that samples driver angles
+    [rad] up to angles[-1] at angle_step [rad]: four records per angle step, to the last
+    angle plus two records (the driver's angle lags speed*t by speed*ramp/2)."""
+    dt_out = angle_step / speed / 4
+    return dt_out, ramp / 2 + angles[-1] / speed + 2 * dt_out
+
+
 def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
              duration: float, dt: float | None = None, output_step: float = 1e-5,
              safety: float = 0.5, delta_max: float | None = None, raise_on_failure: bool = False,
-             phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL, load_table=None) -> DynamicResult:
+             phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL, load_table=None,
+             all_teeth: bool = False) -> DynamicResult:
     """Integrate from rest with the driver speed ramp 0 -> speed [rad/s] over speed_ramp [s]
     and the resisting torque ramp 0 -> torque [N·m] over torque_ramp [s], for duration [s].
 
@@ -241,42 +196,26 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     ``energy_tol`` [-]: the run stops ("energy growth") when the energy balance shows more
     energy in the pair than the work put in, by more than this fraction of the larger of the
     work and the stored energy: the signature of an unstable step.
+    ``all_teeth``: integrate every tooth from the start and never freeze one (the model of
+    the scipy peer `solver.peers.scipy_dynamics`, for like-for-like error figures).
     """
-    for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp), ("output_step", output_step)):
-        if not (v > 0 and math.isfinite(v)):
-            raise ValueError(f"{name}: must be positive, got {v}")
+    check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step)
     table, torque, side = run_loads(load_table, torque)
     omega_max = float("nan")
     if dt is None or dt <= 0:
         dt, omega_max = stable_time_step(model, torque, safety)
-    out_every = max(1, int(math.ceil(output_step / dt)))
-    dt = output_step / out_every
-    n_steps = int(round(duration / dt))
-    n_out = n_steps // out_every + 1
+    grid = step_grid(dt, output_step, duration)
     if delta_max is None:
         delta_max = 0.1 * model.geometry[0].spec.module
-    o = [np.zeros(n_out) for _ in range(10)]
-    theta2 = float(model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset))
-    phi = np.zeros(model.n_teeth)
-    dphi = np.zeros(model.n_teeth)
-    omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
     if model.teeth_coupled and not model.coupled:
         raise ValueError("tooth_compliance: the dynamics of teeth coupled through the body need the body "
                          "springs too (coupling.model = 'compliance' identifies both)")
     if model.coupled:
-        from solver.mbs.kernels.explicit_coupled import verlet_coupled
-        status, step, max_act = verlet_coupled(model.gear_par, model.pair_par, model.law_par, model.k_phi,
-                                               model.tooth_compliance,
-                                               float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                               table, dt, n_steps, out_every, 0.0, 0.0, theta2, 0.0, theta2, 0.0, phi, dphi,
-                                               phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
+        from solver.mbs.kernels.explicit_coupled import verlet_coupled as kernel
     else:
-        status, step, max_act = verlet(model.gear_par, model.pair_par, model.law_par, model.k_phi,
-                                       float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                       table, dt, n_steps, out_every, theta2, 0.0, phi, dphi,
-                                       phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol), *o)
-    n = min(n_out, step // out_every + 1)
-    t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
-    msg = status_message(status, step, dt, delta_max, raise_on_failure)
-    return DynamicResult(t, te, th2, fmax, nc.astype(int), react, ke, pe, work, diss, dt, step,
-                         int(status), msg, omega_max, int(max_act))
+        kernel = verlet
+    par = dict(DELTA_MAX=float(delta_max), PHI_QUIET=phi_quiet, ENERGY_TOL=float(energy_tol))
+    (status, step, max_act, _n), out = run_kernel(kernel, model, (float(speed), float(speed_ramp), float(torque),
+                                                  float(torque_ramp), table, side), grid, par, all_teeth)
+    msg = status_message(status, step, grid[0], delta_max, raise_on_failure)
+    return DynamicResult(*result_fields(out), grid[0], int(step), int(status), msg, omega_max, int(max_act))

@@ -11,15 +11,24 @@ frequency: explicit at its stability step when that step is affordable, implicit
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from solver.mbs.dynamics import ENERGY_TOL, DynamicResult, run_loads, stable_time_step, status_message
+from solver.mbs.dynamics import (
+    ENERGY_TOL,
+    DynamicResult,
+    check_positive,
+    result_fields,
+    run_kernel,
+    run_loads,
+    status_message,
+    step_grid,
+)
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.implicit import hht
 from solver.mbs.model import Model
+from solver.mbs.stability import stable_time_step
 
 
 @dataclass
@@ -56,10 +65,8 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
     ``all_teeth``: integrate every tooth from the start and never freeze one (the model of
     the scipy peer `solver.peers.scipy_dynamics`, for like-for-like error figures).
     """
-    for name, v in (("duration", duration), ("speed_ramp", speed_ramp), ("torque_ramp", torque_ramp),
-                    ("output_step", output_step), ("newton_tol", newton_tol)):
-        if not (v > 0 and math.isfinite(v)):
-            raise ValueError(f"{name}: must be positive, got {v}")
+    check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step,
+                   newton_tol=newton_tol)
     if not -1.0 / 3.0 <= alpha <= 0.0:
         raise ValueError(f"alpha: must lie in [-1/3, 0] (HHT), got {alpha}")
     if model.coupled:
@@ -72,31 +79,17 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
     if dt is None or dt <= 0:
         dt, omega_max = stable_time_step(model, torque)
         dt *= 4.0
-    out_every = max(1, int(math.ceil(output_step / dt - 1e-9)))
-    dt = output_step / out_every
-    n_steps = int(round(duration / dt))
-    n_out = n_steps // out_every + 1
+    grid = step_grid(dt, output_step, duration)
     if delta_max is None:
         delta_max = 0.1 * model.geometry[0].spec.module
-    o = [np.zeros(n_out) for _ in range(10)]
-    o_newton = np.zeros(n_out, dtype=np.int64)
-    theta2 = float(model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset))
-    phi = np.full(model.n_teeth, 1e-300) if all_teeth else np.zeros(model.n_teeth)
-    dphi = np.zeros(model.n_teeth)
-    if all_teeth:
-        phi_quiet = 0.0
-    omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
-    status, step, max_act, total = hht(model.gear_par, model.pair_par, model.law_par, model.k_phi,
-                                       float(speed), float(speed_ramp), float(torque), float(torque_ramp),
-                                       table, dt, n_steps, out_every, float(alpha), theta2, 0.0, phi, dphi,
-                                       phi_quiet, phi_quiet * omega_tooth, float(delta_max), float(energy_tol),
-                                       float(newton_tol), int(max_iter), *o, o_newton)
-    n = min(n_out, step // out_every + 1)
-    t, te, fmax, nc, react, ke, pe, work, diss, th2 = (a[:n] for a in o)
-    msg = status_message(status, step, dt, delta_max, raise_on_failure)
-    return ImplicitResult(t, te, th2, fmax, nc.astype(int), react, ke, pe, work, diss, dt, step,
-                          int(status), msg, omega_max, int(max_act),
-                          alpha=float(alpha), newton_max=o_newton[:n], newton_total=int(total))
+    par = dict(DELTA_MAX=float(delta_max), PHI_QUIET=phi_quiet, ENERGY_TOL=float(energy_tol), HHT_ALPHA=float(alpha),
+               NEWTON_TOL=float(newton_tol), MAX_ITER=int(max_iter))
+    (status, step, max_act, total), out = run_kernel(hht, model, (float(speed), float(speed_ramp), float(torque),
+                                                     float(torque_ramp), table, side), grid, par, all_teeth)
+    msg = status_message(status, step, grid[0], delta_max, raise_on_failure)
+    return ImplicitResult(*result_fields(out), grid[0], int(step), int(status), msg, omega_max, int(max_act),
+                          alpha=float(alpha), newton_max=out[:, L.O_NEWTON].astype(np.int64),
+                          newton_total=int(total))
 
 
 @dataclass(frozen=True)

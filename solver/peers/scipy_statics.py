@@ -12,7 +12,8 @@ Unloaded teeth sit at phi = 0 where the spring tangent n*k*|phi|^(n-1) vanishes 
 as in `kernels/statics.py`, 1e-9 of each tooth's k_phi is added to the Jacobian's diagonal
 (the residual, and so the solution, stays exact).
 
-SI units. Entry point: `static_te_root`.
+SI units. Entry points: `static_te_root`; `solve_static_scipy` (MINPACK hybrd on the loaded
+teeth only).
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ from scipy import optimize
 
 from solver.mbs.model import Model
 from solver.mbs.statics import StaticResult
-from solver.peers.scipy_dynamics import PairEquations
+from solver.peers.pair_equations import PairEquations
 
 
 def _residual(eq: PairEquations, theta1: float, x: np.ndarray, zeros: np.ndarray):
@@ -86,3 +87,59 @@ def static_te_root(model: Model, angles, torque: float, tol: float = 1e-12) -> S
                 f1[a, c.ia] += c.force
         it[a] = sol.nfev if sol.success else -sol.nfev
     return StaticResult(angles, te, th2, ncon, f1, it, float(torque), x[1:].copy())
+
+
+def solve_static_scipy(model: Model, angles, torque: float, xtol: float = 1e-13) -> np.ndarray:
+    """Static TE [m] at driver angles [rad] under ``torque`` [N·m] with `scipy.optimize.root`
+    (MINPACK hybrd, finite-difference Jacobian) on the plain-Python contact and spring forces.
+
+    An independent check of the numba static kernel: unknowns are theta2 and the rotations of
+    the teeth in loaded contact (an unloaded tooth rests at phi = 0 exactly, where the spring
+    tangent of n_k > 1 vanishes); the set is updated until it no longer changes. The first
+    angle starts from rigid teeth closing the backlash, the others from the previous angle's
+    solution (continuation, as the static kernel does: where corner contacts make the
+    equilibrium non-unique, both then follow the same branch).
+    """
+    eq = PairEquations(model, 0.0, 1.0, torque, 1.0)
+    rb1, rb2 = model.base_radii
+    z = eq.nt
+    out = np.empty(len(angles))
+    sgn = 1.0 if torque >= 0 else -1.0
+    k, m1 = eq.law[0], eq.law[1]
+    te = sgn * (model.backlash_offset + (abs(torque) / rb2 / k) ** (1.0 / m1))
+    phi = np.zeros(z)
+    for a, th1 in enumerate(angles):
+        theta2 = float(model.theta2_for_te(th1, te))
+        teeth: list[int] = []
+        for _ in range(20):
+            cons = eq.contacts(th1, theta2, phi, 0.0, 0.0, np.zeros(z))
+            new = sorted({c.ia for c in cons if c.force > 0} | {c.ib for c in cons if c.force > 0})
+            if new == teeth and _:
+                break
+            teeth = new
+            keep = np.zeros(z, bool)
+            keep[teeth] = True
+            phi[~keep] = 0.0
+
+            def residual(u, teeth=teeth):
+                p = np.zeros(z)
+                p[teeth] = u[1:] * 1e-3
+                q = np.empty(len(teeth) + 1)
+                q[0] = torque
+                tq = eq.spring_torques(p, np.zeros(z))
+                qt = {t: tq[t] for t in teeth}
+                for c in eq.contacts(th1, u[0], p, 0.0, 0.0, np.zeros(z)):
+                    q[0] -= c.force * c.g[2]
+                    if c.ia in qt:
+                        qt[c.ia] -= c.force * c.g[1]
+                    if c.ib in qt:
+                        qt[c.ib] -= c.force * c.g[3]
+                q[1:] = [qt[t] for t in teeth]
+                return q
+
+            sol = optimize.root(residual, np.r_[theta2, phi[teeth] * 1e3], method="hybr",
+                                options={"xtol": xtol})
+            theta2 = float(sol.x[0])
+            phi[teeth] = sol.x[1:] * 1e-3
+        out[a] = te = rb1 * th1 + rb2 * theta2
+    return out

@@ -19,12 +19,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver import units
-from solver.mbs.dynamics import simulate, stable_time_step
+from solver.mbs.dynamics import at_driver_angles, simulate, slow_ramp_window
 from solver.mbs.implicit import simulate_implicit
-from solver.mbs.kernels.explicit import driver_motion
 from solver.mbs.model import Model
+from solver.mbs.stability import stable_time_step
 from solver.mbs.statics import solve_static
-from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy, solve_static_scipy
+from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
+from solver.peers.scipy_statics import solve_static_scipy
 from study.scene import Scene
 
 
@@ -152,8 +153,7 @@ def static_case(scene: Scene, rotation_deg: float = 6.0) -> StaticCase:
 
 def _transient_te(res, case: StaticCase) -> np.ndarray:
     """Transient TE [m] interpolated at the case's driver angles (NaN past the run's end)."""
-    th1 = np.array([driver_motion(t, case.speed, case.ramp)[0] for t in res.time])
-    return np.interp(case.angles, th1, res.te, right=np.nan)
+    return at_driver_angles(res, case.speed, case.ramp, case.angles)[0]
 
 
 def static_specs(model: Model, case: StaticCase, tols=(1e-2, 1e-4, 1e-6, 1e-8),
@@ -170,8 +170,7 @@ def static_specs(model: Model, case: StaticCase, tols=(1e-2, 1e-4, 1e-6, 1e-8),
             return r.te, int(np.sum(np.abs(r.iterations))), int(bad > 0), f"not converged at {bad} angles" if bad else "ok"
         specs.append(Spec("static Newton", math.nan, tol, run))
     dt_b, _w = stable_time_step(model, case.torque)
-    dt_out = case.angle_step / case.speed / 4
-    t_end = case.ramp / 2 + angles[-1] / case.speed + 2 * dt_out
+    dt_out, t_end = slow_ramp_window(angles, case.angle_step, case.speed, case.ramp)
     L = (case.speed, case.ramp, case.torque, case.ramp, t_end)
 
     def transient(res):

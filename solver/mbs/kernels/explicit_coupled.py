@@ -14,7 +14,8 @@ prescribed, so the teeth no longer see its acceleration: the driver torque is
 I_HUB1*theta1'' + k_body1*(theta1 - r1) + c_body1*(theta1' - r1'). The body springs carry
 linear damping c_body (``C_BODY``, from a damping ratio on the body mode). TE is read at the
 hubs: rb1*theta1 + rb2*h2. Energy bookkeeping as in `explicit.py` plus the hub kinetic
-energy and the body springs' potential energy.
+energy and the body springs' potential energy. The three body angles r1, theta2, h2 are the
+state columns H_R1, H_TH2, H_H2 (`layout`); they move alike, as one array.
 
 Teeth coupled through the body (``ctooth``, the compliance model; 0 x 0 otherwise): the
 teeth of the pre-search candidates form the set S whose springs act through
@@ -30,30 +31,54 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.explicit import _dissipation_power, driver_acc_left, driver_motion, load_torque
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
-from solver.mbs.kernels.laws import contact_energy, spring_energy
-from solver.mbs.kernels.layout import C_BODY, C_DELTA, C_FORCE, I_CPL, I_HUB, I_P, I_TOT, K_BODY, K_CON, M1, N_K, RB, TOOTH0
+from solver.mbs.kernels.layout import (
+    ACC,
+    B_E0,
+    B_P_D,
+    B_P_IN,
+    C_BODY,
+    DT,
+    H_H2,
+    H_R1,
+    H_TH2,
+    I_CPL,
+    I_HUB,
+    I_P,
+    I_TOT,
+    K_BODY,
+    N_HUB,
+    N_STEPS,
+    OUT_EVERY,
+    POS,
+    RATE,
+    RB,
+    SPEED,
+    SPEED_RAMP,
+    T_ACT,
+    T_INCAND,
+    TOOTH0,
+    TORQUE,
+    TORQUE_RAMP,
+)
+from solver.mbs.kernels.mechanics import dissipation_power, driver_acc_left, driver_motion, load_torque, mesh_energies
 from solver.mbs.kernels.stepping import (
     OK,
-    PENETRATION,
-    checked_status,
-    clear_candidates,
-    freeze_quiet_teeth,
-    loaded_contacts,
+    activate,
+    end_step,
+    initial_set,
     record_output,
 )
-from solver.mbs.kernels.toothcoupling import set_energy, set_moment, set_stiffness
+from solver.mbs.kernels.toothcoupling import coupled_set, set_energy, set_springs, update_set
 
 
 @njit(cache=True)
-def _rim_accelerations(q, act, nact, gp, acc, tz2, m1, m2):
-    """Arrowhead solves of both rims: returns (r1'', theta2''); fills the teeth's acc.
-
-    q[0], q[1]: generalised forces on the rims (contacts + body springs); m1, m2 the rim inertias.
-    """
-    s1 = m1
-    s2 = m2
+def rim_accelerations(q, act, nact, gp, acc, ha):
+    """Arrowhead solves of both rims: fills ha[H_R1] (r1''), ha[H_TH2] (theta2'') and the
+    teeth's acc. q[0], q[1]: generalised forces on the rims (contacts + body springs)."""
+    tz2 = int(gp[1, TOOTH0])
+    s1 = gp[0, I_TOT] - gp[0, I_HUB]
+    s2 = gp[1, I_TOT] - gp[1, I_HUB]
     rhs1 = q[0]
     rhs2 = q[1]
     for a in range(nact):
@@ -66,264 +91,171 @@ def _rim_accelerations(q, act, nact, gp, acc, tz2, m1, m2):
         else:
             s1 -= c * c / gp[0, I_P]
             rhs1 -= c * q[2 + i] / gp[0, I_P]
-    a1 = rhs1 / s1
-    a2 = rhs2 / s2
+    ha[H_R1] = rhs1 / s1
+    ha[H_TH2] = rhs2 / s2
     for a in range(nact):
         i = act[a]
         g = 1 if i >= tz2 else 0
-        ar = a2 if g == 1 else a1
+        ar = ha[H_TH2] if g == 1 else ha[H_R1]
         acc[i] = (q[2 + i] - gp[g, I_CPL] * ar) / gp[g, I_P]
-    return a1, a2
 
 
 @njit(cache=True)
-def _energies_coupled(w1, v1, w2, wh2, th1, r1, th2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2,
-                      ks, slst, ns):
-    ke = 0.5 * gp[0, I_HUB] * w1 * w1 + 0.5 * (gp[0, I_TOT] - gp[0, I_HUB]) * v1 * v1
-    ke += 0.5 * gp[1, I_HUB] * wh2 * wh2 + 0.5 * (gp[1, I_TOT] - gp[1, I_HUB]) * w2 * w2
-    pe = 0.5 * gp[0, K_BODY] * (th1 - r1) ** 2 + 0.5 * gp[1, K_BODY] * (h2 - th2) ** 2
-    for a in range(nact):
-        i = act[a]
-        g = 1 if i >= tz2 else 0
-        w = w2 if g == 1 else v1
-        ke += gp[g, I_CPL] * w * dphi[i] + 0.5 * gp[g, I_P] * dphi[i] * dphi[i]
-        pe += spring_energy(phi[i], kphi[i], gp[g, N_K])
-    for c in range(nc):
-        pe += contact_energy(rec[c, C_DELTA], lp[K_CON], lp[M1])
-    if ns > 0:      # the set's springs through K_S instead of their own (linear) springs
-        pe += set_energy(ks, slst, ns, phi)
+def body_moments(gp, th1, w1, x, v):
+    """Moments [N m] of the body springs and dampers on the driver rim and the driven hub, at
+    the body angles x and rates v (columns H_*), driver hub at th1 [rad], w1 [rad/s]."""
+    mb1 = gp[0, K_BODY] * (th1 - x[H_R1]) + gp[0, C_BODY] * (w1 - v[H_R1])
+    mb2 = gp[1, K_BODY] * (x[H_H2] - x[H_TH2]) + gp[1, C_BODY] * (v[H_H2] - v[H_TH2])
+    return mb1, mb2
+
+
+@njit(cache=True)
+def body_dissipation(p, gp, w1, v):
+    """p plus the power [W] of the body dampers at the driver hub rate w1 and the body rates
+    v [rad/s]."""
+    d1 = w1 - v[H_R1]
+    d2 = v[H_H2] - v[H_TH2]
+    return p + gp[0, C_BODY] * d1 * d1 + gp[1, C_BODY] * d2 * d2
+
+
+@njit(cache=True)
+def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, phi):
+    """Forces and accelerations for the contacts ws[0][:nc], the tooth rotations phi and rates
+    ws[3], the body angles hub[POS] and rates v (columns H_*): fills q, the teeth's and the
+    bodies' accelerations (row ACC of hub, and of the teeth through ``acc``);
+    drv = (theta1 [rad], theta1' [rad/s], theta1'' [rad/s²], load torque [N m], acc).
+    Returns (driver torque [N m], body-spring moment on the driver rim [N m])."""
+    gp, _pp, _lp, kphi, _ct = mdl
+    rec, _pairs, q, vel, tset, _book = ws
+    th1, w1, acc1, tl, acc = drv
+    q[:] = 0.0
+    generalized_forces(rec, nc, phi, vel, tset[T_ACT], nact, kphi, gp, 0.0, q)
+    set_springs(cset, ns, kphi, phi, q)
+    mb1, mb2 = body_moments(gp, th1, w1, hub[POS], v)
+    q[0] += mb1
+    q[1] += mb2
+    rim_accelerations(q, tset[T_ACT], nact, gp, acc, hub[ACC])
+    hub[ACC, H_H2] = (tl - mb2) / gp[1, I_HUB]
+    return gp[0, I_HUB] * acc1 + mb1, mb1
+
+
+@njit(cache=True)
+def coupled_energies(mdl, th1, w1, hub, teeth, tset, nact, rec, nc, cset, ns):
+    """(kinetic, potential) energy [J]: hubs, rims, body springs, then `mesh_energies` with
+    the teeth on the rims, and the coupled set's springs through K_S instead of their own."""
+    gp, _pp, _lp, kphi, _ct = mdl
+    x = hub[POS]
+    v = hub[RATE]
+    ke = 0.5 * gp[0, I_HUB] * w1 * w1 + 0.5 * (gp[0, I_TOT] - gp[0, I_HUB]) * v[H_R1] * v[H_R1]
+    ke += 0.5 * gp[1, I_HUB] * v[H_H2] * v[H_H2] + 0.5 * (gp[1, I_TOT] - gp[1, I_HUB]) * v[H_TH2] * v[H_TH2]
+    pe = 0.5 * gp[0, K_BODY] * (th1 - x[H_R1]) ** 2 + 0.5 * gp[1, K_BODY] * (x[H_H2] - x[H_TH2]) ** 2
+    ke, pe = mesh_energies(ke, pe, v[H_R1], v[H_TH2], teeth, tset[T_ACT], nact, mdl, rec, nc)
+    if ns > 0:
+        pe += set_energy(cset[1], cset[2], ns, teeth[POS])
         for a in range(ns):
-            i = slst[a]
-            pe -= 0.5 * kphi[i] * phi[i] * phi[i]
+            i = cset[2][a]
+            pe -= 0.5 * kphi[i] * teeth[POS, i] * teeth[POS, i]
     return ke, pe
 
 
 @njit(cache=True)
-def _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, vpred, mo, dmo):
-    """Make newl[:nn] the coupled set (``inset`` flags the old members): teeth that join take
-    their neighbours' share of rotation and rate, teeth that leave give it back (see the
-    module docstring for what stays continuous). Returns the new size."""
-    for a in range(nn):
-        innew[newl[a]] = True
-    same = nn == ns
-    if same:
-        for a in range(ns):
-            if not innew[slst[a]]:
-                same = False
-                break
-    if not same:
-        for a in range(ns):
-            mo[a] = set_moment(ks, slst, ns, phi, a)
-            dmo[a] = set_moment(ks, slst, ns, vpred, a)
-        for a in range(ns):                     # leaving
-            i = slst[a]
-            if not innew[i]:
-                for b in range(ns):
-                    j = slst[b]
-                    if j != i:
-                        phi[i] -= ctooth[i, j] * mo[b]
-                        dphi[i] -= ctooth[i, j] * dmo[b]
-                        vpred[i] -= ctooth[i, j] * dmo[b]
-                inset[i] = False
-        for a in range(nn):                     # joining
-            i = newl[a]
-            if not inset[i]:
-                for b in range(ns):
-                    j = slst[b]
-                    phi[i] += ctooth[i, j] * mo[b]
-                    dphi[i] += ctooth[i, j] * dmo[b]
-                    vpred[i] += ctooth[i, j] * dmo[b]
-        for a in range(nn):
-            slst[a] = newl[a]
-            inset[newl[a]] = True
-        set_stiffness(ctooth, slst, nn, ks)
-        ns = nn
-    for a in range(nn):
-        innew[newl[a]] = False
-    return ns
-
-
-@njit(cache=True)
-def _set_springs(ks, slst, ns, kphi, phi, q):
-    """Replace the own elastic spring torque of the set's teeth by the coupled one."""
-    for a in range(ns):
-        i = slst[a]
-        q[2 + i] += kphi[i] * phi[i] - set_moment(ks, slst, ns, phi, a)
-
-
-@njit(cache=True)
-def verlet_coupled(gp, pp, lp, kphi, ctooth, speed, speed_ramp, torque, torque_ramp, load_table, dt, n_steps, out_every,
-                   r1, v1, theta2, w2, h2, wh2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol,
-                   o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
-    """Integrate n_steps of size dt [s] from t = 0 (see the module docstring).
-
-    Initial state: driver rim r1 [rad] and speed v1, driven rim theta2 and w2, driven hub h2
-    and wh2, phi and dphi (updated in place). Outputs as `explicit.verlet`, with TE and
-    theta2 at the hubs; the same guards (energy growth beyond ``energy_tol`` as in `verlet`).
-    ``ctooth``: the tooth compliance [rad/(N m)] of teeth coupled through the body, or 0 x 0.
-    Returns (status, step reached, max active teeth).
-    """
-    ntooth = phi.shape[0]
-    tz2 = int(gp[1, TOOTH0])
-    rb1 = gp[0, RB]
-    rb2 = gp[1, RB]
-    kb1 = gp[0, K_BODY]
-    kb2 = gp[1, K_BODY]
-    cb1 = gp[0, C_BODY]
-    cb2 = gp[1, C_BODY]
-    mr1 = gp[0, I_TOT] - gp[0, I_HUB]
-    mr2 = gp[1, I_TOT] - gp[1, I_HUB]
-    ih1 = gp[0, I_HUB]
-    ih2 = gp[1, I_HUB]
-    rec = np.zeros((64, 15))
-    pairs = np.zeros((64, 3), dtype=np.int64)
-    q = np.zeros(ntooth + 2)
-    acc = np.zeros(ntooth)
-    vpred = np.zeros(ntooth)
-    active = np.zeros(ntooth, dtype=np.int64)
-    act = np.zeros(ntooth, dtype=np.int64)
-    incand = np.zeros(ntooth, dtype=np.int64)
-    coupled = ctooth.shape[0] > 0
-    ms = 2 * pairs.shape[0] if coupled else 0   # the coupled set: at most both teeth of every candidate pair
-    ks = np.zeros((ms, 2 * ms))
-    slst = np.zeros(ms, dtype=np.int64)
-    newl = np.zeros(ms, dtype=np.int64)
-    mo = np.zeros(ms)
-    dmo = np.zeros(ms)
-    inset = np.zeros(ntooth, dtype=np.int64)
-    innew = np.zeros(ntooth, dtype=np.int64)
-    ns = np.int64(0)
-    for i in range(ntooth):
-        if phi[i] != 0.0 or dphi[i] != 0.0:
-            active[i] = True
-    max_act = np.int64(0)
-
-    t = 0.0
-    th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
-    tl = load_torque(0.0, torque, torque_ramp, load_table)
-    nc, npair = mesh_contacts(r1, theta2, phi, v1, w2, dphi, gp, pp, lp, pairs, rec)
+def new_candidates(newl, incand, pairs, npair, tz2):
+    """Teeth of the candidate pairs not yet flagged in incand, in pair order, into newl (and
+    flag them). Returns their number."""
     nn = np.int64(0)
     for p in range(npair):
         for g in range(2):
             i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
-            active[i] = True
-            if coupled and not incand[i]:
+            if not incand[i]:
                 incand[i] = True
                 newl[nn] = i
                 nn += 1
+    return nn
+
+
+@njit(cache=True)
+def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
+    """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0 (see the module docstring);
+    arguments, outputs and guards as `explicit.verlet`, with the body angles hub[:, H_*]
+    (driver rim, driven rim, driven hub) and TE and theta2 at the hubs. mdl[4]: the tooth
+    compliance [rad/(N m)] of teeth coupled through the body, or 0 x 0.
+    Returns (status, step reached, max active teeth, 0).
+    """
+    gp, pp, lp, _kphi, ctooth = mdl
+    par, ipar, table = ctl
+    phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
+    tz2 = int(gp[1, TOOTH0])
+    dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
+    rec, pairs, q, vpred, tset, book = ws
+    act = tset[T_ACT]
+    x, v, ha = hub[POS], hub[RATE], hub[ACC]
+    vh = np.zeros(N_HUB)
+    vp = np.zeros(N_HUB)
+    cset = coupled_set(ctooth)
+    coupled = ctooth.shape[0] > 0
+    th1, w1, acc1 = driver_motion(0.0, speed, ramp)
+    tl = load_torque(0.0, par[TORQUE], par[TORQUE_RAMP], table)
+    nc, npair = mesh_contacts(x[H_R1], x[H_TH2], phi, v[H_R1], v[H_TH2], dphi, gp, pp, lp, pairs, rec)
+    ns = np.int64(0)
     if coupled:
-        ns = _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, dphi, mo, dmo)
-        clear_candidates(incand, pairs, npair, tz2)
-    nact = np.int64(0)     # not a literal 0: numba would compile the callees once more for it
-    for i in range(ntooth):
-        if active[i]:
-            act[nact] = i
-            nact += 1
-    for i in range(ntooth + 2):
-        q[i] = 0.0
-    generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, 0.0, q)
-    _set_springs(ks, slst, ns, kphi, phi, q)
-    mb1 = kb1 * (th1 - r1) + cb1 * (w1 - v1)
-    mb2 = kb2 * (h2 - theta2) + cb2 * (wh2 - w2)
-    q[0] += mb1
-    q[1] += mb2
-    a1, a2 = _rim_accelerations(q, act, nact, gp, acc, tz2, mr1, mr2)
-    ah2 = (tl - mb2) / ih2
-    react = ih1 * acc1 + mb1
-    ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2, ks, slst, ns)
-    e0 = ke + pe
-    work = 0.0
-    diss = 0.0
-    p_in_old = react * w1 + tl * wh2
-    p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2) + cb1 * (w1 - v1) ** 2 + cb2 * (wh2 - w2) ** 2
-    fmax = 0.0
-    o = np.int64(0)
-    record_output(o, 0.0, rb1 * th1 + rb2 * h2, 0.0, nc, react, ke, pe, 0.0, 0.0, h2,
-                  o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
-    status = np.int64(OK)
+        nn = new_candidates(cset[3], tset[T_INCAND], pairs, npair, tz2)
+        ns = update_set(cset, ns, nn, phi, dphi, dphi)
+        tset[T_INCAND, :] = 0
+    nact = initial_set(tset, teeth, pairs, npair, tz2)
+    vpred[:] = dphi
+    react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, (th1, w1, acc1, tl, acc), hub, v, phi)
+    ke, pe = coupled_energies(mdl, th1, w1, hub, teeth, tset, nact, rec, nc, cset, ns)
+    book[B_E0] = ke + pe
+    book[B_P_IN] = react * w1 + tl * v[H_H2]
+    book[B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl, rec, nc), gp, w1, v)
+    o = max_act = np.int64(0)
+    row = (0.0, gp[0, RB] * th1 + gp[1, RB] * x[H_H2], x[H_H2], react, ke, pe)
+    status = record_output(out, o, row, book, rec, nc, math.isfinite(row[1]), par, np.int64(OK))
     step = 0
-    for step in range(1, n_steps + 1):
+    for step in range(1, ipar[N_STEPS] + 1):
         t = step * dt
         # half kick, drift
-        v1h = v1 + 0.5 * dt * a1
-        w2h = w2 + 0.5 * dt * a2
-        wh2h = wh2 + 0.5 * dt * ah2
+        for k in range(N_HUB):
+            vh[k] = v[k] + 0.5 * dt * ha[k]
         for a in range(nact):
             i = act[a]
             dphi[i] += 0.5 * dt * acc[i]
             phi[i] += dt * dphi[i]
-        r1 += dt * v1h
-        theta2 += dt * w2h
-        h2 += dt * wh2h
-        th1, w1, acc1 = driver_motion(t, speed, speed_ramp)
-        tl = load_torque(t, torque, torque_ramp, load_table)
-        # predicted velocities for the damping terms
-        v1p = v1h + 0.5 * dt * a1
-        w2p = w2h + 0.5 * dt * a2
-        wh2p = wh2h + 0.5 * dt * ah2
+        for k in range(N_HUB):
+            x[k] += dt * vh[k]
+            vp[k] = vh[k] + 0.5 * dt * ha[k]    # predicted velocities for the damping terms
+        th1, w1, acc1 = driver_motion(t, speed, ramp)
+        tl = load_torque(t, par[TORQUE], par[TORQUE_RAMP], table)
         for a in range(nact):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
-        nc, npair = mesh_contacts(r1, theta2, phi, v1p, w2p, vpred, gp, pp, lp, pairs, rec)
-        nn = np.int64(0)
-        for p in range(npair):
-            for g in range(2):
-                i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
-                if coupled and not incand[i]:
-                    newl[nn] = i
-                    nn += 1
-                incand[i] = True
-                if not active[i]:
-                    active[i] = True
-                    act[nact] = i
-                    nact += 1
-                    acc[i] = 0.0
-                    vpred[i] = 0.0
+        nc, npair = mesh_contacts(x[H_R1], x[H_TH2], phi, vp[H_R1], vp[H_TH2], vpred, gp, pp, lp, pairs, rec)
+        nn = new_candidates(cset[3], tset[T_INCAND], pairs, npair, tz2) if coupled else 0
+        n_old = nact
+        nact = activate(tset, nact, pairs, npair, tz2)
+        for a in range(n_old, nact):
+            acc[act[a]] = 0.0
+            vpred[act[a]] = 0.0
         if coupled:
-            ns = _update_set(ctooth, ks, slst, ns, newl, nn, inset, innew, phi, dphi, vpred, mo, dmo)
-        for i in range(ntooth + 2):
-            q[i] = 0.0
-        generalized_forces(rec, nc, phi, vpred, act, nact, kphi, gp, 0.0, q)
-        _set_springs(ks, slst, ns, kphi, phi, q)
-        mb1 = kb1 * (th1 - r1) + cb1 * (w1 - v1p)
-        mb2 = kb2 * (h2 - theta2) + cb2 * (wh2p - w2p)
-        q[0] += mb1
-        q[1] += mb2
-        a1, a2 = _rim_accelerations(q, act, nact, gp, acc, tz2, mr1, mr2)
-        ah2 = (tl - mb2) / ih2
-        react = ih1 * acc1 + mb1
+            ns = update_set(cset, ns, nn, phi, dphi, vpred)
+        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, (th1, w1, acc1, tl, acc), hub, vp, phi)
         # second half kick
-        v1 = v1h + 0.5 * dt * a1
-        w2 = w2h + 0.5 * dt * a2
-        wh2 = wh2h + 0.5 * dt * ah2
+        for k in range(N_HUB):
+            v[k] = vh[k] + 0.5 * dt * ha[k]
         for a in range(nact):
             i = act[a]
             dphi[i] += 0.5 * dt * acc[i]
-        for c in range(nc):
-            if rec[c, C_FORCE] > fmax:
-                fmax = rec[c, C_FORCE]
-            if rec[c, C_DELTA] > delta_max:
-                status = PENETRATION
         # the driver's hub inertia sees the one-sided acceleration where the ramp ends
-        p_in_left = (ih1 * driver_acc_left(t, speed, speed_ramp) + mb1) * w1 + tl * wh2
-        p_in = react * w1 + tl * wh2
-        p_d = (_dissipation_power(vpred, act, nact, gp, rec, nc, lp, tz2)
-               + cb1 * (w1 - v1p) * (w1 - v1p) + cb2 * (wh2p - w2p) * (wh2p - w2p))
-        work += 0.5 * dt * (p_in_left + p_in_old)
-        diss += 0.5 * dt * (p_d + p_d_old)
-        p_in_old = p_in
-        p_d_old = p_d
-        nact = freeze_quiet_teeth(act, nact, active, incand, phi, dphi, acc, q, phi_quiet, dphi_quiet)
-        clear_candidates(incand, pairs, npair, tz2)
-        if nact > max_act:
-            max_act = nact
-        if step % out_every == 0:
+        p_in_left = (gp[0, I_HUB] * driver_acc_left(t, speed, ramp) + mb1) * w1 + tl * v[H_H2]
+        p_d = body_dissipation(dissipation_power(vpred, act, nact, mdl, rec, nc), gp, w1, vp)
+        status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * v[H_H2], p_d), par, status)
+        max_act = max(max_act, nact)
+        if step % ipar[OUT_EVERY] == 0:
             o += 1
-            ke, pe = _energies_coupled(w1, v1, w2, wh2, th1, r1, theta2, h2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2, ks, slst, ns)
-            record_output(o, t, rb1 * th1 + rb2 * h2, fmax, loaded_contacts(rec, nc), react, ke, pe, work, diss, h2,
-                          o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
-            fmax = 0.0
-            status = checked_status(status, math.isfinite(theta2) and math.isfinite(h2) and math.isfinite(ke + pe), ke, pe, e0, work, diss, energy_tol)
+            ke, pe = coupled_energies(mdl, th1, w1, hub, teeth, tset, nact, rec, nc, cset, ns)
+            te = gp[0, RB] * th1 + gp[1, RB] * x[H_H2]
+            finite = math.isfinite(x[H_TH2]) and math.isfinite(x[H_H2])
+            status = record_output(out, o, (t, te, x[H_H2], react, ke, pe), book, rec, nc, finite, par, status)
         if status != OK:
             break
-    return status, step, max_act
+    return status, step, max_act, 0

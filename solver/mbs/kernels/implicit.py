@@ -23,16 +23,24 @@ Converged when the last correction moves no flank point by more than newton_tol 
 forces are then re-evaluated at the converged state (they start the next step).
 
 Status codes: those of the explicit kernel, plus 4 Newton failure.
+
+Newton work arrays ``nw`` = (coef, q_old, pred, hpred, A, r, dx, loc, cl) (`newton_arrays`):
+the scheme's coefficients (K_* columns below), the forces of the last step, the Newmark
+predictors of the teeth and of theta2 (rows POS, RATE), the system, residual, correction,
+and the condensation's index maps.
 """
 import math
 
 import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.explicit import _dissipation_power, _energies, driver_motion, driver_speed, load_torque
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
 from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
 from solver.mbs.kernels.layout import (
+    ACC,
+    B_E0,
+    B_P_D,
+    B_P_IN,
     C_CON,
     C_DDELTA,
     C_DELTA,
@@ -44,92 +52,92 @@ from solver.mbs.kernels.layout import (
     C_PHI,
     C_TOOTH1,
     C_TOOTH2,
+    DT,
+    H_TH2,
+    HHT_ALPHA,
     I_CPL,
     I_P,
     I_TOT,
     M2,
     M3,
     MAX_CONTACTS,
+    MAX_ITER,
     N_C,
+    N_STEPS,
+    NEWTON_TOL,
+    O_NEWTON,
+    OUT_EVERY,
+    POS,
     R_BND,
+    RATE,
     RB,
+    SPEED,
+    SPEED_RAMP,
+    T_ACT,
     TOOTH0,
+    TORQUE,
+    TORQUE_RAMP,
+)
+from solver.mbs.kernels.mechanics import (
+    arrowhead_accelerations,
+    dissipation_power,
+    driver_motion,
+    driver_speed,
+    load_torque,
+    mesh_energies,
 )
 from solver.mbs.kernels.statics import solve_dense
 from solver.mbs.kernels.stepping import (
+    NEWTON,
     NONFINITE,
     OK,
-    PENETRATION,
-    checked_status,
-    clear_candidates,
-    freeze_quiet_teeth,
-    loaded_contacts,
+    activate,
+    end_step,
+    initial_set,
     record_output,
 )
 
-NEWTON = 4
+# coefficients of the scheme: nw[0]
+K_BETA = 0          # Newmark beta [-]
+K_GAMMA = 1         # Newmark gamma [-]
+K_CM = 2            # mass factor of the tangent 1/(beta dt^2) [1/s^2]
+K_CK = 3            # stiffness factor 1 + alpha [-]
+K_CC = 4            # damping factor (1 + alpha) gamma/(beta dt) [1/s]
+K_ALPHA = 5         # alpha [-]
 
 
 @njit(cache=True)
-def _activate(pairs, npair, tz2, active, act, nact, incand):
-    """Add the teeth of the candidate pairs to the active set; returns the new count."""
-    for p in range(npair):
-        for g in range(2):
-            i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
-            incand[i] = True
-            if not active[i]:
-                active[i] = True
-                act[nact] = i
-                nact += 1
-    return nact
+def newton_arrays(ntooth, alpha, dt):
+    """Work arrays ``nw`` of the HHT-alpha Newton for ntooth teeth, alpha [-], step dt [s]."""
+    beta = 0.25 * (1.0 - alpha) ** 2
+    gamma = 0.5 - alpha
+    coef = np.array([beta, gamma, 1.0 / (beta * dt * dt), 1.0 + alpha, (1.0 + alpha) * gamma / (beta * dt), alpha])
+    m = 2 * MAX_CONTACTS
+    return (coef, np.zeros(ntooth + 2), np.zeros((2, ntooth)), np.zeros(2), np.zeros((m + 1, m + 1)),
+            np.zeros(ntooth + 1), np.zeros(ntooth + 1), np.zeros(ntooth, dtype=np.int64), np.zeros(m, dtype=np.int64))
 
 
 @njit(cache=True)
-def _newton_step(rec, nc, phi, dphi, act, nact, kphi, gp, lp, tz2, cm, ck, cc, r, loc, cl, A, dx):
-    """Solve J dx = r for J = cm*M + ck*K + cc*C over (theta2, active teeth); r indexed as dx
-    (0: theta2, a + 1: tooth act[a]).
+def _tooth_tangent(i, mdl, teeth, coef):
+    """(diagonal entry, coupling to theta2) of tooth i in the Newton matrix."""
+    gp, _pp, _lp, kphi, _ct = mdl
+    g = 1 if i >= int(gp[1, TOOTH0]) else 0
+    d = (coef[K_CM] * gp[g, I_P] + coef[K_CK] * tooth_spring_tangent(i, teeth[POS], kphi, gp)
+         + coef[K_CC] * spring_damping_tangent(teeth[RATE, i], gp[g, C_PHI], gp[g, N_C]))
+    return d, (coef[K_CM] * gp[1, I_CPL] if g == 1 else 0.0)
 
-    A tooth without a loaded contact couples to theta2 only (through the hub inertia of gear 2)
-    and is condensed out first; the dense solve runs over theta2 and the teeth in contact.
-    """
-    m = 0
-    for c in range(nc):
-        if rec[c, C_FORCE] <= 0.0:
-            continue
-        for g in range(2):
-            i = int(rec[c, C_TOOTH1]) if g == 0 else tz2 + int(rec[c, C_TOOTH2])
-            if loc[i] == 0:
-                m += 1
-                loc[i] = m
-                cl[m - 1] = i
-    n = m + 1
-    for u in range(n):
-        for v in range(n):
-            A[u, v] = 0.0
-    A[0, 0] = cm * gp[1, I_TOT]
-    b = np.empty(n)
-    b[0] = r[0]
-    for a in range(nact):
-        i = act[a]
-        g = 1 if i >= tz2 else 0
-        d = (cm * gp[g, I_P] + ck * tooth_spring_tangent(i, phi, kphi, gp)
-             + cc * spring_damping_tangent(dphi[i], gp[g, C_PHI], gp[g, N_C]))
-        c0 = cm * gp[1, I_CPL] if g == 1 else 0.0
-        k = loc[i]
-        if k > 0:
-            A[k, k] += d
-            A[0, k] += c0
-            A[k, 0] += c0
-            b[k] = r[a + 1]
-        else:
-            A[0, 0] -= c0 * c0 / d
-            b[0] -= c0 * r[a + 1] / d
+
+@njit(cache=True)
+def _contact_rows(mdl, rec, nc, loc, A, coef):
+    """Add the loaded contacts' tangents w G G^T (over theta2 and the teeth at loc) to A."""
+    lp = mdl[2]
+    tz2 = int(mdl[0][1, TOOTH0])
     for c in range(nc):
         if rec[c, C_FORCE] <= 0.0:
             continue
         kd, cd = contact_damping_tangents(rec[c, C_DELTA], rec[c, C_DDELTA], rec[c, C_FORCE],
                                           lp[C_CON], lp[M2], lp[M3])
-        w = ck * (rec[c, C_KT] + kd) + cc * cd
+        w = coef[K_CK] * (rec[c, C_KT] + kd) + coef[K_CC] * cd
         i1 = loc[int(rec[c, C_TOOTH1])]
         i2 = loc[tz2 + int(rec[c, C_TOOTH2])]
         g0 = rec[c, C_G2]
@@ -144,223 +152,249 @@ def _newton_step(rec, nc, phi, dphi, act, nact, kphi, gp, lp, tz2, cm, ck, cc, r
         A[i2, 0] += w * g2 * g0
         A[i2, i1] += w * g2 * g1
         A[i2, i2] += w * g2 * g2
+
+
+@njit(cache=True)
+def newton_correction(mdl, rec, nc, teeth, act, nact, nw):
+    """Solve J dx = r for J = cm*M + ck*K + cc*C over (theta2, active teeth); r and dx of nw
+    indexed 0: theta2, a + 1: tooth act[a].
+
+    A tooth without a loaded contact couples to theta2 only (through the hub inertia of gear 2)
+    and is condensed out first; the dense solve runs over theta2 and the teeth in contact.
+    """
+    gp = mdl[0]
+    coef, _q_old, _pred, _hpred, A, r, dx, loc, cl = nw
+    tz2 = int(gp[1, TOOTH0])
+    m = 0
+    for c in range(nc):
+        if rec[c, C_FORCE] <= 0.0:
+            continue
+        for g in range(2):
+            i = int(rec[c, C_TOOTH1]) if g == 0 else tz2 + int(rec[c, C_TOOTH2])
+            if loc[i] == 0:
+                m += 1
+                loc[i] = m
+                cl[m - 1] = i
+    n = m + 1
+    A[:n, :n] = 0.0
+    A[0, 0] = coef[K_CM] * gp[1, I_TOT]
+    b = np.empty(n)
+    b[0] = r[0]
+    for a in range(nact):
+        d, c0 = _tooth_tangent(act[a], mdl, teeth, coef)
+        k = loc[act[a]]
+        if k > 0:
+            A[k, k] += d
+            A[0, k] += c0
+            A[k, 0] += c0
+            b[k] = r[a + 1]
+        else:
+            A[0, 0] -= c0 * c0 / d
+            b[0] -= c0 * r[a + 1] / d
+    _contact_rows(mdl, rec, nc, loc, A, coef)
     y = solve_dense(A[:n, :n], b)
     dx[0] = y[0]
     for a in range(nact):
-        i = act[a]
-        k = loc[i]
+        k = loc[act[a]]
         if k > 0:
             dx[a + 1] = y[k]
         else:
-            g = 1 if i >= tz2 else 0
-            d = (cm * gp[g, I_P] + ck * tooth_spring_tangent(i, phi, kphi, gp)
-                 + cc * spring_damping_tangent(dphi[i], gp[g, C_PHI], gp[g, N_C]))
-            c0 = cm * gp[1, I_CPL] if g == 1 else 0.0
+            d, c0 = _tooth_tangent(act[a], mdl, teeth, coef)
             dx[a + 1] = (r[a + 1] - c0 * y[0]) / d
     for u in range(m):
         loc[cl[u]] = 0
 
 
 @njit(cache=True)
-def hht(gp, pp, lp, kphi, speed, speed_ramp, torque, torque_ramp, load_table, dt, n_steps, out_every, alpha,
-        theta2, w2, phi, dphi, phi_quiet, dphi_quiet, delta_max, energy_tol, newton_tol, max_iter,
-        o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2, o_newton):
-    """Integrate n_steps of size dt [s] from t = 0 with HHT-alpha; write every out_every-th state.
-
-    Arguments as `explicit.verlet`, plus alpha [-] (in [-1/3, 0]), energy_tol [-] (relative
-    energy growth that stops the run), newton_tol [m] and max_iter (Newton per step), and
-    o_newton (most Newton iterations in a step of each output interval). Returns
-    (status, step reached, max active teeth, total Newton iterations).
-    """
-    ntooth = phi.shape[0]
+def driver_torque(q, act, nact, gp, acc, a1):
+    """Torque the driver applies [N m] at driver acceleration a1 [rad/s²]:
+    I_tot1*a1 - Q_theta1 + I_cpl1 * (sum of the gear-1 tooth accelerations)."""
     tz2 = int(gp[1, TOOTH0])
-    rb1 = gp[0, RB]
-    rb2 = gp[1, RB]
-    beta = 0.25 * (1.0 - alpha) ** 2
-    gamma = 0.5 - alpha
-    cm = 1.0 / (beta * dt * dt)
-    ck = 1.0 + alpha
-    cc = (1.0 + alpha) * gamma / (beta * dt)
-    rec = np.zeros((64, 15))
-    pairs = np.zeros((64, 3), dtype=np.int64)
-    q = np.zeros(ntooth + 2)
-    q_old = np.zeros(ntooth + 2)
-    acc = np.zeros(ntooth)
-    xt = np.zeros(ntooth)        # Newmark predictors of phi and dphi
-    vt = np.zeros(ntooth)
-    active = np.zeros(ntooth, dtype=np.int64)
-    act = np.zeros(ntooth, dtype=np.int64)
-    incand = np.zeros(ntooth, dtype=np.int64)
-    A = np.zeros((2 * MAX_CONTACTS + 1, 2 * MAX_CONTACTS + 1))
-    r = np.zeros(ntooth + 1)
-    dx = np.zeros(ntooth + 1)
-    loc = np.zeros(ntooth, dtype=np.int64)
-    cl = np.zeros(2 * MAX_CONTACTS, dtype=np.int64)
-    nact = np.int64(0)     # not a literal 0: numba would compile the callees once more for it
-    for i in range(ntooth):
-        if phi[i] != 0.0 or dphi[i] != 0.0:
-            active[i] = True
-            act[nact] = i
-            nact += 1
-    th1, w1, acc1 = driver_motion(0.0, speed, speed_ramp)
-    nc, npair = mesh_contacts(th1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec)
-    nact = _activate(pairs, npair, tz2, active, act, nact, incand)
-    tl = load_torque(0.0, torque, torque_ramp, load_table)
-    generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
-    # initial accelerations: the explicit arrowhead solve, plus the driver coupling
-    s = gp[1, I_TOT]
-    rhs = q[1]
-    for a in range(nact):
-        i = act[a]
-        if i >= tz2:
-            s -= gp[1, I_CPL] ** 2 / gp[1, I_P]
-            rhs -= gp[1, I_CPL] * q[2 + i] / gp[1, I_P]
-    a2 = rhs / s
-    for a in range(nact):
-        i = act[a]
-        if i >= tz2:
-            acc[i] = (q[2 + i] - gp[1, I_CPL] * a2) / gp[1, I_P]
-        else:
-            acc[i] = (q[2 + i] - gp[0, I_CPL] * acc1) / gp[0, I_P]
-    react = gp[0, I_TOT] * acc1 - q[0]
+    react = gp[0, I_TOT] * a1 - q[0]
     for a in range(nact):
         if act[a] < tz2:
             react += gp[0, I_CPL] * acc[act[a]]
-    ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
-    e0 = ke + pe
-    work = 0.0
-    diss = 0.0
-    p_in_old = react * w1 + tl * w2
-    p_d_old = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
-    o = np.int64(0)
-    record_output(o, 0.0, rb1 * th1 + rb2 * theta2, 0.0, nc, react, ke, pe, 0.0, 0.0, theta2,
-                  o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
-    o_newton[0] = 0
-    fmax = 0.0
-    itmax = 0
-    total_it = 0
+    return react
+
+
+@njit(cache=True)
+def driver_jump(react, act, nact, gp, acc, da):
+    """Right limits where the driver acceleration jumps by da [rad/s²] (end of the speed ramp):
+    the gear-1 tooth accelerations (their inertial coupling) and the driver torque [N m]."""
+    tz2 = int(gp[1, TOOTH0])
+    react += gp[0, I_TOT] * da
+    for a in range(nact):
+        i = act[a]
+        if i < tz2:
+            acc[i] -= gp[0, I_CPL] / gp[0, I_P] * da
+            react -= gp[0, I_CPL] ** 2 / gp[0, I_P] * da
+    return react
+
+
+@njit(cache=True)
+def hht_residual(mdl, q, nw, hub, acc, act, nact, a1m):
+    """r = -(M a - (1+alpha) Q_{n+1} + alpha Q_n) into nw's r, over (theta2, active teeth);
+    a1m [rad/s²]: the driver acceleration over the step (inertia on the gear-1 teeth)."""
+    gp = mdl[0]
+    coef, q_old, _pred, _hpred, _A, r, _dx, _loc, _cl = nw
+    tz2 = int(gp[1, TOOTH0])
+    alpha = coef[K_ALPHA]
+    a2 = hub[ACC, H_TH2]
+    r[0] = (1.0 + alpha) * q[1] - alpha * q_old[1] - gp[1, I_TOT] * a2
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        ri = (1.0 + alpha) * q[2 + i] - alpha * q_old[2 + i] - gp[g, I_P] * acc[i]
+        if g == 1:
+            ri -= gp[1, I_CPL] * a2
+            r[0] -= gp[1, I_CPL] * acc[i]
+        else:
+            ri -= gp[0, I_CPL] * a1m
+        r[a + 1] = ri
+
+
+@njit(cache=True)
+def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
+    """One HHT-alpha step: Newmark predictors, then Newton from a_{n+1} = a_n until the last
+    correction moves no flank point by more than par[NEWTON_TOL] [m] and the active set stays;
+    the forces q and contacts end at the converged state. drv = (theta1 [rad], theta1'
+    [rad/s], load torque [N m], driver acceleration over the step [rad/s²]).
+    Returns (status, iterations, contacts, candidate pairs, active teeth)."""
+    gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
+    par, ipar, _table = ctl
+    rec, pairs, q, _vpred, tset, _book = ws
+    coef, q_old, pred, hpred, _A, _r, dx, _loc, _cl = nw
+    th1, w1, tl, a1m = drv
+    act = tset[T_ACT]
+    phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
+    tz2 = int(gp[1, TOOTH0])
+    dt, beta, gamma, cm = par[DT], coef[K_BETA], coef[K_GAMMA], coef[K_CM]
+    a2 = hub[ACC, H_TH2]
+    hpred[POS] = hub[POS, H_TH2] + dt * hub[RATE, H_TH2] + dt * dt * (0.5 - beta) * a2
+    hpred[RATE] = hub[RATE, H_TH2] + dt * (1.0 - gamma) * a2
+    for a in range(nact):
+        i = act[a]
+        pred[POS, i] = phi[i] + dt * dphi[i] + dt * dt * (0.5 - beta) * acc[i]
+        pred[RATE, i] = dphi[i] + dt * (1.0 - gamma) * acc[i]
+    hub[POS, H_TH2] = hpred[POS] + beta * dt * dt * a2
+    for a in range(nact):
+        i = act[a]
+        phi[i] = pred[POS, i] + beta * dt * dt * acc[i]
+    it = 0
+    last = 1e300
+    status = OK
+    while True:
+        # velocities and accelerations of the iterate
+        hub[ACC, H_TH2] = (hub[POS, H_TH2] - hpred[POS]) * cm
+        hub[RATE, H_TH2] = hpred[RATE] + gamma * dt * hub[ACC, H_TH2]
+        for a in range(nact):
+            i = act[a]
+            acc[i] = (phi[i] - pred[POS, i]) * cm
+            dphi[i] = pred[RATE, i] + gamma * dt * acc[i]
+        nc, npair = mesh_contacts(th1, hub[POS, H_TH2], phi, w1, hub[RATE, H_TH2], dphi, gp, pp, lp, pairs, rec)
+        n_before = nact
+        nact = activate(tset, nact, pairs, npair, tz2)
+        for a in range(n_before, nact):
+            # a tooth entering the active set: at rest on its hub, zero force history
+            i = act[a]
+            pred[POS, i] = pred[RATE, i] = acc[i] = dphi[i] = q_old[2 + i] = 0.0
+        q[:] = 0.0
+        generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
+        if last < par[NEWTON_TOL] and nact == n_before:
+            break
+        if it >= ipar[MAX_ITER]:
+            status = NEWTON
+            break
+        it += 1
+        hht_residual(mdl, q, nw, hub, acc, act, nact, a1m)
+        newton_correction(mdl, rec, nc, teeth, act, nact, nw)
+        last = abs(dx[0]) * gp[1, RB]
+        hub[POS, H_TH2] += dx[0]
+        for a in range(nact):
+            i = act[a]
+            phi[i] += dx[a + 1]
+            d = abs(dx[a + 1]) * gp[1 if i >= tz2 else 0, R_BND]
+            if d > last:
+                last = d
+        if not math.isfinite(last):
+            status = NONFINITE
+            break
+    return status, it, nc, npair, nact
+
+
+@njit(cache=True)
+def hht(mdl, ctl, hub, teeth, out, ws):
+    """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0 with HHT-alpha (par[HHT_ALPHA]
+    in [-1/3, 0]); arguments, outputs and guards as `explicit.verlet`, plus Newton's
+    par[NEWTON_TOL] [m] and ipar[MAX_ITER] per step, and out[:, O_NEWTON] (most Newton
+    iterations in a step of each output interval). Returns (status, step reached, max active
+    teeth, total Newton iterations).
+    """
+    gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
+    par, ipar, table = ctl
+    phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
+    tz2 = int(gp[1, TOOTH0])
+    dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
+    rec, pairs, q, _vpred, tset, book = ws
+    nw = newton_arrays(phi.shape[0], par[HHT_ALPHA], dt)
+    act = tset[T_ACT]
+    nact = initial_set(tset, teeth, pairs, np.int64(0), tz2)     # the teeth already moving
+    th1, w1, acc1 = driver_motion(0.0, speed, ramp)
+    nc, npair = mesh_contacts(th1, hub[POS, H_TH2], phi, w1, hub[RATE, H_TH2], dphi, gp, pp, lp, pairs, rec)
+    nact = activate(tset, nact, pairs, npair, tz2)
+    tl = load_torque(0.0, par[TORQUE], par[TORQUE_RAMP], table)
+    generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
+    # initial accelerations: the explicit arrowhead solve, plus the driver coupling
+    hub[ACC, H_TH2], _s1, _r1 = arrowhead_accelerations(q, act, nact, gp, acc)
+    for a in range(nact):
+        if act[a] < tz2:
+            acc[act[a]] = (q[2 + act[a]] - gp[0, I_CPL] * acc1) / gp[0, I_P]
+    react = driver_torque(q, act, nact, gp, acc, acc1)
+    w2 = hub[RATE, H_TH2]
+    ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+                           teeth, act, nact, mdl, rec, nc)
+    book[B_E0] = ke + pe
+    book[B_P_IN] = react * w1 + tl * w2
+    book[B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
+    o = itmax = total_it = np.int64(0)
+    row = (0.0, gp[0, RB] * th1 + gp[1, RB] * hub[POS, H_TH2], hub[POS, H_TH2], react, ke, pe)
+    status = record_output(out, o, row, book, rec, nc, math.isfinite(row[1]), par, np.int64(OK))
     a1_prev = acc1
     max_act = nact
-    status = np.int64(OK)
     step = 0
-    for step in range(1, n_steps + 1):
+    for step in range(1, ipar[N_STEPS] + 1):
         t_old = (step - 1) * dt
         t = step * dt
-        for i in range(ntooth + 2):
-            q_old[i] = q[i]
+        nw[1][:] = q
         # driver acceleration over the step (constant when the ramp end lies on the grid)
-        a1m = (driver_speed(t, speed, speed_ramp) - driver_speed(t_old, speed, speed_ramp)) / dt
+        a1m = (driver_speed(t, speed, ramp) - driver_speed(t_old, speed, ramp)) / dt
         if a1m != a1_prev:
             # the driver acceleration jumps at t_old (end of the ramp): right limits of the
             # gear-1 tooth accelerations and of the driver power start this step
-            react += gp[0, I_TOT] * (a1m - a1_prev)
-            for a in range(nact):
-                i = act[a]
-                if i < tz2:
-                    acc[i] -= gp[0, I_CPL] / gp[0, I_P] * (a1m - a1_prev)
-                    react -= gp[0, I_CPL] ** 2 / gp[0, I_P] * (a1m - a1_prev)
-            p_in_old = react * driver_speed(t_old, speed, speed_ramp) + load_torque(t_old, torque, torque_ramp, load_table) * w2
+            react = driver_jump(react, act, nact, gp, acc, a1m - a1_prev)
+            tl_old = load_torque(t_old, par[TORQUE], par[TORQUE_RAMP], table)
+            book[B_P_IN] = react * driver_speed(t_old, speed, ramp) + tl_old * hub[RATE, H_TH2]
             a1_prev = a1m
-        th1, w1, _a1 = driver_motion(t, speed, speed_ramp)
-        tl = load_torque(t, torque, torque_ramp, load_table)
-        # Newmark predictors; start Newton from a_{n+1} = a_n
-        th2t = theta2 + dt * w2 + dt * dt * (0.5 - beta) * a2
-        w2t = w2 + dt * (1.0 - gamma) * a2
-        for a in range(nact):
-            i = act[a]
-            xt[i] = phi[i] + dt * dphi[i] + dt * dt * (0.5 - beta) * acc[i]
-            vt[i] = dphi[i] + dt * (1.0 - gamma) * acc[i]
-        theta2 = th2t + beta * dt * dt * a2
-        for a in range(nact):
-            i = act[a]
-            phi[i] = xt[i] + beta * dt * dt * acc[i]
-        it = 0
-        last = 1e300
-        while True:
-            # velocities and accelerations of the iterate
-            a2 = (theta2 - th2t) * cm
-            w2 = w2t + gamma * dt * a2
-            for a in range(nact):
-                i = act[a]
-                acc[i] = (phi[i] - xt[i]) * cm
-                dphi[i] = vt[i] + gamma * dt * acc[i]
-            nc, npair = mesh_contacts(th1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec)
-            n_before = nact
-            nact = _activate(pairs, npair, tz2, active, act, nact, incand)
-            for a in range(n_before, nact):
-                # a tooth entering the active set: at rest on its hub, zero force history
-                i = act[a]
-                xt[i] = 0.0
-                vt[i] = 0.0
-                acc[i] = 0.0
-                dphi[i] = 0.0
-                q_old[2 + i] = 0.0
-            for i in range(ntooth + 2):
-                q[i] = 0.0
-            generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
-            if last < newton_tol and nact == n_before:
-                break
-            if it >= max_iter:
-                status = NEWTON
-                break
-            it += 1
-            # residual M a - (1+alpha) Q_{n+1} + alpha Q_n  (as r = -residual)
-            r[0] = (1.0 + alpha) * q[1] - alpha * q_old[1] - gp[1, I_TOT] * a2
-            for a in range(nact):
-                i = act[a]
-                g = 1 if i >= tz2 else 0
-                ri = (1.0 + alpha) * q[2 + i] - alpha * q_old[2 + i] - gp[g, I_P] * acc[i]
-                if g == 1:
-                    ri -= gp[1, I_CPL] * a2
-                    r[0] -= gp[1, I_CPL] * acc[i]
-                else:
-                    ri -= gp[0, I_CPL] * a1m
-                r[a + 1] = ri
-            _newton_step(rec, nc, phi, dphi, act, nact, kphi, gp, lp, tz2, cm, ck, cc, r, loc, cl, A, dx)
-            last = abs(dx[0]) * rb2
-            theta2 += dx[0]
-            for a in range(nact):
-                i = act[a]
-                g = 1 if i >= tz2 else 0
-                phi[i] += dx[a + 1]
-                d = abs(dx[a + 1]) * gp[g, R_BND]
-                if d > last:
-                    last = d
-            if not math.isfinite(last):
-                status = NONFINITE
-                break
+        th1, w1, _a1 = driver_motion(t, speed, ramp)
+        tl = load_torque(t, par[TORQUE], par[TORQUE_RAMP], table)
+        status, it, nc, npair, nact = newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, (th1, w1, tl, a1m))
         total_it += it
-        if it > itmax:
-            itmax = it
-        react = gp[0, I_TOT] * a1m - q[0]
-        for a in range(nact):
-            if act[a] < tz2:
-                react += gp[0, I_CPL] * acc[act[a]]
-        for c in range(nc):
-            if rec[c, C_FORCE] > fmax:
-                fmax = rec[c, C_FORCE]
-            if rec[c, C_DELTA] > delta_max:
-                status = PENETRATION
+        itmax = max(itmax, it)
+        react = driver_torque(q, act, nact, gp, acc, a1m)
+        w2 = hub[RATE, H_TH2]
         p_in = react * w1 + tl * w2
-        p_d = _dissipation_power(dphi, act, nact, gp, rec, nc, lp, tz2)
-        work += 0.5 * dt * (p_in + p_in_old)
-        diss += 0.5 * dt * (p_d + p_d_old)
-        p_in_old = p_in
-        p_d_old = p_d
-        # freeze quiet teeth outside the candidates
-        nact = freeze_quiet_teeth(act, nact, active, incand, phi, dphi, acc, q, phi_quiet, dphi_quiet)
-        clear_candidates(incand, pairs, npair, tz2)
-        if nact > max_act:
-            max_act = nact
-        if step % out_every == 0:
+        p_d = dissipation_power(dphi, act, nact, mdl, rec, nc)
+        status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in, p_in, p_d), par, status)
+        max_act = max(max_act, nact)
+        if step % ipar[OUT_EVERY] == 0:
             o += 1
-            ke, pe = _energies(w1, w2, phi, dphi, act, nact, kphi, gp, rec, nc, lp, tz2)
-            record_output(o, t, rb1 * th1 + rb2 * theta2, fmax, loaded_contacts(rec, nc), react, ke, pe, work, diss, theta2,
-                          o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2)
-            o_newton[o] = itmax
-            fmax = 0.0
+            theta2 = hub[POS, H_TH2]
+            ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+                                   teeth, act, nact, mdl, rec, nc)
+            row = (t, gp[0, RB] * th1 + gp[1, RB] * theta2, theta2, react, ke, pe)
+            status = record_output(out, o, row, book, rec, nc, math.isfinite(theta2) and math.isfinite(w2), par, status)
+            out[o, O_NEWTON] = itmax
             itmax = 0
-            status = checked_status(status, math.isfinite(theta2) and math.isfinite(w2) and math.isfinite(ke + pe), ke, pe, e0, work, diss, energy_tol)
         if status != OK:
             break
     return status, step, max_act, total_it

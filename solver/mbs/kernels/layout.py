@@ -59,3 +59,62 @@ C_TOOTH2 = 13   # gear-2 tooth index (float)
 C_KIND = 14     # 1 flank-flank, 2 gear-1 tip corner, 3 gear-2 tip corner; sign = side (+drive, -coast)
 N_C_COLS = 15
 MAX_CONTACTS = 64
+
+# ---- the time-stepping kernels (`stepping`, `explicit`, `explicit_coupled`, `implicit`)
+# control scalars: float array ``par``
+SPEED = 0           # driver speed [rad/s]
+SPEED_RAMP = 1      # driver speed ramp [s]
+TORQUE = 2          # resisting torque after its ramp [N m]
+TORQUE_RAMP = 3     # [s]
+DT = 4              # time step [s]
+PHI_QUIET = 5       # a tooth outside the mesh freezes below this rotation [rad] ...
+DPHI_QUIET = 6      # ... and this rate [rad/s]
+DELTA_MAX = 7       # penetration bound [m]
+ENERGY_TOL = 8      # relative energy growth that stops a run [-]
+HHT_ALPHA = 9       # HHT-alpha parameter [-]
+NEWTON_TOL = 10     # Newton stops when no flank point moves more than this [m]
+N_PAR = 11
+# control integers: int array ``ipar``
+N_STEPS = 0
+OUT_EVERY = 1       # steps per output record
+MAX_ITER = 2        # Newton iterations per step
+N_IPAR = 3
+
+# state: ``hub[row, H_*]`` the bodies, ``teeth[row, i]`` the tooth rotations relative to their
+# hub (or rim); rows: angle [rad], rate [rad/s], acceleration [rad/s^2]
+POS = 0
+RATE = 1
+ACC = 2
+H_R1 = 0            # driver rim (body-torsion coupling; the driver hub itself is prescribed)
+H_TH2 = 1           # theta2: the driven gear's rim (its hub in the plain model), as the mesh sees it
+H_H2 = 2            # driven hub (body-torsion coupling)
+N_HUB = 3
+
+# output records: ``out[o, :]`` at the o-th output instant
+O_TIME = 0          # [s]
+O_TE = 1            # transmission error at the hubs [m]
+O_FMAX = 2          # largest contact force over the interval [N]
+O_NC = 3            # loaded contacts [-]
+O_REACT = 4         # torque the driver applies [N m]
+O_KE = 5            # kinetic energy [J]
+O_PE = 6            # potential energy [J]
+O_WORK = 7          # work of the driver and the load since t = 0 [J]
+O_DISS = 8          # dissipated energy [J]
+O_THETA2 = 9        # driven hub angle [rad]
+O_NEWTON = 10       # most Newton iterations in a step of the interval (implicit) [-]
+N_OUT = 11
+
+# running sums of a run: float array ``book``
+B_WORK = 0          # work in [J]
+B_DISS = 1          # dissipated [J]
+B_P_IN = 2          # input power at the last step [W]
+B_P_D = 3           # dissipation power at the last step [W]
+B_FMAX = 4          # largest contact force since the last output [N]
+B_E0 = 5            # kinetic + potential energy at t = 0 [J]
+N_BOOK = 6
+
+# active-tooth set: int array ``tset[row, :]``
+T_ACT = 0           # active tooth indices (the first nact valid)
+T_ACTIVE = 1        # 0/1 per tooth: in the active set
+T_INCAND = 2        # 0/1 per tooth: named by this step's pre-search
+N_TSET = 3

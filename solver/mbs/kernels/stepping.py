@@ -1,92 +1,197 @@
 """Pieces shared by the time-stepping loops (explicit, coupled explicit, implicit; numba):
-status codes, the active-tooth set, output records and the output-time guards.
+status codes, work arrays, the active-tooth set, and the end of a step (guards, energy
+bookkeeping, output records).
 
-Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy growth.
+Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy growth,
+4 Newton failure (implicit).
 
 Teeth away from the mesh are left out of the integration, rigid to their hub; a tooth joins
 the set when the pre-search names it a candidate and leaves it once it is outside the
-candidates and at rest (rotation below ``phi_quiet`` [rad], rate below ``dphi_quiet``
-[rad/s]). Arrays: ``act`` the active tooth indices (first ``nact`` valid), ``active`` and
-``incand`` per-tooth 0/1 flags, ``q`` the generalised forces (hubs first, then the teeth).
-The flags are int64 arrays, not bool: numba then reuses the int64 allocation it compiles
-anyway instead of compiling np.zeros once more for bool.
+candidates and at rest (rotation below ``par[PHI_QUIET]`` [rad], rate below
+``par[DPHI_QUIET]`` [rad/s]). ``tset`` rows (`layout` T_*): the active tooth indices (first
+``nact`` valid), and per-tooth 0/1 flags "active" and "candidate of this step". The flags are
+int64, not bool: numba then reuses the int64 allocation it compiles anyway instead of
+compiling np.zeros once more for bool. ``q``: generalised forces (hubs first, then the teeth).
+
+Running sums of a run sit in ``book`` (`layout` B_* columns); the loops pass the powers of
+each step to `end_step`, which integrates them with the trapezoidal rule.
 """
+import math
+
+import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.layout import C_FORCE
+from solver.mbs.kernels.layout import (
+    ACC,
+    B_DISS,
+    B_E0,
+    B_FMAX,
+    B_P_D,
+    B_P_IN,
+    B_WORK,
+    C_DELTA,
+    C_FORCE,
+    DELTA_MAX,
+    DPHI_QUIET,
+    DT,
+    ENERGY_TOL,
+    MAX_CONTACTS,
+    N_BOOK,
+    N_C_COLS,
+    N_TSET,
+    O_DISS,
+    O_FMAX,
+    O_KE,
+    O_NC,
+    O_PE,
+    O_REACT,
+    O_TE,
+    O_THETA2,
+    O_TIME,
+    O_WORK,
+    PHI_QUIET,
+    POS,
+    RATE,
+    T_ACT,
+    T_ACTIVE,
+    T_INCAND,
+)
 
 OK = 0
 NONFINITE = 1
 PENETRATION = 2
 ENERGY = 3
+NEWTON = 4
+
+
+def work_arrays(ntooth):
+    """(rec, pairs, q, vpred, tset, book), the work arrays ``ws`` of a loop over ntooth teeth:
+    contact records, candidate pairs, generalised forces, predicted tooth rates, active set,
+    running sums. Plain Python (the caller allocates them: one numba function less to
+    compile)."""
+    rec = np.zeros((MAX_CONTACTS, N_C_COLS))
+    pairs = np.zeros((MAX_CONTACTS, 3), dtype=np.int64)
+    q = np.zeros(ntooth + 2)
+    vpred = np.zeros(ntooth)
+    tset = np.zeros((N_TSET, ntooth), dtype=np.int64)
+    book = np.zeros(N_BOOK)
+    return rec, pairs, q, vpred, tset, book
 
 
 @njit(cache=True)
-def freeze_quiet_teeth(act, nact, active, incand, phi, dphi, acc, q, phi_quiet, dphi_quiet):
-    """Set the quiet teeth outside the candidates exactly to rest and drop them from the set.
-
-    Their rotation, rate, acceleration and generalised force become zero (rigid to the hub,
-    whose inertia already holds them). Returns the new number of active teeth.
-    """
-    a = 0
-    while a < nact:
-        i = act[a]
-        if not incand[i] and abs(phi[i]) < phi_quiet and abs(dphi[i]) < dphi_quiet:
-            phi[i] = 0.0
-            dphi[i] = 0.0
-            acc[i] = 0.0
-            q[2 + i] = 0.0
-            active[i] = False
-            nact -= 1
-            act[a] = act[nact]
-        else:
-            a += 1
+def initial_set(tset, teeth, pairs, npair, tz2):
+    """Active set at t = 0: the teeth already moving and those of the npair candidate pairs,
+    in tooth order. Returns its size."""
+    ntooth = teeth.shape[1]
+    active = tset[T_ACTIVE]
+    for i in range(ntooth):
+        if teeth[POS, i] != 0.0 or teeth[RATE, i] != 0.0:
+            active[i] = True
+    for p in range(npair):
+        active[int(pairs[p, 0])] = True
+        active[tz2 + int(pairs[p, 1])] = True
+    # counters start as np.int64(0), not a literal 0: numba would otherwise compile each callee
+    # once more for the argument type Literal[int](0)
+    nact = np.int64(0)
+    for i in range(ntooth):
+        if active[i]:
+            tset[T_ACT, nact] = i
+            nact += 1
     return nact
 
 
 @njit(cache=True)
-def clear_candidates(incand, pairs, npair, tz2):
-    """Reset the candidate flags of this step's pre-search pairs (gear-2 teeth offset by tz2)."""
+def activate(tset, nact, pairs, npair, tz2):
+    """Flag the teeth of the candidate pairs and append those not yet active to the set
+    (gear-2 teeth offset by tz2). Returns the new size; the new ones are act[old size:]."""
     for p in range(npair):
-        incand[int(pairs[p, 0])] = False
-        incand[tz2 + int(pairs[p, 1])] = False
+        for g in range(2):
+            i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
+            tset[T_INCAND, i] = True
+            if not tset[T_ACTIVE, i]:
+                tset[T_ACTIVE, i] = True
+                tset[T_ACT, nact] = i
+                nact += 1
+    return nact
 
 
 @njit(cache=True)
-def loaded_contacts(rec, nc):
-    """Number of the nc contact records that carry a positive normal force."""
+def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
+    """The end of a step: guards, energy bookkeeping, and the active set.
+
+    Records the largest contact force of ws's contacts rec[:nc] and checks the penetration
+    bound (status PENETRATION); integrates the work [J] and the dissipated energy [J] by the
+    trapezoidal rule from the last step's powers to these, powers = (p_in_left, p_in, p_d):
+    input power p_in [W] (p_in_left its left limit at this instant, where the driver
+    acceleration jumps) and dissipation power p_d [W]; sets the quiet teeth outside the
+    candidates exactly to rest (rotation, rate, acceleration and generalised force zero: rigid
+    to the hub, whose inertia already holds them) and drops them from the set; resets the
+    candidate flags of the npair pre-search pairs (gear-2 teeth offset by tz2). Returns (status, new number of active teeth).
+    """
+    rec, pairs, q, tset, book = ws[0], ws[1], ws[2], ws[4], ws[5]
+    p_in_left, p_in, p_d = powers
+    for c in range(nc):
+        if rec[c, C_FORCE] > book[B_FMAX]:
+            book[B_FMAX] = rec[c, C_FORCE]
+        if rec[c, C_DELTA] > par[DELTA_MAX]:
+            status = PENETRATION
+    dt = par[DT]
+    book[B_WORK] += 0.5 * dt * (p_in_left + book[B_P_IN])
+    book[B_DISS] += 0.5 * dt * (p_d + book[B_P_D])
+    book[B_P_IN] = p_in
+    book[B_P_D] = p_d
+    act = tset[T_ACT]
+    a = 0
+    while a < nact:
+        i = act[a]
+        if (not tset[T_INCAND, i] and abs(teeth[POS, i]) < par[PHI_QUIET]
+                and abs(teeth[RATE, i]) < par[DPHI_QUIET]):
+            teeth[POS, i] = 0.0
+            teeth[RATE, i] = 0.0
+            teeth[ACC, i] = 0.0
+            q[2 + i] = 0.0
+            tset[T_ACTIVE, i] = False
+            nact -= 1
+            act[a] = act[nact]
+        else:
+            a += 1
+    for p in range(npair):
+        tset[T_INCAND, int(pairs[p, 0])] = False
+        tset[T_INCAND, tz2 + int(pairs[p, 1])] = False
+    return status, nact
+
+
+@njit(cache=True)
+def record_output(out, o, row, book, rec, nc, finite, par, status):
+    """Write output record o (`layout` O_* columns) and check the state; returns the status.
+
+    row = (time [s], TE [m], driven hub angle [rad], driver torque [N m], kinetic and
+    potential energy [J]); with the largest contact force since the last record [N] (then
+    reset), the loaded contacts of rec[:nc], and the work and dissipated energy [J] of
+    ``book``. Status NONFINITE when the state is not ``finite`` or the energies are not,
+    ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
+    [J] above par[ENERGY_TOL] times the energy scale, else ``status`` unchanged.
+    """
+    t, te, theta2, react, ke, pe = row
     n = 0
     for c in range(nc):
         if rec[c, C_FORCE] > 0.0:
             n += 1
-    return n
-
-
-@njit(cache=True)
-def record_output(o, t, te, fmax, n_loaded, react, ke, pe, work, diss, theta2,
-                  o_time, o_te, o_fmax, o_nc, o_react, o_ke, o_pe, o_work, o_diss, o_theta2):
-    """Write output record o: time [s], TE [m], largest contact force over the interval [N],
-    loaded contacts, driver torque [N m], kinetic, potential, input and dissipated energy [J],
-    driven hub angle [rad]."""
-    o_time[o] = t
-    o_te[o] = te
-    o_fmax[o] = fmax
-    o_nc[o] = n_loaded
-    o_react[o] = react
-    o_ke[o] = ke
-    o_pe[o] = pe
-    o_work[o] = work
-    o_diss[o] = diss
-    o_theta2[o] = theta2
-
-
-@njit(cache=True)
-def checked_status(status, finite, ke, pe, e0, work, diss, energy_tol):
-    """Status after the checks at an output instant: NONFINITE when the state is not finite,
-    ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
-    [J] above energy_tol times the energy scale, else ``status`` unchanged."""
-    if not finite:
+    out[o, O_TIME] = t
+    out[o, O_TE] = te
+    out[o, O_FMAX] = book[B_FMAX]
+    out[o, O_NC] = n
+    out[o, O_REACT] = react
+    out[o, O_KE] = ke
+    out[o, O_PE] = pe
+    out[o, O_WORK] = book[B_WORK]
+    out[o, O_DISS] = book[B_DISS]
+    out[o, O_THETA2] = theta2
+    book[B_FMAX] = 0.0
+    if not (finite and math.isfinite(ke + pe)):
         return NONFINITE
-    if status == OK and ke + pe - e0 + diss - work > energy_tol * max(abs(work), ke + pe, diss):
+    work = book[B_WORK]
+    diss = book[B_DISS]
+    if status == OK and ke + pe - book[B_E0] + diss - work > par[ENERGY_TOL] * max(abs(work), ke + pe, diss):
         return ENERGY
     return status

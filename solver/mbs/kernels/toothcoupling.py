@@ -11,8 +11,15 @@ alone:
 exactly, whatever the rotations of the unloaded teeth. The kernels keep S small (the
 candidates of the contact pre-search), so K_S is a few teeth square and is rebuilt only when
 S changes. ``lst[:n]`` holds the tooth indices of S; ``ks[:n, :n]`` its stiffness.
+
+The stepping loop keeps S in ``cset`` = (C, ks, lst, newl, inset, innew, mo, dmo)
+(`coupled_set`): C the compliance, ``newl`` the next set's teeth, ``inset``/``innew``
+per-tooth 0/1 flags of the current and the next set, ``mo``/``dmo`` scratch moments.
 """
+import numpy as np
 from numba import njit
+
+from solver.mbs.kernels.layout import MAX_CONTACTS
 
 
 @njit(cache=True)
@@ -55,3 +62,70 @@ def set_energy(ks, lst, n, phi):
     for a in range(n):
         e += 0.5 * phi[lst[a]] * set_moment(ks, lst, n, phi, a)
     return e
+
+
+@njit(cache=True)
+def coupled_set(ctooth):
+    """Work arrays ``cset`` of the coupled set for the compliance ctooth (teeth x teeth, or
+    0 x 0: no coupled teeth, empty arrays). The set holds at most both teeth of every
+    candidate pair."""
+    ntooth = ctooth.shape[0]
+    ms = 2 * MAX_CONTACTS if ntooth > 0 else 0
+    return (ctooth, np.zeros((ms, 2 * ms)), np.zeros(ms, dtype=np.int64), np.zeros(ms, dtype=np.int64),
+            np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth, dtype=np.int64), np.zeros(ms), np.zeros(ms))
+
+
+@njit(cache=True)
+def update_set(cset, ns, nn, phi, dphi, vpred):
+    """Make newl[:nn] the coupled set (``inset`` flags the old members, ns of them): teeth that
+    join take their neighbours' share of rotation phi [rad] and of the rates dphi, vpred
+    [rad/s]; teeth that leave give it back (see the module docstring of `explicit_coupled`
+    for what stays continuous). Returns the new size."""
+    ctooth, ks, slst, newl, inset, innew, mo, dmo = cset
+    for a in range(nn):
+        innew[newl[a]] = True
+    same = nn == ns
+    if same:
+        for a in range(ns):
+            if not innew[slst[a]]:
+                same = False
+                break
+    if not same:
+        for a in range(ns):
+            mo[a] = set_moment(ks, slst, ns, phi, a)
+            dmo[a] = set_moment(ks, slst, ns, vpred, a)
+        for a in range(ns):                     # leaving
+            i = slst[a]
+            if not innew[i]:
+                for b in range(ns):
+                    j = slst[b]
+                    if j != i:
+                        phi[i] -= ctooth[i, j] * mo[b]
+                        dphi[i] -= ctooth[i, j] * dmo[b]
+                        vpred[i] -= ctooth[i, j] * dmo[b]
+                inset[i] = False
+        for a in range(nn):                     # joining
+            i = newl[a]
+            if not inset[i]:
+                for b in range(ns):
+                    j = slst[b]
+                    phi[i] += ctooth[i, j] * mo[b]
+                    dphi[i] += ctooth[i, j] * dmo[b]
+                    vpred[i] += ctooth[i, j] * dmo[b]
+        for a in range(nn):
+            slst[a] = newl[a]
+            inset[newl[a]] = True
+        set_stiffness(ctooth, slst, nn, ks)
+        ns = nn
+    for a in range(nn):
+        innew[newl[a]] = False
+    return ns
+
+
+@njit(cache=True)
+def set_springs(cset, ns, kphi, phi, q):
+    """Replace the own elastic spring torque of the set's teeth in q[2 + i] by the coupled one."""
+    ks, slst = cset[1], cset[2]
+    for a in range(ns):
+        i = slst[a]
+        q[2 + i] += kphi[i] * phi[i] - set_moment(ks, slst, ns, phi, a)

@@ -128,7 +128,8 @@ def test_coupled_model_closes_the_double_contact_gap(body, coupling):
 
 def test_coupled_step_above_the_stability_bound_is_caught(paper_solid_model):
     """Twice the critical step of the coupled pair: the guard stops the run and names why."""
-    from solver.mbs.dynamics import DivergenceError, simulate, stable_time_step
+    from solver.mbs.dynamics import DivergenceError, simulate
+    from solver.mbs.stability import stable_time_step
     m = with_body_springs(paper_solid_model, K_BODY)
     dt, _w = stable_time_step(m, 50.0)          # half the critical step
     ok = simulate(m, 100.0, 0.002, 50.0, 0.002, 0.002, dt=dt)

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 from conftest import assert_energy_closes_at_second_order, solid_scene
 
-from solver.mbs.dynamics import DivergenceError, simulate, stable_time_step
+from solver.mbs.dynamics import DivergenceError, simulate
+from solver.mbs.stability import stable_time_step
 from solver.mbs.statics import solve_static
 from study.run import run_static
 from study.setup import build_scene_model

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from conftest import solid_scene
 
-from solver.mbs.dynamics import DivergenceError, highest_frequency, linearized_system, simulate, stable_time_step
+from solver.mbs.dynamics import DivergenceError, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.kernels.laws import (
     contact_damping_tangents,
@@ -16,6 +16,7 @@ from solver.mbs.kernels.laws import (
     spring_damping_tangent,
     spring_torque,
 )
+from solver.mbs.stability import highest_frequency, linearized_system, stable_time_step
 from study.run import run_scene
 from study.scene import SceneError
 from study.setup import build_scene_model
@@ -165,7 +166,7 @@ def test_step_bound_includes_the_contact_damping():
     c*delta^1.5 overdamps the tooth-on-contact mode: Verlet is then limited by the damping,
     2/(sqrt(w² + h²) + h) with h = zeta*w, far below 2/w. The scene runs at the bound that
     includes it and is caught by the guard at the undamped bound."""
-    from solver.mbs.dynamics import stability_limit
+    from solver.mbs.stability import stability_limit
     m = build_scene_model(solid_scene(**{"contact.k_con": 5.64e4}))
     dt_crit, w = stability_limit(m, 50.0)
     assert dt_crit < 0.1 * 2.0 / w

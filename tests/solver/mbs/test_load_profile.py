@@ -5,7 +5,7 @@ import pytest
 from conftest import solid_scene
 
 from solver.mbs.dynamics import load_profile, run_loads, simulate
-from solver.mbs.kernels.explicit import load_torque
+from solver.mbs.kernels.mechanics import load_torque
 from solver.mbs.statics import solve_static
 from study.scene import SceneError
 

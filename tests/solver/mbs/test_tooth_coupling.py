@@ -9,6 +9,7 @@ from conftest import SMALL_PAIR, assert_energy_closes_at_second_order, slow_tran
 
 from solver.identify.coupling import tooth_compliance_fit
 from solver.identify.pivot import lever
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.toothcoupling import set_energy, set_moment, set_stiffness
 from solver.mbs.model import build_model
 from solver.mbs.statics import solve_static
@@ -190,23 +191,30 @@ def test_diagonal_compliance_dynamics_is_the_body_torsion_model():
 def test_coupled_kernel_matches_its_plain_python_run():
     """The compiled coupled loop against the same loop run as plain Python, set changes
     included (300 steps through a change of the candidate teeth)."""
-    from solver.mbs.dynamics import stable_time_step
     from solver.mbs.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.kernels.stepping import work_arrays
+    from solver.mbs.stability import stable_time_step
     m = coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0})
     dt, _ = stable_time_step(m, 50.0)
     th2 = float(m.theta2_for_te(0.0, m.backlash_offset))
     runs = []
     for f in (verlet_coupled, verlet_coupled.py_func):
-        o = [np.zeros(301) for _ in range(10)]
-        phi, dphi = np.zeros(m.n_teeth), np.zeros(m.n_teeth)
+        par = np.zeros(L.N_PAR)
+        par[[L.SPEED, L.SPEED_RAMP, L.TORQUE, L.TORQUE_RAMP, L.DT, L.DELTA_MAX, L.ENERGY_TOL]] = 300.0, 1e-9, 50.0, 1e-9, dt, 1e-4, 0.5
+        ipar = np.array([300, 1, 0])
+        out = np.zeros((301, L.N_OUT))
+        hub = np.zeros((3, L.N_HUB))
         # at 300 rad/s from the start the mesh turns a pitch in 0.3 ms: the set changes
-        res = f(m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance, 300.0, 1e-9, 50.0, 1e-9, np.zeros((0, 2)),
-                dt, 300, 1, 0.0, 300.0, th2, -300.0, th2, -300.0, phi, dphi, 0.0, 0.0, 1e-4, 0.5, *o)
-        runs.append((res, o, phi))
+        hub[L.POS, L.H_TH2] = hub[L.POS, L.H_H2] = th2
+        hub[L.RATE, L.H_R1] = 300.0
+        hub[L.RATE, L.H_TH2] = hub[L.RATE, L.H_H2] = -300.0
+        teeth = np.zeros((3, m.n_teeth))
+        mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance)
+        res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out, work_arrays(m.n_teeth))
+        runs.append((res, out, teeth[L.POS]))
     (r1, o1, p1), (r2, o2, p2) = runs
     assert r1 == r2 and r1[0] == 0
-    for x, y in zip(o1, o2):
-        assert x == pytest.approx(y, rel=1e-12, abs=1e-18)
+    assert o1 == pytest.approx(o2, rel=1e-12, abs=1e-18)
     assert p1 == pytest.approx(p2, rel=1e-12, abs=1e-18)
 
 
@@ -215,34 +223,35 @@ def test_set_changes_keep_the_spring_moments(jit):
     """A tooth that joins the coupled set unloaded (from rest, as from the frozen set) takes
     the rotation its neighbours give it and changes no moment; a tooth that leaves keeps its
     moment on its own spring."""
-    from solver.mbs.kernels.explicit_coupled import _update_set
-    f = _update_set if jit else _update_set.py_func
+    from solver.mbs.kernels.toothcoupling import coupled_set, update_set
+    f = update_set if jit else update_set.py_func
     z = 9
     C = ring(z, 800.0, (0.15, 0.05))
     k_own = 1.0 / np.diag(C)
     phi = RNG.normal(size=z) * 1e-4
     dphi = RNG.normal(size=z) * 1e-2
     vpred = dphi.copy()
-    ks = np.zeros((8, 16))
-    slst = np.zeros(8, dtype=np.int64)
-    inset = np.zeros(z, dtype=np.int64)
-    innew = np.zeros(z, dtype=np.int64)
-    mo, dmo = np.zeros(8), np.zeros(8)
+    cset = coupled_set.py_func(C)
+    _C, ks, slst, newl, inset, innew, _mo, _dmo = cset
+
+    def joining(teeth):
+        newl[:len(teeth)] = teeth
+        return len(teeth)
 
     def moments(ns):
         return {int(slst[a]): set_moment(ks, slst, ns, phi, a) for a in range(ns)}
 
-    ns = f(C, ks, slst, 0, np.array([3, 4, 5]), 3, inset, innew, phi, dphi, vpred, mo, dmo)
+    ns = f(cset, 0, joining([3, 4, 5]), phi, dphi, vpred)
     before = moments(ns)
     phi[6] = dphi[6] = vpred[6] = 0.0
-    ns = f(C, ks, slst, ns, np.array([3, 4, 5, 6]), 4, inset, innew, phi, dphi, vpred, mo, dmo)   # 6 joins
+    ns = f(cset, ns, joining([3, 4, 5, 6]), phi, dphi, vpred)   # 6 joins
     after = moments(ns)
     for i in (3, 4, 5):
         assert after[i] == pytest.approx(before[i], rel=1e-10)
     assert after[6] == pytest.approx(0.0, abs=1e-12 * abs(before[4]))
     assert phi[6] == pytest.approx(sum(C[6, b] * before[b] for b in (3, 4, 5)), rel=1e-12)
     m3 = after[3]
-    ns = f(C, ks, slst, ns, np.array([4, 5, 6]), 3, inset, innew, phi, dphi, vpred, mo, dmo)      # 3 leaves
+    ns = f(cset, ns, joining([4, 5, 6]), phi, dphi, vpred)      # 3 leaves
     assert k_own[3] * phi[3] == pytest.approx(m3, rel=1e-10)
     assert ns == 3 and sorted(slst[:ns]) == [4, 5, 6]
     assert list(np.flatnonzero(inset)) == [4, 5, 6] and not innew.any()

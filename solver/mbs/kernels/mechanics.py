@@ -1,0 +1,123 @@
+"""The pair's mechanics that every time-stepping loop shares (numba): the prescribed driver
+motion, the load torque, the arrowhead accelerations, the energies and the dissipation power.
+
+``act[:nact]`` are the active (integrated) teeth; ``rec[:nc]`` the contact records
+(`layout` C_* columns); ``mdl`` the model arrays (gear_par, pair_par, law_par, k_phi,
+tooth_compliance) as the stepping kernels take them. SI units.
+"""
+from numba import njit
+
+from solver.mbs.kernels.laws import contact_energy, signed_pow, spring_energy
+from solver.mbs.kernels.layout import C_DDELTA, C_DELTA, C_FORCE, C_PHI, I_CPL, I_P, I_TOT, K_CON, M1, N_C, N_K, TOOTH0
+
+
+@njit(cache=True)
+def driver_motion(t, speed, ramp):
+    """Driver angle [rad], speed [rad/s] and acceleration [rad/s²] of the speed ramp."""
+    if t < ramp:
+        acc = speed / ramp
+        return 0.5 * acc * t * t, acc * t, acc
+    return speed * (t - 0.5 * ramp), speed, 0.0
+
+
+@njit(cache=True)
+def driver_acc_left(t, speed, ramp):
+    """Left limit of the driver acceleration at t [rad/s²]."""
+    return speed / ramp if t <= ramp else 0.0
+
+
+@njit(cache=True)
+def driver_speed(t, speed, ramp):
+    """Driver speed [rad/s] of the ramp (continuous, with a kink at the ramp end)."""
+    return speed * t / ramp if t < ramp else speed
+
+
+@njit(cache=True)
+def load_torque(t, torque, ramp, table):
+    """Resisting torque on gear 2 [N m] at time t [s]: ramped from zero to ``torque`` over
+    ``ramp`` [s], or, when ``table`` (n x 2: time [s], torque [N m], times increasing) has
+    rows, linear between its points and held at its ends."""
+    n = table.shape[0]
+    if n == 0:
+        if t < ramp:
+            return torque * t / ramp
+        return torque
+    if t <= table[0, 0]:
+        return table[0, 1]
+    for k in range(1, n):
+        if t <= table[k, 0]:
+            t0 = table[k - 1, 0]
+            return table[k - 1, 1] + (table[k, 1] - table[k - 1, 1]) * (t - t0) / (table[k, 0] - t0)
+    return table[n - 1, 1]
+
+
+@njit(cache=True)
+def arrowhead_accelerations(q, act, nact, gp, acc):
+    """Solve the arrowhead systems of the plain pair for the force part of the accelerations.
+
+    Gear-1 teeth get (Q_phi)/I_P only: the prescribed driver's inertial coupling
+    -I_cpl/I_P * theta1'' is the caller's (the explicit loop applies it as exact velocity
+    increments, since theta1'' jumps at the end of the speed ramp). Fills acc of the active
+    teeth; returns (theta2'', S1, R1) with the driver torque T = S1*theta1'' + R1.
+    """
+    tz2 = int(gp[1, TOOTH0])
+    s = gp[1, I_TOT]
+    rhs = q[1]
+    for a in range(nact):
+        i = act[a]
+        if i >= tz2:
+            c = gp[1, I_CPL]
+            s -= c * c / gp[1, I_P]
+            rhs -= c * q[2 + i] / gp[1, I_P]
+    a2 = rhs / s
+    s1 = gp[0, I_TOT]
+    r1 = -q[0]
+    for a in range(nact):
+        i = act[a]
+        if i >= tz2:
+            acc[i] = (q[2 + i] - gp[1, I_CPL] * a2) / gp[1, I_P]
+        else:
+            acc[i] = q[2 + i] / gp[0, I_P]
+            s1 -= gp[0, I_CPL] * gp[0, I_CPL] / gp[0, I_P]
+            r1 += gp[0, I_CPL] * acc[i]
+    return a2, s1, r1
+
+
+@njit(cache=True)
+def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
+    """(kinetic, potential) energy [J]: ``ke`` and ``pe`` of the bodies plus the active teeth,
+    their springs and the contacts. w1, w2 [rad/s]: rates of the bodies that carry the teeth
+    of gear 1 and 2; ``teeth`` rows: rotations, rates. The plain pair's bodies are the rigid
+    gears: ke = I_tot1*w1²/2 + I_tot2*w2²/2, pe = 0."""
+    gp, lp, kphi = mdl[0], mdl[2], mdl[3]
+    tz2 = int(gp[1, TOOTH0])
+    phi = teeth[0]
+    dphi = teeth[1]
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        w = w2 if g == 1 else w1
+        ke += gp[g, I_CPL] * w * dphi[i] + 0.5 * gp[g, I_P] * dphi[i] * dphi[i]
+        pe += spring_energy(phi[i], kphi[i], gp[g, N_K])
+    for c in range(nc):
+        pe += contact_energy(rec[c, C_DELTA], lp[K_CON], lp[M1])
+    return ke, pe
+
+
+@njit(cache=True)
+def dissipation_power(dphi, act, nact, mdl, rec, nc):
+    """Power [W] of the tooth-spring dampers at the rates dphi and of the contact dampers."""
+    gp, lp = mdl[0], mdl[2]
+    tz2 = int(gp[1, TOOTH0])
+    p = 0.0
+    for a in range(nact):
+        i = act[a]
+        g = 1 if i >= tz2 else 0
+        if gp[g, C_PHI] != 0.0:
+            p += gp[g, C_PHI] * signed_pow(dphi[i], gp[g, N_C]) * dphi[i]
+    for c in range(nc):
+        d = rec[c, C_DELTA]
+        if d > 0.0:
+            fel = lp[K_CON] * d ** lp[M1]
+            p += (rec[c, C_FORCE] - fel) * rec[c, C_DDELTA]
+    return p

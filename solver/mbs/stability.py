@@ -1,0 +1,141 @@
+"""Step bound of the explicit integrator: the pair linearised at static equilibrium, its
+natural frequencies and modal damping, and the body-spring modes.
+
+`stable_time_step` gives ``dt = safety * 2 / omega_max`` (velocity Verlet is stable for
+omega*dt < 2), reduced where the modal damping of the loaded contacts asks for it
+(`stability_limit`); the model is linearised at several positions across one mesh cycle
+under the full load.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg
+
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
+from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
+from solver.mbs.model import Model
+from solver.mbs.statics import solve_static
+
+
+def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False):
+    """Mass and tangent stiffness over the free DOFs (theta2, then the teeth near the mesh).
+
+    Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF. With
+    ``damping`` also the damping tangent at rest, (M, K, C, dof_teeth): spring dampers and
+    contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1).
+    The damping laws run as plain Python here (``.py_func``, a few dozen calls): compiling
+    them would add to the first run's compile time for nothing.
+    """
+    rec, pairs = new_contact_buffer()
+    zeros = np.zeros(model.n_teeth)
+    gp = model.gear_par
+    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, model.pair_par, model.law_par, pairs, rec)
+    tz2 = int(gp[1, L.TOOTH0])
+    teeth = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
+    pos = {t: i + 1 for i, t in enumerate(teeth)}
+    n = len(teeth) + 1
+    M = np.zeros((n, n))
+    K = np.zeros((n, n))
+    C = np.zeros((n, n))
+    M[0, 0] = gp[1, L.I_TOT]
+    lp = model.law_par
+    for t, i in pos.items():
+        g = 1 if t >= tz2 else 0
+        M[i, i] = gp[g, L.I_P]
+        if g == 1:
+            M[0, i] = M[i, 0] = gp[1, L.I_CPL]
+        if not model.teeth_coupled:
+            K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
+        C[i, i] += spring_damping_tangent.py_func(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
+    if model.teeth_coupled:     # the springs of the teeth near the mesh: (C[S, S])^-1
+        K[1:, 1:] += np.linalg.inv(model.tooth_compliance[np.ix_(teeth, teeth)])
+    for c in range(nc):
+        kt = rec[c, L.C_KT]
+        ia = int(rec[c, L.C_TOOTH1])
+        ib = tz2 + int(rec[c, L.C_TOOTH2])
+        idx = [0, pos[ia], pos[ib]]
+        g = np.array([rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB]])
+        K[np.ix_(idx, idx)] += kt * np.outer(g, g)
+        _kd, cd = contact_damping_tangents.py_func(rec[c, L.C_DELTA], 0.0, max(rec[c, L.C_FORCE], 1e-300),
+                                           lp[L.C_CON], lp[L.M2], lp[L.M3])
+        C[np.ix_(idx, idx)] += cd * np.outer(g, g)
+    if damping:
+        return M, K, C, teeth
+    return M, K, teeth
+
+
+def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[float, float]:
+    """(critical Verlet step [s], highest natural frequency [rad/s]) of the loaded pair over one
+    mesh cycle.
+
+    The pair is linearised at static equilibrium under ``torque`` [N·m] (1 N·m if zero) at
+    ``positions`` driver angles across one angular pitch; the generalised eigenproblem
+    K x = w² M x gives the frequencies. Each mode i, with its modal damping ratio
+    zeta_i = x_i^T C x_i / (2 w_i) (mass-normalised x_i), limits the step to
+    2/w_i * (sqrt(1 + zeta_i²) - zeta_i): velocity Verlet with damping forces evaluated at the
+    predicted velocity is stable up to there (2/w_i undamped). A deep, damped contact (m3 > 1)
+    can make a lower but overdamped mode the limit. The equilibria come from one static sweep
+    with continuation (tooth rotations carried from angle to angle); positions where it does
+    not converge are left out.
+    """
+    angles = np.linspace(0.0, model.geometry[0].pitch_angle, positions, endpoint=False)
+    load = torque if abs(torque) > 1e-9 else 1.0
+    wmax = 0.0
+    dt_crit = math.inf
+    phi, te0, used = None, None, 0
+    for theta1 in angles:
+        st = solve_static(model, np.array([theta1]), load, phi0=phi, te0=te0, raise_on_failure=False)
+        if not st.converged[0]:
+            continue
+        phi, te0 = st.phi_last, float(st.te[0])
+        # a coupled model's mesh sits at the rim angles: the hubs less the body wind-up
+        kb1, kb2 = model.body_stiffness
+        rb1, rb2 = model.base_radii
+        rim1 = theta1 - load * rb1 / rb2 / kb1
+        rim2 = st.theta2[0] - load / kb2
+        M, K, C, _t = linearized_system(model, rim1, rim2, phi, damping=True)
+        lam, x = scipy.linalg.eigh(K, M)
+        w = np.sqrt(np.maximum(lam, 0.0))
+        h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
+        lim = 2.0 / np.maximum(np.hypot(w, h) + h, 1e-300)    # = 2/w (sqrt(1+zeta²) - zeta)
+        wmax = max(wmax, float(w.max()))
+        dt_crit = min(dt_crit, float(lim.min()))
+        used += 1
+    if used == 0:
+        raise ValueError(f"no static equilibrium under {load} N·m found to estimate the highest natural frequency")
+    return dt_crit, wmax
+
+
+def highest_frequency(model: Model, torque: float, positions: int = 12) -> float:
+    """Highest natural frequency [rad/s] of the loaded pair over one mesh cycle (see
+    `stability_limit`)."""
+    return stability_limit(model, torque, positions)[1]
+
+
+def body_frequency(model: Model) -> float:
+    """Highest natural frequency [rad/s] of the body springs alone (hub against rim and teeth);
+    the tooth modes of `highest_frequency` are usually far above it."""
+    gp = model.gear_par
+    w = 0.0
+    for g in range(2):
+        if gp[g, L.K_BODY] > 0:
+            i_rim = gp[g, L.I_TOT] - gp[g, L.I_HUB]
+            inv = 1.0 / i_rim + (1.0 / gp[g, L.I_HUB] if g == 1 else 0.0)   # the driver's hub is prescribed
+            w = max(w, math.sqrt(gp[g, L.K_BODY] * inv))
+    return w
+
+
+def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[float, float]:
+    """(dt [s], omega_max [rad/s]) for the explicit integrator: safety times the critical step
+    of `stability_limit` (2/omega_max without damping)."""
+    dt_crit, w = stability_limit(model, torque)
+    if model.coupled:   # the body modes are not in the mesh linearisation
+        wb = body_frequency(model)
+        w = max(w, wb)
+        dt_crit = min(dt_crit, 2.0 / wb)
+    if not w > 0:
+        raise ValueError("no loaded contact found to estimate the highest natural frequency")
+    return safety * dt_crit, w
