@@ -69,3 +69,41 @@ def body_inertia(g: GearGeometry, body: BodySpec, density: float) -> tuple[float
     parts = [ring(rf, r_rim, b), ring(r_rim, r_hub, body.web_thickness), ring(r_hub, r_bore, b)]
     m_holes, i_holes = hole_inertia(body, density)
     return sum(p[0] for p in parts) - m_holes, sum(p[1] for p in parts) - i_holes
+
+
+@dataclass(frozen=True)
+class GearMass:
+    """Mass properties of a whole gear (body and teeth) and of the same gear solid
+    (`solver.geometry.solid_body`: no holes, web as thick as the face). SI: kg, kg·m²."""
+
+    mass: float            # kg
+    inertia: float         # kg·m² about the gear axis
+    mass_solid: float      # kg
+    inertia_solid: float   # kg·m²
+
+    @property
+    def mass_saving(self) -> float:
+        """Mass saved against the solid gear [%]."""
+        return 100.0 * (1.0 - self.mass / self.mass_solid)
+
+    @property
+    def inertia_saving(self) -> float:
+        """Inertia saved against the solid gear [%]."""
+        return 100.0 * (1.0 - self.inertia / self.inertia_solid)
+
+
+def gear_inertia(g: GearGeometry, body: BodySpec, density: float) -> tuple[float, float]:
+    """Mass [kg] and polar inertia about the axis [kg·m²] of the whole gear: the body inside the
+    root circle plus the z teeth. The inertia is the model's total inertia of the gear (the
+    hub plus every tooth about the gear centre, `solver.mbs.model` I_TOT)."""
+    tooth = tooth_inertia(g, density, g.root_radius)
+    m_body, i_body = body_inertia(g, body, density)
+    return m_body + g.teeth * tooth.mass, i_body + g.teeth * tooth.inertia_center
+
+
+def gear_mass(g: GearGeometry, body: BodySpec, density: float) -> GearMass:
+    """Mass and inertia of the gear and of the same gear solid (see `GearMass`)."""
+    from solver.geometry import solid_body
+    m, i = gear_inertia(g, body, density)
+    ms, is_ = gear_inertia(g, solid_body(body, g.spec.face_width), density)
+    return GearMass(m, i, ms, is_)

@@ -17,7 +17,9 @@ from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.kernels.layout import R_PV
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
+from study.inputs.gearsetup import gear_setups
 from study.report import results
+from study.report.lightening import lightening_variables
 from study.scene import Scene
 from study.setup import build_scene_model, load_table, scene_springs, static_angles
 
@@ -66,6 +68,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     t_springs = time.perf_counter() - t0
     model = build_scene_model(scene, springs)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
+    c, v = lightening_variables(gear_setups(scene))      # mass, inertia; root stress from the springs' FE
+    coords.update(c); data.update(v)
     z1, z2 = model.teeth
     d = scene.dynamic
     driven_speed = d.speed * z1 / z2

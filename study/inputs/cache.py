@@ -4,7 +4,9 @@ On disk, under ``$LIGHTGEAR_CACHE/fe`` (default ``./.lightgear-cache/fe``), one 
 named by `FECache.key` of everything the result depends on:
 
 * ``{key}.nc``: a tooth-stiffness map (NetCDF, ``k_fe`` [N·m/rad] per tooth, the settings as a
-  JSON attribute);
+  JSON attribute) and the largest fillet stress of each tooth under the same load
+  (``root_stress`` [Pa]; a file written before it was stored lacks it: the map is then
+  recomputed when the stress is asked for);
 * ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.ltca.BodyCompliance`).
 
 In memory: the same results once read or computed, the last `BODY_SLOTS` factorised bodies (a
@@ -30,6 +32,7 @@ class FECache:
 
     def __init__(self):
         self.stiffness: dict[str, np.ndarray] = {}   # key -> tooth stiffness map [N·m/rad]
+        self.root_stress: dict[str, np.ndarray] = {}  # key -> largest fillet stress of each tooth [Pa]
         self.compliance: dict = {}                   # key -> BodyCompliance
         self.bodies: dict = {}                       # body key -> factorised BodyModel (least recently used first)
         self.fits: dict = {}                         # fit key -> coupling fit (least recently used first)
@@ -46,7 +49,7 @@ class FECache:
 
     def clear(self) -> None:
         """Forget every result held in memory (maps, compliances, factorised bodies, fits)."""
-        for held in (self.stiffness, self.compliance, self.bodies, self.fits):
+        for held in (self.stiffness, self.root_stress, self.compliance, self.bodies, self.fits):
             held.clear()
 
     def _read(self, held: dict, key: str, name: str, load):
@@ -72,13 +75,27 @@ class FECache:
         k = self._read(self.stiffness, key, f"{key}.nc", load)
         return None if k is None else k.copy()
 
-    def write_stiffness(self, key: str, k: np.ndarray, settings: dict) -> None:
+    def read_root_stress(self, key: str) -> np.ndarray | None:
+        """A copy of the fillet stresses [Pa] stored with the map of ``key``, or None."""
+        def load(path):
+            import xarray as xr
+            with xr.open_dataset(path) as ds:
+                return ds["root_stress"].values.copy()
+        s = self._read(self.root_stress, key, f"{key}.nc", load)
+        return None if s is None else s.copy()
+
+    def write_stiffness(self, key: str, k: np.ndarray, settings: dict, root_stress: np.ndarray | None = None) -> None:
+        """Store the map ``k`` [N·m/rad] and, when given, the fillet stresses [Pa] of the same teeth."""
         import xarray as xr
 
         from study.report.results import write_netcdf
         self.stiffness[key] = k.copy()
-        ds = xr.Dataset({"k_fe": xr.Variable("tooth", k, {"units": "N m rad-1", "long_name": "FE tooth torsion stiffness"})},
-                        attrs={"settings": json.dumps(settings, default=float)})
+        data = {"k_fe": xr.Variable("tooth", k, {"units": "N m rad-1", "long_name": "FE tooth torsion stiffness"})}
+        if root_stress is not None:
+            self.root_stress[key] = root_stress.copy()
+            data["root_stress"] = xr.Variable("tooth", root_stress, {
+                "units": "Pa", "long_name": "largest von Mises fillet stress under the tooth's own reference load"})
+        ds = xr.Dataset(data, attrs={"settings": json.dumps(settings, default=float)})
         try:
             write_netcdf(ds, self.folder / f"{key}.nc")
         except OSError:

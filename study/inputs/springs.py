@@ -33,13 +33,14 @@ from study.scene import Scene
 def fe_stiffness(setup: GearSetup, teeth=None, keep_fields: bool = False):
     """FE torsion stiffness [N·m/rad] of the gear's teeth (all, or ``teeth``), cached.
 
+    The same solve gives each tooth's largest fillet stress (`root_stress`), cached with the map.
     Returns k (n,) and, when ``keep_fields``, the (model, U) pair for renders (not cached).
     """
     from solver.fe import body as fe
     from solver.fe.mesh import mesh_body
 
     settings = setup.settings
-    tooth_list = list(range(setup.teeth)) if teeth is None else [int(t) for t in teeth]
+    tooth_list = _teeth(setup, teeth)
     key = FE_CACHE.key({**settings, "teeth": tooth_list})
     if not keep_fields:
         k = FE_CACHE.read_stiffness(key)
@@ -49,8 +50,25 @@ def fe_stiffness(setup: GearSetup, teeth=None, keep_fields: bool = False):
     mesh = mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body")
     model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, setup.material)
     k, U = fe.tooth_stiffness(model, geo, setup.pivot_radius, tooth_list, setup.force, setup.patch)
-    FE_CACHE.write_stiffness(key, k, settings)
+    stress = fe.fillet_stress(model, geo, U, tooth_list)
+    FE_CACHE.write_stiffness(key, k, settings, stress)
     return (k, (model, U)) if keep_fields else k
+
+
+def _teeth(setup: GearSetup, teeth) -> list[int]:
+    return list(range(setup.teeth)) if teeth is None else [int(t) for t in teeth]
+
+
+def root_stress(setup: GearSetup, teeth=None) -> np.ndarray:
+    """Largest von Mises fillet stress [Pa] of the gear's teeth (all, or ``teeth``), each under
+    its own FE reference load (``setup.force`` at the pitch point): from the FE solve of the
+    stiffness map (`fe_stiffness`), cached with it; a map cached without it is solved again."""
+    key = FE_CACHE.key({**setup.settings, "teeth": _teeth(setup, teeth)})
+    s = FE_CACHE.read_root_stress(key)
+    if s is None:
+        fe_stiffness(setup, teeth, keep_fields=True)
+        s = FE_CACHE.read_root_stress(key)
+    return s
 
 
 def fe_ratio(setup: GearSetup) -> tuple[np.ndarray, np.ndarray, float]:
@@ -60,12 +78,18 @@ def fe_ratio(setup: GearSetup) -> tuple[np.ndarray, np.ndarray, float]:
     return k, k / k_solid, k_solid
 
 
+def uses_fe_springs(setup: GearSetup) -> bool:
+    """True when the gear's springs come from the FE body (a lightened gear, stiffness not
+    'uniform'): its FE map, and that of its solid reference, are computed for the springs."""
+    return setup.lightened and setup.spring.stiffness != "uniform"
+
+
 def tooth_springs(setup: GearSetup) -> tuple[np.ndarray, np.ndarray]:
     """Per-tooth spring k_phi [N·mm/rad^n_k] and FE stiffness ratio [1] of the gear (a solid
     gear, or spring.stiffness 'uniform': the scene's k_phi on every tooth, no FE)."""
     spring = setup.spring
     z = setup.teeth
-    if not setup.lightened or spring.stiffness == "uniform":
+    if not uses_fe_springs(setup):
         return np.full(z, spring.k_phi), np.ones(z)
     k_fe, ratio, _ = fe_ratio(setup)
     if spring.stiffness == "fe-ratio":

@@ -26,13 +26,10 @@ DISPLACEMENT_CMAP = "cividis"
 
 def fillet_peak(f, geo, tooth: int) -> float:
     """Largest element von Mises stress [Pa] in the root/fillet band of the loaded tooth
-    (radius within one module of the root circle, within one pitch of the tooth axis)."""
-    c = f.points[f.triangles].mean(axis=1)
-    r = np.hypot(c[:, 0], c[:, 1])
-    a = np.arctan2(c[:, 1], c[:, 0]) - tooth * geo.pitch_angle
-    a = (a + math.pi) % (2 * math.pi) - math.pi
-    m = geo.spec.module
-    sel = (np.abs(r - geo.root_radius) < m) & (np.abs(a) < geo.pitch_angle)
+    (`solver.fe.body.fillet_band`: radius within one module of the root circle, within one pitch
+    of the tooth axis)."""
+    from solver.fe.body import fillet_band
+    sel = fillet_band(f.points[f.triangles].mean(axis=1), geo, tooth)
     return float(f.von_mises[sel].max()) if sel.any() else float("nan")
 
 

@@ -31,6 +31,11 @@ def summarize(ds: xr.Dataset) -> dict:
         z = ds.attrs["mesh_order"]
         for name, order in (("mesh", z), ("mesh2", 2 * z), ("mesh3", 3 * z), ("hole", ds.attrs["hole_order"])):
             out[f"amp_{name}_order"] = amplitude_at_order(ds, order) if order > 0 else nan
+    if "mass" in ds:
+        from study.sweep.outputs import GEAR_VARIABLES
+        for g in (1, 2):
+            for name in GEAR_VARIABLES:
+                out[f"{name}_gear{g}"] = float(ds[name].sel(gear=g)) if name in ds else nan
     for k in ("wall_time_springs_s", "wall_time_static_s", "wall_time_dynamic_s"):
         if k in ds.attrs:
             out[k] = float(ds.attrs[k])
@@ -58,6 +63,16 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         for f, o, a in results.largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
+    if "mass" in ds:
+        for g in (1, 2):
+            line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "
+                    f"solid), inertia {s[f'inertia_gear{g}']:.5g} kg mm2")
+            if np.isfinite(s[f"root_stress_max_gear{g}"]):
+                line += (f", root stress max {s[f'root_stress_max_gear{g}']:.1f} MPa "
+                         f"(x{s[f'root_stress_ratio_gear{g}']:.3f} solid)")
+            else:
+                line += ", root stress not computed (its springs need no FE)"
+            w(line + "\n")
     for what in ("dte", "ste"):
         if f"{what}_peak_amplitude" in ds:
             named = [(str(n), float(a)) for n, a in zip(ds[f"{what}_peak"].values, ds[f"{what}_peak_amplitude"].values)

@@ -66,7 +66,11 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
             scene = scene_from_dict(scene)
         elif isinstance(scene, str):
             scene = loads_scene(scene)
-        ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic)
+        if outputs.static or outputs.dynamic:
+            ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic)
+        else:   # geometry (and root stress) only: no model, no solve
+            from study.report.lightening import lightening_dataset
+            ds = lightening_dataset(scene, stress=outputs.fe)
         s = summarize(ds)
         bad = set()          # analyses whose numbers are not to be trusted
         problems = []

@@ -4,7 +4,11 @@ selection a study makes (`Outputs`), and the status flags of a point.
 A scalar is one number per point (the names of `study.report.summary.summarize`), with its
 units and long name; a curve is a run-archive variable over its own axis, archived with the
 units and long name the run archive gives it (`study.report.results`). Each output needs one
-analysis: 'static' (quasi-static STE) or 'dynamic' (DTE run).
+analysis: 'static' (quasi-static STE), 'dynamic' (DTE run), 'geometry' (mass properties, no
+solve) or 'fe' (the FE body of the springs: root stress, NaN for a gear whose springs need no FE).
+
+The per-gear outputs of the run archive (`study.report.lightening`) are scalars named
+``{variable}_gear{g}``: ``mass_gear2`` is ``mass.sel(gear=2)``.
 """
 from __future__ import annotations
 
@@ -17,7 +21,7 @@ from study.scene import SceneError
 class Scalar:
     units: str
     long_name: str
-    analysis: str        # 'static' or 'dynamic'
+    analysis: str        # 'static', 'dynamic', 'geometry' or 'fe'
 
 
 @dataclass(frozen=True)
@@ -40,6 +44,17 @@ SCALARS = {
     "amp_hole_order": Scalar("um", "DTE amplitude at the hole order N (NaN for a gear without holes)", "dynamic"),
     "tooth_force_max": Scalar("N", "largest tooth contact force of the dynamic run after the ramp", "dynamic"),
 }
+for _g, _which in ((1, "driver"), (2, "driven gear")):
+    SCALARS.update({
+        f"mass_gear{_g}": Scalar("kg", f"mass of the {_which} (body and teeth)", "geometry"),
+        f"mass_saving_gear{_g}": Scalar("%", f"mass of the {_which} saved against the same gear solid", "geometry"),
+        f"inertia_gear{_g}": Scalar("kg mm2", f"polar moment of inertia of the {_which} about its axis", "geometry"),
+        f"root_stress_max_gear{_g}": Scalar("MPa", f"largest fillet stress of the {_which}'s teeth (FE; NaN when its "
+                                                   "springs need no FE)", "fe"),
+        f"root_stress_ratio_gear{_g}": Scalar("1", f"largest fillet stress of the {_which} relative to the same gear solid "
+                                                   "(FE; NaN when its springs need no FE)", "fe"),
+    })
+GEAR_VARIABLES = ("mass", "mass_saving", "inertia", "root_stress_max", "root_stress_ratio")   # scalars *_gear{g}
 
 CURVES = {
     "ste": Curve("angle", "static"),
@@ -53,7 +68,7 @@ STATUS = ("pending", "ok", "diverged", "invalid", "failed")   # CF flag meanings
 
 
 def analysis_of(output: str) -> str:
-    """'static' or 'dynamic': the analysis an output (scalar or curve) needs."""
+    """'static', 'dynamic', 'geometry' or 'fe': the analysis an output (scalar or curve) needs."""
     return (SCALARS.get(output) or CURVES[output]).analysis
 
 
@@ -72,6 +87,11 @@ class Outputs:
     def dynamic(self) -> bool:
         """True when a dynamic (DTE) analysis is needed."""
         return any(analysis_of(x) == "dynamic" for x in self.scalars + self.curves)
+
+    @property
+    def fe(self) -> bool:
+        """True when an output needs the FE body of the springs (root stress)."""
+        return any(analysis_of(x) == "fe" for x in self.scalars + self.curves)
 
 
 def outputs_from_table(table) -> Outputs:

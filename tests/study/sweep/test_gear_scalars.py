@@ -1,0 +1,13 @@
+"""Per-gear sweep scalars (mass, saving, inertia, root stress) in the shared tiny study."""
+import numpy as np
+from sweep_cases import swept  # noqa: F401  (the sweep, run once per session)
+
+
+def test_swept_mass_saving_follows_the_body_not_the_speed(swept):
+    ds = swept[0].dataset
+    saving = ds["mass_saving_gear2"]
+    assert float(saving.sel(n_holes=0, web_thickness=17.0).max()) == 0.0
+    assert (saving.sel(n_holes=4) > 0).all() and (saving.sel(web_thickness=12.0) > 0).all()
+    assert (ds["mass_gear2"].sel(speed=50.0) == ds["mass_gear2"].sel(speed=100.0)).all()
+    assert ds["mass_gear2"].attrs["units"] == "kg" and ds["inertia_gear2"].attrs["units"] == "kg mm2"
+    assert np.isnan(ds["root_stress_max_gear2"]).all()          # uniform springs: no FE
