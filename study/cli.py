@@ -74,8 +74,11 @@ def run_arguments(p) -> None:
 def run_command(args) -> int:
     import study
     from solver.mbs.dynamics import DivergenceError
+    from study.plausibility import check_dynamic_window
     from study.report.summary import print_summary
     scene = study.load_scene(args.scene, args.overrides)
+    if not args.no_dynamic:
+        check_dynamic_window(scene)       # the summary needs a steady part after the ramps
     checked_output(args.output)
     t0 = time.perf_counter()
     try:
