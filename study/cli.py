@@ -3,8 +3,7 @@
 The commands parse arguments and print; the work is done by the Python API (`study`) and
 the modules behind it, which keep no argument parsing. Modules are imported only when their
 command runs, so ``lightgear --help`` is quick and ``lightgear run`` never loads gmsh or VTK.
-Exit codes: 0 done, 2 invalid scene or study (the message names the field) or missing
-archive, 1 sweep points lost to failed workers, 130 sweep interrupted.
+Exit codes (also in ``lightgear --help``): see `EXIT_CODES`.
 """
 from __future__ import annotations
 
@@ -12,6 +11,46 @@ import argparse
 import sys
 import time
 from pathlib import Path
+
+EXIT_CODES = """exit codes:
+  0    done
+  1    an unexpected error (one line on stderr; LIGHTGEAR_DEBUG=1 shows the traceback),
+       or sweep points lost to failed workers (run the same command again)
+  2    invalid input, before any work: scene or study field (named), option, output path,
+       archive to render
+  3    a run that diverged or whose statics did not converge (archive written, cause on stderr)
+  130  interrupted (a sweep keeps its finished points)"""
+
+
+class UsageError(Exception):
+    """Bad command-line input (an option, an output path, an archive): exit 2."""
+
+    def __init__(self, option: str, reason: str):
+        super().__init__(f"{option}: {reason}")
+
+
+def writable_folder(folder: Path, option: str = "-o") -> None:
+    """Create ``folder`` if needed and prove that a file can be written in it, before any work."""
+    import tempfile
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(option, f"{folder} is a file, not a directory")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".lightgear-probe"):
+            pass
+    except OSError as e:
+        raise UsageError(option, f"cannot write in {folder}: {e.strerror or e}") from None
+
+
+def checked_output(path, option: str = "-o") -> Path:
+    """An archive path that ends in .nc, is no directory and whose folder is writable."""
+    path = Path(path)
+    if path.is_dir():
+        raise UsageError(option, f"{path} is a directory; give the archive's file name (e.g. {path / 'run.nc'})")
+    if path.suffix != ".nc":
+        raise UsageError(option, f"archives are NetCDF files ending in .nc, got {path.name!r}")
+    writable_folder(path.parent, option)
+    return path
 
 
 def scene_arguments(p, output: str | None, output_help: str = "archive to write (NetCDF)") -> None:
@@ -34,16 +73,39 @@ def run_arguments(p) -> None:
 
 def run_command(args) -> int:
     import study
+    from solver.mbs.dynamics import DivergenceError
+    from study.plausibility import check_dynamic_window
     from study.report.summary import print_summary
     scene = study.load_scene(args.scene, args.overrides)
+    if not args.no_dynamic:
+        check_dynamic_window(scene)       # the summary needs a steady part after the ramps
+    checked_output(args.output)
     t0 = time.perf_counter()
-    ds = study.run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None)
+    try:
+        ds = study.run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None)
+    except DivergenceError as e:
+        print(f"lightgear run: diverged: {e}", file=sys.stderr)
+        return 3
     study.write(ds, args.output)
     print_summary(ds, args.output, time.perf_counter() - t0)
     if args.figures:
         for path in study.render(ds, Path(args.output).parent):
             print(f"  figure: {path}")
-    return 0
+    problems = run_problems(ds)
+    for msg in problems:
+        print(f"lightgear run: {msg} (see the archive's attributes)", file=sys.stderr)
+    return 3 if problems else 0
+
+
+def run_problems(ds) -> list[str]:
+    """Why a run archive's numbers are not to be trusted: unconverged statics, a stopped dynamic run."""
+    out = []
+    if "ste_converged" in ds and not ds["ste_converged"].values.all():
+        conv = ds["ste_converged"].values
+        out.append(f"static equilibrium not reached at {int((conv == 0).sum())} of {conv.size} angles")
+    if ds.attrs.get("dynamic_status", "ok") != "ok":
+        out.append(f"dynamic run diverged: {ds.attrs['dynamic_status']}")
+    return out
 
 
 # ---------------------------------------------------------------- stiffness
@@ -61,6 +123,7 @@ def stiffness_command(args) -> int:
     from study.inputs.springs import hole_offset, identify_spring, stiffness_dataset
     from study.setup import gear_setup
     scene = study.load_scene(args.scene, args.overrides)
+    checked_output(args.output)
     ds = stiffness_dataset(scene)
     study.write(ds, args.output)
     print(f"tooth stiffness map -> {args.output} ({ds.attrs['wall_time_springs_s']:.2f} s)")
@@ -97,15 +160,20 @@ def sweep_command(args) -> int:
     import numpy as np
 
     import study
-    from study.sweep.engine import parts_folder
+    from study.sweep.engine import SchedulerUnreachable, parts_folder
     from study.sweep.outputs import STATUS
     st = study.load_study(args.study)
     output = args.output or f"results/{Path(args.study).stem}.nc"
+    checked_output(output)
+    if args.workers is not None and args.workers < 0:
+        raise UsageError("--workers", f"must be >= 0 (0 runs the points in this process), got {args.workers}")
     n = int(np.prod(st.shape))
     print(f"{st.title}: {n} points ({' x '.join(map(str, st.shape))}, {st.layout} layout) -> {output}")
     try:
         res = study.run_sweep(st, output, workers=args.workers, scheduler=args.scheduler,
                               progress=not args.no_progress, keep_parts=args.keep_parts)
+    except SchedulerUnreachable as e:
+        raise UsageError("--scheduler", str(e)) from None
     except KeyboardInterrupt:
         print(f"interrupted: finished points are kept in {parts_folder(output)}; run the same command to resume",
               file=sys.stderr)
@@ -162,15 +230,32 @@ def render_arguments(p) -> None:
 
 def render_command(args) -> int:
     import study
-    path = Path(args.archive)
-    if not path.exists():
-        print(f"lightgear render: no such archive: {path}")
-        return 2
+    path = checked_archive(args.archive)
+    writable_folder(Path(args.output) if args.output else path.parent)
     t0 = time.perf_counter()
     for p in study.render(path, args.output, renders=not args.no_renders):
         print(f"  figure: {p}")
     print(f"  {time.perf_counter() - t0:.1f} s")
     return 0
+
+
+def checked_archive(name) -> Path:
+    """An existing NetCDF file written by lightgear (its provenance attributes), else UsageError."""
+    import xarray as xr
+    path = Path(name)
+    if not path.exists():
+        raise UsageError("archive", f"no such file: {path}")
+    if not path.is_file():
+        raise UsageError("archive", f"{path} is not a file")
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as ds:
+            attrs = dict(ds.attrs)
+    except Exception as e:  # noqa: BLE001 - netCDF4/HDF5 raise many kinds for a damaged file
+        reason = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise UsageError("archive", f"{path} is not a readable NetCDF file ({reason}); empty, truncated or of another kind") from None
+    if "code_fingerprint" not in attrs:
+        raise UsageError("archive", f"{path} is NetCDF but not a lightgear archive (no lightgear provenance attributes)")
+    return path
 
 
 # ---------------------------------------------------------------- precision
@@ -191,9 +276,8 @@ def precision_command(args) -> int:
     from study.setup import build_scene_model
     from study.verify.precision import dynamic_study, plot, setting_label, static_study, table
     scene = study.load_scene(args.scene, args.overrides)
+    base = checked_output(args.output)
     model = build_scene_model(scene)
-    base = Path(args.output)
-    base.parent.mkdir(parents=True, exist_ok=True)
 
     def progress(i, s, e, w, msg):
         setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
@@ -231,6 +315,7 @@ def reference_command(args) -> int:
     scene = study.load_scene(args.scene, args.overrides)
     if args.step is not None and not args.step > 0:
         raise study.SceneError("--step", f"must be positive, got {args.step}")
+    checked_output(args.output)
     ds = reference_dataset(scene, None if args.step is None else static_angles(scene, args.step))
     study.write(ds, args.output)
     ste = ds["ste"].values
@@ -260,7 +345,8 @@ COMMANDS = {
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="lightgear", description="Transmission error of lightened spur gears (MUBOCO-PR).")
+    parser = argparse.ArgumentParser(prog="lightgear", description="Transmission error of lightened spur gears (MUBOCO-PR).",
+                                     epilog=EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
     for name, (help_, arguments, command) in COMMANDS.items():
         p = sub.add_parser(name, help=help_, description=help_)
@@ -271,12 +357,27 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
+    import os
+
     from study.scene import SceneError
     try:
         return int(args._command(args) or 0)
     except SceneError as e:
         print(f"lightgear {args.command}: invalid scene: {e}", file=sys.stderr)
         return 2
+    except UsageError as e:
+        print(f"lightgear {args.command}: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"lightgear {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as e:  # noqa: BLE001 - the backstop: one line, no traceback unless asked
+        if os.environ.get("LIGHTGEAR_DEBUG", "") not in ("", "0"):
+            raise
+        first = str(e).splitlines()[0] if str(e) else ""
+        print(f"lightgear {args.command}: error: {type(e).__name__}: {first} (LIGHTGEAR_DEBUG=1 shows the traceback)",
+              file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

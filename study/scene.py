@@ -76,7 +76,7 @@ class SpringSection:
 
 @dataclass(frozen=True)
 class GearSection:
-    module: float = _f(1.5, "mm", "module", 0, lo_open=True)
+    module: float = _f(1.5, "mm", "module", 0, 100.0, lo_open=True)
     teeth: int = _f(67, "1", "number of teeth", 6)
     pressure_angle: float = _f(20.0, "deg", "pressure angle", 10.0, 35.0)
     addendum: float = _f(1.0, "1", "addendum coefficient", 0, lo_open=True)
@@ -119,7 +119,7 @@ class DynamicSection:
     enabled: bool = _f(True, "", "compute the dynamic transmission error")
     method: str = _f("explicit", "", "time integrator: 'explicit' (velocity Verlet), 'implicit' (HHT-alpha), 'auto' (explicit when its stability step is affordable for the duration, implicit otherwise)", choices=("explicit", "implicit", "auto"))
     alpha: float = _f(0.0, "1", "HHT-alpha numerical damping of the implicit integrator: 0 = none (trapezoidal rule), down to -1/3", -1.0 / 3.0, 0.0)
-    speed: float = _f(100.0, "rad/s", "final driver speed")
+    speed: float = _f(100.0, "rad/s", "final driver speed (the driver turns forward; a reversed load is a negative torque)", 0.0)
     torque: float = _f(50.0, "N*m", "final resisting torque on gear 2")
     ramp_time: float = _f(0.01, "s", "speed and torque ramp time", 0, lo_open=True)
     torque_change_time: float = _f(0.0, "s", "time at which the resisting torque starts to move, linearly, from dynamic.torque to dynamic.torque_after (a load step or a reversal during the run); 0 = never", 0.0)
@@ -280,6 +280,8 @@ def check_scene(scene: Scene) -> None:
                          f"of the run ({d.duration} s), got {d.torque_change_time} s")
     if d.spectrum_start >= d.duration:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
+    from study.plausibility import check_plausibility  # mesh, steady window and load bounds
+    check_plausibility(scene)
 
 
 def scene_from_dict(data: dict) -> Scene:

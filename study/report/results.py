@@ -54,12 +54,24 @@ def code_fingerprint() -> str:
     return h.hexdigest()[:16]
 
 
+def history_line(created: str | None = None) -> str:
+    """CF ``history``: UTC time, then the program and its arguments."""
+    import shlex
+    import sys
+    created = created or datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    spec = getattr(sys.modules.get("__main__"), "__spec__", None)
+    program = f"python -m {spec.name.removesuffix('.__main__')}" if spec is not None and spec.name else Path(sys.argv[0]).name
+    return f"{created} {program} {shlex.join(sys.argv[1:])}".strip()
+
+
 def provenance() -> dict:
+    created = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     return {
         "software": versions(),
         "code_fingerprint": code_fingerprint(),
         "machine": f"{platform.node()} {platform.machine()} {platform.processor() or ''} python {platform.python_version()}".strip(),
-        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "created": created,
+        "history": history_line(created),
         "Conventions": "CF-1.8",
     }
 
@@ -117,7 +129,8 @@ def ste_spectrum_variables(angle_deg, ste_um, z1: int, z2: int, hole_order: floa
 
 def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_order: float = 0.0,
                       mesh_order: float | None = None) -> tuple[dict, dict, dict]:
-    coords = {"time": _var("time", res.time, "s", "time")}
+    coords = {"time": _var("time", res.time, "s", "time",
+                           comment="elapsed time from the start of the run, not a calendar time")}
     data = {
         "dte": _var("time", res.te * units.UM_PER_M, "um", "dynamic transmission error rb1*theta1 + rb2*theta2"),
         "contact_force_max": _var("time", res.force_max, "N", "largest tooth contact force over the output interval"),
@@ -159,20 +172,79 @@ def stiffness_variables(k_nmm: tuple, ratio: tuple) -> tuple[dict, dict]:
     return coords, data
 
 
+def cf_ready(ds: xr.Dataset) -> tuple[xr.Dataset, dict]:
+    """A shallow copy of ``ds`` and its NetCDF encoding in the form CF-1.8 asks for.
+
+    Integers become int32 where the values fit (CF has no 64-bit integers), coordinate
+    variables get no ``_FillValue`` (a coordinate has no missing values), floats and integers
+    are compressed, and a dataset without ``history`` (one not made with `provenance`) gets
+    one. Names, values and every other attribute stay as they are.
+    """
+    ds = ds.copy(deep=False)
+    i32 = np.iinfo(np.int32)
+    for name in list(ds.variables):
+        v = ds[name]
+        if v.dtype.kind in "iu" and v.dtype.itemsize > 4 and (v.size == 0 or i32.min <= int(v.min()) and int(v.max()) <= i32.max):
+            ds[name] = v.astype(np.int32)
+    enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars if ds[v].dtype.kind in "fiu"}
+    for c in ds.coords:
+        enc.setdefault(c, {})["_FillValue"] = None
+    if not str(ds.attrs.get("history", "")).strip():
+        ds.attrs["history"] = history_line()
+    return ds, enc
+
+
+TMP_MARK = ".tmp"
+
+
+def host_tag() -> str:
+    """Short tag of this machine in temporary names: a shared folder on a cluster holds other
+    hosts' temporary files, whose process ids mean nothing here."""
+    return hashlib.sha256(platform.node().encode()).hexdigest()[:6]
+
+
+def clean_stale_temporaries(path) -> list[Path]:
+    """Remove the temporary files of ``path`` (``.NAME.tmpPID.HOST-XXXXXXXX``) left by writers
+    on this machine that no longer run (a kill during a write) -> the paths removed. Files
+    of live processes and of other hosts are left alone."""
+    import os
+    path = Path(path)
+    removed = []
+    for tmp in path.parent.glob(f".{path.name}{TMP_MARK}*"):
+        pid_text, _, rest = tmp.name[len(path.name) + 1 + len(TMP_MARK):].partition(".")
+        host = rest.partition("-")[0] if "-" in rest else host_tag()   # older names carry no host
+        if not pid_text.isdigit() or host != host_tag() or int(pid_text) == os.getpid():
+            continue
+        try:
+            os.kill(int(pid_text), 0)
+            continue                       # its writer still runs
+        except ProcessLookupError:
+            pass
+        except PermissionError:
+            continue                       # alive, owned by another user
+        try:
+            tmp.unlink()
+            removed.append(tmp)
+        except OSError:
+            pass
+    return removed
+
+
 def write_netcdf(ds: xr.Dataset, path) -> None:
-    """Write compressed NetCDF4 atomically (temporary file, then rename).
+    """Write compressed CF NetCDF4 (`cf_ready`) atomically (temporary file, then rename).
 
     The temporary name is unique per process and call, so concurrent writers of the same path
     (dask workers filling the FE spring cache) never share a half-written file; the last
-    rename wins and readers only ever open complete files.
+    rename wins and readers only ever open complete files. Temporaries that a killed writer
+    left behind are removed on the next write of the same path.
     """
     import os
     import uuid
-    from pathlib import Path
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}.{uuid.uuid4().hex[:8]}")
-    enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars if ds[v].dtype.kind in "fiu"}
+    clean_stale_temporaries(path)
+    tmp = path.with_name(f".{path.name}{TMP_MARK}{os.getpid()}.{host_tag()}-{uuid.uuid4().hex[:8]}")
+    ds, enc = cf_ready(ds)
     try:
         ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
         os.replace(tmp, path)

@@ -117,7 +117,7 @@ def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Datase
         if name not in axes:
             continue  # no point produced it (all failed): nothing to label its axis with
         axis, ax_vals, ax_attrs = axes[name]
-        coords[axis] = xr.Variable(axis, ax_vals, {k: v for k, v in ax_attrs.items() if k in ("units", "long_name")})
+        coords[axis] = xr.Variable(axis, ax_vals, {k: v for k, v in ax_attrs.items() if k in ("units", "long_name", "comment")})
         attrs = {k: v for k, v in curve_attrs[name].items() if k in ("units", "long_name", "window", "comment")}
         if CURVES[name].comment:
             attrs["comment"] = CURVES[name].comment

@@ -152,12 +152,25 @@ def parts_folder(output: str | Path) -> Path:
 
 # ---------------------------------------------------------------- executors
 
+CONNECT_TIMEOUT_S = 10.0   # s, to reach an existing scheduler (dask's default retries for 30 s)
+
+
+class SchedulerUnreachable(ConnectionError):
+    """The scheduler given by address did not answer."""
+
+
 @contextlib.contextmanager
 def dask_client(scheduler: str | None = None, workers: int | None = None):
-    """A dask Client: to ``scheduler``, or to a LocalCluster started (and always closed) here."""
+    """A dask Client: to ``scheduler`` (SchedulerUnreachable after CONNECT_TIMEOUT_S), or to a
+    LocalCluster started (and always closed) here."""
     from distributed import Client, LocalCluster
     if scheduler:
-        with Client(scheduler) as client:
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError) as e:
+            raise SchedulerUnreachable(f"no dask scheduler answered at {scheduler} within {CONNECT_TIMEOUT_S:g} s "
+                                       f"({type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''})") from None
+        with client:
             yield client
         return
     n = workers or os.cpu_count() or 1

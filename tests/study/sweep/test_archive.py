@@ -1,4 +1,5 @@
 """Study archives: labels and units, the NetCDF round trip, and split studies opening as one."""
+import pytest
 import xarray as xr
 from sweep_cases import GRID, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
 
@@ -27,6 +28,13 @@ def test_archive_labels_units_and_netcdf_round_trip(swept):
     with xr.open_dataset(out, engine="netcdf4") as back:
         xr.testing.assert_identical(back.load(), ds)
         assert back["ste"].encoding.get("zlib")
+
+
+def test_archive_passes_the_cf_checker(swept):
+    pytest.importorskip("compliance_checker")
+    from cf_check import cf_errors
+    _, out = swept
+    assert cf_errors(out) == []
 
 
 def test_archives_of_split_studies_open_together(swept, tmp_path):

@@ -103,8 +103,8 @@ def test_interrupt_and_resume_give_the_same_archive(swept, tmp_path, monkeypatch
     again = run_sweep(tiny_study(), out, workers=0, progress=False)
     assert len(calls) == 5 and again.computed == 5 and again.reused == 3
     drop = ["wall_time"]
-    xr.testing.assert_identical(again.dataset.drop_vars(drop).assign_attrs(created=""),
-                                res.dataset.drop_vars(drop).assign_attrs(created=""))
+    xr.testing.assert_identical(again.dataset.drop_vars(drop).assign_attrs(created="", history=""),
+                                res.dataset.drop_vars(drop).assign_attrs(created="", history=""))
 
 
 def test_failing_points_are_recorded_and_the_sweep_goes_on(tmp_path, monkeypatch):
@@ -195,8 +195,8 @@ def test_dask_sweep_is_interruptible_closes_its_cluster_and_resumes(swept, tmp_p
     monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or real(s, o))
     again = run_sweep(tiny_study(), out, workers=0, progress=False)
     assert again.reused == 2 and len(calls) == 6
-    xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created=""),
-                                res.dataset.drop_vars("wall_time").assign_attrs(created=""))
+    xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created="", history=""),
+                                res.dataset.drop_vars("wall_time").assign_attrs(created="", history=""))
 
 
 # ---------------------------------------------------------------- CLI, workflow, scheduling

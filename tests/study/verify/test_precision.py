@@ -1,6 +1,7 @@
 """Work-precision study on tiny cases: dataset contract, references that agree far below the
 smallest error, errors that fall with the step or tolerance, failed runs kept as NaN with
 their message, the plot."""
+import importlib.util
 import math
 
 import numpy as np
@@ -90,6 +91,10 @@ def test_static_study_and_failed_run_kept(scene, model, tmp_path):
     import xarray as xr
     back = xr.open_dataset(tmp_path / "wp.nc")
     assert list(back["message"].values) == list(ds2["message"].values)
+    if importlib.util.find_spec("compliance_checker"):
+        from cf_check import cf_errors
+        results.write_netcdf(ds, tmp_path / "wp_static.nc")
+        assert cf_errors(tmp_path / "wp.nc") == [] and cf_errors(tmp_path / "wp_static.nc") == []
 
 
 def test_stability_suite_subset_ends_ok_or_named():

@@ -1,0 +1,100 @@
+"""Cross-field checks of a scene that need a little physics: what the FE mesh can represent,
+whether the loads are plausible (both called by `study.scene.check_scene`), and whether the
+dynamic window leaves a steady part (called by `lightgear run`). Each raises `SceneError`
+naming the field, before any work.
+"""
+from __future__ import annotations
+
+from solver import units
+from solver.geometry import gear_geometry
+from study.scene import SceneError, SpringSection
+
+# Elements of the outline size across the rim: fewer and the FE body has no element layer
+# between the tooth roots and the web or the holes (the spring map reads points outside the mesh).
+RIM_ELEMENTS = 2
+# Samples of the stored DTE after the ramp that a spectrum and the summary need.
+STEADY_SAMPLES = 16
+# Largest plausible elastic approach of the teeth along the line of action, as a fraction of
+# the module: beyond it the pseudo-rigid teeth leave the range where the model means anything
+# (teeth bent by a sizeable part of their height), and the statics find no equilibrium.
+DEFLECTION_FRACTION = 0.2
+
+
+def mesh_size_mm(scene, g: int) -> float:
+    """FE element size at gear g's outline [mm]: fe.mesh_size, else a quarter of the module
+    (`solver.fe.mesh.default_mesh_size`)."""
+    return scene.fe.mesh_size or scene.gear(g).module / 4.0
+
+
+def check_fe_mesh(scene) -> None:
+    """fe.mesh_size at most the smaller module; a rim at least RIM_ELEMENTS elements thick."""
+    h = scene.fe.mesh_size
+    m_min = min(scene.gear1.module, scene.gear2.module)
+    if h > m_min:
+        raise SceneError("fe.mesh_size", f"must lie in (0, module = {m_min:.4g} mm] (0: module/4), got {h:.4g} mm")
+    for g in (1, 2):
+        b, hg = scene.gear(g).body, mesh_size_mm(scene, g)
+        if b.rim_height < RIM_ELEMENTS * hg:
+            raise SceneError(f"gear{g}.body.rim_height",
+                             f"rim thinner than the FE mesh can represent: it needs {RIM_ELEMENTS} elements of the "
+                             f"outline size ({'fe.mesh_size' if scene.fe.mesh_size else 'module/4'} = {hg:.4g} mm), "
+                             f"i.e. >= {RIM_ELEMENTS * hg:.4g} mm, got {b.rim_height:.4g} mm "
+                             "(a finer fe.mesh_size allows a thinner rim)")
+
+
+def check_dynamic_window(scene) -> None:
+    """The run must leave a steady part after the ramps for the DTE summary and spectrum."""
+    d = scene.dynamic
+    if not d.enabled:
+        return
+    start = d.spectrum_start or 2 * d.ramp_time
+    need = STEADY_SAMPLES * d.output_step
+    if d.duration - start < need:
+        what = "dynamic.spectrum_start" if d.spectrum_start else "twice dynamic.ramp_time"
+        raise SceneError("dynamic.duration",
+                         f"leaves no steady part: the DTE summary and spectrum start at {what} ({start:.4g} s) and need "
+                         f"{STEADY_SAMPLES} samples of dynamic.output_step ({d.output_step:.4g} s) after it, so the "
+                         f"duration must be >= {start + need:.4g} s, got {d.duration:.4g} s")
+
+
+def approach_estimate_mm(scene, torque_nm: float) -> float:
+    """Elastic approach of one tooth pair carrying the whole load [mm], from the scene's laws:
+    the contact (F = k_con delta^m1) plus each tooth's torsion spring (T = k_phi phi^n_k) with the
+    normal force acting at the pitch circle, lever = pitch radius - pivot radius. A rough upper
+    estimate (load sharing halves it); for the coupled body models, whose tooth springs come
+    from the FE body, the springs of the paper's solid tooth stand in."""
+    g1, g2 = (gear_geometry(scene.tooth_spec(g)) for g in (1, 2))
+    force = abs(torque_nm) / g2.base_radius                      # N, along the line of action
+    c = scene.contact
+    k_con = units.contact_stiffness_to_si(c.k_con, c.m1)         # N/m^m1
+    delta = (force / k_con) ** (1.0 / c.m1)                      # m
+    for g, geo in ((1, g1), (2, g2)):
+        spring = scene.gear(g).spring if scene.coupling.model == "none" else SpringSection()
+        lever = max(geo.pitch_radius - scene.pivot_radius(g), 0.25 * scene.gear(g).module * units.MM)   # m
+        k_phi = spring.k_phi * units.NMM                         # N·m/rad^n_k
+        phi = (force * lever / k_phi) ** (1.0 / spring.n_k)       # rad
+        delta += phi * lever
+    return delta / units.MM
+
+
+def check_loads(scene) -> None:
+    """Each torque of the scene against the deflection bound (DEFLECTION_FRACTION of the module)."""
+    loads = [("quasi_static.torque", scene.quasi_static.torque), ("dynamic.torque", scene.dynamic.torque)]
+    if scene.dynamic.torque_change_time > 0:
+        loads.append(("dynamic.torque_after", scene.dynamic.torque_after))
+    bound = DEFLECTION_FRACTION * min(scene.gear1.module, scene.gear2.module)
+    for name, torque in loads:
+        if torque == 0:
+            continue
+        d = approach_estimate_mm(scene, torque)
+        if not d <= bound:
+            raise SceneError(name, f"implausible load: {torque:.4g} N*m bends one tooth pair by about {d:.3g} mm "
+                             f"(contact law and tooth springs), more than {DEFLECTION_FRACTION:g} x module = {bound:.4g} mm; "
+                             "the pseudo-rigid tooth model does not hold there")
+
+
+def check_plausibility(scene) -> None:
+    """The checks every scene passes (mesh, loads). `check_dynamic_window` is for the commands
+    that summarise a run: integrator studies run windows that end with the ramps on purpose."""
+    check_fe_mesh(scene)
+    check_loads(scene)
