@@ -30,8 +30,11 @@ def pretty_unit(unit: str | None) -> str:
 
 
 def axis_label(v: xr.DataArray, name: str | None = None) -> str:
-    """'long name [unit]' of a variable or coordinate."""
-    ln = v.attrs.get("long_name", name or v.name or "")
+    """'long name [unit]' of a variable or coordinate; a long name's remark in parentheses is
+    left out (it belongs in the archive, not on an axis or a legend title)."""
+    ln = str(v.attrs.get("long_name", name or v.name or ""))
+    if len(ln) > 40 and " (" in ln:
+        ln = ln.split(" (", 1)[0]
     return f"{ln} [{pretty_unit(v.attrs.get('units'))}]"
 
 

@@ -174,3 +174,13 @@ def test_hole_passes_on_the_ste_axis_follow_the_gear_ratio():
     shifted = base.replace(**{"gear2.body.hole_phase": 15.0})
     ds = xr.Dataset(attrs={"scene": shifted.to_toml()})
     np.testing.assert_allclose(hole_mesh_angles(ds, 120.0), [15.0, 75.0])
+
+
+def test_axis_labels_leave_a_long_names_remark_to_the_archive():
+    """A long name's remark in parentheses would crowd a legend title and squeeze the panels."""
+    from study.report.plot_style import axis_label
+    speed = xr.DataArray([50.0], dims="speed", attrs={
+        "units": "rad s-1", "long_name": "final driver speed (the driver turns forward; a reversed load is a negative torque)"})
+    assert axis_label(speed) == "final driver speed [rad/s]"
+    short = xr.DataArray([1.0], dims="x", attrs={"units": "mm", "long_name": "rim (l1)"})
+    assert axis_label(short) == "rim (l1) [mm]"
