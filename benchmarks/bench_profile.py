@@ -27,7 +27,7 @@ N_CALLS = 200_000
 def _loop_contacts(n, th1, th2, phi, dphi, gp, pp, lp, pairs, rec):
     s = 0
     for k in range(n):
-        nc, npair = mesh_contacts(th1 + 1e-12 * k, th2, phi, 100.0, 100.0, dphi, gp, pp, lp, pairs, rec)
+        nc, npair = mesh_contacts((th1 + 1e-12 * k, th2, 100.0, 100.0), phi, dphi, (gp, pp, lp), (rec, pairs))
         s += nc
     return s
 
@@ -75,7 +75,7 @@ def main(argv=None) -> int:
     phi = st.phi_last
     dphi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()
-    nc, npair = mesh_contacts(theta1, st.theta2[0], phi, 100.0, 100.0, dphi, gp, pp, lp, pairs, rec)
+    nc, npair = mesh_contacts((theta1, st.theta2[0], 100.0, 100.0), phi, dphi, (gp, pp, lp), (rec, pairs))
     rows = [dict(part="contact search (mesh_contacts)", active_teeth=None,
                  ns_per_call=per_call(_loop_contacts, theta1, st.theta2[0], phi, dphi, gp, pp, lp, pairs, rec),
                  note=f"{npair} candidate pairs, {nc} contacts")]

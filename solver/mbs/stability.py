@@ -32,7 +32,7 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
     rec, pairs = new_contact_buffer()
     zeros = np.zeros(model.n_teeth)
     gp = model.gear_par
-    nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, model.pair_par, model.law_par, pairs, rec)
+    nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, model.pair_par, model.law_par), (rec, pairs))
     tz2 = int(gp[1, L.TOOTH0])
     teeth = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
     pos = {t: i + 1 for i, t in enumerate(teeth)}

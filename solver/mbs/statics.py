@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.statics import static_sweep
 from solver.mbs.model import Model
 
@@ -53,11 +54,8 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
         raise ValueError("angles: need a non-empty 1-D array of driver angles")
     n = angles.size
     z1 = model.teeth[0]
-    te = np.zeros(n)
-    th2 = np.zeros(n)
-    nc = np.zeros(n, dtype=np.int64)
+    out = np.zeros((n, L.N_S_OUT))
     f1 = np.zeros((n, z1))
-    it = np.zeros(n, dtype=np.int64)
     phi = np.zeros(model.n_teeth) if phi0 is None else np.array(phi0, dtype=float)
     sgn = 1.0 if torque >= 0 else -1.0
     te_start = sgn * model.backlash_offset if te0 is None else te0
@@ -72,8 +70,11 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     # teeth coupled through the bodies: their springs act through the compliance matrix alone
     kphi = np.zeros_like(model.k_phi) if model.teeth_coupled else model.k_phi
     ctooth = model.tooth_compliance if model.teeth_coupled else None    # None: the plain kernel
-    fails = static_sweep(rim_angles, float(torque), theta2, phi, model.gear_par, model.pair_par,
-                         model.law_par, kphi, ctooth, tol, max_iter, te, nc, f1, it, th2)
+    mdl = (model.gear_par, model.pair_par, model.law_par, kphi)
+    ctl = (np.array([float(torque), theta2, tol]), np.array([max_iter], dtype=np.int64))
+    fails = static_sweep(mdl, ctooth, ctl, rim_angles, phi, out, f1)
+    te, th2 = out[:, L.S_TE].copy(), out[:, L.S_TH2].copy()
+    nc, it = out[:, L.S_NC].astype(np.int64), out[:, L.S_ITER].astype(np.int64)
     if model.coupled:
         th2 += windup2
         te[:] = rb1 * angles + rb2 * th2

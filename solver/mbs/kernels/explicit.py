@@ -20,29 +20,8 @@ import math
 import numpy as np
 from numba import njit
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
-from solver.mbs.kernels.layout import (
-    ACC,
-    B_E0,
-    B_P_D,
-    B_P_IN,
-    DT,
-    H_TH2,
-    I_CPL,
-    I_P,
-    I_TOT,
-    N_STEPS,
-    OUT_EVERY,
-    POS,
-    RATE,
-    RB,
-    SPEED,
-    SPEED_RAMP,
-    T_ACT,
-    TOOTH0,
-    TORQUE,
-    TORQUE_RAMP,
-)
 from solver.mbs.kernels.mechanics import (
     arrowhead_accelerations,
     dissipation_power,
@@ -76,30 +55,30 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     """
     gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, table = ctl
-    phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
-    tz2 = int(gp[1, TOOTH0])
-    dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
+    phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
+    tz2 = int(gp[1, L.TOOTH0])
+    dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
     rec, pairs, q, vpred, tset, book = ws
-    act = tset[T_ACT]
-    theta2, w2 = hub[POS, H_TH2], hub[RATE, H_TH2]
+    act = tset[L.T_ACT]
+    theta2, w2 = hub[L.POS, L.H_TH2], hub[L.RATE, L.H_TH2]
     th1, w1, acc1 = driver_motion(0.0, speed, ramp)
-    tl = load_torque(0.0, par[TORQUE], par[TORQUE_RAMP], table)
-    nc, npair = mesh_contacts(th1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec)
+    tl = load_torque(0.0, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+    nc, npair = mesh_contacts((th1, theta2, w1, w2), phi, dphi, (gp, pp, lp), (rec, pairs))
     nact = initial_set(tset, teeth, pairs, npair, tz2)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     a2, s1, r1 = arrowhead_accelerations(q, act, nact, gp, acc)
     react = s1 * acc1 + r1
-    cr1 = gp[0, I_CPL] / gp[0, I_P]
-    ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+    cr1 = gp[0, L.I_CPL] / gp[0, L.I_P]
+    ke, pe = mesh_energies(0.5 * gp[0, L.I_TOT] * w1 * w1 + 0.5 * gp[1, L.I_TOT] * w2 * w2, 0.0, w1, w2,
                            teeth, act, nact, mdl, rec, nc)
-    book[B_E0] = ke + pe
-    book[B_P_IN] = react * w1 + tl * w2
-    book[B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
-    te0 = gp[0, RB] * th1 + gp[1, RB] * theta2
+    book[L.B_E0] = ke + pe
+    book[L.B_P_IN] = react * w1 + tl * w2
+    book[L.B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
+    te0 = gp[0, L.RB] * th1 + gp[1, L.RB] * theta2
     o = max_act = np.int64(0)
     status = record_output(out, o, (0.0, te0, theta2, react, ke, pe), book, rec, nc, math.isfinite(te0), par, np.int64(OK))
     step = 0
-    for step in range(1, ipar[N_STEPS] + 1):
+    for step in range(1, ipar[L.N_STEPS] + 1):
         # half kick (the driver coupling of gear-1 teeth as its exact speed increment), drift
         t_old = (step - 1) * dt
         t = step * dt
@@ -114,7 +93,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
             phi[i] += dt * dphi[i]
         theta2 += dt * w2h
         th1, w1, acc1 = driver_motion(t, speed, ramp)
-        tl = load_torque(t, par[TORQUE], par[TORQUE_RAMP], table)
+        tl = load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
         # predicted velocities for the damping terms
         w2p = w2h + 0.5 * dt * a2
         for a in range(nact):
@@ -123,7 +102,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
             if i < tz2:
                 vpred[i] -= cr1 * dw_b
         # contacts; activate the teeth the pre-search finds
-        nc, npair = mesh_contacts(th1, theta2, phi, w1, w2p, vpred, gp, pp, lp, pairs, rec)
+        nc, npair = mesh_contacts((th1, theta2, w1, w2p), phi, vpred, (gp, pp, lp), (rec, pairs))
         n_old = nact
         nact = activate(tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):
@@ -146,14 +125,14 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
         p_d = dissipation_power(vpred, act, nact, mdl, rec, nc)
         status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * w2, p_d), par, status)
         max_act = max(max_act, nact)
-        if step % ipar[OUT_EVERY] == 0:
+        if step % ipar[L.OUT_EVERY] == 0:
             o += 1
-            ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+            ke, pe = mesh_energies(0.5 * gp[0, L.I_TOT] * w1 * w1 + 0.5 * gp[1, L.I_TOT] * w2 * w2, 0.0, w1, w2,
                                    teeth, act, nact, mdl, rec, nc)
-            te = gp[0, RB] * th1 + gp[1, RB] * theta2
+            te = gp[0, L.RB] * th1 + gp[1, L.RB] * theta2
             finite = math.isfinite(theta2) and math.isfinite(w2)
             status = record_output(out, o, (t, te, theta2, react, ke, pe), book, rec, nc, finite, par, status)
         if status != OK:
             break
-    hub[POS, H_TH2], hub[RATE, H_TH2], hub[ACC, H_TH2] = theta2, w2, a2
+    hub[L.POS, L.H_TH2], hub[L.RATE, L.H_TH2], hub[L.ACC, L.H_TH2] = theta2, w2, a2
     return status, step, max_act, 0

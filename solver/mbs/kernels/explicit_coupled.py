@@ -31,36 +31,8 @@ import math
 import numpy as np
 from numba import njit
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
-from solver.mbs.kernels.layout import (
-    ACC,
-    B_E0,
-    B_P_D,
-    B_P_IN,
-    C_BODY,
-    DT,
-    H_H2,
-    H_R1,
-    H_TH2,
-    I_CPL,
-    I_HUB,
-    I_P,
-    I_TOT,
-    K_BODY,
-    N_HUB,
-    N_STEPS,
-    OUT_EVERY,
-    POS,
-    RATE,
-    RB,
-    SPEED,
-    SPEED_RAMP,
-    T_ACT,
-    T_INCAND,
-    TOOTH0,
-    TORQUE,
-    TORQUE_RAMP,
-)
 from solver.mbs.kernels.mechanics import dissipation_power, driver_acc_left, driver_motion, load_torque, mesh_energies
 from solver.mbs.kernels.stepping import (
     OK,
@@ -76,36 +48,36 @@ from solver.mbs.kernels.toothcoupling import coupled_set, set_energy, set_spring
 def rim_accelerations(q, act, nact, gp, acc, ha):
     """Arrowhead solves of both rims: fills ha[H_R1] (r1''), ha[H_TH2] (theta2'') and the
     teeth's acc. q[0], q[1]: generalised forces on the rims (contacts + body springs)."""
-    tz2 = int(gp[1, TOOTH0])
-    s1 = gp[0, I_TOT] - gp[0, I_HUB]
-    s2 = gp[1, I_TOT] - gp[1, I_HUB]
+    tz2 = int(gp[1, L.TOOTH0])
+    s1 = gp[0, L.I_TOT] - gp[0, L.I_HUB]
+    s2 = gp[1, L.I_TOT] - gp[1, L.I_HUB]
     rhs1 = q[0]
     rhs2 = q[1]
     for a in range(nact):
         i = act[a]
         g = 1 if i >= tz2 else 0
-        c = gp[g, I_CPL]
+        c = gp[g, L.I_CPL]
         if g == 1:
-            s2 -= c * c / gp[1, I_P]
-            rhs2 -= c * q[2 + i] / gp[1, I_P]
+            s2 -= c * c / gp[1, L.I_P]
+            rhs2 -= c * q[2 + i] / gp[1, L.I_P]
         else:
-            s1 -= c * c / gp[0, I_P]
-            rhs1 -= c * q[2 + i] / gp[0, I_P]
-    ha[H_R1] = rhs1 / s1
-    ha[H_TH2] = rhs2 / s2
+            s1 -= c * c / gp[0, L.I_P]
+            rhs1 -= c * q[2 + i] / gp[0, L.I_P]
+    ha[L.H_R1] = rhs1 / s1
+    ha[L.H_TH2] = rhs2 / s2
     for a in range(nact):
         i = act[a]
         g = 1 if i >= tz2 else 0
-        ar = ha[H_TH2] if g == 1 else ha[H_R1]
-        acc[i] = (q[2 + i] - gp[g, I_CPL] * ar) / gp[g, I_P]
+        ar = ha[L.H_TH2] if g == 1 else ha[L.H_R1]
+        acc[i] = (q[2 + i] - gp[g, L.I_CPL] * ar) / gp[g, L.I_P]
 
 
 @njit(cache=True)
 def body_moments(gp, th1, w1, x, v):
     """Moments [N m] of the body springs and dampers on the driver rim and the driven hub, at
     the body angles x and rates v (columns H_*), driver hub at th1 [rad], w1 [rad/s]."""
-    mb1 = gp[0, K_BODY] * (th1 - x[H_R1]) + gp[0, C_BODY] * (w1 - v[H_R1])
-    mb2 = gp[1, K_BODY] * (x[H_H2] - x[H_TH2]) + gp[1, C_BODY] * (v[H_H2] - v[H_TH2])
+    mb1 = gp[0, L.K_BODY] * (th1 - x[L.H_R1]) + gp[0, L.C_BODY] * (w1 - v[L.H_R1])
+    mb2 = gp[1, L.K_BODY] * (x[L.H_H2] - x[L.H_TH2]) + gp[1, L.C_BODY] * (v[L.H_H2] - v[L.H_TH2])
     return mb1, mb2
 
 
@@ -113,9 +85,9 @@ def body_moments(gp, th1, w1, x, v):
 def body_dissipation(p, gp, w1, v):
     """p plus the power [W] of the body dampers at the driver hub rate w1 and the body rates
     v [rad/s]."""
-    d1 = w1 - v[H_R1]
-    d2 = v[H_H2] - v[H_TH2]
-    return p + gp[0, C_BODY] * d1 * d1 + gp[1, C_BODY] * d2 * d2
+    d1 = w1 - v[L.H_R1]
+    d2 = v[L.H_H2] - v[L.H_TH2]
+    return p + gp[0, L.C_BODY] * d1 * d1 + gp[1, L.C_BODY] * d2 * d2
 
 
 @njit(cache=True)
@@ -129,32 +101,35 @@ def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, phi):
     rec, _pairs, q, vel, tset, _book = ws
     th1, w1, acc1, tl, acc = drv
     q[:] = 0.0
-    generalized_forces(rec, nc, phi, vel, tset[T_ACT], nact, kphi, gp, 0.0, q)
+    generalized_forces(rec, nc, phi, vel, tset[L.T_ACT], nact, kphi, gp, 0.0, q)
     set_springs(cset, ns, kphi, phi, q)
-    mb1, mb2 = body_moments(gp, th1, w1, hub[POS], v)
+    mb1, mb2 = body_moments(gp, th1, w1, hub[L.POS], v)
     q[0] += mb1
     q[1] += mb2
-    rim_accelerations(q, tset[T_ACT], nact, gp, acc, hub[ACC])
-    hub[ACC, H_H2] = (tl - mb2) / gp[1, I_HUB]
-    return gp[0, I_HUB] * acc1 + mb1, mb1
+    rim_accelerations(q, tset[L.T_ACT], nact, gp, acc, hub[L.ACC])
+    hub[L.ACC, L.H_H2] = (tl - mb2) / gp[1, L.I_HUB]
+    return gp[0, L.I_HUB] * acc1 + mb1, mb1
 
 
 @njit(cache=True)
-def coupled_energies(mdl, th1, w1, hub, teeth, tset, nact, rec, nc, cset, ns):
+def coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth):
     """(kinetic, potential) energy [J]: hubs, rims, body springs, then `mesh_energies` with
-    the teeth on the rims, and the coupled set's springs through K_S instead of their own."""
+    the teeth on the rims, and the coupled set's springs through K_S instead of their own.
+    Arguments as `coupled_forces` (drv: its first two, theta1 [rad] and theta1' [rad/s])."""
     gp, _pp, _lp, kphi, _ct = mdl
-    x = hub[POS]
-    v = hub[RATE]
-    ke = 0.5 * gp[0, I_HUB] * w1 * w1 + 0.5 * (gp[0, I_TOT] - gp[0, I_HUB]) * v[H_R1] * v[H_R1]
-    ke += 0.5 * gp[1, I_HUB] * v[H_H2] * v[H_H2] + 0.5 * (gp[1, I_TOT] - gp[1, I_HUB]) * v[H_TH2] * v[H_TH2]
-    pe = 0.5 * gp[0, K_BODY] * (th1 - x[H_R1]) ** 2 + 0.5 * gp[1, K_BODY] * (x[H_H2] - x[H_TH2]) ** 2
-    ke, pe = mesh_energies(ke, pe, v[H_R1], v[H_TH2], teeth, tset[T_ACT], nact, mdl, rec, nc)
+    rec, tset = ws[0], ws[4]
+    th1, w1 = drv[0], drv[1]
+    x = hub[L.POS]
+    v = hub[L.RATE]
+    ke = 0.5 * gp[0, L.I_HUB] * w1 * w1 + 0.5 * (gp[0, L.I_TOT] - gp[0, L.I_HUB]) * v[L.H_R1] * v[L.H_R1]
+    ke += 0.5 * gp[1, L.I_HUB] * v[L.H_H2] * v[L.H_H2] + 0.5 * (gp[1, L.I_TOT] - gp[1, L.I_HUB]) * v[L.H_TH2] * v[L.H_TH2]
+    pe = 0.5 * gp[0, L.K_BODY] * (th1 - x[L.H_R1]) ** 2 + 0.5 * gp[1, L.K_BODY] * (x[L.H_H2] - x[L.H_TH2]) ** 2
+    ke, pe = mesh_energies(ke, pe, v[L.H_R1], v[L.H_TH2], teeth, tset[L.T_ACT], nact, mdl, rec, nc)
     if ns > 0:
-        pe += set_energy(cset[1], cset[2], ns, teeth[POS])
+        pe += set_energy(cset[1], cset[2], ns, teeth[L.POS])
         for a in range(ns):
             i = cset[2][a]
-            pe -= 0.5 * kphi[i] * teeth[POS, i] * teeth[POS, i]
+            pe -= 0.5 * kphi[i] * teeth[L.POS, i] * teeth[L.POS, i]
     return ke, pe
 
 
@@ -183,54 +158,55 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     """
     gp, pp, lp, _kphi, ctooth = mdl
     par, ipar, table = ctl
-    phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
-    tz2 = int(gp[1, TOOTH0])
-    dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
+    phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
+    tz2 = int(gp[1, L.TOOTH0])
+    dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
     rec, pairs, q, vpred, tset, book = ws
-    act = tset[T_ACT]
-    x, v, ha = hub[POS], hub[RATE], hub[ACC]
-    vh = np.zeros(N_HUB)
-    vp = np.zeros(N_HUB)
+    act = tset[L.T_ACT]
+    x, v, ha = hub[L.POS], hub[L.RATE], hub[L.ACC]
+    vh = np.zeros(L.N_HUB)
+    vp = np.zeros(L.N_HUB)
     cset = coupled_set(ctooth)
     coupled = ctooth.shape[0] > 0
     th1, w1, acc1 = driver_motion(0.0, speed, ramp)
-    tl = load_torque(0.0, par[TORQUE], par[TORQUE_RAMP], table)
-    nc, npair = mesh_contacts(x[H_R1], x[H_TH2], phi, v[H_R1], v[H_TH2], dphi, gp, pp, lp, pairs, rec)
+    tl = load_torque(0.0, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+    nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
     ns = np.int64(0)
     if coupled:
-        nn = new_candidates(cset[3], tset[T_INCAND], pairs, npair, tz2)
+        nn = new_candidates(cset[3], tset[L.T_INCAND], pairs, npair, tz2)
         ns = update_set(cset, ns, nn, phi, dphi, dphi)
-        tset[T_INCAND, :] = 0
+        tset[L.T_INCAND, :] = 0
     nact = initial_set(tset, teeth, pairs, npair, tz2)
     vpred[:] = dphi
-    react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, (th1, w1, acc1, tl, acc), hub, v, phi)
-    ke, pe = coupled_energies(mdl, th1, w1, hub, teeth, tset, nact, rec, nc, cset, ns)
-    book[B_E0] = ke + pe
-    book[B_P_IN] = react * w1 + tl * v[H_H2]
-    book[B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl, rec, nc), gp, w1, v)
+    drv = (th1, w1, acc1, tl, acc)
+    react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, phi)
+    ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth)
+    book[L.B_E0] = ke + pe
+    book[L.B_P_IN] = react * w1 + tl * v[L.H_H2]
+    book[L.B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl, rec, nc), gp, w1, v)
     o = max_act = np.int64(0)
-    row = (0.0, gp[0, RB] * th1 + gp[1, RB] * x[H_H2], x[H_H2], react, ke, pe)
+    row = (0.0, gp[0, L.RB] * th1 + gp[1, L.RB] * x[L.H_H2], x[L.H_H2], react, ke, pe)
     status = record_output(out, o, row, book, rec, nc, math.isfinite(row[1]), par, np.int64(OK))
     step = 0
-    for step in range(1, ipar[N_STEPS] + 1):
+    for step in range(1, ipar[L.N_STEPS] + 1):
         t = step * dt
         # half kick, drift
-        for k in range(N_HUB):
+        for k in range(L.N_HUB):
             vh[k] = v[k] + 0.5 * dt * ha[k]
         for a in range(nact):
             i = act[a]
             dphi[i] += 0.5 * dt * acc[i]
             phi[i] += dt * dphi[i]
-        for k in range(N_HUB):
+        for k in range(L.N_HUB):
             x[k] += dt * vh[k]
             vp[k] = vh[k] + 0.5 * dt * ha[k]    # predicted velocities for the damping terms
         th1, w1, acc1 = driver_motion(t, speed, ramp)
-        tl = load_torque(t, par[TORQUE], par[TORQUE_RAMP], table)
+        tl = load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
         for a in range(nact):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
-        nc, npair = mesh_contacts(x[H_R1], x[H_TH2], phi, vp[H_R1], vp[H_TH2], vpred, gp, pp, lp, pairs, rec)
-        nn = new_candidates(cset[3], tset[T_INCAND], pairs, npair, tz2) if coupled else 0
+        nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, (gp, pp, lp), (rec, pairs))
+        nn = new_candidates(cset[3], tset[L.T_INCAND], pairs, npair, tz2) if coupled else 0
         n_old = nact
         nact = activate(tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):
@@ -238,24 +214,25 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
             vpred[act[a]] = 0.0
         if coupled:
             ns = update_set(cset, ns, nn, phi, dphi, vpred)
-        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, (th1, w1, acc1, tl, acc), hub, vp, phi)
+        drv = (th1, w1, acc1, tl, acc)
+        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, vp, phi)
         # second half kick
-        for k in range(N_HUB):
+        for k in range(L.N_HUB):
             v[k] = vh[k] + 0.5 * dt * ha[k]
         for a in range(nact):
             i = act[a]
             dphi[i] += 0.5 * dt * acc[i]
         # the driver's hub inertia sees the one-sided acceleration where the ramp ends
-        p_in_left = (gp[0, I_HUB] * driver_acc_left(t, speed, ramp) + mb1) * w1 + tl * v[H_H2]
+        p_in_left = (gp[0, L.I_HUB] * driver_acc_left(t, speed, ramp) + mb1) * w1 + tl * v[L.H_H2]
         p_d = body_dissipation(dissipation_power(vpred, act, nact, mdl, rec, nc), gp, w1, vp)
-        status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * v[H_H2], p_d), par, status)
+        status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * v[L.H_H2], p_d), par, status)
         max_act = max(max_act, nact)
-        if step % ipar[OUT_EVERY] == 0:
+        if step % ipar[L.OUT_EVERY] == 0:
             o += 1
-            ke, pe = coupled_energies(mdl, th1, w1, hub, teeth, tset, nact, rec, nc, cset, ns)
-            te = gp[0, RB] * th1 + gp[1, RB] * x[H_H2]
-            finite = math.isfinite(x[H_TH2]) and math.isfinite(x[H_H2])
-            status = record_output(out, o, (t, te, x[H_H2], react, ke, pe), book, rec, nc, finite, par, status)
+            ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth)
+            te = gp[0, L.RB] * th1 + gp[1, L.RB] * x[L.H_H2]
+            finite = math.isfinite(x[L.H_TH2]) and math.isfinite(x[L.H_H2])
+            status = record_output(out, o, (t, te, x[L.H_H2], react, ke, pe), book, rec, nc, finite, par, status)
         if status != OK:
             break
     return status, step, max_act, 0

@@ -15,49 +15,9 @@ import math
 import numpy as np
 from numba import njit
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.contact import cross, flank_flank, moved_center, point_flank, tip_corner, wrap
 from solver.mbs.kernels.laws import contact_force, contact_tangent, spring_tangent, spring_torque
-from solver.mbs.kernels.layout import (
-    ALPHA,
-    C_CON,
-    C_DDELTA,
-    C_DELTA,
-    C_FORCE,
-    C_G1,
-    C_G2,
-    C_GA,
-    C_GB,
-    C_KIND,
-    C_KT,
-    C_NX,
-    C_NY,
-    C_PHI,
-    C_PX,
-    C_PY,
-    C_TOOTH1,
-    C_TOOTH2,
-    CX,
-    CY,
-    GAMMA0,
-    JN_HALF,
-    K_CON,
-    M1,
-    M2,
-    M3,
-    MARGIN,
-    MAX_CONTACTS,
-    N_C,
-    N_K,
-    NZ,
-    PITCH,
-    PSI_B,
-    R_BND,
-    R_PV,
-    RB,
-    TOOTH0,
-    U_HI,
-    U_LO,
-)
 
 
 @njit(cache=True)
@@ -68,34 +28,34 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
     u_hi + margin] on both flanks.
     """
     n = 0
-    z1 = int(gp[0, NZ])
-    z2 = int(gp[1, NZ])
-    p1 = gp[0, PITCH]
-    p2 = gp[1, PITCH]
-    ratio = gp[0, RB] / gp[1, RB]
-    alpha = pp[ALPHA]
-    margin = pp[MARGIN]
+    z1 = int(gp[0, L.NZ])
+    z2 = int(gp[1, L.NZ])
+    p1 = gp[0, L.PITCH]
+    p2 = gp[1, L.PITCH]
+    ratio = gp[0, L.RB] / gp[1, L.RB]
+    alpha = pp[L.ALPHA]
+    margin = pp[L.MARGIN]
     for side in (1, -1):
         s = float(side)
         # s*Psi1 + psi_b1 + alpha in [u_lo1 - margin, u_hi1 + margin]
-        lo = gp[0, U_LO] - margin - gp[0, PSI_B] - alpha
-        hi = gp[0, U_HI] + margin - gp[0, PSI_B] - alpha
+        lo = gp[0, L.U_LO] - margin - gp[0, L.PSI_B] - alpha
+        hi = gp[0, L.U_HI] + margin - gp[0, L.PSI_B] - alpha
         if side < 0:
             lo, hi = -hi, -lo
-        base = theta1 + gp[0, GAMMA0]
+        base = theta1 + gp[0, L.GAMMA0]
         k0 = int(math.ceil((lo - base) / p1))
         k1 = int(math.floor((hi - base) / p1))
         for kk in range(k0, k1 + 1):
             k = kk % z1
             psi1 = base + kk * p1
             # gear-2 space facing tooth k under conjugate rolling, then its side-s neighbour
-            x = (math.pi - psi1 * ratio - theta2 - gp[1, GAMMA0]) / p2
+            x = (math.pi - psi1 * ratio - theta2 - gp[1, L.GAMMA0]) / p2
             j_space = int(math.floor(x))
             jj = j_space if side > 0 else j_space + 1
             j = jj % z2
-            psi2 = theta2 + gp[1, GAMMA0] + j * p2
-            ub = s * wrap(psi2 - math.pi) + gp[1, PSI_B] + alpha
-            if ub < gp[1, U_LO] - margin or ub > gp[1, U_HI] + margin:
+            psi2 = theta2 + gp[1, L.GAMMA0] + j * p2
+            ub = s * wrap(psi2 - math.pi) + gp[1, L.PSI_B] + alpha
+            if ub < gp[1, L.U_LO] - margin or ub > gp[1, L.U_HI] + margin:
                 continue
             if n < out.shape[0]:
                 out[n, 0] = k
@@ -106,105 +66,107 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
 
 
 @njit(cache=True)
-def _record(rec, nc, delta, g1, ga, g2, gb, px, py, nx, ny, k, j, kind, w1, wa, w2, wb, lp):
+def _record(rec, nc, hit, own, ids, frame, vel, lp):
+    """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
+    point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
+    flank-flank case), -1 when gear 2 does; ids = (gear-1 tooth, gear-2 tooth, kind);
+    frame = (O1, pivot A, O2, pivot B) as x, y pairs [m]; vel = (theta1', phi_A', theta2',
+    phi_B') [rad/s]. The gradient G = d delta/d(theta1, phi_A, theta2, phi_B): the owner's
+    entries +(x - centre) x n, the other gear's negative."""
+    delta, px, py, nx, ny = hit
+    o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
+    w1, wa, w2, wb = vel
+    g1 = own * cross(px - o1x, py - o1y, nx, ny)
+    ga = own * cross(px - pvax, py - pvay, nx, ny)
+    g2 = -own * cross(px - o2x, py - o2y, nx, ny)
+    gb = -own * cross(px - pvbx, py - pvby, nx, ny)
     ddelta = g1 * w1 + ga * wa + g2 * w2 + gb * wb
-    f = contact_force(delta, ddelta, lp[K_CON], lp[M1], lp[C_CON], lp[M2], lp[M3])
-    rec[nc, C_DELTA] = delta
-    rec[nc, C_DDELTA] = ddelta
-    rec[nc, C_FORCE] = f
-    rec[nc, C_G1] = g1
-    rec[nc, C_GA] = ga
-    rec[nc, C_G2] = g2
-    rec[nc, C_GB] = gb
-    rec[nc, C_PX] = px
-    rec[nc, C_PY] = py
-    rec[nc, C_NX] = nx
-    rec[nc, C_NY] = ny
-    rec[nc, C_KT] = contact_tangent(delta, lp[K_CON], lp[M1])
-    rec[nc, C_TOOTH1] = k
-    rec[nc, C_TOOTH2] = j
-    rec[nc, C_KIND] = kind
+    f = contact_force(delta, ddelta, lp[L.K_CON], lp[L.M1], lp[L.C_CON], lp[L.M2], lp[L.M3])
+    rec[nc, L.C_DELTA] = delta
+    rec[nc, L.C_DDELTA] = ddelta
+    rec[nc, L.C_FORCE] = f
+    rec[nc, L.C_G1] = g1
+    rec[nc, L.C_GA] = ga
+    rec[nc, L.C_G2] = g2
+    rec[nc, L.C_GB] = gb
+    rec[nc, L.C_PX] = px
+    rec[nc, L.C_PY] = py
+    rec[nc, L.C_NX] = nx
+    rec[nc, L.C_NY] = ny
+    rec[nc, L.C_KT] = contact_tangent(delta, lp[L.K_CON], lp[L.M1])
+    rec[nc, L.C_TOOTH1], rec[nc, L.C_TOOTH2], rec[nc, L.C_KIND] = ids
 
 
 @njit(cache=True)
-def pair_contacts(k, j, side, theta1, theta2, phi, w1, w2, dphi, gp, pp, lp, rec, nc):
-    """Detailed search for gear-1 tooth k against gear-2 tooth j on side s; append to rec.
-
-    Returns the new number of contacts. Each record holds the penetration, its rate, the
+def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
+    """Detailed search for the candidate pair = (gear-1 tooth k, gear-2 tooth j, side s) at
+    state = (theta1, theta2 [rad], theta1', theta2' [rad/s]) with the tooth rotations phi
+    [rad] and rates dphi [rad/s]; geo = (gear_par, pair_par, law_par). Appends to rec and
+    returns the new number of contacts. Each record holds the penetration, its rate, the
     force and the gradient G = d delta/d(theta1, phi_k, theta2, phi_j).
     """
+    k, j, side = pair[0], pair[1], pair[2]
+    theta1, theta2, w1, w2 = state
+    gp, pp, lp = geo
     s = float(side)
-    ia = int(gp[0, TOOTH0]) + k
-    ib = int(gp[1, TOOTH0]) + j
+    ia = int(gp[0, L.TOOTH0]) + k
+    ib = int(gp[1, L.TOOTH0]) + j
     pa = phi[ia]
     pb = phi[ib]
     # phase 1b: rigid gap bound
-    te = gp[0, RB] * theta1 + gp[1, RB] * theta2
-    bound = s * te - pp[JN_HALF] + abs(pa) * gp[0, R_BND] + abs(pb) * gp[1, R_BND]
+    te = gp[0, L.RB] * theta1 + gp[1, L.RB] * theta2
+    bound = s * te - pp[L.JN_HALF] + abs(pa) * gp[0, L.R_BND] + abs(pb) * gp[1, L.R_BND]
     if bound <= 0.0:
         return nc
-    o1x, o1y = gp[0, CX], gp[0, CY]
-    o2x, o2y = gp[1, CX], gp[1, CY]
-    axa = theta1 + gp[0, GAMMA0] + k * gp[0, PITCH]
-    axb = theta2 + gp[1, GAMMA0] + j * gp[1, PITCH]
-    cax, cay = moved_center(o1x, o1y, gp[0, R_PV], axa, pa)
-    cbx, cby = moved_center(o2x, o2y, gp[1, R_PV], axb, pb)
-    rba = gp[0, RB]
-    rbb = gp[1, RB]
-    ba = axa + pa + s * gp[0, PSI_B]
-    bb = axb + pb + s * gp[1, PSI_B]
-    pvax = o1x + gp[0, R_PV] * math.cos(axa)
-    pvay = o1y + gp[0, R_PV] * math.sin(axa)
-    pvbx = o2x + gp[1, R_PV] * math.cos(axb)
-    pvby = o2y + gp[1, R_PV] * math.sin(axb)
-    wa = dphi[ia]
-    wb = dphi[ib]
+    o1x, o1y = gp[0, L.CX], gp[0, L.CY]
+    o2x, o2y = gp[1, L.CX], gp[1, L.CY]
+    axa = theta1 + gp[0, L.GAMMA0] + k * gp[0, L.PITCH]
+    axb = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
+    cax, cay = moved_center(o1x, o1y, gp[0, L.R_PV], axa, pa)
+    cbx, cby = moved_center(o2x, o2y, gp[1, L.R_PV], axb, pb)
+    rba = gp[0, L.RB]
+    rbb = gp[1, L.RB]
+    ba = axa + pa + s * gp[0, L.PSI_B]
+    bb = axb + pb + s * gp[1, L.PSI_B]
+    frame = (o1x, o1y, o1x + gp[0, L.R_PV] * math.cos(axa), o1y + gp[0, L.R_PV] * math.sin(axa),
+             o2x, o2y, o2x + gp[1, L.R_PV] * math.cos(axb), o2y + gp[1, L.R_PV] * math.sin(axb))
+    vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
-    a_in = gp[0, U_LO] <= ua <= gp[0, U_HI]
-    b_in = gp[1, U_LO] <= ub <= gp[1, U_HI]
-    if a_in and b_in:
+    if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
         if delta > 0.0 and nc < rec.shape[0]:
-            # owner A (gear 1): G_A = +(x - O1) x n, (x - PvA) x n; gear 2 negative
-            g1 = cross(px - o1x, py - o1y, nx, ny)
-            ga = cross(px - pvax, py - pvay, nx, ny)
-            g2 = -cross(px - o2x, py - o2y, nx, ny)
-            gb = -cross(px - pvbx, py - pvby, nx, ny)
-            _record(rec, nc, delta, g1, ga, g2, gb, px, py, nx, ny, k, j, 1.0 * s, w1, wa, w2, wb, lp)
+            # owner A (gear 1)
+            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp)
             nc += 1
         return nc
-    if ua > gp[0, U_HI]:
-        # tip corner of A against flank B (owner B)
-        qx, qy = tip_corner(cax, cay, rba, ba, s, gp[0, U_HI])
-        d, uf, mx, my = point_flank(qx, qy, cbx, cby, rbb, bb, s)
-        if d > 0.0 and gp[1, U_LO] <= uf <= gp[1, U_HI] and nc < rec.shape[0]:
-            g2 = cross(qx - o2x, qy - o2y, mx, my)
-            gb = cross(qx - pvbx, qy - pvby, mx, my)
-            g1 = -cross(qx - o1x, qy - o1y, mx, my)
-            ga = -cross(qx - pvax, qy - pvay, mx, my)
-            _record(rec, nc, d, g1, ga, g2, gb, qx, qy, mx, my, k, j, 2.0 * s, w1, wa, w2, wb, lp)
-            nc += 1
-    if ub > gp[1, U_HI]:
-        # tip corner of B against flank A (owner A)
-        qx, qy = tip_corner(cbx, cby, rbb, bb, s, gp[1, U_HI])
-        d, uf, mx, my = point_flank(qx, qy, cax, cay, rba, ba, s)
-        if d > 0.0 and gp[0, U_LO] <= uf <= gp[0, U_HI] and nc < rec.shape[0]:
-            g1 = cross(qx - o1x, qy - o1y, mx, my)
-            ga = cross(qx - pvax, qy - pvay, mx, my)
-            g2 = -cross(qx - o2x, qy - o2y, mx, my)
-            gb = -cross(qx - pvbx, qy - pvby, mx, my)
-            _record(rec, nc, d, g1, ga, g2, gb, qx, qy, mx, my, k, j, 3.0 * s, w1, wa, w2, wb, lp)
-            nc += 1
+    flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
+    u = (ua, ub)
+    for g in range(2):
+        if u[g] > gp[g, L.U_HI]:
+            # tip corner of gear g against the other gear's flank (owner: the flank's gear)
+            f = 1 - g
+            cx, cy, rb, b = flanks[g]
+            qx, qy = tip_corner(cx, cy, rb, b, s, gp[g, L.U_HI])
+            cx, cy, rb, b = flanks[f]
+            d, uf, mx, my = point_flank(qx, qy, cx, cy, rb, b, s)
+            if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
+                _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
+                        frame, vel, lp)
+                nc += 1
     return nc
 
 
 @njit(cache=True)
-def mesh_contacts(theta1, theta2, phi, w1, w2, dphi, gp, pp, lp, pairs, rec):
-    """All contacts of the mesh at this state. Returns (n_contacts, n_pairs); pairs holds the candidates."""
-    npair = candidate_pairs(theta1, theta2, gp, pp, pairs)
+def mesh_contacts(state, phi, dphi, geo, buf):
+    """All contacts of the mesh at state = (theta1, theta2 [rad], theta1', theta2' [rad/s])
+    with the tooth rotations phi [rad] and rates dphi [rad/s]; geo = (gear_par, pair_par,
+    law_par), buf = (rec, pairs) (`new_contact_buffer`). Returns (n_contacts, n_pairs);
+    pairs holds the candidates."""
+    rec, pairs = buf
+    gp, pp, _lp = geo
+    npair = candidate_pairs(state[0], state[1], gp, pp, pairs)
     nc = np.int64(0)    # not a literal 0: numba would compile pair_contacts once more for Literal[int](0)
     for i in range(npair):
-        nc = pair_contacts(pairs[i, 0], pairs[i, 1], pairs[i, 2], theta1, theta2, phi, w1, w2, dphi,
-                           gp, pp, lp, rec, nc)
+        nc = pair_contacts(pairs[i], state, phi, dphi, geo, rec, nc)
     return nc, npair
 
 
@@ -220,25 +182,24 @@ def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
     q[1] = torque2
     for a in range(nact):
         i = act[a]
-        g = 0 if i < int(gp[1, TOOTH0]) else 1
-        q[2 + i] = spring_torque(phi[i], dphi[i], kphi[i], gp[g, N_K], gp[g, C_PHI], gp[g, N_C])
+        g = 0 if i < int(gp[1, L.TOOTH0]) else 1
+        q[2 + i] = spring_torque(phi[i], dphi[i], kphi[i], gp[g, L.N_K], gp[g, L.C_PHI], gp[g, L.N_C])
     for c in range(nc):
-        f = rec[c, C_FORCE]
-        ia = int(rec[c, C_TOOTH1]) + int(gp[0, TOOTH0])
-        ib = int(rec[c, C_TOOTH2]) + int(gp[1, TOOTH0])
-        q[0] -= f * rec[c, C_G1]
-        q[2 + ia] -= f * rec[c, C_GA]
-        q[1] -= f * rec[c, C_G2]
-        q[2 + ib] -= f * rec[c, C_GB]
+        f = rec[c, L.C_FORCE]
+        ia = int(rec[c, L.C_TOOTH1]) + int(gp[0, L.TOOTH0])
+        ib = int(rec[c, L.C_TOOTH2]) + int(gp[1, L.TOOTH0])
+        q[0] -= f * rec[c, L.C_G1]
+        q[2 + ia] -= f * rec[c, L.C_GA]
+        q[1] -= f * rec[c, L.C_G2]
+        q[2 + ib] -= f * rec[c, L.C_GB]
 
 
 @njit(cache=True)
 def tooth_spring_tangent(i, phi, kphi, gp):
-    g = 0 if i < int(gp[1, TOOTH0]) else 1
-    return spring_tangent(phi[i], kphi[i], gp[g, N_K])
+    g = 0 if i < int(gp[1, L.TOOTH0]) else 1
+    return spring_tangent(phi[i], kphi[i], gp[g, L.N_K])
 
 
 def new_contact_buffer():
     """Preallocated contact records and candidate-pair table."""
-    from solver.mbs.kernels.layout import N_C_COLS
-    return np.zeros((MAX_CONTACTS, N_C_COLS)), np.zeros((MAX_CONTACTS, 3), dtype=np.int64)
+    return np.zeros((L.MAX_CONTACTS, L.N_C_COLS)), np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)

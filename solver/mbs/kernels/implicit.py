@@ -34,50 +34,9 @@ import math
 import numpy as np
 from numba import njit
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
 from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
-from solver.mbs.kernels.layout import (
-    ACC,
-    B_E0,
-    B_P_D,
-    B_P_IN,
-    C_CON,
-    C_DDELTA,
-    C_DELTA,
-    C_FORCE,
-    C_G2,
-    C_GA,
-    C_GB,
-    C_KT,
-    C_PHI,
-    C_TOOTH1,
-    C_TOOTH2,
-    DT,
-    H_TH2,
-    HHT_ALPHA,
-    I_CPL,
-    I_P,
-    I_TOT,
-    M2,
-    M3,
-    MAX_CONTACTS,
-    MAX_ITER,
-    N_C,
-    N_STEPS,
-    NEWTON_TOL,
-    O_NEWTON,
-    OUT_EVERY,
-    POS,
-    R_BND,
-    RATE,
-    RB,
-    SPEED,
-    SPEED_RAMP,
-    T_ACT,
-    TOOTH0,
-    TORQUE,
-    TORQUE_RAMP,
-)
 from solver.mbs.kernels.mechanics import (
     arrowhead_accelerations,
     dissipation_power,
@@ -112,7 +71,7 @@ def newton_arrays(ntooth, alpha, dt):
     beta = 0.25 * (1.0 - alpha) ** 2
     gamma = 0.5 - alpha
     coef = np.array([beta, gamma, 1.0 / (beta * dt * dt), 1.0 + alpha, (1.0 + alpha) * gamma / (beta * dt), alpha])
-    m = 2 * MAX_CONTACTS
+    m = 2 * L.MAX_CONTACTS
     return (coef, np.zeros(ntooth + 2), np.zeros((2, ntooth)), np.zeros(2), np.zeros((m + 1, m + 1)),
             np.zeros(ntooth + 1), np.zeros(ntooth + 1), np.zeros(ntooth, dtype=np.int64), np.zeros(m, dtype=np.int64))
 
@@ -121,28 +80,28 @@ def newton_arrays(ntooth, alpha, dt):
 def _tooth_tangent(i, mdl, teeth, coef):
     """(diagonal entry, coupling to theta2) of tooth i in the Newton matrix."""
     gp, _pp, _lp, kphi, _ct = mdl
-    g = 1 if i >= int(gp[1, TOOTH0]) else 0
-    d = (coef[K_CM] * gp[g, I_P] + coef[K_CK] * tooth_spring_tangent(i, teeth[POS], kphi, gp)
-         + coef[K_CC] * spring_damping_tangent(teeth[RATE, i], gp[g, C_PHI], gp[g, N_C]))
-    return d, (coef[K_CM] * gp[1, I_CPL] if g == 1 else 0.0)
+    g = 1 if i >= int(gp[1, L.TOOTH0]) else 0
+    d = (coef[K_CM] * gp[g, L.I_P] + coef[K_CK] * tooth_spring_tangent(i, teeth[L.POS], kphi, gp)
+         + coef[K_CC] * spring_damping_tangent(teeth[L.RATE, i], gp[g, L.C_PHI], gp[g, L.N_C]))
+    return d, (coef[K_CM] * gp[1, L.I_CPL] if g == 1 else 0.0)
 
 
 @njit(cache=True)
 def _contact_rows(mdl, rec, nc, loc, A, coef):
     """Add the loaded contacts' tangents w G G^T (over theta2 and the teeth at loc) to A."""
     lp = mdl[2]
-    tz2 = int(mdl[0][1, TOOTH0])
+    tz2 = int(mdl[0][1, L.TOOTH0])
     for c in range(nc):
-        if rec[c, C_FORCE] <= 0.0:
+        if rec[c, L.C_FORCE] <= 0.0:
             continue
-        kd, cd = contact_damping_tangents(rec[c, C_DELTA], rec[c, C_DDELTA], rec[c, C_FORCE],
-                                          lp[C_CON], lp[M2], lp[M3])
-        w = coef[K_CK] * (rec[c, C_KT] + kd) + coef[K_CC] * cd
-        i1 = loc[int(rec[c, C_TOOTH1])]
-        i2 = loc[tz2 + int(rec[c, C_TOOTH2])]
-        g0 = rec[c, C_G2]
-        g1 = rec[c, C_GA]
-        g2 = rec[c, C_GB]
+        kd, cd = contact_damping_tangents(rec[c, L.C_DELTA], rec[c, L.C_DDELTA], rec[c, L.C_FORCE],
+                                          lp[L.C_CON], lp[L.M2], lp[L.M3])
+        w = coef[K_CK] * (rec[c, L.C_KT] + kd) + coef[K_CC] * cd
+        i1 = loc[int(rec[c, L.C_TOOTH1])]
+        i2 = loc[tz2 + int(rec[c, L.C_TOOTH2])]
+        g0 = rec[c, L.C_G2]
+        g1 = rec[c, L.C_GA]
+        g2 = rec[c, L.C_GB]
         A[0, 0] += w * g0 * g0
         A[0, i1] += w * g0 * g1
         A[0, i2] += w * g0 * g2
@@ -164,20 +123,20 @@ def newton_correction(mdl, rec, nc, teeth, act, nact, nw):
     """
     gp = mdl[0]
     coef, _q_old, _pred, _hpred, A, r, dx, loc, cl = nw
-    tz2 = int(gp[1, TOOTH0])
+    tz2 = int(gp[1, L.TOOTH0])
     m = 0
     for c in range(nc):
-        if rec[c, C_FORCE] <= 0.0:
+        if rec[c, L.C_FORCE] <= 0.0:
             continue
         for g in range(2):
-            i = int(rec[c, C_TOOTH1]) if g == 0 else tz2 + int(rec[c, C_TOOTH2])
+            i = int(rec[c, L.C_TOOTH1]) if g == 0 else tz2 + int(rec[c, L.C_TOOTH2])
             if loc[i] == 0:
                 m += 1
                 loc[i] = m
                 cl[m - 1] = i
     n = m + 1
     A[:n, :n] = 0.0
-    A[0, 0] = coef[K_CM] * gp[1, I_TOT]
+    A[0, 0] = coef[K_CM] * gp[1, L.I_TOT]
     b = np.empty(n)
     b[0] = r[0]
     for a in range(nact):
@@ -209,11 +168,11 @@ def newton_correction(mdl, rec, nc, teeth, act, nact, nw):
 def driver_torque(q, act, nact, gp, acc, a1):
     """Torque the driver applies [N m] at driver acceleration a1 [rad/s²]:
     I_tot1*a1 - Q_theta1 + I_cpl1 * (sum of the gear-1 tooth accelerations)."""
-    tz2 = int(gp[1, TOOTH0])
-    react = gp[0, I_TOT] * a1 - q[0]
+    tz2 = int(gp[1, L.TOOTH0])
+    react = gp[0, L.I_TOT] * a1 - q[0]
     for a in range(nact):
         if act[a] < tz2:
-            react += gp[0, I_CPL] * acc[act[a]]
+            react += gp[0, L.I_CPL] * acc[act[a]]
     return react
 
 
@@ -221,13 +180,13 @@ def driver_torque(q, act, nact, gp, acc, a1):
 def driver_jump(react, act, nact, gp, acc, da):
     """Right limits where the driver acceleration jumps by da [rad/s²] (end of the speed ramp):
     the gear-1 tooth accelerations (their inertial coupling) and the driver torque [N m]."""
-    tz2 = int(gp[1, TOOTH0])
-    react += gp[0, I_TOT] * da
+    tz2 = int(gp[1, L.TOOTH0])
+    react += gp[0, L.I_TOT] * da
     for a in range(nact):
         i = act[a]
         if i < tz2:
-            acc[i] -= gp[0, I_CPL] / gp[0, I_P] * da
-            react -= gp[0, I_CPL] ** 2 / gp[0, I_P] * da
+            acc[i] -= gp[0, L.I_CPL] / gp[0, L.I_P] * da
+            react -= gp[0, L.I_CPL] ** 2 / gp[0, L.I_P] * da
     return react
 
 
@@ -237,19 +196,19 @@ def hht_residual(mdl, q, nw, hub, acc, act, nact, a1m):
     a1m [rad/s²]: the driver acceleration over the step (inertia on the gear-1 teeth)."""
     gp = mdl[0]
     coef, q_old, _pred, _hpred, _A, r, _dx, _loc, _cl = nw
-    tz2 = int(gp[1, TOOTH0])
+    tz2 = int(gp[1, L.TOOTH0])
     alpha = coef[K_ALPHA]
-    a2 = hub[ACC, H_TH2]
-    r[0] = (1.0 + alpha) * q[1] - alpha * q_old[1] - gp[1, I_TOT] * a2
+    a2 = hub[L.ACC, L.H_TH2]
+    r[0] = (1.0 + alpha) * q[1] - alpha * q_old[1] - gp[1, L.I_TOT] * a2
     for a in range(nact):
         i = act[a]
         g = 1 if i >= tz2 else 0
-        ri = (1.0 + alpha) * q[2 + i] - alpha * q_old[2 + i] - gp[g, I_P] * acc[i]
+        ri = (1.0 + alpha) * q[2 + i] - alpha * q_old[2 + i] - gp[g, L.I_P] * acc[i]
         if g == 1:
-            ri -= gp[1, I_CPL] * a2
-            r[0] -= gp[1, I_CPL] * acc[i]
+            ri -= gp[1, L.I_CPL] * a2
+            r[0] -= gp[1, L.I_CPL] * acc[i]
         else:
-            ri -= gp[0, I_CPL] * a1m
+            ri -= gp[0, L.I_CPL] * a1m
         r[a + 1] = ri
 
 
@@ -265,55 +224,55 @@ def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
     rec, pairs, q, _vpred, tset, _book = ws
     coef, q_old, pred, hpred, _A, _r, dx, _loc, _cl = nw
     th1, w1, tl, a1m = drv
-    act = tset[T_ACT]
-    phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
-    tz2 = int(gp[1, TOOTH0])
-    dt, beta, gamma, cm = par[DT], coef[K_BETA], coef[K_GAMMA], coef[K_CM]
-    a2 = hub[ACC, H_TH2]
-    hpred[POS] = hub[POS, H_TH2] + dt * hub[RATE, H_TH2] + dt * dt * (0.5 - beta) * a2
-    hpred[RATE] = hub[RATE, H_TH2] + dt * (1.0 - gamma) * a2
+    act = tset[L.T_ACT]
+    phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
+    tz2 = int(gp[1, L.TOOTH0])
+    dt, beta, gamma, cm = par[L.DT], coef[K_BETA], coef[K_GAMMA], coef[K_CM]
+    a2 = hub[L.ACC, L.H_TH2]
+    hpred[L.POS] = hub[L.POS, L.H_TH2] + dt * hub[L.RATE, L.H_TH2] + dt * dt * (0.5 - beta) * a2
+    hpred[L.RATE] = hub[L.RATE, L.H_TH2] + dt * (1.0 - gamma) * a2
     for a in range(nact):
         i = act[a]
-        pred[POS, i] = phi[i] + dt * dphi[i] + dt * dt * (0.5 - beta) * acc[i]
-        pred[RATE, i] = dphi[i] + dt * (1.0 - gamma) * acc[i]
-    hub[POS, H_TH2] = hpred[POS] + beta * dt * dt * a2
+        pred[L.POS, i] = phi[i] + dt * dphi[i] + dt * dt * (0.5 - beta) * acc[i]
+        pred[L.RATE, i] = dphi[i] + dt * (1.0 - gamma) * acc[i]
+    hub[L.POS, L.H_TH2] = hpred[L.POS] + beta * dt * dt * a2
     for a in range(nact):
         i = act[a]
-        phi[i] = pred[POS, i] + beta * dt * dt * acc[i]
+        phi[i] = pred[L.POS, i] + beta * dt * dt * acc[i]
     it = 0
     last = 1e300
     status = OK
     while True:
         # velocities and accelerations of the iterate
-        hub[ACC, H_TH2] = (hub[POS, H_TH2] - hpred[POS]) * cm
-        hub[RATE, H_TH2] = hpred[RATE] + gamma * dt * hub[ACC, H_TH2]
+        hub[L.ACC, L.H_TH2] = (hub[L.POS, L.H_TH2] - hpred[L.POS]) * cm
+        hub[L.RATE, L.H_TH2] = hpred[L.RATE] + gamma * dt * hub[L.ACC, L.H_TH2]
         for a in range(nact):
             i = act[a]
-            acc[i] = (phi[i] - pred[POS, i]) * cm
-            dphi[i] = pred[RATE, i] + gamma * dt * acc[i]
-        nc, npair = mesh_contacts(th1, hub[POS, H_TH2], phi, w1, hub[RATE, H_TH2], dphi, gp, pp, lp, pairs, rec)
+            acc[i] = (phi[i] - pred[L.POS, i]) * cm
+            dphi[i] = pred[L.RATE, i] + gamma * dt * acc[i]
+        nc, npair = mesh_contacts((th1, hub[L.POS, L.H_TH2], w1, hub[L.RATE, L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
         n_before = nact
         nact = activate(tset, nact, pairs, npair, tz2)
         for a in range(n_before, nact):
             # a tooth entering the active set: at rest on its hub, zero force history
             i = act[a]
-            pred[POS, i] = pred[RATE, i] = acc[i] = dphi[i] = q_old[2 + i] = 0.0
+            pred[L.POS, i] = pred[L.RATE, i] = acc[i] = dphi[i] = q_old[2 + i] = 0.0
         q[:] = 0.0
         generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
-        if last < par[NEWTON_TOL] and nact == n_before:
+        if last < par[L.NEWTON_TOL] and nact == n_before:
             break
-        if it >= ipar[MAX_ITER]:
+        if it >= ipar[L.MAX_ITER]:
             status = NEWTON
             break
         it += 1
         hht_residual(mdl, q, nw, hub, acc, act, nact, a1m)
         newton_correction(mdl, rec, nc, teeth, act, nact, nw)
-        last = abs(dx[0]) * gp[1, RB]
-        hub[POS, H_TH2] += dx[0]
+        last = abs(dx[0]) * gp[1, L.RB]
+        hub[L.POS, L.H_TH2] += dx[0]
         for a in range(nact):
             i = act[a]
             phi[i] += dx[a + 1]
-            d = abs(dx[a + 1]) * gp[1 if i >= tz2 else 0, R_BND]
+            d = abs(dx[a + 1]) * gp[1 if i >= tz2 else 0, L.R_BND]
             if d > last:
                 last = d
         if not math.isfinite(last):
@@ -332,37 +291,37 @@ def hht(mdl, ctl, hub, teeth, out, ws):
     """
     gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, table = ctl
-    phi, dphi, acc = teeth[POS], teeth[RATE], teeth[ACC]
-    tz2 = int(gp[1, TOOTH0])
-    dt, speed, ramp = par[DT], par[SPEED], par[SPEED_RAMP]
+    phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
+    tz2 = int(gp[1, L.TOOTH0])
+    dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
     rec, pairs, q, _vpred, tset, book = ws
-    nw = newton_arrays(phi.shape[0], par[HHT_ALPHA], dt)
-    act = tset[T_ACT]
+    nw = newton_arrays(phi.shape[0], par[L.HHT_ALPHA], dt)
+    act = tset[L.T_ACT]
     nact = initial_set(tset, teeth, pairs, np.int64(0), tz2)     # the teeth already moving
     th1, w1, acc1 = driver_motion(0.0, speed, ramp)
-    nc, npair = mesh_contacts(th1, hub[POS, H_TH2], phi, w1, hub[RATE, H_TH2], dphi, gp, pp, lp, pairs, rec)
+    nc, npair = mesh_contacts((th1, hub[L.POS, L.H_TH2], w1, hub[L.RATE, L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
     nact = activate(tset, nact, pairs, npair, tz2)
-    tl = load_torque(0.0, par[TORQUE], par[TORQUE_RAMP], table)
+    tl = load_torque(0.0, par[L.TORQUE], par[L.TORQUE_RAMP], table)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     # initial accelerations: the explicit arrowhead solve, plus the driver coupling
-    hub[ACC, H_TH2], _s1, _r1 = arrowhead_accelerations(q, act, nact, gp, acc)
+    hub[L.ACC, L.H_TH2], _s1, _r1 = arrowhead_accelerations(q, act, nact, gp, acc)
     for a in range(nact):
         if act[a] < tz2:
-            acc[act[a]] = (q[2 + act[a]] - gp[0, I_CPL] * acc1) / gp[0, I_P]
+            acc[act[a]] = (q[2 + act[a]] - gp[0, L.I_CPL] * acc1) / gp[0, L.I_P]
     react = driver_torque(q, act, nact, gp, acc, acc1)
-    w2 = hub[RATE, H_TH2]
-    ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+    w2 = hub[L.RATE, L.H_TH2]
+    ke, pe = mesh_energies(0.5 * gp[0, L.I_TOT] * w1 * w1 + 0.5 * gp[1, L.I_TOT] * w2 * w2, 0.0, w1, w2,
                            teeth, act, nact, mdl, rec, nc)
-    book[B_E0] = ke + pe
-    book[B_P_IN] = react * w1 + tl * w2
-    book[B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
+    book[L.B_E0] = ke + pe
+    book[L.B_P_IN] = react * w1 + tl * w2
+    book[L.B_P_D] = dissipation_power(dphi, act, nact, mdl, rec, nc)
     o = itmax = total_it = np.int64(0)
-    row = (0.0, gp[0, RB] * th1 + gp[1, RB] * hub[POS, H_TH2], hub[POS, H_TH2], react, ke, pe)
+    row = (0.0, gp[0, L.RB] * th1 + gp[1, L.RB] * hub[L.POS, L.H_TH2], hub[L.POS, L.H_TH2], react, ke, pe)
     status = record_output(out, o, row, book, rec, nc, math.isfinite(row[1]), par, np.int64(OK))
     a1_prev = acc1
     max_act = nact
     step = 0
-    for step in range(1, ipar[N_STEPS] + 1):
+    for step in range(1, ipar[L.N_STEPS] + 1):
         t_old = (step - 1) * dt
         t = step * dt
         nw[1][:] = q
@@ -372,28 +331,28 @@ def hht(mdl, ctl, hub, teeth, out, ws):
             # the driver acceleration jumps at t_old (end of the ramp): right limits of the
             # gear-1 tooth accelerations and of the driver power start this step
             react = driver_jump(react, act, nact, gp, acc, a1m - a1_prev)
-            tl_old = load_torque(t_old, par[TORQUE], par[TORQUE_RAMP], table)
-            book[B_P_IN] = react * driver_speed(t_old, speed, ramp) + tl_old * hub[RATE, H_TH2]
+            tl_old = load_torque(t_old, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+            book[L.B_P_IN] = react * driver_speed(t_old, speed, ramp) + tl_old * hub[L.RATE, L.H_TH2]
             a1_prev = a1m
         th1, w1, _a1 = driver_motion(t, speed, ramp)
-        tl = load_torque(t, par[TORQUE], par[TORQUE_RAMP], table)
+        tl = load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
         status, it, nc, npair, nact = newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, (th1, w1, tl, a1m))
         total_it += it
         itmax = max(itmax, it)
         react = driver_torque(q, act, nact, gp, acc, a1m)
-        w2 = hub[RATE, H_TH2]
+        w2 = hub[L.RATE, L.H_TH2]
         p_in = react * w1 + tl * w2
         p_d = dissipation_power(dphi, act, nact, mdl, rec, nc)
         status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in, p_in, p_d), par, status)
         max_act = max(max_act, nact)
-        if step % ipar[OUT_EVERY] == 0:
+        if step % ipar[L.OUT_EVERY] == 0:
             o += 1
-            theta2 = hub[POS, H_TH2]
-            ke, pe = mesh_energies(0.5 * gp[0, I_TOT] * w1 * w1 + 0.5 * gp[1, I_TOT] * w2 * w2, 0.0, w1, w2,
+            theta2 = hub[L.POS, L.H_TH2]
+            ke, pe = mesh_energies(0.5 * gp[0, L.I_TOT] * w1 * w1 + 0.5 * gp[1, L.I_TOT] * w2 * w2, 0.0, w1, w2,
                                    teeth, act, nact, mdl, rec, nc)
-            row = (t, gp[0, RB] * th1 + gp[1, RB] * theta2, theta2, react, ke, pe)
+            row = (t, gp[0, L.RB] * th1 + gp[1, L.RB] * theta2, theta2, react, ke, pe)
             status = record_output(out, o, row, book, rec, nc, math.isfinite(theta2) and math.isfinite(w2), par, status)
-            out[o, O_NEWTON] = itmax
+            out[o, L.O_NEWTON] = itmax
             itmax = 0
         if status != OK:
             break

@@ -118,3 +118,19 @@ T_ACT = 0           # active tooth indices (the first nact valid)
 T_ACTIVE = 1        # 0/1 per tooth: in the active set
 T_INCAND = 2        # 0/1 per tooth: named by this step's pre-search
 N_TSET = 3
+
+# ---- the static sweep (`statics`)
+# control scalars: float array ``par``
+S_TORQUE = 0        # resisting torque on gear 2 [N m]
+S_THETA2 = 1        # driven angle at the first driver angle, the start guess [rad]
+S_TOL = 2           # residual tolerance relative to the torque [-]
+N_S_PAR = 3
+# control integers: int array ``ipar``
+S_MAX_ITER = 0      # Newton iterations per angle
+N_S_IPAR = 1
+# results: ``out[a, S_*]`` at the a-th driver angle
+S_TE = 0            # transmission error [m]
+S_TH2 = 1           # driven angle [rad]
+S_NC = 2            # loaded contacts [-]
+S_ITER = 3          # Newton iterations (negative: not converged) [-]
+N_S_OUT = 4

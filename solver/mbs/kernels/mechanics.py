@@ -7,8 +7,8 @@ tooth_compliance) as the stepping kernels take them. SI units.
 """
 from numba import njit
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.laws import contact_energy, signed_pow, spring_energy
-from solver.mbs.kernels.layout import C_DDELTA, C_DELTA, C_FORCE, C_PHI, I_CPL, I_P, I_TOT, K_CON, M1, N_C, N_K, TOOTH0
 
 
 @njit(cache=True)
@@ -60,26 +60,26 @@ def arrowhead_accelerations(q, act, nact, gp, acc):
     increments, since theta1'' jumps at the end of the speed ramp). Fills acc of the active
     teeth; returns (theta2'', S1, R1) with the driver torque T = S1*theta1'' + R1.
     """
-    tz2 = int(gp[1, TOOTH0])
-    s = gp[1, I_TOT]
+    tz2 = int(gp[1, L.TOOTH0])
+    s = gp[1, L.I_TOT]
     rhs = q[1]
     for a in range(nact):
         i = act[a]
         if i >= tz2:
-            c = gp[1, I_CPL]
-            s -= c * c / gp[1, I_P]
-            rhs -= c * q[2 + i] / gp[1, I_P]
+            c = gp[1, L.I_CPL]
+            s -= c * c / gp[1, L.I_P]
+            rhs -= c * q[2 + i] / gp[1, L.I_P]
     a2 = rhs / s
-    s1 = gp[0, I_TOT]
+    s1 = gp[0, L.I_TOT]
     r1 = -q[0]
     for a in range(nact):
         i = act[a]
         if i >= tz2:
-            acc[i] = (q[2 + i] - gp[1, I_CPL] * a2) / gp[1, I_P]
+            acc[i] = (q[2 + i] - gp[1, L.I_CPL] * a2) / gp[1, L.I_P]
         else:
-            acc[i] = q[2 + i] / gp[0, I_P]
-            s1 -= gp[0, I_CPL] * gp[0, I_CPL] / gp[0, I_P]
-            r1 += gp[0, I_CPL] * acc[i]
+            acc[i] = q[2 + i] / gp[0, L.I_P]
+            s1 -= gp[0, L.I_CPL] * gp[0, L.I_CPL] / gp[0, L.I_P]
+            r1 += gp[0, L.I_CPL] * acc[i]
     return a2, s1, r1
 
 
@@ -90,17 +90,17 @@ def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
     of gear 1 and 2; ``teeth`` rows: rotations, rates. The plain pair's bodies are the rigid
     gears: ke = I_tot1*w1²/2 + I_tot2*w2²/2, pe = 0."""
     gp, lp, kphi = mdl[0], mdl[2], mdl[3]
-    tz2 = int(gp[1, TOOTH0])
+    tz2 = int(gp[1, L.TOOTH0])
     phi = teeth[0]
     dphi = teeth[1]
     for a in range(nact):
         i = act[a]
         g = 1 if i >= tz2 else 0
         w = w2 if g == 1 else w1
-        ke += gp[g, I_CPL] * w * dphi[i] + 0.5 * gp[g, I_P] * dphi[i] * dphi[i]
-        pe += spring_energy(phi[i], kphi[i], gp[g, N_K])
+        ke += gp[g, L.I_CPL] * w * dphi[i] + 0.5 * gp[g, L.I_P] * dphi[i] * dphi[i]
+        pe += spring_energy(phi[i], kphi[i], gp[g, L.N_K])
     for c in range(nc):
-        pe += contact_energy(rec[c, C_DELTA], lp[K_CON], lp[M1])
+        pe += contact_energy(rec[c, L.C_DELTA], lp[L.K_CON], lp[L.M1])
     return ke, pe
 
 
@@ -108,16 +108,16 @@ def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
 def dissipation_power(dphi, act, nact, mdl, rec, nc):
     """Power [W] of the tooth-spring dampers at the rates dphi and of the contact dampers."""
     gp, lp = mdl[0], mdl[2]
-    tz2 = int(gp[1, TOOTH0])
+    tz2 = int(gp[1, L.TOOTH0])
     p = 0.0
     for a in range(nact):
         i = act[a]
         g = 1 if i >= tz2 else 0
-        if gp[g, C_PHI] != 0.0:
-            p += gp[g, C_PHI] * signed_pow(dphi[i], gp[g, N_C]) * dphi[i]
+        if gp[g, L.C_PHI] != 0.0:
+            p += gp[g, L.C_PHI] * signed_pow(dphi[i], gp[g, L.N_C]) * dphi[i]
     for c in range(nc):
-        d = rec[c, C_DELTA]
+        d = rec[c, L.C_DELTA]
         if d > 0.0:
-            fel = lp[K_CON] * d ** lp[M1]
-            p += (rec[c, C_FORCE] - fel) * rec[c, C_DDELTA]
+            fel = lp[L.K_CON] * d ** lp[L.M1]
+            p += (rec[c, L.C_FORCE] - fel) * rec[c, L.C_DDELTA]
     return p

@@ -11,8 +11,8 @@ that carry no load; the residual, and so the solution, is exact.
 import numpy as np
 from numba import njit
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
-from solver.mbs.kernels.layout import C_FORCE, C_G2, C_GA, C_GB, C_KT, C_TOOTH1, C_TOOTH2, JN_HALF, K_CON, M1, RB, TOOTH0
 from solver.mbs.kernels.toothcoupling import set_moment, set_stiffness
 
 
@@ -50,49 +50,128 @@ def solve_dense(a, b):
 
 
 @njit(cache=True)
-def _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r):
-    """Residual r on theta2 and the unknown teeth; a coupled model's tooth springs act
-    through the set stiffness ks (its per-tooth kphi are zero; ks is None otherwise)."""
+def _unknown_set(ws, npair, gp, phi):
+    """Number the teeth of the npair candidate pairs 1.. in ws's pos (0 is theta2; -1: not an
+    unknown) and list them in lst; the other teeth are unloaded (phi = 0). Returns their number."""
+    _rec, pairs, _q, _zeros, pos, lst, _r = ws
+    for i in range(pos.shape[0]):
+        pos[i] = -1
+    nt = np.int64(0)
+    for i in range(npair):
+        for g in range(2):
+            t = int(pairs[i, g]) + int(gp[g, L.TOOTH0])
+            if pos[t] < 0:
+                nt += 1
+                pos[t] = nt
+                lst[nt - 1] = t
+    for i in range(pos.shape[0]):
+        if pos[i] < 0:
+            phi[i] = 0.0
+    return nt
+
+
+@njit(cache=True)
+def _unknown_forces(mdl, ks, ws, nc, nt, phi, torque):
+    """Residual ws's r [N m] on theta2 and the nt unknown teeth from the contacts rec[:nc]
+    under the resisting torque [N m]; returns its max-norm. A coupled model's tooth springs
+    act through the set stiffness ks (its per-tooth kphi are zero; ks is None otherwise)."""
+    gp, _pp, _lp, kphi = mdl
+    rec, _pairs, q, zeros, _pos, lst, r = ws
     generalized_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, q)
     r[0] = q[1]
     for a in range(nt):
         r[1 + a] = q[2 + lst[a]]
         if ks is not None:
             r[1 + a] -= set_moment(ks, lst, nt, phi, a)
+    rn = 0.0
+    for i in range(nt + 1):
+        rn = max(rn, abs(r[i]))
+    return rn
 
 
 @njit(cache=True)
-def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, tol, max_iter,
-                 te_out, nc_out, force1_out, iter_out, theta2_out):
-    """Equilibrium at each driver angle theta1s[a] [rad] under the resisting torque [N m].
+def _tangent(mdl, ks, ws, nc, nt, phi):
+    """Newton tangent [N m/rad] over theta2 and the nt unknown teeth: the contacts rec[:nc]
+    plus the tooth springs (the set stiffness ks of a coupled model, else each tooth's own
+    tangent, regularised where it vanishes at phi = 0)."""
+    gp, _pp, _lp, kphi = mdl
+    rec, _pairs, _q, _zeros, pos, lst, _r = ws
+    n = nt + 1
+    K = np.zeros((n, n))
+    for c in range(nc):
+        kt = rec[c, L.C_KT]
+        if kt <= 0.0:
+            continue
+        ia = int(rec[c, L.C_TOOTH1]) + int(gp[0, L.TOOTH0])
+        ib = int(rec[c, L.C_TOOTH2]) + int(gp[1, L.TOOTH0])
+        idx = (0, pos[ia], pos[ib])
+        gv = (rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB])
+        for x in range(3):
+            for y in range(3):
+                K[idx[x], idx[y]] += kt * gv[x] * gv[y]
+    if ks is not None:
+        for m in range(nt):
+            for m2 in range(nt):
+                K[m + 1, m2 + 1] += ks[m, m2]
+    else:
+        for m in range(nt):
+            i = lst[m]
+            K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
+    if K[0, 0] <= 0.0:
+        K[0, 0] = 1e-9
+    return K
 
-    ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth are coupled
-    through the body (`toothcoupling`; its kphi are then zero), or None. The coupled code
-    sits under ``if ctooth is not None`` (and ``ks``) so that numba prunes it from the
-    plain model's compiled version.
 
-    phi (Z1+Z2) is the start guess and is updated in place. Writes TE [m], the number of
-    loaded contacts, the force on each gear-1 tooth [N] (force1_out[a, k]), the Newton
-    iterations (negative when not converged) and theta2 [rad]. Returns the number of
-    angles that did not converge.
+@njit(cache=True)
+def _store(out, force1, a, rec, nc, row):
+    """Results at the a-th angle: row = (TE [m], theta2 [rad], signed Newton iterations) and,
+    from the contacts rec[:nc], the loaded ones and the force on each gear-1 tooth [N]."""
+    out[a, L.S_TE], out[a, L.S_TH2], out[a, L.S_ITER] = row
+    nload = 0
+    for k in range(force1.shape[1]):
+        force1[a, k] = 0.0
+    for c in range(nc):
+        f = rec[c, L.C_FORCE]
+        if f > 0.0:
+            nload += 1
+            force1[a, int(rec[c, L.C_TOOTH1])] += f
+    out[a, L.S_NC] = nload
+
+
+@njit(cache=True)
+def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
+    """Equilibrium at each driver angle theta1s[a] [rad].
+
+    mdl: (gear_par, pair_par, law_par, k_phi); ctl: (par, ipar) with the `layout` S_*
+    columns (resisting torque [N m], start guess of theta2 [rad], tolerance; Newton
+    iterations). ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth
+    are coupled through the body (`toothcoupling`; its k_phi are then zero), or None. The
+    coupled code sits under ``if ctooth is not None`` (and ``ks``) so that numba prunes it
+    from the plain model's compiled version (a switch inside a tuple would not be pruned).
+
+    phi (Z1+Z2) is the start guess and is updated in place. Writes out[a, S_*] (TE [m],
+    theta2 [rad], loaded contacts, Newton iterations, negative when not converged) and the
+    force on each gear-1 tooth [N] force1[a, k]. Returns the number of angles that did not
+    converge.
     """
+    gp, pp, lp, _kphi = mdl
+    par, ipar = ctl
+    torque = par[L.S_TORQUE]
     ntooth = phi.shape[0]
     zeros = np.zeros(ntooth)
-    q = np.zeros(ntooth + 2)
-    pos = np.zeros(ntooth, dtype=np.int64)     # set to -1 at each iteration
-    lst = np.zeros(ntooth, dtype=np.int64)
-    rec = np.zeros((64, 15))
-    pairs = np.zeros((64, 3), dtype=np.int64)
-    r = np.zeros(ntooth + 1)
+    rec = np.zeros((L.MAX_CONTACTS, L.N_C_COLS))
+    pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
+    ws = (rec, pairs, np.zeros(ntooth + 2), zeros, np.zeros(ntooth, dtype=np.int64),
+          np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth + 1))
+    lst, r = ws[5], ws[6]
     if ctooth is None:
         ks = None
     else:
         ks = np.zeros((ntooth, 2 * ntooth))
-    rb1 = gp[0, RB]
-    rb2 = gp[1, RB]
-    tol_abs = tol * max(abs(torque), 1e-3)
-    sgn = 1.0 if torque >= 0.0 else -1.0
-    theta2 = theta2_start
+    rb1 = gp[0, L.RB]
+    rb2 = gp[1, L.RB]
+    tol_abs = par[L.S_TOL] * max(abs(torque), 1e-3)
+    theta2 = par[L.S_THETA2]
     failures = 0
     nc = np.int64(0)        # not a literal 0: numba would compile the callees once more for it
     npair = np.int64(0)
@@ -103,73 +182,33 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
         it = 0
         converged = False
         fresh = False       # rec and pairs already hold the search at this very state
-        while it < max_iter:
+        while it < ipar[L.S_MAX_ITER]:
             it += 1
-            # unknown set from the pre-search at the current iterate
-            for i in range(ntooth):
-                pos[i] = -1
             if not fresh:
-                nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
+                nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, pp, lp), (rec, pairs))
             fresh = False
-            # the unknowns: the teeth of the candidate pairs, numbered 1.. in pos (0 is theta2)
-            nt = np.int64(0)
-            for i in range(npair):
-                for g in range(2):
-                    t = int(pairs[i, g]) + int(gp[g, TOOTH0])
-                    if pos[t] < 0:
-                        nt += 1
-                        pos[t] = nt
-                        lst[nt - 1] = t
+            # the unknowns: the teeth the pre-search finds at the current iterate
+            nt = _unknown_set(ws, npair, gp, phi)
             if ctooth is not None:
                 set_stiffness(ctooth, lst, nt, ks)
-            for i in range(ntooth):
-                if pos[i] < 0:
-                    phi[i] = 0.0
             nload = 0
             for c in range(nc):
-                if rec[c, C_FORCE] > 0.0:
+                if rec[c, L.C_FORCE] > 0.0:
                     nload += 1
             if nload == 0:
                 if torque == 0.0:
                     converged = True
                     break
                 # no contact yet: close the gap rigidly, plus the contact-only penetration
-                dpen = (abs(torque) / rb2 / lp[K_CON]) ** (1.0 / lp[M1])
-                theta2 = (sgn * (pp[JN_HALF] + dpen) - rb1 * theta1) / rb2
+                dpen = (abs(torque) / rb2 / lp[L.K_CON]) ** (1.0 / lp[L.M1])
+                theta2 = ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
             # residual from the contacts just found (same state: no second search)
-            _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r)
-            n = nt + 1
-            rn = 0.0
-            for i in range(n):
-                rn = max(rn, abs(r[i]))
+            rn = _unknown_forces(mdl, ks, ws, nc, nt, phi, torque)
             if rn < tol_abs:
                 converged = True
                 break
-            # tangent
-            K = np.zeros((n, n))
-            for c in range(nc):
-                kt = rec[c, C_KT]
-                if kt <= 0.0:
-                    continue
-                ia = int(rec[c, C_TOOTH1]) + int(gp[0, TOOTH0])
-                ib = int(rec[c, C_TOOTH2]) + int(gp[1, TOOTH0])
-                idx = (0, pos[ia], pos[ib])
-                gv = (rec[c, C_G2], rec[c, C_GA], rec[c, C_GB])
-                for x in range(3):
-                    for y in range(3):
-                        K[idx[x], idx[y]] += kt * gv[x] * gv[y]
-            if ctooth is not None:
-                for m in range(nt):
-                    for m2 in range(nt):
-                        K[m + 1, m2 + 1] += ks[m, m2]
-            else:
-                for m in range(nt):
-                    i = lst[m]
-                    K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
-            if K[0, 0] <= 0.0:
-                K[0, 0] = 1e-9
-            dx = solve_dense(K, r[:n].copy())
+            dx = solve_dense(_tangent(mdl, ks, ws, nc, nt, phi), r[:nt + 1].copy())
             # backtracking on the max-norm of the residual
             th_old = theta2
             ph_old = np.empty(nt)
@@ -182,11 +221,8 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
                     phi[lst[m]] = ph_old[m] + step * dx[m + 1]
                 # (written out, not a helper kernel: a kernel around mesh_contacts costs its own
                 # optimisation of the whole contact search at compile time)
-                nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
-                _unknown_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, ks, q, r)
-                rn2 = 0.0
-                for i in range(n):
-                    rn2 = max(rn2, abs(r[i]))
+                nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, pp, lp), (rec, pairs))
+                rn2 = _unknown_forces(mdl, ks, ws, nc, nt, phi, torque)
                 if rn2 < rn or rn2 < tol_abs:
                     break
                 step *= 0.5
@@ -196,19 +232,7 @@ def static_sweep(theta1s, torque, theta2_start, phi, gp, pp, lp, kphi, ctooth, t
                 break
         # outputs at the solution: a converged iteration ended on a search at this very state
         if not converged:
-            nc, npair = mesh_contacts(theta1, theta2, phi, 0.0, 0.0, zeros, gp, pp, lp, pairs, rec)
-        te_out[a] = rb1 * theta1 + rb2 * theta2
-        theta2_out[a] = theta2
-        nload = 0
-        for k in range(force1_out.shape[1]):
-            force1_out[a, k] = 0.0
-        for c in range(nc):
-            f = rec[c, C_FORCE]
-            if f > 0.0:
-                nload += 1
-                force1_out[a, int(rec[c, C_TOOTH1])] += f
-        nc_out[a] = nload
-        iter_out[a] = it if converged else -it
-        if not converged:
+            nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, pp, lp), (rec, pairs))
             failures += 1
+        _store(out, force1, a, rec, nc, (rb1 * theta1 + rb2 * theta2, theta2, float(it if converged else -it)))
     return failures

@@ -21,41 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
-from solver.mbs.kernels.layout import (
-    ACC,
-    B_DISS,
-    B_E0,
-    B_FMAX,
-    B_P_D,
-    B_P_IN,
-    B_WORK,
-    C_DELTA,
-    C_FORCE,
-    DELTA_MAX,
-    DPHI_QUIET,
-    DT,
-    ENERGY_TOL,
-    MAX_CONTACTS,
-    N_BOOK,
-    N_C_COLS,
-    N_TSET,
-    O_DISS,
-    O_FMAX,
-    O_KE,
-    O_NC,
-    O_PE,
-    O_REACT,
-    O_TE,
-    O_THETA2,
-    O_TIME,
-    O_WORK,
-    PHI_QUIET,
-    POS,
-    RATE,
-    T_ACT,
-    T_ACTIVE,
-    T_INCAND,
-)
+from solver.mbs.kernels import layout as L
 
 OK = 0
 NONFINITE = 1
@@ -69,12 +35,12 @@ def work_arrays(ntooth):
     contact records, candidate pairs, generalised forces, predicted tooth rates, active set,
     running sums. Plain Python (the caller allocates them: one numba function less to
     compile)."""
-    rec = np.zeros((MAX_CONTACTS, N_C_COLS))
-    pairs = np.zeros((MAX_CONTACTS, 3), dtype=np.int64)
+    rec = np.zeros((L.MAX_CONTACTS, L.N_C_COLS))
+    pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
     q = np.zeros(ntooth + 2)
     vpred = np.zeros(ntooth)
-    tset = np.zeros((N_TSET, ntooth), dtype=np.int64)
-    book = np.zeros(N_BOOK)
+    tset = np.zeros((L.N_TSET, ntooth), dtype=np.int64)
+    book = np.zeros(L.N_BOOK)
     return rec, pairs, q, vpred, tset, book
 
 
@@ -83,9 +49,9 @@ def initial_set(tset, teeth, pairs, npair, tz2):
     """Active set at t = 0: the teeth already moving and those of the npair candidate pairs,
     in tooth order. Returns its size."""
     ntooth = teeth.shape[1]
-    active = tset[T_ACTIVE]
+    active = tset[L.T_ACTIVE]
     for i in range(ntooth):
-        if teeth[POS, i] != 0.0 or teeth[RATE, i] != 0.0:
+        if teeth[L.POS, i] != 0.0 or teeth[L.RATE, i] != 0.0:
             active[i] = True
     for p in range(npair):
         active[int(pairs[p, 0])] = True
@@ -95,7 +61,7 @@ def initial_set(tset, teeth, pairs, npair, tz2):
     nact = np.int64(0)
     for i in range(ntooth):
         if active[i]:
-            tset[T_ACT, nact] = i
+            tset[L.T_ACT, nact] = i
             nact += 1
     return nact
 
@@ -107,10 +73,10 @@ def activate(tset, nact, pairs, npair, tz2):
     for p in range(npair):
         for g in range(2):
             i = int(pairs[p, g]) + (tz2 if g == 1 else 0)
-            tset[T_INCAND, i] = True
-            if not tset[T_ACTIVE, i]:
-                tset[T_ACTIVE, i] = True
-                tset[T_ACT, nact] = i
+            tset[L.T_INCAND, i] = True
+            if not tset[L.T_ACTIVE, i]:
+                tset[L.T_ACTIVE, i] = True
+                tset[L.T_ACT, nact] = i
                 nact += 1
     return nact
 
@@ -131,33 +97,33 @@ def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     rec, pairs, q, tset, book = ws[0], ws[1], ws[2], ws[4], ws[5]
     p_in_left, p_in, p_d = powers
     for c in range(nc):
-        if rec[c, C_FORCE] > book[B_FMAX]:
-            book[B_FMAX] = rec[c, C_FORCE]
-        if rec[c, C_DELTA] > par[DELTA_MAX]:
+        if rec[c, L.C_FORCE] > book[L.B_FMAX]:
+            book[L.B_FMAX] = rec[c, L.C_FORCE]
+        if rec[c, L.C_DELTA] > par[L.DELTA_MAX]:
             status = PENETRATION
-    dt = par[DT]
-    book[B_WORK] += 0.5 * dt * (p_in_left + book[B_P_IN])
-    book[B_DISS] += 0.5 * dt * (p_d + book[B_P_D])
-    book[B_P_IN] = p_in
-    book[B_P_D] = p_d
-    act = tset[T_ACT]
+    dt = par[L.DT]
+    book[L.B_WORK] += 0.5 * dt * (p_in_left + book[L.B_P_IN])
+    book[L.B_DISS] += 0.5 * dt * (p_d + book[L.B_P_D])
+    book[L.B_P_IN] = p_in
+    book[L.B_P_D] = p_d
+    act = tset[L.T_ACT]
     a = 0
     while a < nact:
         i = act[a]
-        if (not tset[T_INCAND, i] and abs(teeth[POS, i]) < par[PHI_QUIET]
-                and abs(teeth[RATE, i]) < par[DPHI_QUIET]):
-            teeth[POS, i] = 0.0
-            teeth[RATE, i] = 0.0
-            teeth[ACC, i] = 0.0
+        if (not tset[L.T_INCAND, i] and abs(teeth[L.POS, i]) < par[L.PHI_QUIET]
+                and abs(teeth[L.RATE, i]) < par[L.DPHI_QUIET]):
+            teeth[L.POS, i] = 0.0
+            teeth[L.RATE, i] = 0.0
+            teeth[L.ACC, i] = 0.0
             q[2 + i] = 0.0
-            tset[T_ACTIVE, i] = False
+            tset[L.T_ACTIVE, i] = False
             nact -= 1
             act[a] = act[nact]
         else:
             a += 1
     for p in range(npair):
-        tset[T_INCAND, int(pairs[p, 0])] = False
-        tset[T_INCAND, tz2 + int(pairs[p, 1])] = False
+        tset[L.T_INCAND, int(pairs[p, 0])] = False
+        tset[L.T_INCAND, tz2 + int(pairs[p, 1])] = False
     return status, nact
 
 
@@ -175,23 +141,23 @@ def record_output(out, o, row, book, rec, nc, finite, par, status):
     t, te, theta2, react, ke, pe = row
     n = 0
     for c in range(nc):
-        if rec[c, C_FORCE] > 0.0:
+        if rec[c, L.C_FORCE] > 0.0:
             n += 1
-    out[o, O_TIME] = t
-    out[o, O_TE] = te
-    out[o, O_FMAX] = book[B_FMAX]
-    out[o, O_NC] = n
-    out[o, O_REACT] = react
-    out[o, O_KE] = ke
-    out[o, O_PE] = pe
-    out[o, O_WORK] = book[B_WORK]
-    out[o, O_DISS] = book[B_DISS]
-    out[o, O_THETA2] = theta2
-    book[B_FMAX] = 0.0
+    out[o, L.O_TIME] = t
+    out[o, L.O_TE] = te
+    out[o, L.O_FMAX] = book[L.B_FMAX]
+    out[o, L.O_NC] = n
+    out[o, L.O_REACT] = react
+    out[o, L.O_KE] = ke
+    out[o, L.O_PE] = pe
+    out[o, L.O_WORK] = book[L.B_WORK]
+    out[o, L.O_DISS] = book[L.B_DISS]
+    out[o, L.O_THETA2] = theta2
+    book[L.B_FMAX] = 0.0
     if not (finite and math.isfinite(ke + pe)):
         return NONFINITE
-    work = book[B_WORK]
-    diss = book[B_DISS]
-    if status == OK and ke + pe - book[B_E0] + diss - work > par[ENERGY_TOL] * max(abs(work), ke + pe, diss):
+    work = book[L.B_WORK]
+    diss = book[L.B_DISS]
+    if status == OK and ke + pe - book[L.B_E0] + diss - work > par[L.ENERGY_TOL] * max(abs(work), ke + pe, diss):
         return ENERGY
     return status

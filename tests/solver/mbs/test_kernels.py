@@ -40,7 +40,7 @@ def test_contact_law_against_numpy_and_clipped_at_zero():
 def _potential(m, th1, th2, phi):
     """Plain-numpy potential energy: springs + contacts (contacts from the kernel's penetrations)."""
     rec, pairs = new_contact_buffer()
-    nc, _ = mesh_contacts(th1, th2, phi, 0.0, 0.0, np.zeros_like(phi), m.gear_par, m.pair_par, m.law_par, pairs, rec)
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     n = m.gear_par[:, L.N_K]
     z1 = m.teeth[0]
     e = sum(m.k_phi[i] * abs(phi[i]) ** (n[0 if i < z1 else 1] + 1) / (n[0 if i < z1 else 1] + 1) for i in range(len(phi)))
@@ -56,10 +56,10 @@ def test_generalized_forces_are_minus_the_energy_gradient(paper_solid_model):
     rng = np.random.default_rng(3)
     phi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()
-    nc, npair = mesh_contacts(th1, th2, phi, 0.0, 0.0, phi, m.gear_par, m.pair_par, m.law_par, pairs, rec)
+    nc, npair = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     teeth = sorted({int(p) for p in pairs[:npair, 0]} | {m.teeth[0] + int(p) for p in pairs[:npair, 1]})
     phi[teeth] = rng.normal(scale=1e-3, size=len(teeth))
-    nc, _ = mesh_contacts(th1, th2, phi, 0.0, 0.0, np.zeros_like(phi), m.gear_par, m.pair_par, m.law_par, pairs, rec)
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     act = np.array(teeth, dtype=np.int64)
     q = np.zeros(m.n_teeth + 2)
     generalized_forces(rec, nc, phi, np.zeros_like(phi), act, len(act), m.k_phi, m.gear_par, 0.0, q)
@@ -86,9 +86,10 @@ def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
     out = []
     for f in (static_sweep, static_sweep.py_func):
         n = angles.size
-        res = (np.zeros(n), np.zeros(n, dtype=np.int64), np.zeros((n, m.teeth[0])), np.zeros(n, dtype=np.int64), np.zeros(n))
+        res = (np.zeros((n, L.N_S_OUT)), np.zeros((n, m.teeth[0])))
         phi = np.zeros(m.n_teeth)
-        fails = f(angles, 50.0, theta2, phi, m.gear_par, m.pair_par, m.law_par, m.k_phi, None, 1e-10, 60, *res)
+        ctl = (np.array([50.0, theta2, 1e-10]), np.array([60]))
+        fails = f((m.gear_par, m.pair_par, m.law_par, m.k_phi), None, ctl, angles, phi, *res)
         assert fails == 0
         out.append((*res, phi))
     for a, b in zip(*out):
