@@ -31,13 +31,7 @@ from solver.mbs.kernels.mechanics import (
     load_torque,
     mesh_energies,
 )
-from solver.mbs.kernels.stepping import (
-    OK,
-    activate,
-    end_step,
-    initial_set,
-    record_output,
-)
+from solver.mbs.kernels.stepping import OK, activate, end_step, initial_set, record_output
 
 
 @njit(cache=True)
