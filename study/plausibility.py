@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from solver import units
 from solver.geometry import gear_geometry
-from study.scene import SceneError, SpringSection
+from study.errors import SceneError
 
 # Elements of the outline size across the rim: fewer and the FE body has no element layer
 # between the tooth roots and the web or the holes (the spring map reads points outside the mesh).
@@ -69,7 +69,9 @@ def approach_estimate_mm(scene, torque_nm: float) -> float:
     k_con = units.contact_stiffness_to_si(c.k_con, c.m1)         # N/m^m1
     delta = (force / k_con) ** (1.0 / c.m1)                      # m
     for g, geo in ((1, g1), (2, g2)):
-        spring = scene.gear(g).spring if scene.coupling.model == "none" else SpringSection()
+        spring = scene.gear(g).spring
+        if scene.coupling.model != "none":    # the coupled models' springs: the paper's solid tooth stands in
+            spring = type(spring)()
         lever = max(geo.pitch_radius - scene.pivot_radius(g), 0.25 * scene.gear(g).module * units.MM)   # m
         k_phi = spring.k_phi * units.NMM                         # N·m/rad^n_k
         phi = (force * lever / k_phi) ** (1.0 / spring.n_k)       # rad

@@ -21,16 +21,8 @@ from pathlib import Path
 
 from solver import units
 from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
+from study.errors import SceneError
 from study.toml_writer import dumps_toml
-
-
-class SceneError(ValueError):
-    """Invalid scene input; ``field`` is the dotted path of the offending key."""
-
-    def __init__(self, field: str, reason: str):
-        self.field = field
-        self.reason = reason
-        super().__init__(f"{field}: {reason}")
 
 
 def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None):

@@ -1,0 +1,11 @@
+"""The error every input check raises: scene fields, study grids, options and paths."""
+from __future__ import annotations
+
+
+class SceneError(ValueError):
+    """Invalid scene input; ``field`` is the dotted path of the offending key."""
+
+    def __init__(self, field: str, reason: str):
+        self.field = field
+        self.reason = reason
+        super().__init__(f"{field}: {reason}")
