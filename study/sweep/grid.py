@@ -47,6 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
+from study.plausibility import check_dynamic_window
 from study.scene import (
     Scene,
     SceneError,
@@ -164,7 +165,10 @@ class Study:
             for path, v in vals.items():
                 set_dotted(data, path, v)
             try:
-                out.append(Point(idx, vals, scene_from_dict(data)))
+                scene = scene_from_dict(data)
+                if self.outputs.dynamic:    # a DTE summary needs a steady part after the ramps
+                    check_dynamic_window(scene)
+                out.append(Point(idx, vals, scene))
             except SceneError as e:
                 out.append(Point(idx, vals, None, str(e)))
         return out

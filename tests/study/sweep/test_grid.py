@@ -89,3 +89,15 @@ def test_a_study_built_in_python_is_checked_like_a_file(grid, field, reason):
     assert e.value.field == field and reason in str(e.value), str(e.value)
     with pytest.raises(SceneError, match="unknown output 'dtee'"):
         make_study(base, {"dynamic.speed": [50.0]}, outputs={"curves": ["dtee"]})
+
+
+def test_a_point_whose_run_has_no_steady_part_is_invalid_when_dynamics_are_asked_for():
+    """Twice the ramp (4 ms) plus 16 output steps is the shortest run a DTE summary can use: a
+    shorter point is recorded invalid with the reason, before any work; a study asking only for
+    STE keeps it."""
+    grid = '[grid]\n"dynamic.duration" = [0.004, 0.01]\n'
+    dyn = tiny_study(grid + '[outputs]\nscalars = ["dte_rms"]\n').points()
+    assert dyn[0].scene is None and dyn[0].error.startswith("dynamic.duration: leaves no steady part")
+    assert dyn[1].scene is not None
+    static = tiny_study(grid + '[outputs]\nscalars = ["ste_p2p"]\n').points()
+    assert all(p.scene is not None for p in static)
