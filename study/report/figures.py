@@ -6,8 +6,11 @@ dataset cannot support (no STE, no DTE, no lightened body to show stress in) is 
 printed line saying why. A spectrum needs no render, and a solid gear needs no FE: renders of
 a lightened body reuse one FE solve (cached springs, one factorisation) for both images.
 
-A sweep archive (dimensions beyond a single run's) gets one sweep view per output that varies
-only over the swept dimensions.
+A sweep archive (dimensions beyond a single run's) gets, for any number of swept dimensions,
+the study views (`study.report.study_views`): main effects of each output, the sensitivity
+ranking (grid layout) and the mass / TE trade-off with its Pareto set, with their tables
+(``sensitivity_share``, ``pareto_*``) written to ``study_tables.nc`` beside the figures; and,
+with up to four swept dimensions, one sweep view per output that varies only over them.
 
 CLI: ``lightgear render ARCHIVE.nc [-o DIR]`` (default: beside the archive).
 """
@@ -21,10 +24,11 @@ import xarray as xr
 
 # dimensions of a single run archive; any other dimension is a swept parameter
 RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "ste_order", "ste_peak", "dte_peak"}
+TABLE_DIMS = {"output", "term"}          # the study's sensitivity table (`study.report.effects`)
 
 
 def swept_dims(ds: xr.Dataset) -> list[str]:
-    return [d for d in ds.dims if d not in RUN_DIMS]
+    return [d for d in ds.dims if d not in RUN_DIMS and d not in TABLE_DIMS]
 
 
 def run_plots() -> tuple:
@@ -94,13 +98,57 @@ def _renders(ds, name, skip) -> list[Path]:
 
 
 def _sweep_figures(ds, swept, name, skip) -> list[Path]:
+    out = _study_views(ds, swept, name, skip)
+    if len(swept) > 4:
+        skip("sweep views", f"{len(swept)} swept dimensions ({', '.join(swept)}): "
+                            "the main effects, sensitivity and trade-off views cover them")
+        return out
+    return out + _sweep_views(ds, swept, name, skip)
+
+
+def _study_views(ds, swept, name, skip) -> list[Path]:
+    """Main effects, sensitivity ranking and trade-off; their tables go to ``study_tables.nc``
+    beside the figures. They are computed here, from the points of the archive rendered, and
+    not stored by ``lightgear sweep``: the archives of the parts of a split study open together
+    as one (open_mfdataset), and a variance split or Pareto set of one part is wrong for the whole."""
+    from study.report.effects import pareto_table, sensitivity_table, study_outputs
+    from study.report.results import write_netcdf
+    from study.report.study_views import main_effects_figure, sensitivity_figure, tradeoff_figure
+    out, tables = [], []
+    outputs = study_outputs(ds, swept)
+    if swept == ["point"]:
+        skip("main effects and sensitivity", "explicit study points (no factorial grid to average over)")
+    elif not outputs:
+        skip("main effects and sensitivity", f"no numeric output over the swept dimensions ({', '.join(swept)})")
+    else:
+        for var in outputs:
+            out.append(main_effects_figure(ds, var, swept, name(f"main_effects_{var}")))
+        table = sensitivity_table(ds, swept, outputs)
+        tables.append(table)
+        if np.isfinite(table["sensitivity_share"].values).any():
+            out.append(sensitivity_figure(ds, table, name("sensitivity")))
+        else:
+            skip("sensitivity ranking", "every output is constant over the points that are ok")
+    pareto = pareto_table(ds, skip=skip)
+    if pareto.data_vars:
+        tables.append(pareto)
+        out.append(tradeoff_figure(ds, pareto, name("tradeoff")))
+    if tables:
+        path = name("study_tables").with_suffix(".nc")
+        attrs = {k: ds.attrs[k] for k in ("title", "study_key") if k in ds.attrs}
+        write_netcdf(xr.merge(tables).assign_attrs(attrs, comment="computed by `lightgear render` from the "
+                              "study archive's points (study.report.effects)"), path)
+        print(f"  study tables: {path}")
+    return out
+
+
+def _sweep_views(ds, swept, name, skip) -> list[Path]:
     from study.report.sweep_view import sweep_view
     out = []
-    if len(swept) > 4:
-        skip("sweep views", f"{len(swept)} swept dimensions ({', '.join(swept)}): select up to four first")
-        return out
     for var in ds.data_vars:
         da = ds[var]
+        if str(var).startswith("pareto_"):
+            continue   # a flag, drawn in the trade-off view
         if da.dtype.kind not in "fiu" or not da.dims or not set(da.dims) <= set(swept) or swept[0] not in da.dims:
             continue
         dims = [d for d in swept if d in da.dims]

@@ -1,0 +1,163 @@
+"""Views of a whole study, for any number of swept dimensions (matplotlib, Agg, PNG), from the
+archive alone (`study.report.effects` computes what they show):
+
+  main_effects_figure   one output against each swept parameter: mean over the other parameters,
+                        min-max band, one panel a parameter
+  sensitivity_figure    each output's variance split into parameters, largest interaction and
+                        rest, a horizontal bar chart a panel
+  tradeoff_figure       mass saving [%] against a TE measure, coloured by root stress [MPa], the
+                        points over the stress limit hollow, the Pareto set joined and ringed
+"""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import xarray as xr
+
+from study.report.effects import MASS_SAVING, STRESS_RATIO, kept, main_effect
+from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, axis_label, figure_title, pretty_unit, save_figure
+
+STRESS = "root_stress_max_gear2"
+
+
+def _positions(ds, dim):
+    """x positions and tick labels of a swept parameter (numbers as they are, text as 0, 1, ...)."""
+    v = ds[dim].values if dim in ds.coords else np.arange(ds.sizes[dim])
+    if v.dtype.kind in "fiub":
+        return v.astype(float), None
+    return np.arange(v.size, dtype=float), [str(s) for s in v]
+
+
+def _param_label(ds, dim: str, n: int = 38) -> str:
+    """'long name [unit]' of a swept parameter, or 'name [unit]' when that is too long for a panel."""
+    if dim not in ds.coords:
+        return dim
+    label = axis_label(ds[dim], dim)
+    return label if len(label) <= n else f"{dim} [{pretty_unit(ds[dim].attrs.get('units'))}]"
+
+
+def main_effects_figure(ds: xr.Dataset, var: str, swept: list[str], path):
+    """``var`` against each swept parameter (mean over the others, min-max band); writes ``path``."""
+    n = len(swept)
+    ncol = min(n, 3)
+    nrow = -(-n // ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(3.6 * ncol + 0.6, 2.9 * nrow + 1.3), sharey=True,
+                             squeeze=False, constrained_layout=True)
+    unit = pretty_unit(ds[var].attrs.get("units"))
+    for k, dim in enumerate(swept):
+        ax = axes[k // ncol, k % ncol]
+        me = main_effect(ds, var, dim)
+        x, labels = _positions(ds, dim)
+        ax.fill_between(x, me["min"].values, me["max"].values, color=C_LIGHT, alpha=0.18, lw=0,
+                        label="min–max over the others")
+        ax.plot(x, me["mean"].values, marker="o", ms=4, color=C_LIGHT, label="mean over the others")
+        if labels:
+            ax.set_xticks(x, labels)
+        elif x.size <= 6:
+            ax.set_xticks(x)
+        ax.set_xlabel(_param_label(ds, dim), fontsize=9)
+        ax.grid(alpha=0.3)
+        if k % ncol == 0:
+            ax.set_ylabel(f"{var} [{unit}]")
+    for k in range(n, nrow * ncol):
+        axes[k // ncol, k % ncol].set_visible(False)
+    axes[0, 0].legend(fontsize=8, loc="best")
+    kept_n, total = int(kept(ds, var).notnull().sum()), int(np.prod([ds.sizes[d] for d in ds[var].dims]))
+    note = "" if kept_n == total else f" ({kept_n} of {total} points ok)"
+    figure_title(fig, ds, f"Main effects on {var}: {ds[var].attrs.get('long_name', var)}{note}",
+                 width=int(9 * (3.6 * ncol + 0.6)))
+    return save_figure(fig, path)
+
+
+def _term_colour(term: str, swept: list[str]) -> str:
+    if term == "rest":
+        return "0.6"
+    if " x " in term:
+        return C_HOLE
+    return C_LIGHT
+
+
+def sensitivity_figure(ds: xr.Dataset, table: xr.Dataset, path):
+    """One horizontal bar chart a study output: its variance shares (main effects, its largest
+    two-way interaction, rest); outputs constant over the study are left out. Writes ``path``."""
+    share = table["sensitivity_share"]
+    outputs = [str(o) for o in share["output"].values if np.isfinite(share.sel(output=o).values).any()]
+    terms = [str(t) for t in share["term"].values]
+    swept = [t for t in terms if t != "rest" and " x " not in t]
+    ncol = min(len(outputs), 4)
+    nrow = -(-len(outputs) // ncol)
+    height = 0.22 * (len(swept) + 2) + 0.9
+    fig, axes = plt.subplots(nrow, ncol, figsize=(3.9 * ncol + 1.2, height * nrow + 1.4), sharex=True,
+                             squeeze=False, constrained_layout=True)
+    for k, out in enumerate(outputs):
+        ax = axes[k // ncol, k % ncol]
+        s = share.sel(output=out)
+        names = [t for t in terms if np.isfinite(float(s.sel(term=t)))]
+        vals = np.array([float(s.sel(term=t)) for t in names])
+        y = np.arange(len(names))[::-1]
+        ax.barh(y, vals, color=[_term_colour(t, swept) for t in names], height=0.7)
+        ax.set_yticks(y, names, fontsize=7.5)
+        for yi, v in zip(y, vals):
+            ax.text(max(v, 0.0) + 0.02, yi, f"{100 * v:.0f} %", va="center", fontsize=7)
+        ax.set_xlim(min(0.0, vals.min() - 0.05), 1.18)
+        ax.axvline(0.0, color="0.3", lw=0.6)
+        npts = int(table["sensitivity_points"].sel(output=out)) if "sensitivity_points" in table else None
+        ax.set_title(out + (f" ({npts} pts)" if npts is not None else ""), fontsize=9)
+        ax.grid(axis="x", alpha=0.3)
+        if k // ncol == nrow - 1 or k + ncol >= len(outputs):
+            ax.set_xlabel("share of the variance [–]", fontsize=8)
+            ax.xaxis.set_tick_params(labelbottom=True)
+    for k in range(len(outputs), nrow * ncol):
+        axes[k // ncol, k % ncol].set_visible(False)
+    figure_title(fig, ds, "Sensitivity: share of each output's variance over the study grid "
+                          "(red: a parameter's main effect, blue: the largest two-way interaction, grey: rest)",
+                 width=int(10 * (3.9 * ncol + 1.2)))
+    return save_figure(fig, path)
+
+
+def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path):
+    """Mass saving against each TE measure with a ``pareto_<te>`` flag in ``pareto``; colour:
+    root stress [MPa] when archived; hollow: over the stress limit; the Pareto set joined."""
+    te = [str(v)[len("pareto_"):] for v in pareto.data_vars]
+    fig, axes = plt.subplots(1, len(te), figsize=(5.6 * len(te) + 1.4, 5.0), squeeze=False, constrained_layout=True)
+    gain = kept(ds, MASS_SAVING)
+    stress = kept(ds, STRESS) if STRESS in ds else None
+    ratio = kept(ds, STRESS_RATIO)
+    sc = None
+    for ax, t in zip(axes[0], te):
+        flag = pareto[f"pareto_{t}"]
+        limit = float(flag.attrs.get("stress_limit", np.nan))
+        g, c, r, f = (a.values.ravel() for a in xr.broadcast(gain, kept(ds, t), ratio, flag.astype(bool)))
+        s = xr.broadcast(stress, gain)[0].values.ravel() if stress is not None else np.full(g.shape, np.nan)
+        shown = np.isfinite(g) & np.isfinite(c)
+        within = shown & (r <= limit)
+        over = shown & ~(r <= limit)
+        if stress is not None and np.isfinite(s[shown]).any():
+            norm = plt.Normalize(np.nanmin(s[shown]), np.nanmax(s[shown]))
+            coloured = within & np.isfinite(s)
+            sc = ax.scatter(c[coloured], g[coloured], c=s[coloured], cmap="viridis", norm=norm, s=28, zorder=3,
+                            label=f"stress ratio ≤ {limit:g}")
+            ax.scatter(c[over], g[over], facecolors="none", edgecolors=plt.get_cmap("viridis")(norm(s[over])),
+                       s=28, zorder=3, label=f"stress ratio > {limit:g} (or unknown)")
+            nostress = within & ~np.isfinite(s)
+            if nostress.any():
+                ax.scatter(c[nostress], g[nostress], color="0.5", s=28, zorder=3, label="no root stress archived")
+        else:
+            ax.scatter(c[within], g[within], color=C_LIGHT, s=28, zorder=3, label=f"stress ratio ≤ {limit:g}")
+            ax.scatter(c[over], g[over], facecolors="none", edgecolors=C_LIGHT, s=28, zorder=3,
+                       label=f"stress ratio > {limit:g} (or unknown)")
+        order = np.argsort(c[f])
+        ax.plot(c[f][order], g[f][order], color=C_SOLID, lw=1.2, zorder=2, drawstyle="steps-post")
+        ax.scatter(c[f], g[f], s=110, facecolors="none", edgecolors=C_SOLID, lw=1.4, zorder=4,
+                   label=f"Pareto set ({int(f.sum())} points)")
+        ax.set_xlabel(axis_label(ds[t], t))
+        ax.set_ylabel(axis_label(ds[MASS_SAVING], MASS_SAVING))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="lower right")
+        ax.set_title(f"{MASS_SAVING} against {t}: up and left is better", fontsize=9)
+    if sc is not None:
+        fig.colorbar(sc, ax=axes[0, -1], label=axis_label(ds[STRESS], STRESS))
+    n_ok = int(np.isfinite(gain.values).sum())
+    figure_title(fig, ds, f"Trade-off: mass saved against transmission error ({n_ok} points ok)",
+                 width=int(9 * (5.6 * len(te) + 1.4)))
+    return save_figure(fig, path)
