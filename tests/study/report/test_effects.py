@@ -109,3 +109,13 @@ def test_pareto_flags_over_the_grid_skip_failed_points_and_say_what_is_missing()
     assert not pareto_table(ds.drop_vars("mass_saving_gear2"), skip=lambda w, y: said.append(y)).data_vars
     assert said == ["the archive has no mass_saving_gear2"]
     assert set(with_study_tables(ds, ["a", "b"]).data_vars) >= {"pareto_ste_p2p", "sensitivity_share"}
+
+
+def test_a_solid_gear_without_a_stress_ratio_is_its_own_reference_in_the_pareto_set():
+    """The run leaves the ratio NaN for a solid gear (no FE); it is the stress reference (1)."""
+    dims = ("a",)
+    ds = xr.Dataset({"mass_saving_gear2": (dims, [0.0, 20.0, 30.0]), "ste_p2p": (dims, [0.5, 0.7, 0.6]),
+                     "root_stress_ratio_gear2": (dims, [np.nan, 1.05, 1.3]), "status": (dims, np.ones(3, np.int8))},
+                    coords={"a": [0, 1, 2]})
+    # the solid point has the least TE; the 30 % point is over the stress limit
+    assert pareto_table(ds)["pareto_ste_p2p"].values.tolist() == [1, 1, 0]
