@@ -66,23 +66,22 @@ class FECache:
         return held[key]
 
     # ---- tooth stiffness maps
-    def read_stiffness(self, key: str) -> np.ndarray | None:
-        """A copy of the stiffness map of ``key`` from memory or disk, or None."""
+    def _read_array(self, held: dict, key: str, var: str) -> np.ndarray | None:
+        """A copy of the variable ``var`` of the map file of ``key``, from ``held`` or disk, or None."""
         def load(path):
             import xarray as xr
             with xr.open_dataset(path) as ds:
-                return ds["k_fe"].values.copy()
-        k = self._read(self.stiffness, key, f"{key}.nc", load)
-        return None if k is None else k.copy()
+                return ds[var].values.copy()
+        a = self._read(held, key, f"{key}.nc", load)
+        return None if a is None else a.copy()
+
+    def read_stiffness(self, key: str) -> np.ndarray | None:
+        """A copy of the stiffness map of ``key`` from memory or disk, or None."""
+        return self._read_array(self.stiffness, key, "k_fe")
 
     def read_root_stress(self, key: str) -> np.ndarray | None:
         """A copy of the fillet stresses [Pa] stored with the map of ``key``, or None."""
-        def load(path):
-            import xarray as xr
-            with xr.open_dataset(path) as ds:
-                return ds["root_stress"].values.copy()
-        s = self._read(self.root_stress, key, f"{key}.nc", load)
-        return None if s is None else s.copy()
+        return self._read_array(self.root_stress, key, "root_stress")
 
     def write_stiffness(self, key: str, k: np.ndarray, settings: dict, root_stress: np.ndarray | None = None) -> None:
         """Store the map ``k`` [N·m/rad] and, when given, the fillet stresses [Pa] of the same teeth."""
