@@ -19,13 +19,13 @@ import math
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def wrap(a):
     """Angle wrapped to [-pi, pi)."""
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def flank_flank(ca_x, ca_y, rb_a, beta_a, cb_x, cb_y, rb_b, beta_b, s):
     """Penetration of flank A (gear 1) and flank B (gear 2) of sense s along their common normal.
 
@@ -52,7 +52,7 @@ def flank_flank(ca_x, ca_y, rb_a, beta_a, cb_x, cb_y, rb_b, beta_b, s):
     return ha + hb, ua, ub, nx, ny, px, py
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def point_flank(qx, qy, c_x, c_y, rb, beta, s):
     """Penetration of point Q into the involute flank (c, rb, beta, s).
 
@@ -72,7 +72,7 @@ def point_flank(qx, qy, c_x, c_y, rb, beta, s):
     return rb * (uf - uq), uf, nx, ny
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def tip_corner(c_x, c_y, rb, beta, s, u_tip):
     """Tip corner point of a flank (c, rb, beta, s) [m]."""
     t = beta - s * u_tip
@@ -81,13 +81,13 @@ def tip_corner(c_x, c_y, rb, beta, s, u_tip):
     return c_x + rb * ct - s * rb * u_tip * st, c_y + rb * st + s * rb * u_tip * ct
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def moved_center(ox, oy, r_pv, axis, phi):
     """Base-circle centre of a tooth whose axis is at angle ``axis`` rotated by phi about its pivot."""
     return (ox + r_pv * (math.cos(axis) - math.cos(axis + phi)),
             oy + r_pv * (math.sin(axis) - math.sin(axis + phi)))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def cross(ax, ay, bx, by):
     return ax * by - ay * bx

@@ -20,7 +20,7 @@ from solver.mbs.kernels.contact import cross, flank_flank, moved_center, point_f
 from solver.mbs.kernels.laws import contact_force, contact_tangent, spring_tangent, spring_torque
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def candidate_pairs(theta1, theta2, gp, pp, out):
     """Pre-search: fill out[n, :] = (gear-1 tooth, gear-2 tooth, side) of pairs that may touch.
 
@@ -65,7 +65,7 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
     return n
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _record(rec, nc, hit, own, ids, frame, vel, lp):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
@@ -97,7 +97,7 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp):
     rec[nc, L.C_TOOTH1], rec[nc, L.C_TOOTH2], rec[nc, L.C_KIND] = ids
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     """Detailed search for the candidate pair = (gear-1 tooth k, gear-2 tooth j, side s) at
     state = (theta1, theta2 [rad], theta1', theta2' [rad/s]) with the tooth rotations phi
@@ -155,7 +155,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     return nc
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def mesh_contacts(state, phi, dphi, geo, buf):
     """All contacts of the mesh at state = (theta1, theta2 [rad], theta1', theta2' [rad/s])
     with the tooth rotations phi [rad] and rates dphi [rad/s]; geo = (gear_par, pair_par,
@@ -170,7 +170,7 @@ def mesh_contacts(state, phi, dphi, geo, buf):
     return nc, npair
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
     """Generalised forces: q[0] on theta1, q[1] on theta2, q[2 + i] on tooth i.
 
@@ -194,7 +194,7 @@ def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
         q[2 + ib] -= f * rec[c, L.C_GB]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def tooth_spring_tangent(i, phi, kphi, gp):
     g = 0 if i < int(gp[1, L.TOOTH0]) else 1
     return spring_tangent(phi[i], kphi[i], gp[g, L.N_K])

@@ -8,7 +8,7 @@ Contact (eq. 1.3), for delta > 0, clipped at zero (the damping term can pull oth
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def signed_pow(x, n):
     """sgn(x)|x|^n."""
     if n == 1.0:
@@ -20,13 +20,13 @@ def signed_pow(x, n):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def spring_torque(phi, dphi, k, n_k, c, n_c):
     """Torque on the tooth from its joint spring [N m]."""
     return -k * signed_pow(phi, n_k) - c * signed_pow(dphi, n_c)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def spring_tangent(phi, k, n_k):
     """d|T|/d phi of the elastic part [N m/rad]; 0 at phi = 0 when n_k > 1."""
     a = abs(phi)
@@ -37,13 +37,13 @@ def spring_tangent(phi, k, n_k):
     return n_k * k * a ** (n_k - 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def spring_energy(phi, k, n_k):
     """Elastic energy of the spring [J]."""
     return k * abs(phi) ** (n_k + 1.0) / (n_k + 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def contact_force(delta, ddelta, k, m1, c, m2, m3):
     """Normal force [N] (>= 0) for penetration delta [m] and its rate [m/s]."""
     if delta <= 0.0:
@@ -54,7 +54,7 @@ def contact_force(delta, ddelta, k, m1, c, m2, m3):
     return f if f > 0.0 else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def contact_tangent(delta, k, m1):
     """dF/d delta of the elastic part [N/m]."""
     if delta <= 0.0:
@@ -64,7 +64,7 @@ def contact_tangent(delta, k, m1):
     return m1 * k * delta ** (m1 - 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def contact_energy(delta, k, m1):
     """Elastic energy stored in a contact [J]."""
     if delta <= 0.0:
@@ -72,7 +72,7 @@ def contact_energy(delta, k, m1):
     return k * delta ** (m1 + 1.0) / (m1 + 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def spring_damping_tangent(dphi, c, n_c):
     """d|T_damping|/d dphi [N m s/rad]: c*n_c*|dphi|^(n_c-1).
 
@@ -88,7 +88,7 @@ def spring_damping_tangent(dphi, c, n_c):
     return c * n_c * a ** (n_c - 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def contact_damping_tangents(delta, ddelta, force, c, m2, m3):
     """Tangents of the damping term c*sgn(dd)|dd|^m2*delta^m3 of eq. (1.3).
 

@@ -11,7 +11,7 @@ from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.laws import contact_energy, signed_pow, spring_energy
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def driver_motion(t, speed, ramp):
     """Driver angle [rad], speed [rad/s] and acceleration [rad/s²] of the speed ramp."""
     if t < ramp:
@@ -20,19 +20,19 @@ def driver_motion(t, speed, ramp):
     return speed * (t - 0.5 * ramp), speed, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def driver_acc_left(t, speed, ramp):
     """Left limit of the driver acceleration at t [rad/s²]."""
     return speed / ramp if t <= ramp else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def driver_speed(t, speed, ramp):
     """Driver speed [rad/s] of the ramp (continuous, with a kink at the ramp end)."""
     return speed * t / ramp if t < ramp else speed
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def load_torque(t, torque, ramp, table):
     """Resisting torque on gear 2 [N m] at time t [s]: ramped from zero to ``torque`` over
     ``ramp`` [s], or, when ``table`` (n x 2: time [s], torque [N m], times increasing) has
@@ -51,7 +51,7 @@ def load_torque(t, torque, ramp, table):
     return table[n - 1, 1]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def arrowhead_accelerations(q, act, nact, gp, acc):
     """Solve the arrowhead systems of the plain pair for the force part of the accelerations.
 
@@ -83,7 +83,7 @@ def arrowhead_accelerations(q, act, nact, gp, acc):
     return a2, s1, r1
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
     """(kinetic, potential) energy [J]: ``ke`` and ``pe`` of the bodies plus the active teeth,
     their springs and the contacts. w1, w2 [rad/s]: rates of the bodies that carry the teeth
@@ -104,7 +104,7 @@ def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
     return ke, pe
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def dissipation_power(dphi, act, nact, mdl, rec, nc):
     """Power [W] of the tooth-spring dampers at the rates dphi and of the contact dampers."""
     gp, lp = mdl[0], mdl[2]

@@ -16,7 +16,7 @@ from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth
 from solver.mbs.kernels.toothcoupling import set_moment, set_stiffness
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def solve_dense(a, b):
     """Solve a x = b by Gaussian elimination with partial pivoting (a, b overwritten).
 
@@ -49,7 +49,7 @@ def solve_dense(a, b):
     return x
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _unknown_set(ws, npair, gp, phi):
     """Number the teeth of the npair candidate pairs 1.. in ws's pos (0 is theta2; -1: not an
     unknown) and list them in lst; the other teeth are unloaded (phi = 0). Returns their number."""
@@ -70,7 +70,7 @@ def _unknown_set(ws, npair, gp, phi):
     return nt
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _unknown_forces(mdl, ks, ws, nc, nt, phi, torque):
     """Residual ws's r [N m] on theta2 and the nt unknown teeth from the contacts rec[:nc]
     under the resisting torque [N m]; returns its max-norm. A coupled model's tooth springs
@@ -89,7 +89,7 @@ def _unknown_forces(mdl, ks, ws, nc, nt, phi, torque):
     return rn
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _tangent(mdl, ks, ws, nc, nt, phi):
     """Newton tangent [N m/rad] over theta2 and the nt unknown teeth: the contacts rec[:nc]
     plus the tooth springs (the set stiffness ks of a coupled model, else each tooth's own
@@ -122,7 +122,7 @@ def _tangent(mdl, ks, ws, nc, nt, phi):
     return K
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _store(out, force1, a, rec, nc, row):
     """Results at the a-th angle: row = (TE [m], theta2 [rad], signed Newton iterations) and,
     from the contacts rec[:nc], the loaded ones and the force on each gear-1 tooth [N]."""
@@ -138,7 +138,7 @@ def _store(out, force1, a, rec, nc, row):
     out[a, L.S_NC] = nload
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     """Equilibrium at each driver angle theta1s[a] [rad].
 

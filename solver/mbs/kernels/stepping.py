@@ -44,7 +44,7 @@ def work_arrays(ntooth):
     return rec, pairs, q, vpred, tset, book
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def initial_set(tset, teeth, pairs, npair, tz2):
     """Active set at t = 0: the teeth already moving and those of the npair candidate pairs,
     in tooth order. Returns its size."""
@@ -66,7 +66,7 @@ def initial_set(tset, teeth, pairs, npair, tz2):
     return nact
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def activate(tset, nact, pairs, npair, tz2):
     """Flag the teeth of the candidate pairs and append those not yet active to the set
     (gear-2 teeth offset by tz2). Returns the new size; the new ones are act[old size:]."""
@@ -81,7 +81,7 @@ def activate(tset, nact, pairs, npair, tz2):
     return nact
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     """The end of a step: guards, energy bookkeeping, and the active set.
 
@@ -127,7 +127,7 @@ def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     return status, nact
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def record_output(out, o, row, book, rec, nc, finite, par, status):
     """Write output record o (`layout` O_* columns) and check the state; returns the status.
 

@@ -22,7 +22,7 @@ from numba import njit
 from solver.mbs.kernels.layout import MAX_CONTACTS
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def set_stiffness(ctooth, lst, n, ks):
     """ks[:n, :n] = inverse of ctooth[lst[:n], lst[:n]] (Gauss-Jordan; C is SPD, no pivoting
     needed). Uses ks[:n, n:2n] as scratch, so ks needs at least 2n columns."""
@@ -45,7 +45,7 @@ def set_stiffness(ctooth, lst, n, ks):
             ks[a, b] = ks[a, n + b]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def set_moment(ks, lst, n, phi, a):
     """Elastic moment [N m] on the a-th tooth of the set: (K_S phi_S)[a] (its spring pushes
     back with minus this)."""
@@ -55,7 +55,7 @@ def set_moment(ks, lst, n, phi, a):
     return s
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def set_energy(ks, lst, n, phi):
     """Strain energy [J] of the set's springs: phi_S^T K_S phi_S / 2."""
     e = 0.0
@@ -64,7 +64,7 @@ def set_energy(ks, lst, n, phi):
     return e
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def coupled_set(ctooth):
     """Work arrays ``cset`` of the coupled set for the compliance ctooth (teeth x teeth, or
     0 x 0: no coupled teeth, empty arrays). The set holds at most both teeth of every
@@ -75,7 +75,7 @@ def coupled_set(ctooth):
             np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth, dtype=np.int64), np.zeros(ms), np.zeros(ms))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def update_set(cset, ns, nn, phi, dphi, vpred):
     """Make newl[:nn] the coupled set (``inset`` flags the old members, ns of them): teeth that
     join take their neighbours' share of rotation phi [rad] and of the rates dphi, vpred
@@ -122,7 +122,7 @@ def update_set(cset, ns, nn, phi, dphi, vpred):
     return ns
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def set_springs(cset, ns, kphi, phi, q):
     """Replace the own elastic spring torque of the set's teeth in q[2 + i] by the coupled one."""
     ks, slst = cset[1], cset[2]
