@@ -22,9 +22,9 @@ from solver.mbs.model import Model
 from solver.mbs.stability import stable_time_step
 
 STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound", 3: "energy growth",
-               4: "Newton failure", 5: "inaccurate"}
+               4: "Newton failure", 5: "wall-time limit", 6: "inaccurate"}     # 5: the scipy peer's
 ENERGY_TOL = 0.05   # relative energy growth that stops a run (see `simulate`)
-INACCURATE = 5      # a run that completed but whose energy balance does not close (`accuracy_check`)
+INACCURATE = 6      # a run that completed but whose energy balance does not close (`accuracy_check`)
 # Largest energy-balance error of a completed run, as a fraction of the largest potential
 # energy of the mesh: the error of a converged run is a few % of it (paper pair 1.6 %, a
 # rattling 150/150-tooth pair at a step small enough 22-26 %); the runs whose step misses the
@@ -70,6 +70,8 @@ def status_message(status: int, step: int, dt: float, delta_max: float, raise_on
     msg = f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"
     if status == 2:
         msg += f"; bound {delta_max * 1e6:.4g} um"
+    if status in (2, 3):
+        msg += "; a step too coarse for the contact forces reached does this: try a smaller dynamic.time_step"
     if raise_on_failure:
         raise DivergenceError(msg)
     return msg

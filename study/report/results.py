@@ -30,7 +30,7 @@ import xarray as xr
 from solver import units
 from study.report.spectra import WINDOW, amplitude_spectrum, named_peaks, ste_order_spectrum
 
-INACCURATE = 5      # `solver.mbs.dynamics.INACCURATE` (not imported: the reports load no numba)
+INACCURATE = 6      # `solver.mbs.dynamics.INACCURATE` (not imported: the reports load no numba)
 
 
 def versions() -> str:

@@ -126,3 +126,27 @@ def test_unconverged_statics_exit_3_with_the_count(small_scene, tmp_path, capsys
 def test_an_inaccurate_sweep_status_is_a_cf_flag():
     from study.sweep.outputs import STATUS
     assert STATUS[:5] == ("pending", "ok", "diverged", "invalid", "failed") and STATUS[5] == "inaccurate"
+
+
+def test_a_coarse_implicit_run_of_a_rattling_150_tooth_pair_is_flagged():
+    """150/150 teeth (solid): the pair rattles across the backlash with forces of 10-20 x the
+    static one. HHT at 2.5 us completes with a wrong DTE and an energy balance error ten times
+    the potential energy of the mesh; flagged, not ok."""
+    from solver.mbs.dynamics import INACCURATE
+    from solver.mbs.implicit import simulate_implicit
+    from study.setup import build_scene_model
+    sc = study.load_scene(None, ["gear1.teeth=150", "gear2.teeth=150", "gear2.body.holes=0",
+                                 "gear2.body.web_thickness=17"])
+    m = build_scene_model(sc)
+    r = simulate_implicit(m, 100.0, 0.01, 50.0, 0.01, 0.025, dt=2.5e-6)
+    assert r.status == INACCURATE and np.max(r.force_max) > 10 * 50.0 / m.base_radii[1]
+
+
+@pytest.mark.parametrize("k_phi", ["10600", "1060"])
+def test_soft_tooth_springs_are_refused_before_the_statics(k_phi, small_scene, tmp_path, capsys):
+    # 100 x and 1000 x softer than the paper's springs: the paper torque bends a pair by 0.8 / 6.6 mm
+    out = tmp_path / "x.nc"
+    assert main(["run", "-o", str(out), "--no-dynamic", "--set", f"gear1.spring.k_phi={k_phi}",
+                 "--set", f"gear2.spring.k_phi={k_phi}"]) == 2
+    err = capsys.readouterr().err
+    assert "quasi_static.torque: implausible load" in err and "Traceback" not in err and not out.exists()
