@@ -89,14 +89,16 @@ def run_arguments(p) -> None:
 
 def run_command(args) -> int:
     import study
-    from solver.mbs.dynamics import DivergenceError
+    from study.estimate import check_dynamic_memory
     from study.plausibility import check_dynamic_window
     from study.report.summary import print_summary
     scene = study.load_scene(args.scene, args.overrides)
     if not args.no_dynamic:
         check_dynamic_window(scene)       # the summary needs a steady part after the ramps
+        check_dynamic_memory(scene)       # at once, before the solver is even loaded
     checked_output(args.output)
     max_time = checked_max_time(args)
+    from solver.mbs.dynamics import DivergenceError
     t0 = time.perf_counter()
     try:
         ds = study.run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None,

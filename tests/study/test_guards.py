@@ -150,3 +150,13 @@ def test_soft_tooth_springs_are_refused_before_the_statics(k_phi, small_scene, t
                  "--set", f"gear2.spring.k_phi={k_phi}"]) == 2
     err = capsys.readouterr().err
     assert "quasi_static.torque: implausible load" in err and "Traceback" not in err and not out.exists()
+
+
+def test_a_sweep_point_whose_run_is_inaccurate_keeps_its_scalars_flagged():
+    from study.sweep.engine import run_point
+    from study.sweep.outputs import Outputs
+    from tests.conftest import solid_scene
+    sc = solid_scene(**{"contact.k_con": 5.64e9, "dynamic.duration": 0.021})
+    r = run_point(sc, Outputs(scalars=("dte_rms", "tooth_force_max")))
+    assert r["status"] == "inaccurate" and r["message"].startswith("inaccurate: energy balance error")
+    assert np.isfinite(r["scalars"]["dte_rms"]) and r["scalars"]["tooth_force_max"] > 10 * 1062.0
