@@ -63,12 +63,15 @@ def default_scene():
     return default_scene()
 
 
-def run_scene(scene, static: bool | None = None, dynamic: bool | None = None):
+def run_scene(scene, static: bool | None = None, dynamic: bool | None = None, max_time: float | None = None,
+              progress: bool = False):
     """Run a scene -> run archive (xarray.Dataset): tooth springs, then the quasi-static STE and
     the dynamic DTE with their spectra. ``static``/``dynamic`` force an analysis on or off
-    (None: as the scene's ``quasi_static.enabled`` / ``dynamic.enabled``)."""
+    (None: as the scene's ``quasi_static.enabled`` / ``dynamic.enabled``). Output arrays that
+    would not fit in memory, or with ``max_time`` [s] an estimated run time beyond it, raise
+    `study.errors.BudgetError` before any work; ``progress``: bars on stderr for long parts."""
     from study.run import run_scene
-    return run_scene(scene, static=static, dynamic=dynamic)
+    return run_scene(scene, static=static, dynamic=dynamic, max_time=max_time, progress=progress)
 
 
 def write(ds, path):

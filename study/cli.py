@@ -17,8 +17,10 @@ EXIT_CODES = """exit codes:
   1    an unexpected error (one line on stderr; LIGHTGEAR_DEBUG=1 shows the traceback),
        or sweep points lost to failed workers (run the same command again)
   2    invalid input, before any work: scene or study field (named), option, output path,
-       archive to render
-  3    a run that diverged or whose statics did not converge (archive written, cause on stderr)
+       archive to render; or a run refused by its estimate (memory it would need, or a
+       run time beyond --max-time)
+  3    a run that diverged, whose energy balance does not close (inaccurate) or whose statics
+       did not converge (archive written, cause and count on stderr)
   130  interrupted (a sweep keeps its finished points)"""
 
 
@@ -53,6 +55,19 @@ def checked_output(path, option: str = "-o") -> Path:
     return path
 
 
+def max_time_argument(p) -> None:
+    from study.estimate import DEFAULT_MAX_TIME_S
+    p.add_argument("--max-time", type=float, default=DEFAULT_MAX_TIME_S, metavar="SECONDS",
+                   help=f"refuse (exit 2, before any work) a run estimated to take longer (default {DEFAULT_MAX_TIME_S:g} s); "
+                        "a run expected to take more than a few seconds shows a progress bar")
+
+
+def checked_max_time(args) -> float:
+    if not args.max_time > 0:
+        raise UsageError("--max-time", f"must be a positive number of seconds, got {args.max_time}")
+    return args.max_time
+
+
 def scene_arguments(p, output: str | None, output_help: str = "archive to write (NetCDF)") -> None:
     """The scene file, the archive (when the command writes one) and ``--set`` overrides."""
     p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
@@ -69,20 +84,25 @@ def run_arguments(p) -> None:
     p.add_argument("--no-static", action="store_true", help="skip the quasi-static STE")
     p.add_argument("--no-dynamic", action="store_true", help="skip the dynamic DTE")
     p.add_argument("--figures", action="store_true", help="also write plots and renders beside the archive")
+    max_time_argument(p)
 
 
 def run_command(args) -> int:
     import study
-    from solver.mbs.dynamics import DivergenceError
+    from study.estimate import check_dynamic_memory
     from study.plausibility import check_dynamic_window
     from study.report.summary import print_summary
     scene = study.load_scene(args.scene, args.overrides)
     if not args.no_dynamic:
         check_dynamic_window(scene)       # the summary needs a steady part after the ramps
+        check_dynamic_memory(scene)       # at once, before the solver is even loaded
     checked_output(args.output)
+    max_time = checked_max_time(args)
+    from solver.mbs.dynamics import DivergenceError
     t0 = time.perf_counter()
     try:
-        ds = study.run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None)
+        ds = study.run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None,
+                             max_time=max_time, progress=True)
     except DivergenceError as e:
         print(f"lightgear run: diverged: {e}", file=sys.stderr)
         return 3
@@ -102,9 +122,11 @@ def run_problems(ds) -> list[str]:
     out = []
     if "ste_converged" in ds and not ds["ste_converged"].values.all():
         conv = ds["ste_converged"].values
-        out.append(f"static equilibrium not reached at {int((conv == 0).sum())} of {conv.size} angles")
-    if ds.attrs.get("dynamic_status", "ok") != "ok":
-        out.append(f"dynamic run diverged: {ds.attrs['dynamic_status']}")
+        out.append(ds.attrs.get("static_status", "ok") if ds.attrs.get("static_status", "ok") != "ok" else
+                   f"static equilibrium not reached at {int((conv == 0).sum())} of {conv.size} angles")
+    status = ds.attrs.get("dynamic_status", "ok")
+    if status != "ok":
+        out.append(f"dynamic run {'not to be trusted' if status.startswith('inaccurate') else 'diverged'}: {status}")
     return out
 
 
@@ -114,16 +136,21 @@ def stiffness_arguments(p) -> None:
     scene_arguments(p, "results/stiffness.nc")
     p.add_argument("--identify", action="store_true",
                    help="also fit (pivot radius, k_phi, n) of each gear's tooth to FE compliance along the profile")
+    max_time_argument(p)
 
 
 def stiffness_command(args) -> int:
     import numpy as np
 
     import study
+    from study import estimate
     from study.inputs.springs import hole_offset, identify_spring, stiffness_dataset
     from study.setup import gear_setup
     scene = study.load_scene(args.scene, args.overrides)
     checked_output(args.output)
+    est = estimate.Estimate({"FE bodies": estimate.fe_seconds(scene)})
+    estimate.check_time(est, checked_max_time(args))
+    estimate.run_fe_bodies(scene)
     ds = stiffness_dataset(scene)
     study.write(ds, args.output)
     print(f"tooth stiffness map -> {args.output} ({ds.attrs['wall_time_springs_s']:.2f} s)")
@@ -305,18 +332,22 @@ def reference_arguments(p) -> None:
     scene_arguments(p, "results/reference.nc")
     p.add_argument("--step", type=float, default=None, metavar="DEG",
                    help="driver angle step [deg] (default: quasi_static.angle_step)")
+    max_time_argument(p)
 
 
 def reference_command(args) -> int:
     import numpy as np
 
     import study
+    from study import estimate
     from study.verify.fe_reference import reference_dataset, static_angles
     scene = study.load_scene(args.scene, args.overrides)
     if args.step is not None and not args.step > 0:
         raise study.SceneError("--step", f"must be positive, got {args.step}")
     checked_output(args.output)
-    ds = reference_dataset(scene, None if args.step is None else static_angles(scene, args.step))
+    angles = static_angles(scene, args.step)
+    estimate.check_time(estimate.reference_estimate(scene, angles), checked_max_time(args))
+    ds = reference_dataset(scene, angles, progress=True)
     study.write(ds, args.output)
     ste = ds["ste"].values
     print(f"FE reference STE -> {args.output}")
@@ -359,6 +390,7 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     import os
 
+    from study.errors import BudgetError
     from study.scene import SceneError
     try:
         return int(args._command(args) or 0)
@@ -367,6 +399,9 @@ def main(argv=None) -> int:
         return 2
     except UsageError as e:
         print(f"lightgear {args.command}: {e}", file=sys.stderr)
+        return 2
+    except BudgetError as e:
+        print(f"lightgear {args.command}: refused before any work: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"lightgear {args.command}: interrupted", file=sys.stderr)

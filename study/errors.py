@@ -9,3 +9,13 @@ class SceneError(ValueError):
         self.field = field
         self.reason = reason
         super().__init__(f"{field}: {reason}")
+
+
+class BudgetError(Exception):
+    """A run refused before any work because its estimate exceeds the machine's memory or the
+    time bound (``lightgear ... --max-time``); ``field`` names what to change."""
+
+    def __init__(self, field: str, reason: str):
+        self.field = field
+        self.reason = reason
+        super().__init__(f"{field}: {reason}")

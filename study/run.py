@@ -17,6 +17,7 @@ from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.kernels.layout import R_PV
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
+from study import estimate
 from study.inputs.gearsetup import gear_setups
 from study.report import results
 from study.report.lightening import lightening_variables
@@ -40,33 +41,71 @@ def run_static(scene: Scene, model: Model):
     return StaticResult(angles, te, th2, nc, np.full((angles.size, model.teeth[0]), np.nan), it, qs.torque, np.full(model.n_teeth, np.nan))
 
 
-def run_dynamic(scene: Scene, model: Model):
+def dynamic_choice(scene: Scene, model: Model):
+    """Integrator and step of the scene's dynamic run (`solver.mbs.implicit.choose_method`)."""
+    d = scene.dynamic
+    step_torque = run_loads(load_table(scene), d.torque)[1]
+    return choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
+
+
+def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False):
     """DTE run with the scene's integrator: dynamic.method 'explicit', 'implicit' or 'auto'
-    (chosen from the stability step; see `solver.mbs.implicit.choose_method`). The result carries
-    ``choice`` (the MethodChoice) for the archive."""
+    (chosen from the stability step; see `solver.mbs.implicit.choose_method`), or ``choice``
+    when already made. The result carries ``choice`` (the MethodChoice) for the archive.
+    ``progress``: a bar on stderr when the run is expected to take more than a few seconds."""
     d = scene.dynamic
     table = load_table(scene)
-    step_torque = run_loads(table, d.torque)[1]
-    choice = choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
+    choice = choice or dynamic_choice(scene, model)
     args = (model, d.speed, d.ramp_time, d.torque, d.ramp_time, d.duration)
-    if choice.method == "implicit":
-        res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha, load_table=table)
-    else:
-        res = simulate(*args, dt=choice.dt, output_step=d.output_step, load_table=table)
+    bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration), d.duration,
+                                f"dynamic run ({choice.method})", "s", show=progress)
+    watch = None if bar is None else (lambda t: bar.update(t - bar.n))
+    try:
+        if choice.method == "implicit":
+            res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha, load_table=table,
+                                    progress=watch)
+        else:
+            res = simulate(*args, dt=choice.dt, output_step=d.output_step, load_table=table, progress=watch)
+    finally:
+        if bar is not None:
+            bar.close()
     if math.isfinite(choice.omega_max):
         res.omega_max = choice.omega_max
     res.choice = choice
     return res
 
 
-def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None) -> xr.Dataset:
-    """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive."""
+def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
+              max_time: float | None = None, progress: bool = False) -> xr.Dataset:
+    """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive.
+
+    Before any work: a dynamic run whose output arrays do not fit in memory is refused
+    (`study.errors.BudgetError`), and, with ``max_time`` [s], so is a run whose estimated
+    time (FE bodies, statics, time steps; `study.estimate`) exceeds it, each before the part
+    it concerns starts. ``progress``: bars on stderr for the parts expected to be long."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
+    if dynamic:
+        estimate.check_dynamic_memory(scene)
+    est = estimate.Estimate()
+    if springs is None:
+        est.seconds["FE bodies"] = estimate.fe_seconds(scene)
+        estimate.check_time(est, max_time)
     t0 = time.perf_counter()
+    if springs is None:
+        estimate.run_fe_bodies(scene, progress)
     springs = springs or scene_springs(scene)
     t_springs = time.perf_counter() - t0
     model = build_scene_model(scene, springs)
+    choice = None
+    if static:
+        est.seconds["statics"] = estimate.static_seconds(scene, model)
+    if dynamic:
+        choice = dynamic_choice(scene, model)
+        est.seconds[f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"] = \
+            estimate.dynamic_seconds(model, choice, scene.dynamic.duration)
+    est.seconds["FE bodies"] = 0.0          # done
+    estimate.check_time(est, max_time)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
     c, v = lightening_variables(gear_setups(scene))      # mass, inertia; root stress from the springs' FE
     coords.update(c); data.update(v)
@@ -94,6 +133,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         t0 = time.perf_counter()
         st = run_static(scene, model)
         attrs["wall_time_static_s"] = time.perf_counter() - t0
+        attrs["static_status"] = getattr(st, "message", "ok")
         attrs["static_method"] = scene.quasi_static.method
         attrs["static_torque_N_m"] = scene.quasi_static.torque
         c, v = results.static_variables(st, model.backlash_offset)
@@ -102,7 +142,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         coords.update(c); data.update(v)
     if dynamic:
         t0 = time.perf_counter()
-        dy = run_dynamic(scene, model)
+        dy = run_dynamic(scene, model, choice, progress)
         attrs["wall_time_dynamic_s"] = time.perf_counter() - t0
         start = d.spectrum_start or 2 * d.ramp_time
         attrs["spectrum_start_s"] = start

@@ -35,7 +35,7 @@ import xarray as xr
 
 import study
 from solver import units
-from solver.mbs.dynamics import simulate
+from solver.mbs.dynamics import INACCURATE, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.stability import linearized_system
 from solver.mbs.statics import solve_static
@@ -167,7 +167,10 @@ def run_suite(scene, duration: float = 0.002, methods=METHODS, scipy_wall: float
                 te_min[i, j] = np.min(res.te) * units.UM_PER_M if res.te.size else np.nan
                 te_max[i, j] = np.max(res.te) * units.UM_PER_M if res.te.size else np.nan
                 fmax[i, j] = np.max(res.force_max) if res.force_max.size else np.nan
-                if res.status:
+                if res.status == INACCURATE:
+                    status[i, j] = "implausible"
+                    message[i, j] = res.message
+                elif res.status:
                     status[i, j] = "failed"
                     message[i, j] = res.message
                 else:

@@ -21,9 +21,15 @@ from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.statics import static_sweep
 from solver.mbs.model import Model
 
+# Largest elastic approach of the flanks along the line of action at an equilibrium, as a
+# fraction of the module: beyond it the pseudo-rigid teeth are bent by a sizeable part of
+# their height and a Newton "equilibrium" is no result (the scene check
+# `study.plausibility.check_loads` refuses such loads up front with the same fraction).
+DEFLECTION_FRACTION = 0.2
+
 
 class StaticSolveError(RuntimeError):
-    """Newton failed to reach equilibrium at some angles."""
+    """Newton failed to reach equilibrium at some angles, or reached one beyond the deflection bound."""
 
 
 @dataclass
@@ -36,6 +42,7 @@ class StaticResult:
     iterations: np.ndarray     # Newton iterations (negative: not converged)
     torque: float              # resisting torque [N·m]
     phi_last: np.ndarray       # tooth rotations at the last angle [rad] (Z1 + Z2)
+    message: str = "ok"        # why angles count as not converged ("ok": all converged)
 
     @property
     def converged(self) -> np.ndarray:
@@ -72,15 +79,24 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     ctooth = model.tooth_compliance if model.teeth_coupled else None    # None: the plain kernel
     mdl = (model.gear_par, model.pair_par, model.law_par, kphi)
     ctl = (np.array([float(torque), theta2, tol]), np.array([max_iter], dtype=np.int64))
-    fails = static_sweep(mdl, ctooth, ctl, rim_angles, phi, out, f1)
+    static_sweep(mdl, ctooth, ctl, rim_angles, phi, out, f1)
     te, th2 = out[:, L.S_TE].copy(), out[:, L.S_TH2].copy()
     nc, it = out[:, L.S_NC].astype(np.int64), out[:, L.S_ITER].astype(np.int64)
     if model.coupled:
         th2 += windup2
         te[:] = rb1 * angles + rb2 * th2
+    # an equilibrium whose flanks approach beyond the bound is no result: not converged
+    bound = DEFLECTION_FRACTION * min(g.spec.module for g in model.geometry)
+    approach = np.abs(te - sgn * model.backlash_offset)
+    deep = (it > 0) & ~(approach <= bound)
+    it[deep] = -it[deep]
+    bad = np.flatnonzero(it < 0)
     res = StaticResult(angles, te, th2, nc, f1, it, float(torque), phi)
-    if fails and raise_on_failure:
-        bad = np.flatnonzero(it < 0)
-        raise StaticSolveError(f"static equilibrium not reached at {fails} of {n} angles, first at "
-                               f"{np.degrees(angles[bad[0]]):.3f} deg")
+    if bad.size:
+        res.message = f"static equilibrium not reached at {bad.size} of {n} angles, first at {np.degrees(angles[bad[0]]):.3f} deg"
+        if deep.any():
+            res.message += (f"; at {int(deep.sum())} of them the flanks approach by up to {np.nanmax(approach[deep]) * 1e3:.3g} mm, "
+                            f"beyond {DEFLECTION_FRACTION:g} x module = {bound * 1e3:.3g} mm (teeth bent out of the model's range)")
+        if raise_on_failure:
+            raise StaticSolveError(res.message)
     return res

@@ -30,6 +30,8 @@ import xarray as xr
 from solver import units
 from study.report.spectra import WINDOW, amplitude_spectrum, named_peaks, ste_order_spectrum
 
+INACCURATE = 6      # `solver.mbs.dynamics.INACCURATE` (not imported: the reports load no numba)
+
 
 def versions() -> str:
     out = []
@@ -140,7 +142,7 @@ def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_orde
     }
     attrs = {}
     sel = res.time >= spectrum_start
-    if sel.sum() >= 16 and res.status == 0:
+    if sel.sum() >= 16 and res.status in (0, INACCURATE):     # an inaccurate run keeps its numbers, flagged
         dt = float(res.time[1] - res.time[0])
         f, a = amplitude_spectrum(res.te[sel] * units.UM_PER_M, dt)
         f_rot = driven_speed / (2 * np.pi)

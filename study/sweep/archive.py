@@ -6,7 +6,7 @@ Layout
   point layout: one ``point`` dimension, each swept field a coordinate along it.
 Each coordinate carries ``units``, ``long_name`` (from the scene's field metadata) and
 ``scene_field`` (the dotted path). Variables, over the study dimensions:
-  status      CF flags 0 pending, 1 ok, 2 diverged, 3 invalid, 4 failed
+  status      CF flags 0 pending, 1 ok, 2 diverged, 3 invalid, 4 failed, 5 inaccurate
   message     text: 'ok', or why the point is not ok
   wall_time   s, compute time of the point
   <scalar>    each requested scalar (`outputs.SCALARS`), NaN where not ok

@@ -1,7 +1,7 @@
 """Parametric sweeps: one task per study point, run in process or with dask.distributed.
 
 `run_point(scene, outputs)` runs only the analyses the outputs need and never raises: it
-returns a status (ok / diverged / invalid / failed), a message, its wall time [s], the
+returns a status (ok / diverged / invalid / failed / inaccurate), a message, its wall time [s], the
 requested scalars and curves (`study.sweep.outputs`).
 
 `run_sweep(study, output)` computes the points that are not finished yet, stores each result
@@ -36,6 +36,7 @@ from pathlib import Path
 
 import xarray as xr
 
+from study.errors import BudgetError
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
@@ -79,9 +80,12 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
             if not conv.all():
                 bad.add("static")
                 problems.append(f"static equilibrium not reached at {int((conv == 0).sum())} of {conv.size} angles")
-        if outputs.dynamic and ds.attrs.get("dynamic_status", "ok") != "ok":
+        dyn_status = ds.attrs.get("dynamic_status", "ok") if outputs.dynamic else "ok"
+        if dyn_status.startswith("inaccurate"):
+            status, message = "inaccurate", dyn_status
+        elif dyn_status != "ok":
             bad.add("dynamic")
-            problems.append(f"dynamic run stopped: {ds.attrs['dynamic_status']}")
+            problems.append(f"dynamic run stopped: {dyn_status}")
         if problems:
             status, message = "diverged", "; ".join(problems)
         for k in outputs.scalars:
@@ -92,7 +96,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
                 var = ds[name]
                 axis = var.dims[0]
                 curves[name] = (axis, ds[axis].values.copy(), dict(ds[axis].attrs), var.values.copy(), dict(var.attrs))
-    except SceneError as e:
+    except (SceneError, BudgetError) as e:
         status, message = "invalid", str(e)
     except Exception as e:  # noqa: BLE001 - a point must never stop the sweep
         from solver.geometry import GeometryError

@@ -64,7 +64,9 @@ CURVES = {
                            "spectrum of DTE after the ramp"),
 }
 
-STATUS = ("pending", "ok", "diverged", "invalid", "failed")   # CF flag meanings, values 0..4
+# CF flag meanings, values 0..5; inaccurate: the dynamic run completed but its energy balance
+# does not close (`solver.mbs.dynamics.accuracy_check`): its scalars are kept, flagged
+STATUS = ("pending", "ok", "diverged", "invalid", "failed", "inaccurate")
 
 
 def analysis_of(output: str) -> str:

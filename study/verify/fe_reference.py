@@ -50,16 +50,35 @@ def teeth_in_mesh(model, angles) -> tuple[list, list, int]:
     return sorted(s1), sorted(s2), spread
 
 
-def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS):
+def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS, progress: bool = False):
     """(LTCAResult, model, info) of the scene at driver ``angles`` [rad] (default: quasi-static).
 
     ``rigid``: rigid bodies, only the contact law deforms (the closed-form check);
-    ``n_u``: profile points per flank of the influence coefficients."""
+    ``n_u``: profile points per flank of the influence coefficients; ``progress``: a bar on
+    stderr (unit: the estimated second) when the run is expected to be long."""
+    from study import estimate
     qs = scene.quasi_static
     if not qs.torque > 0:
         raise SceneError("quasi_static.torque", f"the FE reference needs a positive (drive-side) torque, got {qs.torque}")
     angles = static_angles(scene) if angles is None else np.asarray(angles, float)
     model = geometry_model(scene)        # the LTCA takes its compliance from the FE, not springs
+    parts = estimate.reference_parts(scene, angles)
+    bar = estimate.progress_bar(sum(parts.values()), sum(parts.values()), "FE reference", "s (estimated)", progress)
+    try:
+        return _reference(scene, angles, rigid, n_u, model, parts, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _reference(scene, angles, rigid, n_u, model, parts, bar):
+    def stage(name):
+        if bar is not None:
+            bar.set_postfix_str(name)
+
+    def done(name):
+        if bar is not None:
+            bar.update(parts[name])
     info = {}
     t0, c0 = time.perf_counter(), time.process_time()
     if rigid:
@@ -68,23 +87,29 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
         t1, t2, spread = teeth_in_mesh(model, angles)
         info.update(wall_time_teeth_s=time.perf_counter() - t0, cpu_time_teeth_s=time.process_time() - c0)
         setup1, setup2 = gear_setups(scene)
+        stage("gear 1 FE body")
         c1, i1 = gear_compliance(setup1, t1, spread, n_u)
+        done("gear 1 FE body")
+        stage("gear 2 FE body")
         c2, i2 = gear_compliance(setup2, t2, spread, n_u)
+        done("gear 2 FE body")
         comp = (c1, c2)
         info.update(gear1=i1, gear2=i2)
     info.update(wall_time_compliance_s=time.perf_counter() - t0, cpu_time_compliance_s=time.process_time() - c0)
     t0, c0 = time.perf_counter(), time.process_time()
-    res = ltca_sweep(model, comp, angles, qs.torque)
+    stage("contact sweep")
+    res = ltca_sweep(model, comp, angles, scene.quasi_static.torque)
     info.update(wall_time_contact_s=time.perf_counter() - t0, cpu_time_contact_s=time.process_time() - c0)
     return res, model, info
 
 
-def reference_dataset(scene: Scene, angles=None) -> xr.Dataset:
-    """FE reference archive: ste, load sharing and contacts over the driver angle."""
+def reference_dataset(scene: Scene, angles=None, progress: bool = False) -> xr.Dataset:
+    """FE reference archive: ste, load sharing and contacts over the driver angle (``progress``:
+    see `reference`)."""
     from study.report import results
 
     t0 = time.perf_counter()
-    res, model, info = reference(scene, angles)
+    res, model, info = reference(scene, angles, progress=progress)
     wall = time.perf_counter() - t0
     coords = {"angle": results._var("angle", np.degrees(res.angle), "degree", "driver rotation from the nominal position"),
               "driver_tooth": results._var("driver_tooth", np.arange(model.teeth[0]), "1", "driver tooth index")}

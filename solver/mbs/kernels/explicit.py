@@ -34,7 +34,7 @@ from solver.mbs.kernels.mechanics import (
 from solver.mbs.kernels.stepping import OK, activate, end_step, initial_set, record_output
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def verlet(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0; write every
     ipar[OUT_EVERY]-th state to ``out`` (`layout` O_* columns).

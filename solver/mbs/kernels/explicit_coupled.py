@@ -142,7 +142,7 @@ def new_candidates(newl, incand, pairs, npair, tz2):
     return nn
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0 (see the module docstring);
     arguments, outputs and guards as `explicit.verlet`, with the body angles hub[:, H_*]

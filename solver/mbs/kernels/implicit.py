@@ -273,7 +273,7 @@ def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
     return status, it, nc, npair, nact
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def hht(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0 with HHT-alpha (par[HHT_ALPHA]
     in [-1/3, 0]); arguments, outputs and guards as `explicit.verlet`, plus Newton's

@@ -1,0 +1,218 @@
+"""Cost of a run before it starts: memory of the output arrays, run time of the FE bodies, the
+statics and the time integration, checked against what the machine has and a time bound
+(`lightgear run|stiffness|reference --max-time`), and the progress bar of a long run.
+
+The costs per unit are measured on the paper pair (2 cores, warm numba cache) and are rough
+(a factor of two either way): they tell a run of seconds from one of hours, not more.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+from dataclasses import dataclass, field
+
+from solver.mbs.kernels import layout as L
+from study.errors import BudgetError
+
+DEFAULT_MAX_TIME_S = 3600.0       # --max-time default [s]
+PROGRESS_AFTER_S = 5.0            # runs expected to take longer than this show a progress bar [s]
+# Measured costs (paper pair, 67/67 teeth): Verlet 1.2 s CPU for 340 000 steps -> about
+# 2.6e-8 s per step and tooth of the pair; HHT-alpha about 20 x that per step (Newton).
+EXPLICIT_S_PER_STEP_TOOTH = 3e-8
+IMPLICIT_S_PER_STEP_TOOTH = 6e-7
+STATIC_S_PER_ANGLE_TOOTH = 6e-6   # Newton with continuation: 0.45 s for 1201 angles of 67/67 teeth
+# FE body: gmsh mesh, P2 assembly and the Z load cases, 17 s for the paper body's 39 700
+# elements alone (4.4e-4 s per element), twice that with the cores shared -> 8e-4 s per
+# element, growing with the size of the factorisation.
+FE_S_PER_ELEMENT = 8e-4
+FE_REF_ELEMENTS = 4e4
+OUTPUT_COPIES = 2.5               # the kernel's output array, the result's columns and the archive's
+
+
+@dataclass
+class Estimate:
+    """What a run will cost: seconds by part, bytes by part (for the messages)."""
+    seconds: dict = field(default_factory=dict)     # part -> s
+    memory: dict = field(default_factory=dict)      # part -> bytes
+
+    @property
+    def total_s(self) -> float:
+        return float(sum(self.seconds.values()))
+
+    def describe(self) -> str:
+        return ", ".join(f"{k} {duration_text(v)}" for k, v in self.seconds.items() if v > 0) or "nothing"
+
+
+def duration_text(s: float) -> str:
+    """Seconds as '12 s', '3.4 min', '2.1 h' or '5.6 days'."""
+    if s < 90:
+        return f"{s:.2g} s"
+    if s < 5400:
+        return f"{s / 60:.2g} min"
+    if s < 2 * 86400:
+        return f"{s / 3600:.2g} h"
+    return f"{s / 86400:.3g} days"
+
+
+def bytes_text(b: float) -> str:
+    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20)):
+        if b >= size:
+            return f"{b / size:.3g} {unit}"
+    return f"{b / 1024:.3g} KiB"
+
+
+def available_memory() -> float:
+    """Memory the machine can give a run now [bytes]: MemAvailable of /proc/meminfo, else the
+    physical memory."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return math.inf
+
+
+# ---------------------------------------------------------------- parts
+
+def dynamic_records(scene) -> int:
+    """Output records of the scene's dynamic run (t = 0 included)."""
+    d = scene.dynamic
+    return int(d.duration / d.output_step + 1e-9) + 1
+
+
+def check_dynamic_memory(scene) -> None:
+    """Refuse, before anything is built, a dynamic run whose output arrays do not fit in memory."""
+    if not scene.dynamic.enabled:
+        return
+    n = dynamic_records(scene)
+    need = OUTPUT_COPIES * n * L.N_OUT * 8.0
+    have = available_memory()
+    if need > 0.8 * have:
+        raise BudgetError("dynamic.duration", f"the run's outputs need about {bytes_text(need)} ({n:.3g} records of "
+                          f"dynamic.output_step = {scene.dynamic.output_step:.3g} s over {scene.dynamic.duration:.4g} s), "
+                          f"more than the {bytes_text(have)} of memory available; shorten the run or raise "
+                          "dynamic.output_step")
+
+
+def dynamic_seconds(model, choice, duration: float) -> float:
+    """Estimated run time [s] of the time integration with the chosen method and step."""
+    per = IMPLICIT_S_PER_STEP_TOOTH if choice.method == "implicit" else EXPLICIT_S_PER_STEP_TOOTH
+    return duration / choice.dt * per * model.n_teeth
+
+
+def static_seconds(scene, model) -> float:
+    """Estimated run time [s] of the quasi-static analysis."""
+    from study.setup import static_angles
+    qs = scene.quasi_static
+    if qs.method == "static":
+        return static_angles(scene).size * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth
+    return 0.0      # the transient's steps are counted like a dynamic run's by the caller when needed
+
+
+def body_elements(setup) -> float:
+    """Triangles of gear ``setup``'s FE body (`solver.fe.mesh`): outline size h over teeth and
+    rim, h/2 on the fillets, about 5 h in web and hub (equilateral triangles, +10 %)."""
+    g, b = setup.geometry, setup.body
+    h = setup.mesh_size
+    r_rim = g.root_radius - b.rim_height
+    r_bore = max(r_rim - b.web_height - b.hub_height, 0.0)
+    tri = math.sqrt(3.0) / 4.0
+    teeth_rim = 0.5 * math.pi * (g.tip_radius**2 - g.root_radius**2) + math.pi * (g.root_radius**2 - r_rim**2)
+    web_hub = math.pi * (r_rim**2 - r_bore**2)
+    return 1.1 * (teeth_rim / (tri * h * h) + web_hub / (tri * 25.0 * h * h))
+
+
+def body_seconds(setup) -> float:
+    """Estimated run time [s] of one FE body: mesh, assembly, factorisation and load cases."""
+    n = body_elements(setup)
+    return FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25
+
+
+def fe_bodies(scene) -> list:
+    """(label, setup, teeth) of the FE bodies the scene's springs need and the cache lacks."""
+    from study.inputs.cache import FE_CACHE
+    from study.inputs.gearsetup import gear_setups
+    from study.inputs.springs import uses_fe_springs
+    out = []
+    setups = gear_setups(scene)
+    for g, setup in zip((1, 2), setups):
+        need = []
+        if uses_fe_springs(setup):
+            need += [(f"gear {g}", setup, None), (f"gear {g} solid reference", setup.solid(), [0])]
+        elif scene.coupling.model != "none":
+            need.append((f"gear {g}", setup, None))
+        for label, s, teeth in need:
+            key = FE_CACHE.key({**s.settings, "teeth": list(range(s.teeth)) if teeth is None else teeth})
+            if key not in FE_CACHE.stiffness and not (FE_CACHE.folder / f"{key}.nc").exists():
+                out.append((label, s, teeth))
+    return out
+
+
+def fe_seconds(scene) -> float:
+    """Estimated run time [s] of the FE bodies the scene needs and the cache lacks (the
+    coupling fits load each body at several profile points: counted as three bodies)."""
+    factor = 3.0 if scene.coupling.model == "compliance" else 1.0
+    return sum(body_seconds(s) for _, s, _ in fe_bodies(scene)) * factor
+
+
+LTCA_S_PER_ANGLE = 1.5e-3        # contact solve of one angle, influence coefficients cached
+LTCA_BODY_FACTOR = 2.0           # a body of the LTCA is loaded at several profile points per tooth
+
+
+def reference_parts(scene, angles) -> dict:
+    """Estimated seconds of the FE reference's parts: each body's influence coefficients (as
+    if not cached: the cache key needs the teeth in mesh) and the contact sweep."""
+    from study.inputs.gearsetup import gear_setups
+    parts = {f"gear {g} FE body": LTCA_BODY_FACTOR * body_seconds(s) for g, s in zip((1, 2), gear_setups(scene))}
+    parts["contact sweep"] = LTCA_S_PER_ANGLE * len(angles)
+    return parts
+
+
+def reference_estimate(scene, angles) -> Estimate:
+    return Estimate(reference_parts(scene, angles))
+
+
+def run_fe_bodies(scene, show: bool = True) -> None:
+    """Compute (into the FE cache) the bodies the scene's springs need, with a bar whose unit
+    is the estimated second, when they are expected to take more than PROGRESS_AFTER_S; else
+    nothing (the springs compute them as they go). The coupling fits compute their own bodies."""
+    if scene.coupling.model != "none":
+        return
+    bodies = fe_bodies(scene)
+    secs = [body_seconds(s) for _, s, _ in bodies]
+    bar = progress_bar(sum(secs), sum(secs), "FE bodies", "s (estimated)", show)
+    if bar is None:
+        return
+    from study.inputs.springs import fe_stiffness
+    try:
+        for (label, setup, teeth), sec in zip(bodies, secs):
+            bar.set_postfix_str(label)
+            fe_stiffness(setup, teeth)
+            bar.update(sec)
+    finally:
+        bar.close()
+
+
+def check_time(est: Estimate, max_time: float | None) -> None:
+    """Refuse a run whose estimated time exceeds ``max_time`` [s] (None: no bound)."""
+    if max_time is not None and est.total_s > max_time:
+        raise BudgetError("--max-time", f"the run is estimated at {duration_text(est.total_s)} ({est.describe()}), "
+                          f"more than the bound of {max_time:.4g} s; raise --max-time to run it anyway, "
+                          "or make it smaller (coarser fe.mesh_size, shorter dynamic.duration, fewer teeth)")
+
+
+# ---------------------------------------------------------------- progress
+
+def progress_bar(expected_s: float, total: float, desc: str, unit: str, show: bool = True):
+    """A tqdm bar on stderr for a run expected to take more than PROGRESS_AFTER_S, else None."""
+    if not show or not expected_s > PROGRESS_AFTER_S:
+        return None
+    from tqdm import tqdm
+    return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, leave=False, dynamic_ncols=True,
+                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} {unit} [{elapsed}<{remaining}]")
