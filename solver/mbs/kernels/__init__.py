@@ -4,5 +4,6 @@ Every kernel is compiled with ``@njit(cache=True, no_cfunc_wrapper=True)``: cach
 (``$NUMBA_CACHE_DIR``), and without the C-callable wrapper numba otherwise builds beside the
 Python one for each function (nothing here takes a kernel's C address; the wrappers were
 about a tenth of the LLVM work of a first, uncached run). The Python wrapper stays, so every
-kernel can be called and tested from Python. Column indices of the arrays are in `layout`.
+kernel can be called and tested from Python. The stepping loops also release the GIL
+(``nogil=True``), so that a progress bar can follow them from another thread. Column indices of the arrays are in `layout`.
 """
