@@ -25,8 +25,23 @@ from study.errors import SceneError
 from study.toml_writer import dumps_toml
 
 
-def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None):
-    return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=lo_open, choices=choices))
+def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None, optional=False):
+    return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=lo_open, choices=choices,
+                                                optional=optional))
+
+
+NOT_GIVEN = math.nan   # an optional field left out (written as ``nan`` when a scene is saved)
+
+# Damping defaults, as ratios of critical (see README "Damping"). Mesh: measured spur-gear mesh
+# damping ratios are a few percent of critical: 0.03-0.17 (the range Kasuba & Evans 1981, ASME
+# J. Mech. Des. 103, give from dynamic-load tests), about 0.05-0.10 (Gerber 1984, FZG
+# back-to-back rig, from the width of the resonance of the dynamic factor), and a few percent
+# from the EHL film of the mesh interface (Li & Kahraman 2011, Tribol. Int. 44, a model
+# checked against measured resonance amplitudes). 0.05 sits at the low, conservative end.
+# Teeth: 0.02, the structural damping of a steel cantilever with its root joint (no value in
+# the paper; the coefficient the scenes used before, c_phi = 0.062 N·mm·s/rad, is 2 %).
+MESH_DAMPING_RATIO = 0.05
+TOOTH_DAMPING_RATIO = 0.02
 
 
 @dataclass(frozen=True)
@@ -58,10 +73,18 @@ class SpringSection:
     """Torsion spring of each tooth about its pivot (eq. 1.2): T = k_phi phi^n_k + c_phi dphi^n_c."""
     k_phi: float = _f(1.06e6, "N*mm/rad^n_k", "torsion spring stiffness of a tooth of the solid gear (eq. 1.2)", 0, lo_open=True)
     n_k: float = _f(1.1, "1", "stiffness exponent (>= 1: a finite tangent at zero deflection)", 1.0, 3.0)
-    # Damping: 2 % of critical on the tooth's own mode (66 kHz, I_pivot 3.7e-9 kg·m², tangent
-    # 640 N·m/rad at 50 N·m): c = 2*0.02*sqrt(640*3.7e-9) = 6.2e-5 N·m·s/rad.
-    c_phi: float = _f(0.062, "N*mm*s/rad^n_c", "torsion spring damping coefficient", 0.0)
+    # Damping: give c_phi (a coefficient) or damping_ratio (of the tooth's own mode), not both;
+    # neither: set by contact.damping_ratio when the mesh damping is a ratio (the joint dampers
+    # then carry it), else damping_ratio = TOOTH_DAMPING_RATIO. For Table 1, 2 % of critical on the tooth
+    # mode (66 kHz, I_pivot 3.7e-9 kg·m², tangent 640 N·m/rad at 50 N·m) is
+    # c = 2*0.02*sqrt(640*3.7e-9) = 6.2e-5 N·m·s/rad = 0.062 N·mm·s/rad.
+    c_phi: float = _f(NOT_GIVEN, "N*mm*s/rad^n_c", "torsion spring damping coefficient (or damping_ratio)", 0.0, optional=True)
+    damping_ratio: float = _f(NOT_GIVEN, "1", "tooth damper as a ratio of critical damping of the tooth's own mode "
+                              "(the tooth on its spring's tangent at the mean load, about its pivot), converted to c_phi "
+                              "once per run; needs n_c = 1 (or c_phi; neither: set by contact.damping_ratio, or "
+                              f"{TOOTH_DAMPING_RATIO} when the contact gives c_con)", 0.0, 0.5, optional=True)
     n_c: float = _f(1.0, "1", "damping exponent", 0.5, 2.0)
+    EXCLUSIVE = ("c_phi", "damping_ratio", None, "n_c")   # coefficient, ratio, default ratio (None: see damping_ratios), exponent = 1
     stiffness: str = _f("fe-ratio", "", "per-tooth springs of a lightened body: 'fe-ratio' scales k_phi by the FE stiffness ratio to the solid body, 'fe' uses FE values directly, 'uniform' ignores the lightening",
                         choices=("fe-ratio", "fe", "uniform"))
 
@@ -86,11 +109,19 @@ class ContactSection:
     F = k_con delta^m1 + c_con ddelta^m2 delta^m3."""
     k_con: float = _f(5.64e6, "N/mm^m1", "contact stiffness (eq. 1.3; paper: fit of Weber's deflection)", 0, lo_open=True)
     m1: float = _f(1.24, "1", "stiffness exponent (>= 1)", 1.0, 3.0)
-    # Damping: 5 % of critical on the local contact mode (tangent 1.3e9 N/m at 1 um and
-    # ~1e-3 kg equivalent tooth mass at the contact: c = 115 N·s/m), reached at the loaded
-    # penetration of 1 um with m3 = 1.5, so the force fades in from zero at first touch:
-    # c_con = 0.115 N·s/mm / (1e-3 mm)^1.5 = 3640.
-    c_con: float = _f(3640.0, "N*s/mm^(1+m3)", "contact damping coefficient", 0.0)
+    # Damping: give c_con (a coefficient) or damping_ratio (of the mesh mode), not both;
+    # neither: damping_ratio = MESH_DAMPING_RATIO. The coefficient the scenes used before,
+    # c_con = 3640 (5 % of a local contact mode at 1 um), damps the Table 1 mesh mode at 0.003 %
+    # (with c_phi = 0.062 at 0.14 %). A ratio is carried by the tooth-root joint dampers when
+    # the springs give no damper (c_contact = 0), else by c_con (see study/setup.py).
+    c_con: float = _f(NOT_GIVEN, "N*s/mm^(1+m3)", "contact damping coefficient (or damping_ratio)", 0.0, optional=True)
+    damping_ratio: float = _f(NOT_GIVEN, "1", "mesh damping as a ratio of critical damping of the mesh mode (the "
+                              "pair linearised at the mean load, mean over one mesh period), converted once per run: "
+                              "to the tooth-root joint dampers c_phi of both gears when their springs give no damper "
+                              "(c_con = 0), else to c_con on top of them (needs m2 = 1); or c_con; neither: "
+                              f"{MESH_DAMPING_RATIO}",
+                              0.0, 0.5, optional=True)
+    EXCLUSIVE = ("c_con", "damping_ratio", MESH_DAMPING_RATIO, None)    # m2 = 1 checked where c_con carries it
     m2: float = _f(1.0, "1", "damping (velocity) exponent", 0.5, 2.0)
     m3: float = _f(1.5, "1", "indentation exponent of the damping term", 0.0, 3.0)
 
@@ -233,8 +264,10 @@ def _build(cls, table, path: str):
             continue
         if name not in table:
             continue
-        v = _coerce(table[name], typ, where)
         md = f.metadata
+        if md.get("optional") and isinstance(table[name], float) and math.isnan(table[name]):
+            continue      # left out (a saved scene writes nan)
+        v = _coerce(table[name], typ, where)
         unit = f" {md['unit']}" if md.get("unit") not in (None, "", "1") else ""
         if md.get("choices") and v not in md["choices"]:
             raise SceneError(where, f"must be one of {', '.join(map(repr, md['choices']))}, got {v!r}")
@@ -245,7 +278,26 @@ def _build(cls, table, path: str):
         if hi is not None and v > hi:
             raise SceneError(where, f"must be <= {hi}{unit}, got {v}{unit}")
         kwargs[name] = v
+    _resolve_exclusive(cls, kwargs, path)
     return cls(**kwargs)
+
+
+def _resolve_exclusive(cls, kwargs: dict, path: str) -> None:
+    """A damper given as a coefficient or as a ratio of critical, exactly one of them: both is
+    a SceneError, neither takes the default ratio; a ratio needs a linear damper (exponent 1)."""
+    coef, ratio, default, exponent = getattr(cls, "EXCLUSIVE", (None,) * 4)
+    if coef is None:
+        return
+    if coef in kwargs and ratio in kwargs:
+        raise SceneError(f"{path}.{ratio}", f"give either {path}.{coef} (a coefficient) or {path}.{ratio} "
+                                            "(a ratio of critical damping), not both")
+    if coef not in kwargs and default is not None:
+        kwargs.setdefault(ratio, default)
+    if ratio in kwargs and exponent is not None:
+        if kwargs.get(exponent, 1.0) != 1.0:
+            raise SceneError(f"{path}.{exponent}", f"a damping ratio ({path}.{ratio} = {kwargs[ratio]}) needs a linear "
+                                                   f"damper ({exponent} = 1); give {path}.{coef} for {exponent} = "
+                                                   f"{kwargs[exponent]}")
 
 
 def check_scene(scene: Scene) -> None:
@@ -306,8 +358,14 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
     if path is not None and not Path(path).is_file():
         raise SceneError("scene", f"no such file: {Path(path)}")
     data = _tables(default_scene_text() if path is None else Path(path).read_text(), str(path or "scene"))
-    for item in overrides:
-        set_dotted(data, *parse_override(item))
+    items = [parse_override(item) for item in overrides]
+    keys = {k for k, _v in items}
+    for key, _v in items:
+        partner = _damping_partner(key.split("."))
+        if partner and key.rsplit(".", 1)[0] + "." + partner in keys:
+            raise SceneError(key, f"give either {key} or {key.rsplit('.', 1)[0]}.{partner}, not both")
+    for key, value in items:
+        set_dotted(data, key, value)
     return scene_from_dict(data)
 
 
@@ -342,6 +400,19 @@ def set_dotted(data: dict, path: str, value) -> None:
             raise SceneError(".".join(parts[: i + 1]), "is a value, not a table")
         node = nxt
     node[parts[-1]] = value
+    partner = _damping_partner(parts)
+    if partner and not (isinstance(value, float) and math.isnan(value)):
+        node.pop(partner, None)     # a damper set one way replaces the scene's other way
+
+
+def _damping_partner(parts: list[str]) -> str | None:
+    """The other way to give the same damper ('c_con' <-> 'damping_ratio' in ``contact``,
+    'c_phi' <-> 'damping_ratio' in ``gearN.spring``), or None."""
+    pairs = {"contact": ("c_con", "damping_ratio"), "spring": ("c_phi", "damping_ratio")}
+    if len(parts) < 2 or parts[-2] not in pairs or parts[-1] not in pairs[parts[-2]]:
+        return None
+    a, b = pairs[parts[-2]]
+    return b if parts[-1] == a else a
 
 
 def get_dotted(scene: Scene, path: str):
