@@ -20,8 +20,9 @@ from solver.mbs.statics import solve_static
 from study.inputs.gearsetup import gear_setups
 from study.report import results
 from study.report.lightening import lightening_variables
+from study.report.modes import modal_variables
 from study.scene import Scene
-from study.setup import build_scene_model, load_table, scene_springs, static_angles
+from study.setup import build_scene_model, damping_ratios, load_table, mean_load, scene_springs, static_angles
 
 
 def run_static(scene: Scene, model: Model):
@@ -90,6 +91,11 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
         **results.provenance(),
     }
+    t0 = time.perf_counter()
+    c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
+    coords.update(c); data.update(v); attrs.update(a)
+    attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
+    attrs["wall_time_modes_s"] = time.perf_counter() - t0
     if static:
         t0 = time.perf_counter()
         st = run_static(scene, model)

@@ -63,6 +63,16 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         for f, o, a in results.largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
+    if "mesh_mode_frequency_hz" in ds.attrs:
+        a = ds.attrs
+        line = (f"  mesh mode: {a['mesh_mode_frequency_hz']:.0f} Hz, damping {a['mesh_mode_damping']:.4f} of critical "
+                f"(modal, mean over the mesh period)")
+        if "mesh_mode_damping_decay" in a:
+            line += f", {a['mesh_mode_damping_decay']:.4f} from the free decay ({a['mesh_mode_damping_at_0']:.4f} modal there)"
+        w(line + "\n")
+        cs = ds["critical_speed"].sel(mode=0)
+        w("    critical driver speeds [rad/s]: " + ", ".join(f"{e} {v:.0f}" for e, v in zip(ds["excitation"].values, cs.values)
+                                                          if v < 1000) + "\n")
     if "mass" in ds:
         for g in (1, 2):
             line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "
