@@ -73,16 +73,16 @@ class SpringSection:
     """Torsion spring of each tooth about its pivot (eq. 1.2): T = k_phi phi^n_k + c_phi dphi^n_c."""
     k_phi: float = _f(1.06e6, "N*mm/rad^n_k", "torsion spring stiffness of a tooth of the solid gear (eq. 1.2)", 0, lo_open=True)
     n_k: float = _f(1.1, "1", "stiffness exponent (>= 1: a finite tangent at zero deflection)", 1.0, 3.0)
-    # Damping: give c_phi (a coefficient) or damping_ratio (of the tooth's own mode), not both;
-    # neither: set by contact.damping_ratio when the mesh damping is a ratio (the joint dampers
-    # then carry it), else damping_ratio = TOOTH_DAMPING_RATIO. For Table 1, 2 % of critical on the tooth
+    # Damping: with a contact given by c_con, give c_phi (a coefficient) or damping_ratio (of
+    # the tooth's own mode), not both; neither: damping_ratio = TOOTH_DAMPING_RATIO. With a mesh
+    # damping ratio (contact.damping_ratio, the default) the ratio sets c_phi: give neither. For Table 1, 2 % of critical on the tooth
     # mode (66 kHz, I_pivot 3.7e-9 kg·m², tangent 640 N·m/rad at 50 N·m) is
     # c = 2*0.02*sqrt(640*3.7e-9) = 6.2e-5 N·m·s/rad = 0.062 N·mm·s/rad.
     c_phi: float = _f(NOT_GIVEN, "N*mm*s/rad^n_c", "torsion spring damping coefficient (or damping_ratio)", 0.0, optional=True)
     damping_ratio: float = _f(NOT_GIVEN, "1", "tooth damper as a ratio of critical damping of the tooth's own mode "
                               "(the tooth on its spring's tangent at the mean load, about its pivot), converted to c_phi "
-                              "once per run; needs n_c = 1 (or c_phi; neither: set by contact.damping_ratio, or "
-                              f"{TOOTH_DAMPING_RATIO} when the contact gives c_con)", 0.0, 0.5, optional=True)
+                              "once per run; needs n_c = 1 and a contact given by c_con (or c_phi; neither: "
+                              f"{TOOTH_DAMPING_RATIO} with c_con, else set by contact.damping_ratio)", 0.0, 0.5, optional=True)
     n_c: float = _f(1.0, "1", "damping exponent", 0.5, 2.0)
     EXCLUSIVE = ("c_phi", "damping_ratio", None, "n_c")   # coefficient, ratio, default ratio (None: see damping_ratios), exponent = 1
     stiffness: str = _f("fe-ratio", "", "per-tooth springs of a lightened body: 'fe-ratio' scales k_phi by the FE stiffness ratio to the solid body, 'fe' uses FE values directly, 'uniform' ignores the lightening",
@@ -112,14 +112,13 @@ class ContactSection:
     # Damping: give c_con (a coefficient) or damping_ratio (of the mesh mode), not both;
     # neither: damping_ratio = MESH_DAMPING_RATIO. The coefficient the scenes used before,
     # c_con = 3640 (5 % of a local contact mode at 1 um), damps the Table 1 mesh mode at 0.003 %
-    # (with c_phi = 0.062 at 0.14 %). A ratio is carried by the tooth-root joint dampers when
-    # the springs give no damper (c_contact = 0), else by c_con (see study/setup.py).
+    # (with c_phi = 0.062 at 0.14 %). A ratio is carried by the tooth-root joint dampers, the
+    # contact law then has none (why: study/setup.py, damping_from_ratios).
     c_con: float = _f(NOT_GIVEN, "N*s/mm^(1+m3)", "contact damping coefficient (or damping_ratio)", 0.0, optional=True)
     damping_ratio: float = _f(NOT_GIVEN, "1", "mesh damping as a ratio of critical damping of the mesh mode (the "
-                              "pair linearised at the mean load, mean over one mesh period), converted once per run: "
-                              "to the tooth-root joint dampers c_phi of both gears when their springs give no damper "
-                              "(c_con = 0), else to c_con on top of them (needs m2 = 1); or c_con; neither: "
-                              f"{MESH_DAMPING_RATIO}",
+                              "pair linearised at the mean load, mean over one mesh period), converted once per run to "
+                              "the tooth-root joint dampers c_phi of both gears (the springs then give no damper; "
+                              f"c_con = 0); or c_con; neither: {MESH_DAMPING_RATIO}",
                               0.0, 0.5, optional=True)
     EXCLUSIVE = ("c_con", "damping_ratio", MESH_DAMPING_RATIO, None)    # m2 = 1 checked where c_con carries it
     m2: float = _f(1.0, "1", "damping (velocity) exponent", 0.5, 2.0)
@@ -314,6 +313,7 @@ def check_scene(scene: Scene) -> None:
         pair_geometry(*geoms)
     except GeometryError as e:
         raise SceneError(e.field, e.reason) from None
+    check_damping(scene)
     d = scene.dynamic
     if d.output_step > d.duration:
         raise SceneError("dynamic.output_step", f"longer than dynamic.duration ({d.duration} s)")
@@ -326,6 +326,24 @@ def check_scene(scene: Scene) -> None:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
+
+
+def check_damping(scene: Scene) -> None:
+    """A mesh damping ratio (contact.damping_ratio, the default) is carried by the tooth-root
+    joint dampers (`study.setup.damping_from_ratios`): the springs then give no damper of their
+    own and have linear dampers (n_c = 1). Raises SceneError naming the field."""
+    if not math.isnan(scene.contact.c_con):
+        return
+    for g in (1, 2):
+        sp = scene.gear(g).spring
+        for name in ("c_phi", "damping_ratio"):
+            if not math.isnan(getattr(sp, name)):
+                raise SceneError(f"gear{g}.spring.{name}", "the mesh damping ratio (contact.damping_ratio, default "
+                                 f"{MESH_DAMPING_RATIO}) sets the tooth-root joint dampers: give no spring damper with "
+                                 "it, or give contact.c_con instead of the ratio")
+        if sp.n_c != 1.0:
+            raise SceneError(f"gear{g}.spring.n_c", "the mesh damping ratio (contact.damping_ratio) is carried by the "
+                             "tooth-root joint dampers, which needs n_c = 1; give contact.c_con and c_phi instead")
 
 
 def scene_from_dict(data: dict) -> Scene:

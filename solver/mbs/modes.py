@@ -17,12 +17,14 @@ Damping as a ratio (`contact_damping_for_ratio`, `tooth_damping_for_ratio`):
   c_phi = 2 zeta_t sqrt(k_t I_P), k_t the spring tangent of the most deflected tooth of that
   gear at the mean-load equilibria (mean over the mesh positions), I_P the tooth's inertia
   about its pivot (needs n_c = 1);
-* contact damper: zeta_m of the mesh mode. The contact damping is c*ddelta*delta^m3 (m2 = 1),
-  linearised c*delta^m3 per loaded contact; with the mesh mode x (mass-normalised) its modal
-  damping is c * sum_contacts delta^m3 (g.x)² / (2 w), i.e. an equivalent mesh damper
-  c_eq = c * sum delta^m3 (g.x)² m_eq on a mesh spring k_m = w² m_eq, m_eq the equivalent
-  mass of the mesh mode. c is chosen so that the mesh mode's ratio, averaged over the mesh
-  positions, tooth dampers included, equals zeta_m.
+* mesh mode: zeta_m, carried by the joint dampers of both gears (`joint_damping_for_ratio`):
+  the mesh mode of the linearised pair (mesh stiffness: the contact tangents in series with
+  the tooth-spring tangents; its mass from the mode shape) deflects mostly the tooth springs,
+  so the dampers across them damp it; one scale of c_phi (both gears at the same ratio of
+  their own modes) is found by root finding on the state-space eigenvalues so that the mesh
+  mode's ratio, averaged over the mesh positions, equals zeta_m. A contact damper
+  (c*ddelta*delta^m3, in series with the tooth springs) could not do it without overdamping
+  the tooth-on-contact modes (see `study.setup.damping_from_ratios`).
 """
 from __future__ import annotations
 
@@ -230,11 +232,3 @@ def joint_damping_for_ratio(model: Model, equilibria, zeta: float) -> tuple[floa
     m0 = with_damping(model, c_con=0.0, c_phi=(0.0, 0.0))
     s = _solve_scale(_parts(model, equilibria, m0, with_damping(m0, c_phi=unit)), zeta, "tooth-root joint dampers")
     return unit[0] * s, unit[1] * s
-
-
-def contact_damping_for_ratio(model: Model, equilibria, zeta: float) -> float:
-    """Contact damping coefficient c_con [N·s/m^(1+m3)] (m2 = 1) that gives the mesh mode the
-    damping ratio ``zeta`` on average over the equilibria, the model's tooth dampers included
-    (see the module docstring)."""
-    m0 = with_damping(model, c_con=0.0)
-    return _solve_scale(_parts(model, equilibria, m0, with_damping(model, c_con=1.0)), zeta, "contact dampers")

@@ -55,16 +55,23 @@ def test_requested_mesh_ratio_is_what_the_modes_and_the_free_decay_show(zeta):
     assert abs(rd.damping - zeta) <= spread + 0.03 * zeta
 
 
-def test_mesh_ratio_on_the_contact_damper_and_tooth_ratio():
-    """With the tooth dampers given as a ratio of their own mode, the mesh ratio goes to c_con
-    on top of them: the tooth damper is 2 zeta sqrt(k_t I_P) and the mesh mode reaches the
-    requested ratio; raw coefficients stay as given."""
-    m = _model(**{"gear1.spring.damping_ratio": 0.02, "gear2.spring.damping_ratio": 0.02, "contact.damping_ratio": 0.01})
-    assert 5.5e-5 < m.gear_par[0, L.C_PHI] < 6.5e-5         # the 2 % the scenes used before: 6.2e-5 N·m·s/rad
-    assert np.nanmean(modal_analysis(m, 50.0).damping[0]) == pytest.approx(0.01, rel=1e-4)
+def test_tooth_ratio_with_a_raw_contact_and_raw_coefficients():
+    """Tooth dampers as a ratio of the tooth's own mode (the contact given by c_con): 2 % is
+    the 6.2e-5 N·m·s/rad the scenes used before, and with no contact damper the tooth modes of
+    the linearised pair (the tooth on its spring, stiffened a little by the contact and
+    coupled to its neighbour) come out within 10 % of it; raw coefficients stay as given."""
+    m = _model(**{"gear1.spring.damping_ratio": 0.02, "gear2.spring.damping_ratio": 0.02, "contact.c_con": 0.0})
+    assert m.gear_par[0, L.C_PHI] == pytest.approx(6.2e-5, rel=0.03)
+    md = modal_analysis(m, 50.0)
+    # the two lowest tooth modes (~60 kHz; median over the mesh period: where a tooth enters
+    # the mesh lightly loaded, its soft spring tangent gives a slower, relatively more damped mode)
+    tooth = np.nanmedian(md.damping[1:3], axis=1)
+    assert np.all(np.abs(tooth - 0.02) < 0.002), tooth
     raw = _model(**{"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spring.c_phi": 0.062})
     assert raw.gear_par[0, L.C_PHI] == pytest.approx(6.2e-5)
     assert raw.law_par[L.C_CON] == pytest.approx(study.scene.units.contact_damping_to_si(3640.0, 1.0, 1.5))
+    with pytest.raises(study.SceneError, match="gear1.spring.c_phi: the mesh damping ratio"):
+        _model(**{"gear1.spring.c_phi": 0.062, "contact.damping_ratio": 0.05})
 
 
 def test_damping_given_both_ways_is_an_error():
