@@ -24,7 +24,7 @@ def campbell_plot(ds: xr.Dataset, path):
     driver_speed = speed / ratio if ratio > 0 else 0.0
     x_max = max(1.3 * float(cs.sel(excitation="1Z")), 2.0 * driver_speed)
     x = np.linspace(0.0, x_max, 200)
-    fig, ax = plt.subplots(figsize=(8.5, 5.5))
+    fig, ax = plt.subplots(figsize=(8.5, 6.5))
     y_max = 1.6 * float(fmesh.max())
     for m in ds["mode"].values:
         fm = f.sel(mode=m)
@@ -48,8 +48,8 @@ def campbell_plot(ds: xr.Dataset, path):
     for _e, v in crit:
         ax.plot(v, float(fmesh.mean()), "o", color="C3", ms=5)
     if crit:
-        ax.plot([], [], "o", color="C3", label="critical speeds of the mesh mode: " +
-                ", ".join(f"{e} {v:.0f}" for e, v in sorted(crit, key=lambda t: t[1])[:6]) + " rad/s")
+        ax.plot([], [], "o", color="C3", label="critical speeds of the mesh mode (dots; kZ lines solid, N and "
+                "sidebands kZ+-N dashed): " + ", ".join(f"{e} {v:.0f}" for e, v in crit if e.endswith("Z")) + " rad/s")
     if driver_speed > 0:
         ax.axvline(driver_speed, color="C0", lw=1.2, label=f"run speed {driver_speed:.0f} rad/s")
     higher = [float(np.nanmean(f.sel(mode=m))) for m in ds["mode"].values if np.nanmean(f.sel(mode=m)) > y_max]
@@ -60,6 +60,7 @@ def campbell_plot(ds: xr.Dataset, path):
     ax.set_ylim(0, y_max)
     ax.set_xlabel("driver speed [rad/s]")
     ax.set_ylabel("frequency [Hz]")
-    ax.legend(loc="center right", fontsize=7.5, framealpha=0.9)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.11), fontsize=7.5, frameon=False)
     figure_title(fig, ds, "Campbell diagram: modes of the loaded pair and excitation orders")
+    fig.subplots_adjust(bottom=0.24)
     return save_figure(fig, path)
