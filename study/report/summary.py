@@ -31,6 +31,12 @@ def summarize(ds: xr.Dataset) -> dict:
         z = ds.attrs["mesh_order"]
         for name, order in (("mesh", z), ("mesh2", 2 * z), ("mesh3", 3 * z), ("hole", ds.attrs["hole_order"])):
             out[f"amp_{name}_order"] = amplitude_at_order(ds, order) if order > 0 else nan
+    if "mode_frequency" in ds:
+        out["mesh_mode_frequency"] = float(ds.attrs["mesh_mode_frequency_hz"])
+        out["mesh_mode_damping"] = float(ds.attrs["mesh_mode_damping"])
+        out["mesh_mode_damping_decay"] = float(ds.attrs.get("mesh_mode_damping_decay", nan))
+        for k in (1, 2, 3):
+            out[f"critical_speed_{k if k > 1 else ''}z"] = float(ds["critical_speed"].sel(excitation=f"{k}Z", mode=0))
     if "mass" in ds:
         from study.sweep.outputs import GEAR_VARIABLES
         for g in (1, 2):
