@@ -21,6 +21,7 @@ from pathlib import Path
 
 from solver import units
 from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
+from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
 from study.toml_writer import dumps_toml
 
@@ -28,20 +29,6 @@ from study.toml_writer import dumps_toml
 def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None, optional=False):
     return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=lo_open, choices=choices,
                                                 optional=optional))
-
-
-NOT_GIVEN = math.nan   # an optional field left out (written as ``nan`` when a scene is saved)
-
-# Damping defaults, as ratios of critical (see README "Damping"). Mesh: measured spur-gear mesh
-# damping ratios are a few percent of critical: 0.03-0.17 (the range Kasuba & Evans 1981, ASME
-# J. Mech. Des. 103, give from dynamic-load tests), about 0.05-0.10 (Gerber 1984, FZG
-# back-to-back rig, from the width of the resonance of the dynamic factor), and a few percent
-# from the EHL film of the mesh interface (Li & Kahraman 2011, Tribol. Int. 44, a model
-# checked against measured resonance amplitudes). 0.05 sits at the low, conservative end.
-# Teeth: 0.02, the structural damping of a steel cantilever with its root joint (no value in
-# the paper; the coefficient the scenes used before, c_phi = 0.062 N·mm·s/rad, is 2 %).
-MESH_DAMPING_RATIO = 0.05
-TOOTH_DAMPING_RATIO = 0.02
 
 
 @dataclass(frozen=True)
@@ -277,26 +264,8 @@ def _build(cls, table, path: str):
         if hi is not None and v > hi:
             raise SceneError(where, f"must be <= {hi}{unit}, got {v}{unit}")
         kwargs[name] = v
-    _resolve_exclusive(cls, kwargs, path)
+    resolve_exclusive(cls, kwargs, path)
     return cls(**kwargs)
-
-
-def _resolve_exclusive(cls, kwargs: dict, path: str) -> None:
-    """A damper given as a coefficient or as a ratio of critical, exactly one of them: both is
-    a SceneError, neither takes the default ratio; a ratio needs a linear damper (exponent 1)."""
-    coef, ratio, default, exponent = getattr(cls, "EXCLUSIVE", (None,) * 4)
-    if coef is None:
-        return
-    if coef in kwargs and ratio in kwargs:
-        raise SceneError(f"{path}.{ratio}", f"give either {path}.{coef} (a coefficient) or {path}.{ratio} "
-                                            "(a ratio of critical damping), not both")
-    if coef not in kwargs and default is not None:
-        kwargs.setdefault(ratio, default)
-    if ratio in kwargs and exponent is not None:
-        if kwargs.get(exponent, 1.0) != 1.0:
-            raise SceneError(f"{path}.{exponent}", f"a damping ratio ({path}.{ratio} = {kwargs[ratio]}) needs a linear "
-                                                   f"damper ({exponent} = 1); give {path}.{coef} for {exponent} = "
-                                                   f"{kwargs[exponent]}")
 
 
 def check_scene(scene: Scene) -> None:
@@ -326,24 +295,6 @@ def check_scene(scene: Scene) -> None:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
-
-
-def check_damping(scene: Scene) -> None:
-    """A mesh damping ratio (contact.damping_ratio, the default) is carried by the tooth-root
-    joint dampers (`study.setup.damping_from_ratios`): the springs then give no damper of their
-    own and have linear dampers (n_c = 1). Raises SceneError naming the field."""
-    if not math.isnan(scene.contact.c_con):
-        return
-    for g in (1, 2):
-        sp = scene.gear(g).spring
-        for name in ("c_phi", "damping_ratio"):
-            if not math.isnan(getattr(sp, name)):
-                raise SceneError(f"gear{g}.spring.{name}", "the mesh damping ratio (contact.damping_ratio, default "
-                                 f"{MESH_DAMPING_RATIO}) sets the tooth-root joint dampers: give no spring damper with "
-                                 "it, or give contact.c_con instead of the ratio")
-        if sp.n_c != 1.0:
-            raise SceneError(f"gear{g}.spring.n_c", "the mesh damping ratio (contact.damping_ratio) is carried by the "
-                             "tooth-root joint dampers, which needs n_c = 1; give contact.c_con and c_phi instead")
 
 
 def scene_from_dict(data: dict) -> Scene:
@@ -379,7 +330,7 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
     items = [parse_override(item) for item in overrides]
     keys = {k for k, _v in items}
     for key, _v in items:
-        partner = _damping_partner(key.split("."))
+        partner = damping_partner(key.split("."))
         if partner and key.rsplit(".", 1)[0] + "." + partner in keys:
             raise SceneError(key, f"give either {key} or {key.rsplit('.', 1)[0]}.{partner}, not both")
     for key, value in items:
@@ -418,19 +369,9 @@ def set_dotted(data: dict, path: str, value) -> None:
             raise SceneError(".".join(parts[: i + 1]), "is a value, not a table")
         node = nxt
     node[parts[-1]] = value
-    partner = _damping_partner(parts)
+    partner = damping_partner(parts)
     if partner and not (isinstance(value, float) and math.isnan(value)):
         node.pop(partner, None)     # a damper set one way replaces the scene's other way
-
-
-def _damping_partner(parts: list[str]) -> str | None:
-    """The other way to give the same damper ('c_con' <-> 'damping_ratio' in ``contact``,
-    'c_phi' <-> 'damping_ratio' in ``gearN.spring``), or None."""
-    pairs = {"contact": ("c_con", "damping_ratio"), "spring": ("c_phi", "damping_ratio")}
-    if len(parts) < 2 or parts[-2] not in pairs or parts[-1] not in pairs[parts[-2]]:
-        return None
-    a, b = pairs[parts[-2]]
-    return b if parts[-1] == a else a
 
 
 def get_dotted(scene: Scene, path: str):

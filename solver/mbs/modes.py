@@ -2,17 +2,19 @@
 
 The pair is linearised (`solver.mbs.stability.linearized_system`) at static equilibrium under
 the mean load at ``positions`` driver angles across one angular pitch (one mesh period). At
-each position the generalised eigenproblem K x = w² M x over the free DOFs (driven hub, then
-the teeth near the mesh) gives the natural frequencies; with mass-normalised modes x_i the
-modal damping ratio is zeta_i = x_i^T C x_i / (2 w_i) (C: tooth-spring and contact dampers
-linearised at rest, the proportional-damping estimate). Each mode is named by where its
-kinetic energy x_i * (M x_i) lies: the mode with the largest share on the driven hub is the
-mesh mode (the two gear bodies rotating against each other on the mesh spring); the others
-are tooth modes, named by the gear whose teeth carry most of their energy. Modes of teeth
-near the mesh that carry no load (a spring with n_k > 1 has no stiffness at zero deflection)
-have no stiffness and are left out.
+each position the eigenvalues lambda of M x'' + C x' + K x = 0 over the free DOFs (driven
+hub, then the teeth near the mesh; C: tooth-spring and contact dampers linearised at rest),
+from its state-space form, give the natural frequency |lambda| and the damping ratio
+-Re(lambda)/|lambda| of each mode. They are exact for the linearised pair where the modal
+estimate x^T C x / (2 w) on undamped modes is not: a heavily damped tooth joint holds the
+mesh mode's shape (at 5 % that estimate reads twice the ratio the free decay shows). Each
+mode is named by where its kinetic energy lies: the mode with the largest share on the
+driven hub is the mesh mode (the driven gear rotating on the mesh spring against the
+prescribed driver); the others are tooth modes, named by the gear whose teeth carry most of
+their energy. Modes of teeth near the mesh that carry no load (a spring with n_k > 1 has no
+stiffness at zero deflection) and overdamped modes are left out.
 
-Damping as a ratio (`contact_damping_for_ratio`, `tooth_damping_for_ratio`):
+Damping as a ratio (`joint_damping_for_ratio`, `tooth_damping_for_ratio`):
 * tooth dampers: zeta_t of the tooth's own mode, the tooth on its spring about its pivot:
   c_phi = 2 zeta_t sqrt(k_t I_P), k_t the spring tangent of the most deflected tooth of that
   gear at the mean-load equilibria (mean over the mesh positions), I_P the tooth's inertia
