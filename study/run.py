@@ -49,7 +49,8 @@ def run_dynamic(scene: Scene, model: Model):
     table = load_table(scene)
     step_torque = run_loads(table, d.torque)[1]
     choice = choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
-    args = (model, d.speed, d.ramp_time, d.torque, d.ramp_time, d.duration)
+    speed, speed_ramp = (d.speed_end, d.duration) if d.speed_end > 0 else (d.speed, d.ramp_time)   # a run-up: one ramp
+    args = (model, speed, speed_ramp, d.torque, d.ramp_time, d.duration)
     if choice.method == "implicit":
         res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha, load_table=table)
     else:
@@ -112,8 +113,14 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["wall_time_dynamic_s"] = time.perf_counter() - t0
         start = d.spectrum_start or 2 * d.ramp_time
         attrs["spectrum_start_s"] = start
-        c, v, a = results.dynamic_variables(dy, start, driven_speed, scene.gear2.body.holes, z2)
+        runup = d.speed_end > 0         # no spectrum over a changing speed: its order tracking instead
+        c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2)
         coords.update(c); data.update(v); attrs.update(a)
+        if runup and dy.status == 0:
+            from study.report.order_tracking import order_tracking_variables
+            c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
+            coords.update(c); data.update(v)
+            attrs["runup_speed_end_rad_s"] = d.speed_end
         attrs["dynamic_method"] = dy.choice.method
         attrs["dynamic_method_reason"] = dy.choice.reason
         attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")

@@ -129,6 +129,9 @@ class DynamicSection:
     method: str = _f("explicit", "", "time integrator: 'explicit' (velocity Verlet), 'implicit' (HHT-alpha), 'auto' (explicit when its stability step is affordable for the duration, implicit otherwise)", choices=("explicit", "implicit", "auto"))
     alpha: float = _f(0.0, "1", "HHT-alpha numerical damping of the implicit integrator: 0 = none (trapezoidal rule), down to -1/3", -1.0 / 3.0, 0.0)
     speed: float = _f(100.0, "rad/s", "final driver speed (the driver turns forward; a reversed load is a negative torque)", 0.0)
+    speed_end: float = _f(0.0, "rad/s", "run-up: the driver speed rises linearly from 0 to speed_end over the whole run "
+                          "(dynamic.speed is then not used; the torque still ramps over ramp_time) and the archive "
+                          "gets the computed order tracking (order_amplitude); 0 = a run at dynamic.speed", 0.0)
     torque: float = _f(50.0, "N*m", "final resisting torque on gear 2")
     ramp_time: float = _f(0.01, "s", "speed and torque ramp time", 0, lo_open=True)
     torque_change_time: float = _f(0.0, "s", "time at which the resisting torque starts to move, linearly, from dynamic.torque to dynamic.torque_after (a load step or a reversal during the run); 0 = never", 0.0)

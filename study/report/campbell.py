@@ -64,3 +64,45 @@ def campbell_plot(ds: xr.Dataset, path):
     figure_title(fig, ds, "Campbell diagram: modes of the loaded pair and excitation orders")
     fig.subplots_adjust(bottom=0.24)
     return save_figure(fig, path)
+
+
+def order_map_plot(ds: xr.Dataset, path):
+    """Order map of a run-up (log amplitude over driver speed and order) with the Campbell
+    overlay: the mesh mode as the curve order = f 2 pi / (driver speed z1/z2) and the critical
+    speeds of the kZ lines; below, the order cuts N, Z, 2Z, 3Z against speed."""
+    need(ds, "order_amplitude")
+    sp = ds["runup_speed"].values
+    order = ds["tracked_order"].values
+    amp = ds["order_amplitude"].values
+    z = float(ds.attrs["mesh_order"])
+    n = float(ds.attrs.get("hole_order", 0.0))
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 8.5), height_ratios=(3, 2), sharex=True)
+    floor = max(float(np.nanmax(amp)) * 1e-4, 1e-6)
+    mesh = ax.pcolormesh(sp, order, np.log10(np.maximum(amp.T, floor)), shading="nearest", cmap="viridis")
+    fig.colorbar(mesh, ax=(ax, ax2), label="log10 DTE amplitude [um] (order map)", shrink=0.6, anchor=(0.0, 1.0))
+    if "mode_frequency" in ds and "critical_speed" in ds:
+        cs1 = float(ds["critical_speed"].sel(excitation="1Z", mode=0))
+        f = ds["mode_frequency"].sel(mode=0)
+        for fm, ls in ((float(f.mean()), "-"), (float(f.min()), ":"), (float(f.max()), ":")):
+            # order at which the mode sits for driver speed w: f / (w z1/z2 / 2pi) = z * cs1 / w * fm / fmean
+            ax.plot(sp, z * cs1 / sp * fm / float(f.mean()), color="w", lw=1.0, ls=ls)
+        ax.plot([], [], color="k", lw=1.0, label=f"mesh mode {float(f.mean()):.0f} Hz (dotted: range over the mesh period)")
+        for k in range(1, 6):
+            c = float(ds["critical_speed"].sel(excitation=f"{k}Z", mode=0))
+            if sp.min() <= c <= sp.max():
+                ax.plot(c, k * z, "o", mfc="none", mec="r", ms=8)
+                ax2.axvline(c, color="0.6", lw=0.8, ls="--")
+                ax2.text(c, 1.0, f"{k}Z", transform=ax2.get_xaxis_transform(), fontsize=7, ha="center", va="bottom")
+        ax.plot([], [], "o", mfc="none", mec="r", label="critical speeds kZ (modal)")
+        ax.legend(loc="upper right", fontsize=8)
+    ax.set_ylim(0, min(order.max(), 5.5 * z))
+    ax.set_ylabel("order of the driven gear's rotation [1]")
+    cuts = [("Z", z), ("2Z", 2 * z), ("3Z", 3 * z)] + ([("N", n)] if n > 0 else [])
+    for name, o in cuts:
+        sel = np.abs(order - o) <= 0.5
+        ax2.semilogy(sp, amp[:, sel].max(axis=1), lw=1.2, label=f"order {name} = {o:g}")
+    ax2.set_xlabel("driver speed [rad/s]")
+    ax2.set_ylabel("DTE amplitude [um]")
+    ax2.legend(fontsize=8)
+    figure_title(fig, ds, "Run-up: computed order tracking of DTE, Campbell overlay and order cuts")
+    return save_figure(fig, path)

@@ -79,6 +79,15 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         cs = ds["critical_speed"].sel(mode=0)
         w("    critical driver speeds [rad/s]: " + ", ".join(f"{e} {v:.0f}" for e, v in zip(ds["excitation"].values, cs.values)
                                                           if v < 1000) + "\n")
+    if "order_amplitude" in ds:
+        sp, order, amp = ds["runup_speed"].values, ds["tracked_order"].values, ds["order_amplitude"].values
+        z = ds.attrs["mesh_order"]
+        parts = []
+        for k in (1, 2, 3):
+            sel = np.abs(order - k * z) <= 0.5
+            cut = amp[:, sel].max(axis=1)
+            parts.append(f"{k}Z {cut.max():.3g} um at {sp[np.argmax(cut)]:.0f} rad/s")
+        w(f"  run-up {sp[0]:.0f}-{sp[-1]:.0f} rad/s, largest order amplitudes: " + ", ".join(parts) + "\n")
     if "mass" in ds:
         for g in (1, 2):
             line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "
