@@ -21,8 +21,9 @@ from study import estimate
 from study.inputs.gearsetup import gear_setups
 from study.report import results
 from study.report.lightening import lightening_variables
+from study.report.modes import modal_variables
 from study.scene import Scene
-from study.setup import build_scene_model, load_table, scene_springs, static_angles
+from study.setup import build_scene_model, damping_ratios, load_table, mean_load, scene_springs, static_angles
 
 
 def run_static(scene: Scene, model: Model):
@@ -56,7 +57,8 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
     d = scene.dynamic
     table = load_table(scene)
     choice = choice or dynamic_choice(scene, model)
-    args = (model, d.speed, d.ramp_time, d.torque, d.ramp_time, d.duration)
+    speed, speed_ramp = (d.speed_end, d.duration) if d.speed_end > 0 else (d.speed, d.ramp_time)   # a run-up: one ramp
+    args = (model, speed, speed_ramp, d.torque, d.ramp_time, d.duration)
     bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration), d.duration,
                                 f"dynamic run ({choice.method})", "s", show=progress)
     watch = None if bar is None else (lambda t: bar.update(t - bar.n))
@@ -129,6 +131,11 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
         **results.provenance(),
     }
+    t0 = time.perf_counter()
+    c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
+    coords.update(c); data.update(v); attrs.update(a)
+    attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
+    attrs["wall_time_modes_s"] = time.perf_counter() - t0
     if static:
         t0 = time.perf_counter()
         st = run_static(scene, model)
@@ -146,8 +153,14 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["wall_time_dynamic_s"] = time.perf_counter() - t0
         start = d.spectrum_start or 2 * d.ramp_time
         attrs["spectrum_start_s"] = start
-        c, v, a = results.dynamic_variables(dy, start, driven_speed, scene.gear2.body.holes, z2)
+        runup = d.speed_end > 0         # no spectrum over a changing speed: its order tracking instead
+        c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2)
         coords.update(c); data.update(v); attrs.update(a)
+        if runup and dy.status == 0:
+            from study.report.order_tracking import order_tracking_variables
+            c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
+            coords.update(c); data.update(v)
+            attrs["runup_speed_end_rad_s"] = d.speed_end
         attrs["dynamic_method"] = dy.choice.method
         attrs["dynamic_method_reason"] = dy.choice.reason
         attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")

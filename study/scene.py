@@ -21,12 +21,14 @@ from pathlib import Path
 
 from solver import units
 from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
+from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
 from study.toml_writer import dumps_toml
 
 
-def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None):
-    return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=lo_open, choices=choices))
+def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None, optional=False):
+    return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=lo_open, choices=choices,
+                                                optional=optional))
 
 
 @dataclass(frozen=True)
@@ -58,10 +60,18 @@ class SpringSection:
     """Torsion spring of each tooth about its pivot (eq. 1.2): T = k_phi phi^n_k + c_phi dphi^n_c."""
     k_phi: float = _f(1.06e6, "N*mm/rad^n_k", "torsion spring stiffness of a tooth of the solid gear (eq. 1.2)", 0, lo_open=True)
     n_k: float = _f(1.1, "1", "stiffness exponent (>= 1: a finite tangent at zero deflection)", 1.0, 3.0)
-    # Damping: 2 % of critical on the tooth's own mode (66 kHz, I_pivot 3.7e-9 kg·m², tangent
-    # 640 N·m/rad at 50 N·m): c = 2*0.02*sqrt(640*3.7e-9) = 6.2e-5 N·m·s/rad.
-    c_phi: float = _f(0.062, "N*mm*s/rad^n_c", "torsion spring damping coefficient", 0.0)
+    # Damping: with a contact given by c_con, give c_phi (a coefficient) or damping_ratio (of
+    # the tooth's own mode), not both; neither: damping_ratio = TOOTH_DAMPING_RATIO. With a mesh
+    # damping ratio (contact.damping_ratio, the default) the ratio sets c_phi: give neither. For Table 1, 2 % of critical on the tooth
+    # mode (66 kHz, I_pivot 3.7e-9 kg·m², tangent 640 N·m/rad at 50 N·m) is
+    # c = 2*0.02*sqrt(640*3.7e-9) = 6.2e-5 N·m·s/rad = 0.062 N·mm·s/rad.
+    c_phi: float = _f(NOT_GIVEN, "N*mm*s/rad^n_c", "torsion spring damping coefficient (or damping_ratio)", 0.0, optional=True)
+    damping_ratio: float = _f(NOT_GIVEN, "1", "tooth damper as a ratio of critical damping of the tooth's own mode "
+                              "(the tooth on its spring's tangent at the mean load, about its pivot), converted to c_phi "
+                              "once per run; needs n_c = 1 and a contact given by c_con (or c_phi; neither: "
+                              f"{TOOTH_DAMPING_RATIO} with c_con, else set by contact.damping_ratio)", 0.0, 0.5, optional=True)
     n_c: float = _f(1.0, "1", "damping exponent", 0.5, 2.0)
+    EXCLUSIVE = ("c_phi", "damping_ratio", None, "n_c")   # coefficient, ratio, default ratio (None: see damping_ratios), exponent = 1
     stiffness: str = _f("fe-ratio", "", "per-tooth springs of a lightened body: 'fe-ratio' scales k_phi by the FE stiffness ratio to the solid body, 'fe' uses FE values directly, 'uniform' ignores the lightening",
                         choices=("fe-ratio", "fe", "uniform"))
 
@@ -86,11 +96,18 @@ class ContactSection:
     F = k_con delta^m1 + c_con ddelta^m2 delta^m3."""
     k_con: float = _f(5.64e6, "N/mm^m1", "contact stiffness (eq. 1.3; paper: fit of Weber's deflection)", 0, lo_open=True)
     m1: float = _f(1.24, "1", "stiffness exponent (>= 1)", 1.0, 3.0)
-    # Damping: 5 % of critical on the local contact mode (tangent 1.3e9 N/m at 1 um and
-    # ~1e-3 kg equivalent tooth mass at the contact: c = 115 N·s/m), reached at the loaded
-    # penetration of 1 um with m3 = 1.5, so the force fades in from zero at first touch:
-    # c_con = 0.115 N·s/mm / (1e-3 mm)^1.5 = 3640.
-    c_con: float = _f(3640.0, "N*s/mm^(1+m3)", "contact damping coefficient", 0.0)
+    # Damping: give c_con (a coefficient) or damping_ratio (of the mesh mode), not both;
+    # neither: damping_ratio = MESH_DAMPING_RATIO. The coefficient the scenes used before,
+    # c_con = 3640 (5 % of a local contact mode at 1 um), damps the Table 1 mesh mode at 0.003 %
+    # (with c_phi = 0.062 at 0.14 %). A ratio is carried by the tooth-root joint dampers, the
+    # contact law then has none (why: study/setup.py, damping_from_ratios).
+    c_con: float = _f(NOT_GIVEN, "N*s/mm^(1+m3)", "contact damping coefficient (or damping_ratio)", 0.0, optional=True)
+    damping_ratio: float = _f(NOT_GIVEN, "1", "mesh damping as a ratio of critical damping of the mesh mode (the "
+                              "pair linearised at the mean load, mean over one mesh period), converted once per run to "
+                              "the tooth-root joint dampers c_phi of both gears (the springs then give no damper; "
+                              f"c_con = 0); or c_con; neither: {MESH_DAMPING_RATIO}",
+                              0.0, 0.5, optional=True)
+    EXCLUSIVE = ("c_con", "damping_ratio", MESH_DAMPING_RATIO, None)    # m2 = 1 checked where c_con carries it
     m2: float = _f(1.0, "1", "damping (velocity) exponent", 0.5, 2.0)
     m3: float = _f(1.5, "1", "indentation exponent of the damping term", 0.0, 3.0)
 
@@ -112,6 +129,9 @@ class DynamicSection:
     method: str = _f("explicit", "", "time integrator: 'explicit' (velocity Verlet), 'implicit' (HHT-alpha), 'auto' (explicit when its stability step is affordable for the duration, implicit otherwise)", choices=("explicit", "implicit", "auto"))
     alpha: float = _f(0.0, "1", "HHT-alpha numerical damping of the implicit integrator: 0 = none (trapezoidal rule), down to -1/3", -1.0 / 3.0, 0.0)
     speed: float = _f(100.0, "rad/s", "final driver speed (the driver turns forward; a reversed load is a negative torque)", 0.0)
+    speed_end: float = _f(0.0, "rad/s", "run-up: the driver speed rises linearly from 0 to speed_end over the whole run "
+                          "(dynamic.speed is then not used; the torque still ramps over ramp_time) and the archive "
+                          "gets the computed order tracking (order_amplitude); 0 = a run at dynamic.speed", 0.0)
     torque: float = _f(50.0, "N*m", "final resisting torque on gear 2")
     ramp_time: float = _f(0.01, "s", "speed and torque ramp time", 0, lo_open=True)
     torque_change_time: float = _f(0.0, "s", "time at which the resisting torque starts to move, linearly, from dynamic.torque to dynamic.torque_after (a load step or a reversal during the run); 0 = never", 0.0)
@@ -233,8 +253,10 @@ def _build(cls, table, path: str):
             continue
         if name not in table:
             continue
-        v = _coerce(table[name], typ, where)
         md = f.metadata
+        if md.get("optional") and isinstance(table[name], float) and math.isnan(table[name]):
+            continue      # left out (a saved scene writes nan)
+        v = _coerce(table[name], typ, where)
         unit = f" {md['unit']}" if md.get("unit") not in (None, "", "1") else ""
         if md.get("choices") and v not in md["choices"]:
             raise SceneError(where, f"must be one of {', '.join(map(repr, md['choices']))}, got {v!r}")
@@ -245,6 +267,7 @@ def _build(cls, table, path: str):
         if hi is not None and v > hi:
             raise SceneError(where, f"must be <= {hi}{unit}, got {v}{unit}")
         kwargs[name] = v
+    resolve_exclusive(cls, kwargs, path)
     return cls(**kwargs)
 
 
@@ -262,6 +285,7 @@ def check_scene(scene: Scene) -> None:
         pair_geometry(*geoms)
     except GeometryError as e:
         raise SceneError(e.field, e.reason) from None
+    check_damping(scene)
     d = scene.dynamic
     if d.output_step > d.duration:
         raise SceneError("dynamic.output_step", f"longer than dynamic.duration ({d.duration} s)")
@@ -306,8 +330,14 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
     if path is not None and not Path(path).is_file():
         raise SceneError("scene", f"no such file: {Path(path)}")
     data = _tables(default_scene_text() if path is None else Path(path).read_text(), str(path or "scene"))
-    for item in overrides:
-        set_dotted(data, *parse_override(item))
+    items = [parse_override(item) for item in overrides]
+    keys = {k for k, _v in items}
+    for key, _v in items:
+        partner = damping_partner(key.split("."))
+        if partner and key.rsplit(".", 1)[0] + "." + partner in keys:
+            raise SceneError(key, f"give either {key} or {key.rsplit('.', 1)[0]}.{partner}, not both")
+    for key, value in items:
+        set_dotted(data, key, value)
     return scene_from_dict(data)
 
 
@@ -342,6 +372,9 @@ def set_dotted(data: dict, path: str, value) -> None:
             raise SceneError(".".join(parts[: i + 1]), "is a value, not a table")
         node = nxt
     node[parts[-1]] = value
+    partner = damping_partner(parts)
+    if partner and not (isinstance(value, float) and math.isnan(value)):
+        node.pop(partner, None)     # a damper set one way replaces the scene's other way
 
 
 def get_dotted(scene: Scene, path: str):

@@ -12,15 +12,16 @@ import math
 import numpy as np
 
 from solver import units
+from solver.mbs.kernels import layout as L
 from solver.mbs.model import ContactLaw, GearInput, Model, build_model
 from study.inputs import coupling
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup, gear_setup, gear_setups
 from study.inputs.springs import tooth_springs
-from study.scene import Scene
+from study.scene import MESH_DAMPING_RATIO, TOOTH_DAMPING_RATIO, Scene, SceneError
 
 __all__ = ["GearSetup", "gear_setup", "gear_setups", "solid_scene", "coupling_fit", "scene_springs",
-           "build_scene_model", "geometry_model", "static_angles", "load_table"]
+           "build_scene_model", "geometry_model", "static_angles", "load_table", "damping_ratios", "mean_load"]
 
 
 def solid_scene(scene: Scene, gears=(1, 2)) -> Scene:
@@ -67,9 +68,10 @@ def scene_springs(scene: Scene, setups: tuple | None = None):
     return tuple(tooth_springs(s) for s in setups)
 
 
-def build_scene_model(scene: Scene, springs=None) -> Model:
+def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) -> Model:
     """The solver model of a scene (SI). ``springs`` = ((k1, r1), (k2, r2)) skips the FE of
-    the tooth springs (a coupled model still takes its body springs from the FE)."""
+    the tooth springs (a coupled model still takes its body springs from the FE).
+    ``convert_damping=False`` leaves the dampers given as ratios at zero (`damping_from_ratios`)."""
     setups = gear_setups(scene)
     springs = springs or scene_springs(scene, setups)
     gears = []
@@ -85,22 +87,83 @@ def build_scene_model(scene: Scene, springs=None) -> Model:
             k_body, n_k, pivot = math.inf, sp.n_k, setup.pivot_radius
         gears.append(GearInput(tooth=setup.tooth, body=setup.body, pivot_radius=pivot,
                                k_phi=units.spring_stiffness_to_si(np.asarray(k_phi, float)),
-                               n_k=n_k, c_phi=units.spring_damping_to_si(sp.c_phi),
+                               n_k=n_k, c_phi=units.spring_damping_to_si(0.0 if math.isnan(sp.c_phi) else sp.c_phi),
                                n_c=sp.n_c, body_stiffness=k_body, tooth_compliance=cmat))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
-                     units.contact_damping_to_si(c.c_con, c.m2, c.m3), c.m2, c.m3)
-    return build_model(gears[0], gears[1], law, setups[0].material)
+                     units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3)
+    model = build_model(gears[0], gears[1], law, setups[0].material)
+    return damping_from_ratios(scene, model) if convert_damping else model
+
+
+def damping_ratios(scene: Scene) -> dict:
+    """The dampers a scene gives as ratios of critical [1]: 'contact' (of the mesh mode),
+    'gear1' / 'gear2' (of the tooth's own mode). A contact given by neither coefficient nor
+    ratio takes MESH_DAMPING_RATIO; tooth springs given neither take TOOTH_DAMPING_RATIO when
+    the contact gives c_con, else the mesh ratio sets them (`damping_from_ratios`)."""
+    out = {}
+    c = scene.contact
+    if math.isnan(c.c_con):
+        out["contact"] = MESH_DAMPING_RATIO if math.isnan(c.damping_ratio) else c.damping_ratio
+    for g in (1, 2):
+        sp = scene.gear(g).spring
+        if not math.isnan(sp.damping_ratio):
+            out[f"gear{g}"] = sp.damping_ratio
+        elif math.isnan(sp.c_phi) and "contact" not in out:
+            out[f"gear{g}"] = TOOTH_DAMPING_RATIO
+    return out
+
+
+def mean_load(scene: Scene) -> float:
+    """The scene's mean load [N·m], where damping ratios are converted and modes computed: the
+    dynamic run's torque (before any load change), else the quasi-static torque."""
+    d = scene.dynamic
+    return d.torque if d.enabled and d.torque != 0 else scene.quasi_static.torque
+
+
+def damping_from_ratios(scene: Scene, model: Model) -> Model:
+    """The model with the dampers the scene gives as ratios of critical converted, once, to the
+    coefficients of the laws (`solver.mbs.modes`), at the static equilibria under the mean load
+    at 12 positions over one mesh period (the pair linearised there: mesh stiffness = contact
+    tangents in series with the tooth-spring tangents, the mass of the mesh mode from its
+    mass-normalised shape):
+    * tooth ratios (with a contact given by c_con): c_phi = 2 zeta_t sqrt(k_t I_P) on the
+      tooth's own mode;
+    * the mesh ratio: the joint dampers c_phi of both gears (the same ratio of their own modes)
+      such that the mesh mode's ratio, averaged over the mesh positions, is the requested one;
+      the contact law then has no damper (c_con = 0). The springs may then give no damper of
+      their own. The contact damper cannot carry it: the contact is stiff in series with the
+      tooth springs, so even 1 % of critical on the mesh mode needs c_con some 200 000 times
+      the old 3640 N·s/mm^2.5, which overdamps the tooth-on-contact modes near 200 kHz, cuts
+      the explicit step twenty-fold and still lets a run from rest grow energy (Table 1);
+      5 % is beyond what it can give at all (at most about 2.6 % with 2 % tooth dampers)."""
+    ratios = damping_ratios(scene)
+    if not ratios:
+        return model
+    from solver.mbs.modes import joint_damping_for_ratio, loaded_equilibria, tooth_damping_for_ratio, with_damping
+    eqs = loaded_equilibria(model, mean_load(scene))
+    c_phi = tuple(tooth_damping_for_ratio(model, eqs, ratios[f"gear{g}"], g) if f"gear{g}" in ratios
+                  else float(model.gear_par[g - 1, L.C_PHI]) for g in (1, 2))
+    model = with_damping(model, c_phi=c_phi)
+    if "contact" not in ratios:
+        return model
+    # check_scene has made sure the springs give no damper of their own, with n_c = 1
+    try:
+        return with_damping(model, c_con=0.0, c_phi=joint_damping_for_ratio(model, eqs, ratios["contact"]))
+    except SceneError:
+        raise
+    except ValueError as e:
+        raise SceneError("contact.damping_ratio", str(e)) from None
 
 
 def geometry_model(scene: Scene) -> Model:
     """The pair's geometry, inertia and contact law without any FE: plain uniform springs of
-    the scene's k_phi and no foundation coupling. For what needs the kinematics and the
+    the scene's k_phi, no foundation coupling and the dampers given as ratios left at zero. For what needs the kinematics and the
     contact law only (the mesh positions, the FE reference), not the tooth springs."""
     plain = scene.replace(**{"coupling.model": "none"})
     z1, z2 = scene.gear1.teeth, scene.gear2.teeth
     return build_scene_model(plain, springs=((np.full(z1, scene.gear1.spring.k_phi), np.ones(z1)),
-                                             (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2))))
+                                             (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2))), convert_damping=False)
 
 
 def static_angles(scene: Scene) -> np.ndarray:

@@ -17,7 +17,7 @@ from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
 from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
 from solver.mbs.model import Model
-from solver.mbs.statics import solve_static
+from solver.mbs.modes import loaded_equilibria
 
 
 def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False):
@@ -81,31 +81,16 @@ def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[f
     with continuation (tooth rotations carried from angle to angle); positions where it does
     not converge are left out.
     """
-    angles = np.linspace(0.0, model.geometry[0].pitch_angle, positions, endpoint=False)
-    load = torque if abs(torque) > 1e-9 else 1.0
     wmax = 0.0
     dt_crit = math.inf
-    phi, te0, used = None, None, 0
-    for theta1 in angles:
-        st = solve_static(model, np.array([theta1]), load, phi0=phi, te0=te0, raise_on_failure=False)
-        if not st.converged[0]:
-            continue
-        phi, te0 = st.phi_last, float(st.te[0])
-        # a coupled model's mesh sits at the rim angles: the hubs less the body wind-up
-        kb1, kb2 = model.body_stiffness
-        rb1, rb2 = model.base_radii
-        rim1 = theta1 - load * rb1 / rb2 / kb1
-        rim2 = st.theta2[0] - load / kb2
-        M, K, C, _t = linearized_system(model, rim1, rim2, phi, damping=True)
+    for eq in loaded_equilibria(model, torque, positions):
+        M, K, C, _t = linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True)
         lam, x = scipy.linalg.eigh(K, M)
         w = np.sqrt(np.maximum(lam, 0.0))
         h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
         lim = 2.0 / np.maximum(np.hypot(w, h) + h, 1e-300)    # = 2/w (sqrt(1+zeta²) - zeta)
         wmax = max(wmax, float(w.max()))
         dt_crit = min(dt_crit, float(lim.min()))
-        used += 1
-    if used == 0:
-        raise ValueError(f"no static equilibrium under {load} N·m found to estimate the highest natural frequency")
     return dt_crit, wmax
 
 

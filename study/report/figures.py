@@ -23,7 +23,8 @@ import numpy as np
 import xarray as xr
 
 # dimensions of a single run archive; any other dimension is a swept parameter
-RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "ste_order", "ste_peak", "dte_peak"}
+RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "ste_order", "ste_peak", "dte_peak",
+            "mode", "mesh_position", "excitation", "runup_speed", "tracked_order"}
 TABLE_DIMS = {"output", "term"}          # the study's sensitivity table (`study.report.effects`)
 
 
@@ -35,6 +36,7 @@ def run_plots() -> tuple:
     """The plots of a run archive: (variables, any of which the plot draws; file stem; plot
     function; what is skipped and why when the archive has none of the variables). Imported
     here, not at the top: building the command line loads no matplotlib."""
+    from study.report.campbell import campbell_plot, order_map_plot
     from study.report.stiffness_plot import stiffness_plot
     from study.report.te_plots import dte_plot, spectrum_plot, ste_plot
     return (
@@ -43,6 +45,8 @@ def run_plots() -> tuple:
         (("dte_amplitude", "ste_amplitude"), "spectrum", spectrum_plot, "spectrum plot",
          "no spectrum in the archive (DTE record too short or not computed)"),
         (("tooth_stiffness",), "tooth_stiffness", stiffness_plot, "stiffness plot", "no tooth_stiffness in the archive"),
+        (("mode_frequency",), "campbell", campbell_plot, "Campbell diagram", "no modes in the archive"),
+        (("order_amplitude",), "order_map", order_map_plot, "order map", "not a run-up (dynamic.speed_end = 0)"),
     )
 
 

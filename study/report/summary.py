@@ -31,6 +31,12 @@ def summarize(ds: xr.Dataset) -> dict:
         z = ds.attrs["mesh_order"]
         for name, order in (("mesh", z), ("mesh2", 2 * z), ("mesh3", 3 * z), ("hole", ds.attrs["hole_order"])):
             out[f"amp_{name}_order"] = amplitude_at_order(ds, order) if order > 0 else nan
+    if "mode_frequency" in ds:
+        out["mesh_mode_frequency"] = float(ds.attrs["mesh_mode_frequency_hz"])
+        out["mesh_mode_damping"] = float(ds.attrs["mesh_mode_damping"])
+        out["mesh_mode_damping_decay"] = float(ds.attrs.get("mesh_mode_damping_decay", nan))
+        for k in (1, 2, 3):
+            out[f"critical_speed_{k if k > 1 else ''}z"] = float(ds["critical_speed"].sel(excitation=f"{k}Z", mode=0))
     if "mass" in ds:
         from study.sweep.outputs import GEAR_VARIABLES
         for g in (1, 2):
@@ -63,6 +69,25 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         for f, o, a in results.largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
+    if "mesh_mode_frequency_hz" in ds.attrs:
+        a = ds.attrs
+        line = (f"  mesh mode: {a['mesh_mode_frequency_hz']:.0f} Hz, damping {a['mesh_mode_damping']:.4f} of critical "
+                f"(modal, mean over the mesh period)")
+        if "mesh_mode_damping_decay" in a:
+            line += f", {a['mesh_mode_damping_decay']:.4f} from the free decay ({a['mesh_mode_damping_at_0']:.4f} modal there)"
+        w(line + "\n")
+        cs = ds["critical_speed"].sel(mode=0)
+        w("    critical driver speeds [rad/s]: " + ", ".join(f"{e} {v:.0f}" for e, v in zip(ds["excitation"].values, cs.values)
+                                                          if v < 1000) + "\n")
+    if "order_amplitude" in ds:
+        sp, order, amp = ds["runup_speed"].values, ds["tracked_order"].values, ds["order_amplitude"].values
+        z = ds.attrs["mesh_order"]
+        parts = []
+        for k in (1, 2, 3):
+            sel = np.abs(order - k * z) <= 0.5
+            cut = amp[:, sel].max(axis=1)
+            parts.append(f"{k}Z {cut.max():.3g} um at {sp[np.argmax(cut)]:.0f} rad/s")
+        w(f"  run-up {sp[0]:.0f}-{sp[-1]:.0f} rad/s, largest order amplitudes: " + ", ".join(parts) + "\n")
     if "mass" in ds:
         for g in (1, 2):
             line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "

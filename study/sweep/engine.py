@@ -67,7 +67,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
             scene = scene_from_dict(scene)
         elif isinstance(scene, str):
             scene = loads_scene(scene)
-        if outputs.static or outputs.dynamic:
+        if outputs.static or outputs.dynamic or outputs.modes:
             ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic)
         else:   # geometry (and root stress) only: no model, no solve
             from study.report.lightening import lightening_dataset

@@ -4,8 +4,9 @@ selection a study makes (`Outputs`), and the status flags of a point.
 A scalar is one number per point (the names of `study.report.summary.summarize`), with its
 units and long name; a curve is a run-archive variable over its own axis, archived with the
 units and long name the run archive gives it (`study.report.results`). Each output needs one
-analysis: 'static' (quasi-static STE), 'dynamic' (DTE run), 'geometry' (mass properties, no
-solve) or 'fe' (the FE body of the springs: root stress, NaN for a gear whose springs need no FE).
+analysis: 'static' (quasi-static STE), 'dynamic' (DTE run), 'modes' (the pair linearised at the mean
+load: a few static solves, no time integration), 'geometry' (mass properties, no solve) or 'fe' (the
+FE body of the springs: root stress, NaN for a gear whose springs need no FE).
 
 The per-gear outputs of the run archive (`study.report.lightening`) are scalars named
 ``{variable}_gear{g}``: ``mass_gear2`` is ``mass.sel(gear=2)``.
@@ -21,7 +22,7 @@ from study.scene import SceneError
 class Scalar:
     units: str
     long_name: str
-    analysis: str        # 'static', 'dynamic', 'geometry' or 'fe'
+    analysis: str        # 'static', 'dynamic', 'modes', 'geometry' or 'fe'
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,12 @@ SCALARS = {
     "amp_mesh3_order": Scalar("um", "DTE amplitude at three times the mesh order", "dynamic"),
     "amp_hole_order": Scalar("um", "DTE amplitude at the hole order N (NaN for a gear without holes)", "dynamic"),
     "tooth_force_max": Scalar("N", "largest tooth contact force of the dynamic run after the ramp", "dynamic"),
+    "mesh_mode_frequency": Scalar("Hz", "natural frequency of the mesh mode at the mean load (mean over the mesh period)", "modes"),
+    "mesh_mode_damping": Scalar("1", "damping ratio of the mesh mode (modal, mean over the mesh period)", "modes"),
+    "mesh_mode_damping_decay": Scalar("1", "damping ratio of the mesh mode from its simulated free decay", "dynamic"),
+    "critical_speed_z": Scalar("rad/s", "driver speed at which the mesh order Z meets the mesh mode", "modes"),
+    "critical_speed_2z": Scalar("rad/s", "driver speed at which twice the mesh order meets the mesh mode", "modes"),
+    "critical_speed_3z": Scalar("rad/s", "driver speed at which three times the mesh order meets the mesh mode", "modes"),
 }
 for _g, _which in ((1, "driver"), (2, "driven gear")):
     SCALARS.update({
@@ -70,7 +77,7 @@ STATUS = ("pending", "ok", "diverged", "invalid", "failed", "inaccurate")
 
 
 def analysis_of(output: str) -> str:
-    """'static', 'dynamic', 'geometry' or 'fe': the analysis an output (scalar or curve) needs."""
+    """'static', 'dynamic', 'modes', 'geometry' or 'fe': the analysis an output (scalar or curve) needs."""
     return (SCALARS.get(output) or CURVES[output]).analysis
 
 
@@ -89,6 +96,11 @@ class Outputs:
     def dynamic(self) -> bool:
         """True when a dynamic (DTE) analysis is needed."""
         return any(analysis_of(x) == "dynamic" for x in self.scalars + self.curves)
+
+    @property
+    def modes(self) -> bool:
+        """True when an output needs the modal analysis of the loaded pair."""
+        return any(analysis_of(x) == "modes" for x in self.scalars + self.curves)
 
     @property
     def fe(self) -> bool:

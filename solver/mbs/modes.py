@@ -1,0 +1,236 @@
+"""Modes of the loaded pair and damping given as a ratio of critical (numpy, no kernels).
+
+The pair is linearised (`solver.mbs.stability.linearized_system`) at static equilibrium under
+the mean load at ``positions`` driver angles across one angular pitch (one mesh period). At
+each position the eigenvalues lambda of M x'' + C x' + K x = 0 over the free DOFs (driven
+hub, then the teeth near the mesh; C: tooth-spring and contact dampers linearised at rest),
+from its state-space form, give the natural frequency |lambda| and the damping ratio
+-Re(lambda)/|lambda| of each mode. They are exact for the linearised pair where the modal
+estimate x^T C x / (2 w) on undamped modes is not: a heavily damped tooth joint holds the
+mesh mode's shape (at 5 % that estimate reads twice the ratio the free decay shows). Each
+mode is named by where its kinetic energy lies: the mode with the largest share on the
+driven hub is the mesh mode (the driven gear rotating on the mesh spring against the
+prescribed driver); the others are tooth modes, named by the gear whose teeth carry most of
+their energy. Modes of teeth near the mesh that carry no load (a spring with n_k > 1 has no
+stiffness at zero deflection) and overdamped modes are left out.
+
+Damping as a ratio (`joint_damping_for_ratio`, `tooth_damping_for_ratio`):
+* tooth dampers: zeta_t of the tooth's own mode, the tooth on its spring about its pivot:
+  c_phi = 2 zeta_t sqrt(k_t I_P), k_t the spring tangent of the most deflected tooth of that
+  gear at the mean-load equilibria (mean over the mesh positions), I_P the tooth's inertia
+  about its pivot (needs n_c = 1);
+* mesh mode: zeta_m, carried by the joint dampers of both gears (`joint_damping_for_ratio`):
+  the mesh mode of the linearised pair (mesh stiffness: the contact tangents in series with
+  the tooth-spring tangents; its mass from the mode shape) deflects mostly the tooth springs,
+  so the dampers across them damp it; one scale of c_phi (both gears at the same ratio of
+  their own modes) is found by root finding on the state-space eigenvalues so that the mesh
+  mode's ratio, averaged over the mesh positions, equals zeta_m. A contact damper
+  (c*ddelta*delta^m3, in series with the tooth springs) could not do it without overdamping
+  the tooth-on-contact modes (see `study.setup.damping_from_ratios`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+
+from solver.mbs.kernels import layout as L
+from solver.mbs.model import Model
+
+
+@dataclass
+class Equilibrium:
+    """A loaded static equilibrium of the pair, where it is linearised."""
+    theta1: float          # driver hub angle [rad]
+    rim1: float            # driver rim angle (hub less the body wind-up) [rad]
+    rim2: float            # driven rim angle [rad]
+    phi: np.ndarray        # tooth rotations [rad]
+
+
+def loaded_equilibria(model: Model, torque: float, positions: int = 12) -> list[Equilibrium]:
+    """Static equilibria under ``torque`` [N·m] (1 N·m if zero) at ``positions`` driver angles
+    across one angular pitch, by one sweep with continuation; positions that do not converge
+    are left out."""
+    from solver.mbs.statics import solve_static
+    angles = np.linspace(0.0, model.geometry[0].pitch_angle, positions, endpoint=False)
+    load = torque if abs(torque) > 1e-9 else 1.0
+    out, phi, te0 = [], None, None
+    kb1, kb2 = model.body_stiffness
+    rb1, rb2 = model.base_radii
+    for theta1 in angles:
+        st = solve_static(model, np.array([theta1]), load, phi0=phi, te0=te0, raise_on_failure=False)
+        if not st.converged[0]:
+            continue
+        phi, te0 = st.phi_last, float(st.te[0])
+        # a coupled model's mesh sits at the rim angles: the hubs less the body wind-up
+        out.append(Equilibrium(float(theta1), theta1 - load * rb1 / rb2 / kb1, float(st.theta2[0]) - load / kb2, phi.copy()))
+    if not out:
+        raise ValueError(f"no static equilibrium under {load} N·m found to linearise the pair")
+    return out
+
+
+def with_damping(model: Model, c_con: float | None = None, c_phi: tuple | None = None) -> Model:
+    """A copy of ``model`` with the contact damping c_con [SI] and/or the tooth dampers
+    c_phi (gear 1, gear 2) [N·m·s/rad] replaced (the arrays are copied, the rest shared)."""
+    gp, lp = model.gear_par, model.law_par
+    if c_phi is not None:
+        gp = gp.copy()
+        gp[:, L.C_PHI] = c_phi
+    if c_con is not None:
+        lp = lp.copy()
+        lp[L.C_CON] = c_con
+    return dataclasses.replace(model, gear_par=gp, law_par=lp)
+
+
+def _system(model: Model, eq: Equilibrium):
+    from solver.mbs.stability import linearized_system
+    return linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True)
+
+
+def _modes(M, K):
+    """(w [rad/s], mass-normalised modes, kinetic-energy shares) of the modes with stiffness."""
+    lam, x = scipy.linalg.eigh(K, M)
+    keep = lam > 1e-8 * max(lam.max(), 0.0)
+    x = x[:, keep]
+    return np.sqrt(lam[keep]), x, x * (M @ x)
+
+
+def _mesh_index(share) -> int:
+    return int(np.argmax(share[0]))
+
+
+def _damped_modes(M, K, C):
+    """(natural frequency |lambda| [rad/s], damping ratio -Re(lambda)/|lambda| [1], kinetic-energy
+    shares (dof, mode)) of the oscillating modes of M x'' + C x' + K x = 0 (the state-space
+    eigenproblem: exact for non-proportional damping, where a heavily damped tooth joint
+    holds the mesh mode's shape); overdamped and rigid modes are left out."""
+    n = M.shape[0]
+    mi = np.linalg.inv(M)
+    lam, v = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [-mi @ K, -mi @ C]]))
+    wn = np.abs(lam)
+    keep = (lam.imag > 1e-9 * max(wn.max(), 1.0)) & (wn > 1e-4 * max(wn.max(), 1.0))
+    lam, u = lam[keep], v[:n, keep]
+    share = np.real(np.conj(u) * (M @ u))
+    share = share / share.sum(0)
+    return np.abs(lam), -lam.real / np.abs(lam), share
+
+
+def _mesh_damping(M, K, C) -> float:
+    w, z, share = _damped_modes(M, K, C)
+    return float(z[_mesh_index(share)])
+
+
+@dataclass
+class Modes:
+    """Natural frequencies and damping ratios over mesh positions (mode 0 is the mesh mode;
+    then the tooth modes by rising frequency, NaN where a position has fewer)."""
+    position: np.ndarray       # driver angle [rad] of each mesh position
+    frequency: np.ndarray      # (mode, position) [Hz]
+    damping: np.ndarray        # (mode, position) ratio of critical [1]
+    gear: np.ndarray           # (mode, position) gear whose teeth carry most of the mode's energy (0: the hub)
+    kind: tuple                # per mode: 'mesh', 'tooth gear1', 'tooth gear2' (most frequent over positions)
+
+
+def modal_analysis(model: Model, torque: float, positions: int = 12, equilibria=None) -> Modes:
+    """Modes of the pair linearised at static equilibrium under ``torque`` [N·m] at
+    ``positions`` driver angles across one mesh period (see the module docstring)."""
+    eqs = equilibria or loaded_equilibria(model, torque, positions)
+    rows = []
+    tz2 = int(model.gear_par[1, L.TOOTH0])
+    for eq in eqs:
+        M, K, C, teeth = _system(model, eq)
+        w, zeta, share = _damped_modes(M, K, C)
+        g2 = np.array([t >= tz2 for t in teeth])
+        gear = np.where(share[1:][g2].sum(0) > share[1:][~g2].sum(0), 2, 1)
+        im = _mesh_index(share)
+        gear[im] = 0
+        order = [im] + [j for j in np.argsort(w) if j != im]
+        rows.append((w[order] / (2 * math.pi), zeta[order], gear[order]))
+    n = max(len(r[0]) for r in rows)
+
+    def pad(k, fill):
+        return np.array([np.pad(r[k].astype(float), (0, n - len(r[k])), constant_values=fill) for r in rows]).T
+
+    gear = pad(2, -1).astype(int)
+    kind = ["mesh"]
+    for row in gear[1:]:
+        vals = row[row > 0]
+        kind.append(f"tooth gear{np.bincount(vals).argmax()}" if vals.size else "tooth")
+    return Modes(np.array([e.theta1 for e in eqs]), pad(0, np.nan), pad(1, np.nan), gear, tuple(kind))
+
+
+def tooth_damping_for_ratio(model: Model, equilibria, zeta: float, gear: int) -> float:
+    """Tooth damper c_phi [N·m·s/rad] giving ratio ``zeta`` on gear ``gear``'s (1, 2) tooth
+    mode: 2 zeta sqrt(k_t I_P), k_t the spring tangent of its most deflected tooth at the
+    equilibria (mean), I_P the tooth's inertia about its pivot."""
+    from solver.mbs.kernels.gearmesh import tooth_spring_tangent
+    gp = model.gear_par
+    g = gear - 1
+    t0 = int(gp[g, L.TOOTH0])
+    z = model.teeth[g]
+    if model.teeth_coupled:   # the tooth's own spring: the inverse of its compliance
+        ks = [1.0 / model.tooth_compliance[t0 + int(np.argmax(np.abs(e.phi[t0:t0 + z]))),
+                                           t0 + int(np.argmax(np.abs(e.phi[t0:t0 + z])))] for e in equilibria]
+    else:
+        ks = [tooth_spring_tangent(t0 + int(np.argmax(np.abs(e.phi[t0:t0 + z]))), e.phi, model.k_phi, gp)
+              for e in equilibria]
+    return 2.0 * zeta * math.sqrt(float(np.mean(ks)) * gp[g, L.I_P])
+
+
+def _solve_scale(parts, zeta: float, what: str) -> float:
+    """The scale s >= 0 of the damper C1 in C = C0 + s C1 for which the mesh mode's ratio,
+    mean over the positions ``parts`` [(M, K, C0, C1)], is ``zeta``. The ratio grows with s
+    from that of C0 up to a largest value (a very stiff damper locks its joint) and falls
+    after it: the root below that largest value is taken."""
+    def mean(s):
+        return float(np.mean([_mesh_damping(M, K, C0 + s * C1) for M, K, C0, C1 in parts]))
+    z0 = mean(0.0)
+    if z0 > zeta:
+        raise ValueError(f"the other dampers alone give the mesh mode {z0:.4g} of critical, more than {zeta:.4g}")
+    if zeta == z0:
+        return 0.0
+    # first guess: the proportional-damping estimate x^T C1 x / (2 w), linear in s
+    est = []
+    for M, K, _c0, C1 in parts:
+        w, x, share = _modes(M, K)
+        i = _mesh_index(share)
+        est.append(0.5 * x[:, i] @ C1 @ x[:, i] / w[i])
+    unit = float(np.mean(est))
+    if not unit > 0:
+        raise ValueError(f"the {what} do not damp the mesh mode (check the exponents and the load)")
+    lo, hi, z_lo = 0.0, (zeta - z0) / unit, z0
+    best = z0
+    for _ in range(40):
+        z_hi = mean(hi)
+        if z_hi >= zeta:
+            return float(scipy.optimize.brentq(lambda s: mean(s) - zeta, lo, hi, xtol=1e-12 * hi, rtol=1e-10))
+        if z_hi < z_lo:       # past the largest ratio the damper can give
+            break
+        best = max(best, z_hi)
+        lo, z_lo, hi = hi, z_hi, 2.0 * hi
+    raise ValueError(f"the {what} cannot damp the mesh mode to {zeta:.4g} of critical (at most about {best:.3g})")
+
+
+def _parts(model: Model, equilibria, m0: Model, m1: Model):
+    out = []
+    for eq in equilibria:
+        M, K, C0, _t = _system(m0, eq)
+        out.append((M, K, C0, _system(m1, eq)[2] - C0))
+    return out
+
+
+def joint_damping_for_ratio(model: Model, equilibria, zeta: float) -> tuple[float, float]:
+    """Tooth-root joint dampers (c_phi gear 1, gear 2) [N·m·s/rad] that alone (no contact
+    damper) give the mesh mode the ratio ``zeta`` on average over the equilibria; both gears'
+    teeth at the same ratio of their own mode. The mesh mode deflects mostly the tooth
+    springs (the contact is stiff in series with them), so this damps it at a small price on
+    the local modes; a contact damper that did it alone would overdamp the tooth-on-contact
+    modes far above and cut the explicit step by some fifty times."""
+    unit = (tooth_damping_for_ratio(model, equilibria, 1.0, 1), tooth_damping_for_ratio(model, equilibria, 1.0, 2))
+    m0 = with_damping(model, c_con=0.0, c_phi=(0.0, 0.0))
+    s = _solve_scale(_parts(model, equilibria, m0, with_damping(m0, c_phi=unit)), zeta, "tooth-root joint dampers")
+    return unit[0] * s, unit[1] * s

@@ -1,0 +1,83 @@
+"""Modes of the loaded pair, their damping, the free decay and the critical speeds -> run
+archive variables (`solver.mbs.modes`, `solver.mbs.ringdown`).
+
+  mode_frequency(mode, mesh_position)   natural frequency [Hz]
+  mode_damping(mode, mesh_position)     damping ratio [1] (mode 0: the mesh mode)
+  mode_kind(mode)                       'mesh', 'tooth gear1', 'tooth gear2' (largest share of kinetic energy)
+  critical_speed(excitation, mode)      driver speed [rad/s] at which an excitation order meets the
+                                        mode's mean frequency; excitation: 1Z..5Z, N, 2N, kZ-N, kZ+N
+Attributes: the damping coefficients the run has (scene units), the mesh mode's frequency and
+damping ratio from the modal analysis (mean over the mesh period and at the driver angle 0)
+and from the simulated free decay there.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from solver import units
+from solver.mbs.kernels import layout as L
+from solver.mbs.model import Model
+
+
+def _var(dims, data, unit, long_name):
+    return xr.Variable(dims, data, {"units": unit, "long_name": long_name})
+
+
+def excitation_orders(z2: int, holes: int) -> list[tuple[str, float]]:
+    """(label, order of the driven gear's rotation) of the Campbell lines: kZ (k = 1..5), and
+    with holes N, 2N and kZ +- N."""
+    out = [(f"{k}Z", float(k * z2)) for k in range(1, 6)]
+    if holes:
+        out += [("N", float(holes)), ("2N", 2.0 * holes)]
+        out += [(f"{k}Z{s}N", float(k * z2 + (holes if s == "+" else -holes))) for k in range(1, 6) for s in "-+"]
+    return out
+
+
+def critical_speeds(freq_hz: np.ndarray, orders: np.ndarray, z1: int, z2: int) -> np.ndarray:
+    """Driver speeds [rad/s] (order, mode) at which order x driven rotation frequency equals each
+    mode's frequency: omega1 = 2 pi f z2 / (z1 order)."""
+    return 2 * math.pi * freq_hz[None, :] * z2 / (z1 * orders[:, None])
+
+
+def modal_variables(model: Model, torque: float, holes: int, decay: bool = True) -> tuple[dict, dict, dict]:
+    from solver.mbs.modes import modal_analysis
+    md = modal_analysis(model, torque)
+    z1, z2 = model.teeth
+    exc = excitation_orders(z2, holes)
+    coords = {
+        "mode": _var("mode", np.arange(md.frequency.shape[0]), "1", "mode number: 0 the mesh mode, then the tooth modes by frequency"),
+        "mode_kind": _var("mode", np.array(md.kind, dtype=object), "1",
+                          "what the mode is: the mesh mode (largest share of kinetic energy on the driven hub) or a tooth "
+                          "mode of the gear whose teeth carry most of its energy"),
+        "mesh_position": _var("mesh_position", np.degrees(md.position), "degree", "driver angle over one mesh period"),
+        "excitation": _var("excitation", np.array([e[0] for e in exc], dtype=object), "1",
+                           "excitation: kZ mesh orders, N hole order, kZ+-N sidebands"),
+        "excitation_order": _var("excitation", np.array([e[1] for e in exc]), "1", "order of the driven gear's rotation"),
+    }
+    src = f"pair linearised at static equilibrium under {torque:g} N·m; state-space eigenvalues lambda: f = |lambda|/2pi, zeta = -Re(lambda)/|lambda|"
+    fmean = np.nanmean(md.frequency, axis=1)
+    data = {
+        "mode_frequency": xr.Variable(("mode", "mesh_position"), md.frequency, {"units": "Hz", "long_name": "natural frequency", "source": src}),
+        "mode_damping": xr.Variable(("mode", "mesh_position"), md.damping, {"units": "1", "long_name": "damping ratio (of critical)", "source": src}),
+        "critical_speed": xr.Variable(("excitation", "mode"), critical_speeds(fmean, coords["excitation_order"].values, z1, z2),
+                                      {"units": "rad/s", "long_name": "driver speed at which the excitation order meets the mode's mean frequency"}),
+    }
+    attrs = {
+        "mesh_mode_frequency_hz": float(fmean[0]),
+        "mesh_mode_damping": float(np.nanmean(md.damping[0])),
+        "mesh_mode_damping_range": np.array([np.nanmin(md.damping[0]), np.nanmax(md.damping[0])]),
+        "modal_torque_N_m": float(torque),
+        "c_con_used": float(model.law_par[L.C_CON] / units.contact_damping_to_si(1.0, model.law_par[L.M2], model.law_par[L.M3])),
+        "c_phi_used_N_mm_s_rad": model.gear_par[:, L.C_PHI] / units.spring_damping_to_si(1.0),
+    }
+    if decay:
+        from solver.mbs.ringdown import ring_down
+        rd = ring_down(model, torque, float(md.frequency[0, 0]), float(md.damping[0, 0]))
+        attrs.update(mesh_mode_frequency_decay_hz=rd.frequency, mesh_mode_damping_decay=rd.damping,
+                     mesh_mode_damping_at_0=float(md.damping[0, 0]),
+                     mesh_mode_decay_method="free decay after a 10 % load step at driver angle 0 "
+                                            "(solver.mbs.ringdown): damped cosine fitted to TE")
+    return coords, data, attrs
