@@ -81,11 +81,13 @@ def test_progress_reports_the_time_reached_and_leaves_the_result_unchanged(small
 def test_a_contact_too_stiff_for_its_step_is_flagged_inaccurate(paper_solid_model):
     """k_con x 1000: the explicit run completes, but at the step of the static linearisation
     it misses the contact events (force spikes of ~30 x the static force) and the energy
-    balance error grows to the size of the mesh's potential energy: flagged, not silent."""
+    balance error grows to the size of the mesh's potential energy: flagged, not silent.
+    (Lightly damped, with the raw coefficients: the default damping ratio makes the step
+    small enough to follow these contacts.)"""
     from solver.mbs.dynamics import INACCURATE, simulate
     from study.setup import build_scene_model
-    from tests.conftest import solid_scene
-    stiff = build_scene_model(solid_scene(**{"contact.k_con": 5.64e9}))
+    from tests.conftest import RAW_DAMPING, solid_scene
+    stiff = build_scene_model(solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9}))
     r = simulate(stiff, 100.0, 0.01, 50.0, 0.01, 0.02)
     assert r.status == INACCURATE and r.message.startswith("inaccurate: energy balance error")
     assert np.max(r.force_max) > 10 * 50.0 / stiff.base_radii[1]
@@ -131,12 +133,13 @@ def test_an_inaccurate_sweep_status_is_a_cf_flag():
 def test_a_coarse_implicit_run_of_a_rattling_150_tooth_pair_is_flagged():
     """150/150 teeth (solid): the pair rattles across the backlash with forces of 10-20 x the
     static one. HHT at 2.5 us completes with a wrong DTE and an energy balance error ten times
-    the potential energy of the mesh; flagged, not ok."""
+    the potential energy of the mesh; flagged, not ok. (Lightly damped: the raw coefficients.)"""
     from solver.mbs.dynamics import INACCURATE
     from solver.mbs.implicit import simulate_implicit
     from study.setup import build_scene_model
     sc = study.load_scene(None, ["gear1.teeth=150", "gear2.teeth=150", "gear2.body.holes=0",
-                                 "gear2.body.web_thickness=17"])
+                                 "gear2.body.web_thickness=17", "contact.c_con=3640",
+                                 "gear1.spring.c_phi=0.062", "gear2.spring.c_phi=0.062"])
     m = build_scene_model(sc)
     r = simulate_implicit(m, 100.0, 0.01, 50.0, 0.01, 0.025, dt=2.5e-6)
     assert r.status == INACCURATE and np.max(r.force_max) > 10 * 50.0 / m.base_radii[1]
@@ -155,8 +158,8 @@ def test_soft_tooth_springs_are_refused_before_the_statics(k_phi, small_scene, t
 def test_a_sweep_point_whose_run_is_inaccurate_keeps_its_scalars_flagged():
     from study.sweep.engine import run_point
     from study.sweep.outputs import Outputs
-    from tests.conftest import solid_scene
-    sc = solid_scene(**{"contact.k_con": 5.64e9, "dynamic.duration": 0.021})
+    from tests.conftest import RAW_DAMPING, solid_scene
+    sc = solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9, "dynamic.duration": 0.021})
     r = run_point(sc, Outputs(scalars=("dte_rms", "tooth_force_max")))
     assert r["status"] == "inaccurate" and r["message"].startswith("inaccurate: energy balance error")
     assert np.isfinite(r["scalars"]["dte_rms"]) and r["scalars"]["tooth_force_max"] > 10 * 1062.0

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import solid_scene
+from conftest import RAW_DAMPING, solid_scene
 
 from solver.mbs.dynamics import DivergenceError, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
@@ -168,10 +168,11 @@ def test_step_bound_includes_the_contact_damping():
     includes it and is caught by the guard at the undamped bound. At half that bound the run
     is stable but not accurate (the damping power integrated coarsely: 3.5 x the dissipated
     energy, TE off by 5.7 um, peak force 2.9 kN for 1.6 kN): the energy check flags it, and at
-    a tenth of the bound the balance closes."""
+    a tenth of the bound the balance closes. (The raw contact damper: a damping ratio puts the
+    mesh damping in the tooth-root joints instead.)"""
     from solver.mbs.dynamics import INACCURATE
     from solver.mbs.stability import stability_limit
-    m = build_scene_model(solid_scene(**{"contact.k_con": 5.64e4}))
+    m = build_scene_model(solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e4}))
     dt_crit, w = stability_limit(m, 50.0)
     assert dt_crit < 0.1 * 2.0 / w
     stable = simulate(m, 100.0, 0.002, 50.0, 0.002, 0.003, dt=0.5 * dt_crit)
