@@ -17,7 +17,7 @@ NOT_GIVEN = math.nan   # an optional field left out (written as ``nan`` when a s
 # damping ratios are a few percent of critical: 0.03-0.17 (the range Kasuba & Evans 1981, ASME
 # J. Mech. Des. 103, report for the mesh), about 0.05-0.10 (Gerber 1984, measurements on an
 # FZG back-to-back rig), and a few percent from the EHL film of the mesh interface (Li &
-# Kahraman 2011, Tribol. Int. 44, a mesh damping model). 0.05 sits at the low end.
+# Kahraman 2011, Int. J. Powertrains 1, a mesh damping model). 0.05 sits at the low end.
 # Teeth: 0.02, the structural damping of a steel cantilever with its root joint (no value in
 # the paper; the coefficient the scenes used before, c_phi = 0.062 N·mm·s/rad, is 2 %).
 MESH_DAMPING_RATIO = 0.05
