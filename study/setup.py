@@ -140,7 +140,8 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
     ratios = damping_ratios(scene)
     if not ratios:
         return model
-    from solver.mbs.modes import joint_damping_for_ratio, loaded_equilibria, tooth_damping_for_ratio, with_damping
+    from solver.mbs.equilibria import loaded_equilibria
+    from solver.mbs.modes import joint_damping_for_ratio, tooth_damping_for_ratio, with_damping
     eqs = loaded_equilibria(model, mean_load(scene))
     c_phi = tuple(tooth_damping_for_ratio(model, eqs, ratios[f"gear{g}"], g) if f"gear{g}" in ratios
                   else float(model.gear_par[g - 1, L.C_PHI]) for g in (1, 2))

@@ -13,11 +13,11 @@ import math
 import numpy as np
 import scipy.linalg
 
+from solver.mbs.equilibria import loaded_equilibria
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
 from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
 from solver.mbs.model import Model
-from solver.mbs.modes import loaded_equilibria
 
 
 def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False):

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import study
+from solver.mbs.equilibria import loaded_equilibria
 from solver.mbs.kernels import layout as L
-from solver.mbs.modes import loaded_equilibria, modal_analysis
+from solver.mbs.modes import modal_analysis
 from solver.mbs.ringdown import ring_down
 from study.setup import build_scene_model
 
