@@ -18,6 +18,7 @@ can import this package.
 """
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import dataclasses
 import itertools
@@ -39,7 +40,7 @@ import xarray as xr
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
-from study.sweep.outputs import STATUS, Outputs, analysis_of
+from study.sweep.outputs import CURVES, STATUS, Outputs, analysis_of
 
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
@@ -212,12 +213,21 @@ def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int
                    for key, scene in todo.items()}
         try:
             for fut in as_completed(futures):
+                key = futures.pop(fut)
                 try:
-                    yield futures[fut], fut.result()
-                except Exception as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
-                    yield futures[fut], {"lost": f"{type(e).__name__}: {e}"}
+                    res = fut.result()
+                except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
+                    res = {"lost": lost_cause(e)}
+                fut.release()       # the worker drops the result: its memory does not grow with the study
+                yield key, res
         finally:
             client.cancel(list(futures))
+
+
+def lost_cause(e: BaseException) -> str:
+    """One line on why dask gave no result for a point (a worker died running it: KilledWorker)."""
+    text = str(e).strip().splitlines()[0] if str(e).strip() else ""
+    return f"{type(e).__name__}: {text[:300]}" if text else type(e).__name__
 
 
 # ---------------------------------------------------------------- the sweep
@@ -265,7 +275,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
             continue
         found = store.get(key)
         if found is not None:
-            results[key] = found
+            results[key] = without_curves(found)
         else:
             todo[key] = p.scene
     reused = len(results) - n_invalid
@@ -280,13 +290,31 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
                     lost[key] = res["lost"]
                 else:
                     store.put(key, res)
-                    results[key] = res
+                    results[key] = without_curves(res)
                 bar.update(1)
-    ds = study_dataset(study, points, results)
-    write_netcdf(ds, output)
+    ds = study_dataset(study, points, results, read=store.get, lost=lost)
+    import dask
+    with dask.config.set(scheduler="synchronous"):   # the curves are read from the part files here, block by block
+        write_netcdf(ds, output)
     if not lost and not keep_parts:
         store.clear()
-    return SweepResult(ds, len(todo) - len(lost), reused, n_invalid, len(lost), time.perf_counter() - t0)
+    return SweepResult(open_archive(output), len(todo) - len(lost), reused, n_invalid, len(lost),
+                       time.perf_counter() - t0)
+
+
+def without_curves(result: dict) -> dict:
+    """A point's record without its curves (they stay in its part file until the merge)."""
+    return {k: v for k, v in result.items() if k != "curves"}
+
+
+def open_archive(path) -> xr.Dataset:
+    """A study archive with its per-point variables in memory; the curves (study dimensions x
+    their axis: the bulk of a large study) are read from the file when used."""
+    ds = xr.open_dataset(path, engine="netcdf4")
+    for name, var in ds.data_vars.items():
+        if name not in CURVES:
+            var.load()
+    return ds
 
 
 def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset | None:
@@ -294,9 +322,10 @@ def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset |
     if not Path(output).is_file() or parts_folder(output).exists():
         return None
     try:
-        with xr.open_dataset(output, engine="netcdf4") as ds:
-            if ds.attrs.get("study_key") == study_key(study, points) and not (ds["status"].values == 0).any():
-                return ds.load()
+        ds = open_archive(output)
+        if ds.attrs.get("study_key") == study_key(study, points) and not (ds["status"].values == 0).any():
+            return ds
+        ds.close()
     except (OSError, KeyError, ValueError):
         pass
     return None
