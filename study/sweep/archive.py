@@ -73,7 +73,7 @@ MERGE_BLOCK_BYTES = 32 * 2**20   # bytes: curve values the merge reads from the 
 
 
 def study_dataset(study: Study, points: list[Point], results: dict, read=None, lost: dict | None = None,
-                  block_bytes: int = MERGE_BLOCK_BYTES) -> xr.Dataset:
+                  block_bytes: int | None = None) -> xr.Dataset:
     """The labelled archive of a study from ``results`` (point key -> `engine.run_point` dict).
 
     Points without a result are 'pending' (their message says why when ``lost`` maps their key
@@ -82,7 +82,7 @@ def study_dataset(study: Study, points: list[Point], results: dict, read=None, l
 
     With ``read(key)`` (the full record of a finished point, from its part file) the records in
     ``results`` may leave their curves out: the curves are then dask arrays whose blocks (at
-    most ``block_bytes`` each) read the part files when the archive is written, so that no
+    most ``block_bytes``, default `MERGE_BLOCK_BYTES`, each) read the part files when the archive is written, so that no
     more than one block of curves is ever held in memory. Without it the curves come from
     ``results`` and are held in memory.
     """
@@ -131,7 +131,7 @@ def study_dataset(study: Study, points: list[Point], results: dict, read=None, l
             for idx, key in where[name].items():
                 curves[name][idx] = results[key]["curves"][name][3]
         else:
-            curves[name] = lazy_curve(name, shape, n, where[name], read, block_bytes)
+            curves[name] = lazy_curve(name, shape, n, where[name], read, block_bytes or MERGE_BLOCK_BYTES)
     data = {
         "status": xr.Variable(dims, status, {
             "long_name": "status of the study point", "units": "1",
