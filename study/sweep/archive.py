@@ -69,7 +69,7 @@ def study_key(study: Study, points: list[Point]) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()[:24]
 
 
-MERGE_BLOCK_BYTES = 32 * 2**20   # bytes: curve values the merge reads from the part files at once
+MERGE_BLOCK_BYTES = 8 * 2**20    # bytes: curve values the merge reads from the part files at once
 
 
 def study_dataset(study: Study, points: list[Point], results: dict, read=None, lost: dict | None = None,

@@ -6,7 +6,12 @@ requested scalars and curves (`study.sweep.outputs`).
 
 `run_sweep(study, output)` computes the points that are not finished yet, stores each result
 as it arrives (one small file per point in ``.OUT.nc.parts/``, written atomically), and writes
-the study archive (`study.sweep.archive`) atomically at the end. Re-running the same study after an
+the study archive (`study.sweep.archive`) atomically at the end. The client holds only each
+point's status and scalars: the curves are read back from the part files in bounded blocks
+while the archive is written, and dask releases each result once it is stored, so neither the
+client's nor the workers' memory grows with the study. A point dask could not compute (its
+worker died more often than `distributed.scheduler.allowed-failures` allows) stays pending,
+its cause in the archive's message. Re-running the same study after an
 interruption (Ctrl-C, a killed worker or process) computes only the missing points. Points are
 keyed by a hash of their scene, outputs and the code (`results.code_fingerprint`), so an
 edited study reuses the points it shares, and a changed code computes them all again.
@@ -32,6 +37,7 @@ import sys
 import time
 import traceback
 import uuid
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -175,8 +181,13 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
             yield client
         return
     n = workers or os.cpu_count() or 1
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR, env=dict(WORKER_ENV)) as cluster, Client(cluster) as client:
+    # the scheduler's HTTP endpoint (health, metrics; no dashboard) moves to a free port when
+    # 8787 is taken, another user's cluster say: not worth a warning
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Port 8787 is already in use", category=UserWarning)
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.ERROR, env=dict(WORKER_ENV))
+    with cluster, Client(cluster) as client:
         yield client
 
 
@@ -323,9 +334,9 @@ def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset |
         return None
     try:
         ds = open_archive(output)
-        if ds.attrs.get("study_key") == study_key(study, points) and not (ds["status"].values == 0).any():
-            return ds
-        ds.close()
     except (OSError, KeyError, ValueError):
-        pass
+        return None
+    if ds.attrs.get("study_key") == study_key(study, points) and "status" in ds and not (ds["status"].values == 0).any():
+        return ds
+    ds.close()
     return None
