@@ -84,7 +84,9 @@ def merge(study_args: str, out: str, how: str) -> dict:
     base = rss_mib()[0]
     t0 = time.perf_counter()
     if how == "blocks":
-        run_sweep(st, out, workers=0, progress=False, keep_parts=True)
+        res = run_sweep(st, out, workers=0, progress=False, keep_parts=True)
+        if res.computed:    # the code changed since the study ran: its parts are another version's
+            raise SystemExit(f"the merge computed {res.computed} points: the code changed during the benchmark")
     else:
         points = check_points(st)
         store = PartStore(parts_folder(out))
