@@ -213,7 +213,10 @@ def sweep_command(args) -> int:
     for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:
         print(f"    {msg}")
     if res.pending:
+        causes = sorted({str(m) for m in ds["message"].values.ravel() if str(m).startswith("lost: ")})
         print(f"  {res.pending} points lost (worker failures): run the same command again to compute them", file=sys.stderr)
+        for cause in causes[:3]:
+            print(f"    {cause}", file=sys.stderr)
         return 1
     return 0
 

@@ -69,12 +69,22 @@ def study_key(study: Study, points: list[Point]) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()[:24]
 
 
-def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Dataset:
+MERGE_BLOCK_BYTES = 8 * 2**20    # bytes: curve values the merge reads from the part files at once
+
+
+def study_dataset(study: Study, points: list[Point], results: dict, read=None, lost: dict | None = None,
+                  block_bytes: int | None = None) -> xr.Dataset:
     """The labelled archive of a study from ``results`` (point key -> `engine.run_point` dict).
 
-    Points without a result are 'pending'. A curve's axis comes from the first point that has
-    it; a point whose axis differs (another duration or angle step, say) keeps NaN there and
-    says so in its message.
+    Points without a result are 'pending' (their message says why when ``lost`` maps their key
+    to the cause). A curve's axis comes from the first point that has it; a point whose axis
+    differs (another duration or angle step, say) keeps NaN there and says so in its message.
+
+    With ``read(key)`` (the full record of a finished point, from its part file) the records in
+    ``results`` may leave their curves out: the curves are then dask arrays whose blocks (at
+    most ``block_bytes``, default `MERGE_BLOCK_BYTES`, each) read the part files when the archive is written, so that no
+    more than one block of curves is ever held in memory. Without it the curves come from
+    ``results`` and are held in memory.
     """
     out = study.outputs
     dims, coords = study_layout(study, points)
@@ -83,10 +93,13 @@ def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Datase
     message = np.full(shape, "not computed yet", dtype=object)
     wall = np.full(shape, np.nan)
     scal = {k: np.full(shape, np.nan) for k in out.scalars}
-    axes, curves, curve_attrs = {}, {}, {}
+    axes, where, curve_attrs = {}, {}, {}      # per curve: its axis, {point index: key} of the points stored
     for p in points:
-        r = results.get(p.key(out))
+        key = p.key(out)
+        r = results.get(key)
         if r is None:
+            if lost and key in lost:
+                message[p.index] = f"lost: {lost[key]}; run the same command to compute it"
             continue
         idx = p.index
         status[idx] = STATUS.index(r["status"])
@@ -94,16 +107,31 @@ def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Datase
         wall[idx] = r["wall_time"]
         for k in out.scalars:
             scal[k][idx] = r["scalars"].get(k, np.nan)
-        for name, (axis, ax_vals, ax_attrs, vals, attrs) in r["curves"].items():
+        if "curves" in r:
+            point_curves = r["curves"]
+        else:
+            full = read(key) if read is not None else None
+            point_curves = full["curves"] if full else {}
+        for name, (axis, ax_vals, ax_attrs, _, attrs) in point_curves.items():
             if name not in axes:
                 axes[name] = (axis, ax_vals, ax_attrs)
-                curves[name] = np.full(shape + (ax_vals.size,), np.nan)
+                where[name] = {}
                 curve_attrs[name] = attrs
             ref = axes[name][1]
             if ax_vals.shape == ref.shape and np.allclose(ax_vals, ref, rtol=1e-9, atol=0.0):
-                curves[name][idx] = vals
+                where[name][idx] = key
             else:
                 message[idx] = f"{message[idx]}; {name} not stored: its {axis} axis differs from the archive's"
+        del point_curves
+    curves = {}
+    for name in axes:
+        n = axes[name][1].size
+        if all("curves" in results[k] for k in where[name].values()):
+            curves[name] = np.full(shape + (n,), np.nan)
+            for idx, key in where[name].items():
+                curves[name][idx] = results[key]["curves"][name][3]
+        else:
+            curves[name] = lazy_curve(name, shape, n, where[name], read, block_bytes or MERGE_BLOCK_BYTES)
     data = {
         "status": xr.Variable(dims, status, {
             "long_name": "status of the study point", "units": "1",
@@ -126,3 +154,23 @@ def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Datase
              "study_layout": study.layout, "study_key": study_key(study, points),
              "outputs": ", ".join(out.scalars + out.curves), **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def lazy_curve(name: str, shape: tuple, n: int, where: dict, read, block_bytes: int):
+    """The curve ``name`` of the points ``where`` ({point index: key}) as a dask array over the
+    study dimensions and the curve axis (``n`` values), in blocks of at most ``block_bytes``
+    (at least one point) that read the points' records with ``read(key)`` when computed."""
+    import uuid
+
+    import dask.array as da
+    chunks = da.core.normalize_chunks(("auto",) * len(shape) + (n,), shape + (n,), limit=block_bytes, dtype=np.float64)
+
+    def block(block_info=None):
+        loc = block_info[None]["array-location"]
+        values = np.full(tuple(b - a for a, b in loc), np.nan)
+        for idx, key in where.items():
+            if all(a <= i < b for i, (a, b) in zip(idx, loc)):
+                values[tuple(i - a for i, (a, _) in zip(idx, loc))] = read(key)["curves"][name][3]
+        return values
+    return da.map_blocks(block, chunks=chunks, dtype=np.float64, meta=np.empty((0,) * (len(shape) + 1)),
+                         name=f"study-curve-{name}-{uuid.uuid4().hex}")

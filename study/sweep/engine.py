@@ -6,7 +6,12 @@ requested scalars and curves (`study.sweep.outputs`).
 
 `run_sweep(study, output)` computes the points that are not finished yet, stores each result
 as it arrives (one small file per point in ``.OUT.nc.parts/``, written atomically), and writes
-the study archive (`study.sweep.archive`) atomically at the end. Re-running the same study after an
+the study archive (`study.sweep.archive`) atomically at the end. The client holds only each
+point's status and scalars: the curves are read back from the part files in bounded blocks
+while the archive is written, and dask releases each result once it is stored, so neither the
+client's nor the workers' memory grows with the study. A point dask could not compute (its
+worker died more often than `distributed.scheduler.allowed-failures` allows) stays pending,
+its cause in the archive's message. Re-running the same study after an
 interruption (Ctrl-C, a killed worker or process) computes only the missing points. Points are
 keyed by a hash of their scene, outputs and the code (`results.code_fingerprint`), so an
 edited study reuses the points it shares, and a changed code computes them all again.
@@ -18,6 +23,7 @@ can import this package.
 """
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import dataclasses
 import itertools
@@ -31,6 +37,7 @@ import sys
 import time
 import traceback
 import uuid
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,7 +47,7 @@ from study.errors import BudgetError
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
-from study.sweep.outputs import STATUS, Outputs, analysis_of
+from study.sweep.outputs import CURVES, STATUS, Outputs, analysis_of
 
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
@@ -178,8 +185,13 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
             yield client
         return
     n = workers or os.cpu_count() or 1
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR, env=dict(WORKER_ENV)) as cluster, Client(cluster) as client:
+    # the scheduler's HTTP endpoint (health, metrics; no dashboard) moves to a free port when
+    # 8787 is taken, another user's cluster say: not worth a warning
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Port 8787 is already in use", category=UserWarning)
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.ERROR, env=dict(WORKER_ENV))
+    with cluster, Client(cluster) as client:
         yield client
 
 
@@ -216,12 +228,21 @@ def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int
                    for key, scene in todo.items()}
         try:
             for fut in as_completed(futures):
+                key = futures.pop(fut)
                 try:
-                    yield futures[fut], fut.result()
-                except Exception as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
-                    yield futures[fut], {"lost": f"{type(e).__name__}: {e}"}
+                    res = fut.result()
+                except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
+                    res = {"lost": lost_cause(e)}
+                fut.release()       # the worker drops the result: its memory does not grow with the study
+                yield key, res
         finally:
             client.cancel(list(futures))
+
+
+def lost_cause(e: BaseException) -> str:
+    """One line on why dask gave no result for a point (a worker died running it: KilledWorker)."""
+    text = str(e).strip().splitlines()[0] if str(e).strip() else ""
+    return f"{type(e).__name__}: {text[:300]}" if text else type(e).__name__
 
 
 # ---------------------------------------------------------------- the sweep
@@ -269,7 +290,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
             continue
         found = store.get(key)
         if found is not None:
-            results[key] = found
+            results[key] = without_curves(found)
         else:
             todo[key] = p.scene
     reused = len(results) - n_invalid
@@ -284,13 +305,31 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
                     lost[key] = res["lost"]
                 else:
                     store.put(key, res)
-                    results[key] = res
+                    results[key] = without_curves(res)
                 bar.update(1)
-    ds = study_dataset(study, points, results)
-    write_netcdf(ds, output)
+    ds = study_dataset(study, points, results, read=store.get, lost=lost)
+    import dask
+    with dask.config.set(scheduler="synchronous"):   # the curves are read from the part files here, block by block
+        write_netcdf(ds, output)
     if not lost and not keep_parts:
         store.clear()
-    return SweepResult(ds, len(todo) - len(lost), reused, n_invalid, len(lost), time.perf_counter() - t0)
+    return SweepResult(open_archive(output), len(todo) - len(lost), reused, n_invalid, len(lost),
+                       time.perf_counter() - t0)
+
+
+def without_curves(result: dict) -> dict:
+    """A point's record without its curves (they stay in its part file until the merge)."""
+    return {k: v for k, v in result.items() if k != "curves"}
+
+
+def open_archive(path) -> xr.Dataset:
+    """A study archive with its per-point variables in memory; the curves (study dimensions x
+    their axis: the bulk of a large study) are read from the file when used."""
+    ds = xr.open_dataset(path, engine="netcdf4")
+    for name, var in ds.data_vars.items():
+        if name not in CURVES:
+            var.load()
+    return ds
 
 
 def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset | None:
@@ -298,9 +337,10 @@ def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset |
     if not Path(output).is_file() or parts_folder(output).exists():
         return None
     try:
-        with xr.open_dataset(output, engine="netcdf4") as ds:
-            if ds.attrs.get("study_key") == study_key(study, points) and not (ds["status"].values == 0).any():
-                return ds.load()
+        ds = open_archive(output)
     except (OSError, KeyError, ValueError):
-        pass
+        return None
+    if ds.attrs.get("study_key") == study_key(study, points) and "status" in ds and not (ds["status"].values == 0).any():
+        return ds
+    ds.close()
     return None
