@@ -180,7 +180,8 @@ def sweep_command(args) -> int:
         return 130
     ds = res.dataset
     counts = {name: int((ds["status"].values == i).sum()) for i, name in enumerate(STATUS)}
-    print(f"  computed {res.computed}, reused {res.reused}, invalid combinations {res.invalid}, "
+    print(f"  {res.points} points; analyses computed {res.computed}, reused {res.reused} (a static analysis is shared "
+          f"by the points that differ only in dynamic.*); invalid combinations {res.invalid}, "
           f"wall time {res.wall_time:.1f} s")
     print("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v))
     for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:

@@ -4,12 +4,15 @@
 returns a status (ok / diverged / invalid / failed), a message, its wall time [s], the
 requested scalars and curves (`study.sweep.outputs`).
 
-`run_sweep(study, output)` computes the points that are not finished yet, stores each result
-as it arrives (one small file per point in ``.OUT.nc.parts/``, written atomically), and writes
-the study archive (`study.sweep.archive`) atomically at the end. Re-running the same study after an
-interruption (Ctrl-C, a killed worker or process) computes only the missing points. Points are
-keyed by a hash of their scene, outputs and the code (`results.code_fingerprint`), so an
-edited study reuses the points it shares, and a changed code computes them all again.
+`run_sweep(study, output)` computes the tasks of the study that are not finished yet
+(`study.sweep.tasks`: a point's static outputs are one task shared by every point that differs
+only in fields the statics do not read, its dynamic outputs another), stores each result as it
+arrives (one small file per task in ``.OUT.nc.parts/``, written atomically), and writes the
+study archive (`study.sweep.archive`) atomically at the end. Re-running the same study after an
+interruption (Ctrl-C, a killed worker or process) computes only the missing tasks. Tasks are
+keyed by a hash of the scene fields they read, their outputs and the code
+(`results.code_fingerprint`), so an edited study reuses the tasks it shares, and a changed code
+computes them all again.
 
 Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)
@@ -31,6 +34,7 @@ import sys
 import time
 import traceback
 import uuid
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,7 +43,8 @@ import xarray as xr
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
-from study.sweep.outputs import STATUS, Outputs, analysis_of
+from study.sweep.outputs import Outputs, analysis_of
+from study.sweep.tasks import plan, point_result
 
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
@@ -200,15 +205,15 @@ def interleave(todo: dict) -> dict:
     return {k: todo[k] for k in order}
 
 
-def _in_process(todo: dict, outputs: Outputs):
+def _in_process(todo: dict, outputs: dict):
     for key, scene in todo.items():
-        yield key, run_point(scene, outputs)
+        yield key, run_point(scene, outputs[key])
 
 
-def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int | None):
+def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None):
     from distributed import as_completed
     with dask_client(scheduler, workers) as client:
-        futures = {client.submit(run_point, scene, outputs, key=f"lightgear-point-{key}", pure=False): key
+        futures = {client.submit(run_point, scene, outputs[key], key=f"lightgear-task-{key}", pure=False): key
                    for key, scene in todo.items()}
         try:
             for fut in as_completed(futures):
@@ -224,18 +229,21 @@ def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int
 
 @dataclass
 class SweepResult:
-    """What `run_sweep` did: the study archive and how its points were obtained."""
+    """What `run_sweep` did: the study archive and how its tasks were obtained (a task is one
+    point's dynamic run, or the static analysis shared by the points that differ only in
+    ``dynamic.*``: `study.sweep.tasks`)."""
     dataset: xr.Dataset
-    computed: int        # points computed by this call
-    reused: int          # finished points found on disk
-    invalid: int         # invalid combinations (recorded, not computed)
-    pending: int         # points still missing (lost tasks)
+    computed: int        # tasks computed by this call
+    reused: int          # finished tasks found on disk (or in the complete archive)
+    invalid: int         # invalid combinations (points recorded, not computed)
+    pending: int         # tasks still missing (lost)
     wall_time: float     # s
+    points: int = 0      # points of the study
 
 
 def run_sweep(study: Study, output: str | Path, workers: int | None = None, scheduler: str | None = None,
               progress: bool = True, keep_parts: bool = False) -> SweepResult:
-    """Compute the study's missing points, store each as it arrives, write the archive atomically.
+    """Compute the study's missing tasks, store each as it arrives, write the archive atomically.
 
     ``workers=0``: in this process; None: one dask worker per core; ``scheduler``: an existing
     dask cluster. The part files are removed once the archive holds every point (unless
@@ -248,32 +256,26 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     t0 = time.perf_counter()
     points = check_points(study)
     out = study.outputs
+    n_invalid = sum(p.scene is None for p in points)
+    tasks, of_point = plan(study, points)
     done = _complete_archive(study, points, output)
     if done is not None:
-        return SweepResult(done, 0, int((done["status"].values != STATUS.index("invalid")).sum()),
-                           int((done["status"].values == STATUS.index("invalid")).sum()), 0, time.perf_counter() - t0)
+        return SweepResult(done, 0, len(tasks), n_invalid, 0, time.perf_counter() - t0, len(points))
     store = PartStore(parts_folder(output))
     results, todo = {}, {}
-    n_invalid = 0
-    for p in points:
-        key = p.key(out)
-        if key in results or key in todo:
-            continue
-        if p.scene is None:
-            results[key] = invalid_result(p, out)
-            n_invalid += 1
-            continue
+    for key, task in tasks.items():
         found = store.get(key)
         if found is not None:
             results[key] = found
         else:
-            todo[key] = p.scene
-    reused = len(results) - n_invalid
+            todo[key] = task.scene
+    reused = len(results)
     lost = {}
     todo = interleave(todo)
     if todo:
-        run = _in_process(todo, out) if workers == 0 and not scheduler else _with_dask(todo, out, scheduler, workers)
-        with contextlib.closing(run), tqdm(total=len(todo), desc=study.title[:40], unit="point", disable=not progress,
+        outs = {k: tasks[k].outputs for k in todo}
+        run = _in_process(todo, outs) if workers == 0 and not scheduler else _with_dask(todo, outs, scheduler, workers)
+        with contextlib.closing(run), tqdm(total=len(todo), desc=study.title[:40], unit="task", disable=not progress,
                                            file=sys.stderr) as bar:
             for key, res in run:
                 if "lost" in res:
@@ -282,11 +284,17 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
                     store.put(key, res)
                     results[key] = res
                 bar.update(1)
-    ds = study_dataset(study, points, results)
+    shared = Counter(k for keys in of_point.values() for k in keys)
+    per_point = {p.index: invalid_result(p, out) for p in points if p.scene is None}
+    for idx, keys in of_point.items():
+        r = point_result(keys, results, shared)
+        if r is not None:
+            per_point[idx] = r
+    ds = study_dataset(study, points, per_point)
     write_netcdf(ds, output)
     if not lost and not keep_parts:
         store.clear()
-    return SweepResult(ds, len(todo) - len(lost), reused, n_invalid, len(lost), time.perf_counter() - t0)
+    return SweepResult(ds, len(todo) - len(lost), reused, n_invalid, len(lost), time.perf_counter() - t0, len(points))
 
 
 def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset | None:
