@@ -119,3 +119,33 @@ def test_bad_options_are_one_line_errors_before_any_work(argv, field, capsys, tm
 def test_fields_are_the_driven_gear_body():
     assert set(FIELDS) == set(COARSE) and all(p.startswith("gear2.body.") for p in FIELDS)
     assert math.isinf(Limits().stress_max)
+
+
+def test_small_pair_end_to_end_gives_the_lightest_body_its_figure_and_archives(tmp_path, capsys, private_fe_cache):
+    """24-tooth pair, coarse FE mesh, two hole radii and one refined between them: the lightest
+    body is the larger holes, its answer is measured against the solid gear's run."""
+    from conftest import SMALL_PAIR
+
+    from study.scene import default_scene
+    scene = default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+                                       "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
+                                       "quasi_static.rotation": 30.0, "dynamic.ramp_time": 0.002})
+    (tmp_path / "scene.toml").write_text(scene.to_toml())
+    out = tmp_path / "out"
+    rc = main([str(tmp_path / "scene.toml"), "--grid", "gear2.body.holes=4", "--grid", "gear2.body.hole_radius=2.0,3.0",
+               "--grid", "gear2.body.rim_height=4.0", "--grid", "gear2.body.web_thickness=8.0", "--refine", "2",
+               "--ste-factor", "3", "--dte-factor", "3", "--stress-ratio", "3", "--angle-step", "0.5",
+               "--set", "fe.mesh_size=2.0", "--duration", "0.01", "--workers", "0", "--no-progress", "-o", str(out)])
+    text = capsys.readouterr().out
+    assert rc == 0, text
+    assert "coarse grid: 2 of 2 bodies feasible" in text and "refinement: 1 bodies around 2" in text
+    said = (out / "lightest.txt").read_text()
+    assert said.startswith("4 holes of 3 mm radius, a 4 mm rim and a 8 mm web save") and said.strip() in text
+    with xr.open_dataset(out / "refine.nc") as fine, xr.open_dataset(out / "solid.nc") as solid:
+        assert fine["hole_radius"].values.tolist() == [2.5]             # half-way to the lighter neighbour
+        assert float(solid["root_stress_ratio_gear2"].squeeze()) == 1.0 and float(solid["mass_saving_gear2"]) == 0.0
+    with xr.open_dataset(out / "coarse.nc") as coarse:
+        best = coarse.sel(hole_radius=3.0).squeeze()
+        assert f"save {float(best['mass_saving_gear2']):.1f} % mass" in said
+        assert f"root stress {float(best['root_stress_max_gear2']):.1f} MPa" in said
+    assert (out / "tradeoff.png").stat().st_size > 10_000
