@@ -86,11 +86,17 @@ def merge(study_args: str, out: str, how: str) -> dict:
     if how == "blocks":
         res = run_sweep(st, out, workers=0, progress=False, keep_parts=True)
         if res.computed:    # the code changed since the study ran: its parts are another version's
-            raise SystemExit(f"the merge computed {res.computed} points: the code changed during the benchmark")
+            raise SystemExit(f"the merge computed {res.computed} analyses: the code changed during the benchmark")
     else:
+        from collections import Counter
+
+        from study.sweep.tasks import plan, point_result
         points = check_points(st)
         store = PartStore(parts_folder(out))
-        results = {p.key(st.outputs): store.get(p.key(st.outputs)) for p in points}
+        _, of_point = plan(st, points)
+        shared = Counter(k for keys in of_point.values() for k in keys)
+        records = {k: store.get(k) for k in shared}
+        results = {idx: point_result(keys, records, shared) for idx, keys in of_point.items()}
         write_netcdf(study_dataset(st, points, results), out)
     return {"wall_s": time.perf_counter() - t0, "peak_mib": peak_rss_mib(), "base_mib": base}
 
@@ -118,11 +124,12 @@ def main(argv=None) -> int:
     res = run_sweep(large_study(*study_args), out, workers=2, progress=False, keep_parts=True)
     wall = time.perf_counter() - t0
     client_peak = peak_rss_mib()
-    n = res.computed
+    n = res.points
     ds = res.dataset
     curve_mib = sum(ds[c].size * 8 for c in ("dte", "dte_amplitude")) / 2**20
     compute = float(ds["wall_time"].sum())
-    print(f"study: {n} points ({int((ds['status'] == 1).sum())} ok) on 2 workers in {wall:.1f} s: {n / wall:.2f} points/s; "
+    print(f"study: {n} points ({int((ds['status'] == 1).sum())} ok; {res.computed} analyses: a static one per hole "
+          f"count, a dynamic run per point) on 2 workers in {wall:.1f} s: {n / wall:.2f} points/s; "
           f"point compute {compute / n:.3f} s on average; curves {curve_mib:.1f} MiB; {load()}")
     print(f"client (sweep loop + dask client + LocalCluster scheduler): peak RSS {client_peak:.0f} MiB "
           f"({base:.0f} MiB after imports)")
@@ -136,7 +143,7 @@ def main(argv=None) -> int:
               f"(+{m['peak_mib'] - m['base_mib']:.0f} MiB over the process after imports); parts {part_mib:.0f} MiB; {load()}")
     more = tmp / "more.nc"
     run_sweep(large_study(10, 151.0, 160.0), more, workers=0, progress=False)
-    with xr.open_mfdataset([out, more], engine="netcdf4", combine="by_coords") as both:
+    with xr.open_mfdataset([out, more], engine="netcdf4", combine="by_coords", data_vars="minimal") as both:
         sizes = dict(both.sizes)
         same = bool(np.array_equal(both["dte"].sel(speed=ds["speed"].values).values, ds["dte"].values, equal_nan=True))
     print(f"open_mfdataset with a 20-point study: sizes {sizes}, the large study's dte unchanged: {same}")

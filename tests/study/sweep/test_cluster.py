@@ -20,6 +20,7 @@ import study.sweep.engine as sweep
 from study.sweep.engine import WORKER_ENV, PartStore, parts_folder, run_point, run_sweep
 from study.sweep.grid import check_points, load_study, loads_study
 from study.sweep.outputs import STATUS
+from study.sweep.tasks import plan
 
 ROOT = Path(__file__).resolve().parents[3]
 DASK = Path(sys.executable).with_name("dask")
@@ -43,6 +44,7 @@ scalars = ["ste_p2p", "dte_rms", "dte_p2p", "tooth_force_max"]
 curves = ["dte"]
 """
 N_POINTS = 8
+N_TASKS = 2 + 8       # a static task per body (shared by the 4 speeds), a dynamic run per point
 
 
 def free_port() -> int:
@@ -135,15 +137,33 @@ def wait_until(proc, ready, what: str, timeout: float = 90.0):
 
 
 def write_study(tmp_path) -> tuple[Path, dict]:
-    """The study file and {point key: point}."""
+    """The study file and {task key: the points that use it}."""
     path = tmp_path / "cluster.toml"
     path.write_text(STUDY)
     st = load_study(path)
-    return path, {p.key(st.outputs): p for p in check_points(st)}
+    points = check_points(st)
+    _, of_point = plan(st, points)
+    assert len(points) == N_POINTS
+    users = {}
+    for p in points:
+        for key in of_point[p.index]:
+            users.setdefault(key, []).append(p)
+    assert len(users) == N_TASKS
+    return path, users
+
+
+def wall_times(users: dict, finished: dict) -> dict:
+    """{point index: its wall time [s]} of the points whose tasks are all in ``finished`` ({task
+    key: wall time}): the sum of its tasks' times, each split over the points that share it."""
+    share = {}
+    for key, pts in users.items():
+        for p in pts:
+            share.setdefault(p.index, []).append(finished[key] / len(pts) if key in finished else None)
+    return {idx: sum(t) for idx, t in share.items() if None not in t}
 
 
 def stored(parts: Path) -> dict:
-    """{point key: wall time [s]} of the part files stored so far."""
+    """{task key: wall time [s]} of the part files stored so far."""
     out = {}
     for f in parts.glob("*.pkl"):
         with open(f, "rb") as fh:
@@ -157,7 +177,7 @@ def stored(parts: Path) -> dict:
 def test_a_killed_worker_loses_no_point_and_the_rerun_keeps_the_finished_ones(cluster, tmp_path, allowed_failures):
     """dask's default (3 deaths allowed a task) computes the killed worker's points on the other
     worker; with none allowed they come back lost: recorded pending with the cause, exit 1."""
-    study_path, points = write_study(tmp_path)
+    study_path, users = write_study(tmp_path)
     out = tmp_path / "killed_worker.nc"
     victim = cluster.live_workers(2)[0]
 
@@ -167,11 +187,11 @@ def test_a_killed_worker_loses_no_point_and_the_rerun_keeps_the_finished_ones(cl
     victim_addr = cluster.address_of(victim)
     proc = sweep_cli(cluster, study_path, out, "--keep-parts")
 
-    # kill the worker while it runs a point, after two points are stored (both workers are warm)
+    # kill the worker while it runs a task, after two tasks are stored (both workers are warm)
     def victim_busy():
         busy = cluster.client.processing(workers=[victim_addr]).get(victim_addr, [])
         return list(busy) if len(list(parts_folder(out).glob("*.pkl"))) >= 2 and busy else None
-    busy = wait_until(proc, victim_busy, "the worker ran a point")
+    busy = wait_until(proc, victim_busy, "the worker ran a task")
     victim.send_signal(signal.SIGKILL)
     victim.wait(timeout=30)
     stdout, stderr = proc.communicate(timeout=120)
@@ -186,28 +206,32 @@ def test_a_killed_worker_loses_no_point_and_the_rerun_keeps_the_finished_ones(cl
     assert lost.any() == (allowed_failures == 0), (busy, dict(zip(status, message)))
     assert all(m.startswith("lost: KilledWorker") and "run the same command" in m for m in message[lost])
     assert proc.returncode == (1 if lost.any() else 0), (stdout, stderr)
-    # the points the killed worker held ended right: the same numbers as the point run alone here
+    # the points of the tasks the killed worker held ended right: the same numbers as the point run alone here
     st = load_study(study_path)
-    for key in {k.removeprefix("lightgear-point-") for k in busy}:
-        p = points[key]
-        pt = ds.isel(dict(zip(ds["status"].dims, p.index)))
-        if int(pt["status"]) == OK:
-            alone = run_point(p.scene, st.outputs)
-            for k, v in alone["scalars"].items():
-                np.testing.assert_allclose(float(pt[k]), v, rtol=1e-12, err_msg=k)
-            np.testing.assert_allclose(pt["dte"].values, alone["curves"]["dte"][3], rtol=1e-12)
+    for key in {k.removeprefix("lightgear-task-") for k in busy}:
+        for p in users[key]:
+            pt = ds.isel({d: i for d, i in zip(ds["status"].dims, p.index)})
+            if int(pt["status"]) == OK:
+                alone = run_point(p.scene, st.outputs)
+                for k, v in alone["scalars"].items():
+                    np.testing.assert_allclose(float(pt[k]), v, rtol=1e-12, err_msg=k)
+                np.testing.assert_allclose(pt["dte"].values, alone["curves"]["dte"][3], rtol=1e-12)
 
-    # the rerun computes only the points lost, and keeps every finished one as it was
+    # a point is pending exactly when one of its tasks was lost (not stored)
     finished = stored(parts_folder(out))
-    assert len(finished) == N_POINTS - lost.sum()
+    lost_tasks = set(users) - set(finished)
+    assert bool(lost_tasks) == lost.any()
+    pending = {p.index for key in lost_tasks for p in users[key]}
+    assert pending == {idx for idx in np.ndindex(ds["status"].shape) if ds["status"].values[idx] == PENDING}
+    # the rerun computes only the tasks lost, and keeps every finished one as it was
     again = subprocess.run([*sweep_cli_args(cluster, study_path, out)], cwd=ROOT, env=cluster.env,
                            capture_output=True, text=True, timeout=120)
     assert again.returncode == 0, again.stderr
-    assert f"computed {lost.sum()}, reused {N_POINTS - lost.sum()}," in again.stdout
+    assert f"analyses computed {len(lost_tasks)}, reused {N_TASKS - len(lost_tasks)} " in again.stdout
     with xr.open_dataset(out, engine="netcdf4") as ds2:
         assert (ds2["status"] == OK).all()
-        for key, wall in finished.items():
-            assert float(ds2["wall_time"][points[key].index]) == wall
+        for idx, wall in wall_times(users, finished).items():
+            assert float(ds2["wall_time"][idx]) == pytest.approx(wall, rel=1e-12)
     assert not parts_folder(out).exists()
 
 
@@ -225,26 +249,26 @@ RUN_DEPENDENT_ATTRS = ("created", "history")
 
 
 def test_a_killed_sweep_resumes_to_the_archive_of_an_uninterrupted_run(cluster, tmp_path):
-    study_path, points = write_study(tmp_path)
+    study_path, users = write_study(tmp_path)
     cluster.live_workers(2)
     out = tmp_path / "killed_sweep.nc"
     proc = sweep_cli(cluster, study_path, out)
-    wait_until(proc, lambda: len(list(parts_folder(out).glob("*.pkl"))) >= 3, "three points were stored")
+    wait_until(proc, lambda: len(list(parts_folder(out).glob("*.pkl"))) >= 3, "three tasks were stored")
     proc.send_signal(signal.SIGKILL)
     proc.wait(timeout=30)
     assert not out.exists()
     finished = stored(parts_folder(out))
-    assert 3 <= len(finished) < N_POINTS
+    assert 3 <= len(finished) < N_TASKS
 
     again = subprocess.run(sweep_cli_args(cluster, study_path, out), cwd=ROOT, env=cluster.env,
                            capture_output=True, text=True, timeout=120)
     assert again.returncode == 0, again.stderr
-    assert f"computed {N_POINTS - len(finished)}, reused {len(finished)}," in again.stdout
+    assert f"analyses computed {N_TASKS - len(finished)}, reused {len(finished)} " in again.stdout
     reference = run_sweep(load_study(study_path), tmp_path / "uninterrupted.nc", workers=0, progress=False).dataset
     with xr.open_dataset(out, engine="netcdf4") as resumed:
         resumed = resumed.load()
-    for key, wall in finished.items():      # the points stored before the kill were not computed again
-        assert float(resumed["wall_time"][points[key].index]) == wall
+    for idx, wall in wall_times(users, finished).items():   # the tasks stored before the kill were not computed again
+        assert float(resumed["wall_time"][idx]) == pytest.approx(wall, rel=1e-12)
     assert sorted(resumed.variables) == sorted(reference.variables)
     for name in reference.variables:
         if name not in RUN_DEPENDENT:
@@ -263,9 +287,12 @@ def synthetic_study(speeds, n_time: int):
                      + ", ".join(f"{s:.1f}" for s in speeds) + ']\n[outputs]\nscalars = ["dte_rms"]\ncurves = ["dte"]\n')
     t = np.arange(n_time) * 1e-5
     records = {}
-    for p in check_points(st):
+    points = check_points(st)
+    _, of_point = plan(st, points)
+    for p in points:
         speed = p.values["dynamic.speed"]
-        records[p.key(st.outputs)] = {
+        (key,) = of_point[p.index]               # dynamic outputs only: one task a point
+        records[key] = {
             "status": "ok", "message": "ok", "wall_time": 0.0, "scalars": {"dte_rms": speed / 10},
             "curves": {"dte": ("time", t, {"units": "s", "long_name": "time"}, speed + t * 1e3,
                                {"units": "um", "long_name": "dynamic transmission error"})}}
