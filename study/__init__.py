@@ -122,7 +122,8 @@ def run_sweep(study, output, workers: int | None = None, scheduler: str | None =
 
     ``workers=0`` runs the points in this process; None: a dask LocalCluster with one worker per
     core; ``scheduler``: the address of an existing dask cluster. Finished points are kept on
-    disk, so the same call after an interruption computes only the missing ones.
+    disk, so the same call after an interruption computes only the missing ones. The returned
+    dataset is the archive as written, its curves read from the file when used.
     """
     from study.sweep.engine import run_sweep
     return run_sweep(study, output, workers=workers, scheduler=scheduler, progress=progress, keep_parts=keep_parts)

@@ -179,7 +179,7 @@ def sweep_arguments(p) -> None:
     p.add_argument("--scheduler", metavar="ADDRESS", help="address of an existing dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--workers", type=int, default=None,
                    help="LocalCluster workers (default: one per core); 0 runs the points in this process")
-    p.add_argument("--keep-parts", action="store_true", help="keep the per-point files after the archive is complete")
+    p.add_argument("--keep-parts", action="store_true", help="keep the per-task files after the archive is complete")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -207,13 +207,18 @@ def sweep_command(args) -> int:
         return 130
     ds = res.dataset
     counts = {name: int((ds["status"].values == i).sum()) for i, name in enumerate(STATUS)}
-    print(f"  computed {res.computed}, reused {res.reused}, invalid combinations {res.invalid}, "
+    print(f"  {res.points} points; analyses computed {res.computed}, reused {res.reused} (a static analysis is shared "
+          f"by the points that differ only in dynamic.*); invalid combinations {res.invalid}, "
           f"wall time {res.wall_time:.1f} s")
     print("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v))
     for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:
         print(f"    {msg}")
     if res.pending:
-        print(f"  {res.pending} points lost (worker failures): run the same command again to compute them", file=sys.stderr)
+        causes = sorted({str(m) for m in ds["message"].values.ravel() if str(m).startswith("lost: ")})
+        print(f"  {res.pending} analyses lost (worker failures; {counts['pending']} points pending): "
+              "run the same command again to compute them", file=sys.stderr)
+        for cause in causes[:3]:
+            print(f"    {cause}", file=sys.stderr)
         return 1
     return 0
 

@@ -84,7 +84,7 @@ def main(argv=None) -> int:
                           progress=not args.no_progress)
     ds = res.dataset
     counts = ", ".join(f"{name} {int((ds['status'] == i).sum())}" for i, name in enumerate(STATUS) if (ds["status"] == i).any())
-    print(f"  computed {res.computed}, reused {res.reused}, invalid {res.invalid} ({counts}); "
+    print(f"  {res.points} points; analyses computed {res.computed}, reused {res.reused}, invalid {res.invalid} ({counts}); "
           f"wall time {res.wall_time:.1f} s, compute {float(ds['wall_time'].sum()):.1f} s")
     for line in sensitivity_table(ds):
         print("  " + line)

@@ -147,8 +147,8 @@ def pareto_mask(gain: np.ndarray, cost: np.ndarray, feasible: np.ndarray) -> np.
 def pareto_table(ds: xr.Dataset, stress_limit: float = STRESS_LIMIT, skip=None) -> xr.Dataset:
     """``pareto_<te>`` for each TE measure of ``TE_MEASURES`` in ``ds``: 1 where the point is in
     the Pareto set of most mass saved (``mass_saving_gear2``) for least TE, among the ok points
-    with ``root_stress_ratio_gear2 <= stress_limit`` (1 for a solid gear, whose ratio the run leaves
-    NaN: it needs no FE); int8 CF flags over the study's dims.
+    with ``root_stress_ratio_gear2 <= stress_limit`` (a point whose ratio is NaN, a lightened gear on
+    uniform springs say, is left out); int8 CF flags over the study's dims.
     ``skip(what, why)`` is told what cannot be computed."""
     skip = skip or (lambda what, why: None)
     missing = [v for v in (MASS_SAVING, STRESS_RATIO) if v not in ds]
@@ -157,8 +157,7 @@ def pareto_table(ds: xr.Dataset, stress_limit: float = STRESS_LIMIT, skip=None) 
         skip("trade-off view", f"the archive has no {', '.join(missing or ['ste_p2p or dte_rms'])}")
         return xr.Dataset()
     gain = kept(ds, MASS_SAVING)
-    # a solid gear (no mass saved) is its own stress reference: ratio 1, though no FE ran for it
-    ratio = kept(ds, STRESS_RATIO).fillna(xr.where(gain == 0.0, 1.0, np.nan))
+    ratio = kept(ds, STRESS_RATIO)
     out = {}
     for t in te:
         cost = kept(ds, t)

@@ -153,9 +153,9 @@ def _sweep_views(ds, swept, name, skip) -> list[Path]:
         da = ds[var]
         if str(var).startswith("pareto_"):
             continue   # a flag, drawn in the trade-off view
-        if da.dtype.kind not in "fiu" or not da.dims or not set(da.dims) <= set(swept) or swept[0] not in da.dims:
-            continue
         dims = [d for d in swept if d in da.dims]
+        if da.dtype.kind not in "fiu" or not dims or not set(da.dims) <= set(swept):
+            continue   # (a static output lies only over the fields its analysis reads)
         hue = dims[1] if len(dims) > 1 else None
         out.append(sweep_view(ds, var, dims[0], hue=hue, path=name(f"sweep_{var}")))
     if not out:

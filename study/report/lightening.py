@@ -5,7 +5,7 @@
   inertia(gear)              polar inertia about the gear axis [kg mm2]       (geometry)
   root_stress(gear, tooth)   largest fillet stress of each tooth [MPa]        (FE body)
   root_stress_max(gear)      the largest of them [MPa]                        (FE body)
-  root_stress_ratio(gear)    root_stress_max over the solid gear's value [1]  (FE body)
+  root_stress_ratio(gear)    root_stress_max over the solid gear's value [1]  (FE body; 1 for a solid gear)
 
 Mass and inertia are cheap geometry (`solver.inertia.gear_mass`: the body rings at their
 thickness less the holes, plus the teeth from their outline; the solid gear is
@@ -14,6 +14,11 @@ of the stiffness map (`study.inputs.springs.root_stress`, cached with it), so it
 for a gear whose springs come from the FE (a lightened gear, springs not 'uniform'); the solid
 reference's value is the same FE of the solid body that the stiffness ratio uses. Other gears
 get NaN and the reason in the attributes: no FE is started for this output alone.
+
+A solid gear is its own stress reference: its ``root_stress_ratio`` is 1 by definition (no FE
+needed), while its ``root_stress_max`` stays NaN unless its springs ran the FE (never: a solid
+gear's springs need none). So every point of a study that keeps a gear solid has a ratio, and a
+stress limit on the ratio applies to it without special cases.
 """
 from __future__ import annotations
 
@@ -49,6 +54,8 @@ def lightening_variables(setups, stress: bool = True) -> tuple[dict, dict]:
     for i, s in enumerate(setups):
         mp = gear_mass(s.geometry, s.body, s.material.density)
         mass[i], saving[i], inertia[i] = mp.mass, mp.mass_saving, mp.inertia * units.MM_PER_M**2
+        if not s.lightened:
+            ratio[i] = 1.0          # the solid gear is the reference of the ratio: 1 by definition
         if not stress:
             reasons.append(f"gear {s.gear}: not requested")
         elif not uses_fe_springs(s):
@@ -71,10 +78,16 @@ def lightening_variables(setups, stress: bool = True) -> tuple[dict, dict]:
         "root_stress": _var(("gear", "tooth"), sigma, "MPa", "largest fillet (root) stress of each tooth under its reference load",
                             source=FE_SOURCE, load=load, not_computed=nan_reason),
         "root_stress_max": _var("gear", sigma_max, "MPa", "largest fillet (root) stress over the teeth",
-                                source=FE_SOURCE, load=load, not_computed=nan_reason),
+                                source=FE_SOURCE, load=load, not_computed=nan_reason,
+                                comment="NaN for a gear whose springs need no FE, a solid gear included: its stress "
+                                        "is the reference of root_stress_ratio (1 for it), computed by the FE of a "
+                                        "lightened gear only"),
         "root_stress_ratio": _var("gear", ratio, "1", "largest fillet stress relative to the same gear solid",
                                   source=FE_SOURCE + "; the solid body's tooth 0 with the same mesh settings and load "
-                                  "(the reference of the stiffness ratio)", not_computed=nan_reason),
+                                  "(the reference of the stiffness ratio)", not_computed=nan_reason,
+                                  comment="1 by definition for a solid gear (no holes, web as thick as the face: "
+                                          "its own reference, no FE needed); NaN for a lightened gear whose "
+                                          "springs need no FE"),
     }
     return coords, data
 

@@ -115,9 +115,11 @@ def sensitivity_figure(ds: xr.Dataset, table: xr.Dataset, path):
     return save_figure(fig, path)
 
 
-def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path):
+def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path, te_limits: dict | None = None, chosen: int | None = None):
     """Mass saving against each TE measure with a ``pareto_<te>`` flag in ``pareto``; colour:
-    root stress [MPa] when archived; hollow: over the stress limit; the Pareto set joined."""
+    root stress [MPa] when archived; hollow: over the stress limit; the Pareto set joined.
+    ``te_limits``: {TE measure: limit [its units]} drawn as dashed lines; ``chosen``: the index of
+    a point (in the points flattened in the order of the dims) marked by a star."""
     te = [str(v)[len("pareto_"):] for v in pareto.data_vars]
     fig, axes = plt.subplots(1, len(te), figsize=(5.6 * len(te) + 1.4, 5.0), squeeze=False, constrained_layout=True)
     gain = kept(ds, MASS_SAVING)
@@ -150,6 +152,11 @@ def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path):
         ax.plot(c[f][order], g[f][order], color=C_SOLID, lw=1.2, zorder=2, drawstyle="steps-post")
         ax.scatter(c[f], g[f], s=110, facecolors="none", edgecolors=C_SOLID, lw=1.4, zorder=4,
                    label=f"Pareto set ({int(f.sum())} points)")
+        if te_limits and t in te_limits:
+            ax.axvline(te_limits[t], color="0.3", ls="--", lw=1.0, zorder=1, label=f"{t} limit {te_limits[t]:.3g}")
+        if chosen is not None:
+            ax.scatter(c[chosen], g[chosen], marker="*", s=280, color=C_HOLE, edgecolors="k", lw=0.6, zorder=5,
+                       label="chosen")
         ax.set_xlabel(axis_label(ds[t], t))
         ax.set_ylabel(axis_label(ds[MASS_SAVING], MASS_SAVING))
         ax.grid(alpha=0.3)

@@ -8,15 +8,23 @@ Each coordinate carries ``units``, ``long_name`` (from the scene's field metadat
 ``scene_field`` (the dotted path). Variables, over the study dimensions:
   status      CF flags 0 pending, 1 ok, 2 diverged, 3 invalid, 4 failed, 5 inaccurate
   message     text: 'ok', or why the point is not ok
-  wall_time   s, compute time of the point
-  <scalar>    each requested scalar (`outputs.SCALARS`), NaN where not ok
+  wall_time   s, compute time of the point (its share of the analyses it shares with others)
+  <scalar>    each requested scalar (`outputs.SCALARS`), NaN where its analysis failed
   <curve>     each requested curve over its own dimension (angle, time, frequency)
+In the grid layout an output lies only over the swept dimensions its analysis reads
+(`outputs.ANALYSIS_FIELDS`): ``ste_p2p`` over the body fields but not over ``speed``,
+``mass_gear2`` over the body fields only; ``status`` says which points are ok (an output is
+read with ``.where(ds.status == 1)``, which broadcasts it over every dimension). In the point
+layout every variable lies over ``point``. Archives of a split study open together with
+``xr.open_mfdataset(paths, combine="by_coords", data_vars="minimal")`` (outputs that do not lie
+over the split dimension are then taken once, checked equal).
 Global attributes: title, the study TOML, the base scene TOML, the study key (a hash of all
 its points), software versions, machine and date (`results.provenance`).
 """
 from __future__ import annotations
 
 import hashlib
+import json
 
 import numpy as np
 import xarray as xr
@@ -24,7 +32,8 @@ import xarray as xr
 from study.report.results import provenance
 from study.scene import field_doc, field_unit
 from study.sweep.grid import Point, Study, dim_name
-from study.sweep.outputs import CURVES, SCALARS, STATUS
+from study.sweep.outputs import CURVES, SCALARS, STATUS, analysis_of, reads
+from study.sweep.tasks import point_task_keys
 
 CF_UNITS = {"": "1", "deg": "degree", "N*m": "N m", "rad/s": "rad s-1", "kg/m^3": "kg m-3",
             "N*mm/rad^n_k": "N mm rad-n_k", "N/mm^m1": "N mm-m1"}
@@ -64,55 +73,123 @@ def study_layout(study: Study, points: list[Point]) -> tuple[tuple[str, ...], di
 
 
 def study_key(study: Study, points: list[Point]) -> str:
-    """Hash of everything the study computes (its points' keys in order)."""
-    blob = "|".join([study.layout] + [p.key(study.outputs) for p in points])
+    """Hash of everything the study computes (its points' tasks, or invalid values, in order)."""
+    blob = "|".join([study.layout] + [",".join(point_task_keys(p, study.outputs)) or json.dumps(p.values, sort_keys=True)
+                                      for p in points])
     return hashlib.sha256(blob.encode()).hexdigest()[:24]
 
 
-def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Dataset:
-    """The labelled archive of a study from ``results`` (point key -> `engine.run_point` dict).
+MERGE_BLOCK_BYTES = 8 * 2**20    # bytes: curve values the merge reads from the part files at once
 
-    Points without a result are 'pending'. A curve's axis comes from the first point that has
-    it; a point whose axis differs (another duration or angle step, say) keeps NaN there and
-    says so in its message.
+
+def output_axes(study: Study, output: str) -> tuple[int, ...]:
+    """Positions (in ``study.axes``) of the swept dimensions an output lies over: all of them in
+    the point layout, else the fields its analysis reads."""
+    if study.layout == "point":
+        return ()
+    return tuple(i for i, a in enumerate(study.axes) if reads(analysis_of(output), a.path))
+
+
+def study_dataset(study: Study, points: list[Point], results: dict, read=None, lost: dict | None = None,
+                  block_bytes: int | None = None) -> xr.Dataset:
+    """The labelled archive of a study from ``results`` (point index -> record of
+    `tasks.point_result`: status, message, wall_time, scalars, and curves or curve_keys).
+
+    Points without a result are 'pending' (their message says why when ``lost`` maps their index
+    to the cause). An output over fewer dimensions than the study takes its value at a position
+    from the first point there that has a finite one (the points of one position agree on every
+    field the output reads). A curve's axis comes from the first point that has it; a point whose
+    axis differs (another duration or angle step, say) keeps NaN there and says so in its message.
+
+    With ``read(key)`` (the full record of a task, from its part file) a record may give, instead
+    of its curves, ``curve_keys`` ({curve: key of the task that produced it}): the curves are
+    then dask arrays whose blocks (at most ``block_bytes``, default `MERGE_BLOCK_BYTES`, each)
+    read the part files when the archive is written, each task's record once per position of
+    the curve, so that no more than one block of curves is ever held in memory. Curves given in
+    the records are held in memory.
     """
     out = study.outputs
     dims, coords = study_layout(study, points)
     shape = study.shape
+    grid = study.layout == "grid"
+    own = {k: output_axes(study, k) for k in out.scalars + out.curves}
+
+    def dims_of(k):
+        return tuple(dims[i] for i in own[k]) if grid else dims
+
+    def shape_of(k):
+        return tuple(shape[i] for i in own[k]) if grid else shape
+
+    def at(k, idx):
+        return tuple(idx[i] for i in own[k]) if grid else idx
+
     status = np.zeros(shape, np.int8)
     message = np.full(shape, "not computed yet", dtype=object)
     wall = np.full(shape, np.nan)
-    scal = {k: np.full(shape, np.nan) for k in out.scalars}
-    axes, curves, curve_attrs = {}, {}, {}
+    scal = {k: np.full(shape_of(k), np.nan) for k in out.scalars}
+    # per curve: its axis, and per position of the curve the values held ({position: values}) or
+    # the task whose part file has them ({position: key})
+    axes, held, where, curve_attrs = {}, {}, {}, {}
     for p in points:
-        r = results.get(p.key(out))
-        if r is None:
-            continue
         idx = p.index
+        r = results.get(idx)
+        if r is None:
+            if lost and idx in lost:
+                message[idx] = f"lost: {lost[idx]}; run the same command to compute it"
+            continue
         status[idx] = STATUS.index(r["status"])
         message[idx] = r["message"]
         wall[idx] = r["wall_time"]
         for k in out.scalars:
-            scal[k][idx] = r["scalars"].get(k, np.nan)
-        for name, (axis, ax_vals, ax_attrs, vals, attrs) in r["curves"].items():
+            v = r["scalars"].get(k, np.nan)
+            if np.isnan(scal[k][at(k, idx)]):
+                scal[k][at(k, idx)] = v
+        point_curves = dict(r.get("curves", {}))
+        keys = {key for name, key in r.get("curve_keys", {}).items()
+                if at(name, idx) not in where.get(name, {}) and at(name, idx) not in held.get(name, {})}
+        for key in keys:            # read once for the axes of the curves it brings to new positions
+            full = read(key) if read is not None else None
+            for name, curve in (full["curves"] if full else {}).items():
+                if r["curve_keys"].get(name) == key:
+                    point_curves[name] = (*curve[:3], key, curve[4])
+            del full
+        for name, (axis, ax_vals, ax_attrs, vals, attrs) in point_curves.items():
             if name not in axes:
                 axes[name] = (axis, ax_vals, ax_attrs)
-                curves[name] = np.full(shape + (ax_vals.size,), np.nan)
+                held[name], where[name] = {}, {}
                 curve_attrs[name] = attrs
             ref = axes[name][1]
+            pos = at(name, idx)
+            if pos in held[name] or pos in where[name]:
+                continue
             if ax_vals.shape == ref.shape and np.allclose(ax_vals, ref, rtol=1e-9, atol=0.0):
-                curves[name][idx] = vals
+                (where if isinstance(vals, str) else held)[name][pos] = vals
             else:
                 message[idx] = f"{message[idx]}; {name} not stored: its {axis} axis differs from the archive's"
+        del point_curves
+    curves = {}
+    for name in axes:
+        n = axes[name][1].size
+        if where[name]:
+            curves[name] = lazy_curve(name, shape_of(name), n, where[name], read, block_bytes or MERGE_BLOCK_BYTES,
+                                      held[name])
+        else:
+            curves[name] = np.full(shape_of(name) + (n,), np.nan)
+            for pos, vals in held[name].items():
+                curves[name][pos] = vals
     data = {
         "status": xr.Variable(dims, status, {
             "long_name": "status of the study point", "units": "1",
             "flag_values": np.arange(len(STATUS), dtype=np.int8), "flag_meanings": " ".join(STATUS)}),
         "message": xr.Variable(dims, message, {"long_name": "why the point is not ok ('ok' when it is)"}),
-        "wall_time": xr.Variable(dims, wall, {"units": "s", "long_name": "compute time of the point"}),
+        "wall_time": xr.Variable(dims, wall, {
+            "units": "s", "long_name": "compute time of the point",
+            "comment": "an analysis shared by several points (a static one over the speeds, say) counts "
+                       "its time split equally over them"}),
     }
     for k in out.scalars:
-        data[k] = xr.Variable(dims, scal[k], {"units": SCALARS[k].units, "long_name": SCALARS[k].long_name})
+        data[k] = xr.Variable(dims_of(k), scal[k], {"units": SCALARS[k].units, "long_name": SCALARS[k].long_name,
+                                                    "analysis": SCALARS[k].analysis})
     for name in out.curves:
         if name not in axes:
             continue  # no point produced it (all failed): nothing to label its axis with
@@ -121,8 +198,31 @@ def study_dataset(study: Study, points: list[Point], results: dict) -> xr.Datase
         attrs = {k: v for k, v in curve_attrs[name].items() if k in ("units", "long_name", "window", "comment")}
         if CURVES[name].comment:
             attrs["comment"] = CURVES[name].comment
-        data[name] = xr.Variable(dims + (axis,), curves[name], attrs)
+        attrs["analysis"] = CURVES[name].analysis
+        data[name] = xr.Variable(dims_of(name) + (axis,), curves[name], attrs)
     attrs = {"title": study.title, "study": study.text, "base_scene": study.base_scene_toml(),
              "study_layout": study.layout, "study_key": study_key(study, points),
              "outputs": ", ".join(out.scalars + out.curves), **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def lazy_curve(name: str, shape: tuple, n: int, where: dict, read, block_bytes: int, held: dict | None = None):
+    """The curve ``name`` at the positions ``where`` ({position: task key}) as a dask array over
+    the dimensions it lies over (``shape``) and the curve axis (``n`` values), in blocks of at
+    most ``block_bytes`` (at least one position) that read each task's record with ``read(key)``
+    when computed; ``held`` ({position: values}) are curves already in memory."""
+    import uuid
+
+    import dask.array as da
+    chunks = da.core.normalize_chunks(("auto",) * len(shape) + (n,), shape + (n,), limit=block_bytes, dtype=np.float64)
+
+    def block(block_info=None):
+        loc = block_info[None]["array-location"]
+        values = np.full(tuple(b - a for a, b in loc), np.nan)
+        for idx, src in [*where.items(), *(held or {}).items()]:
+            if all(a <= i < b for i, (a, b) in zip(idx, loc)):
+                values[tuple(i - a for i, (a, _) in zip(idx, loc))] = \
+                    read(src)["curves"][name][3] if isinstance(src, str) else src
+        return values
+    return da.map_blocks(block, chunks=chunks, dtype=np.float64, meta=np.empty((0,) * (len(shape) + 1)),
+                         name=f"study-curve-{name}-{uuid.uuid4().hex}")

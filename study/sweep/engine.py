@@ -1,15 +1,24 @@
-"""Parametric sweeps: one task per study point, run in process or with dask.distributed.
+"""Parametric sweeps: at most two tasks per study point, shared by the points that agree on
+what they read, run in process or with dask.distributed.
 
 `run_point(scene, outputs)` runs only the analyses the outputs need and never raises: it
 returns a status (ok / diverged / invalid / failed / inaccurate), a message, its wall time [s], the
 requested scalars and curves (`study.sweep.outputs`).
 
-`run_sweep(study, output)` computes the points that are not finished yet, stores each result
-as it arrives (one small file per point in ``.OUT.nc.parts/``, written atomically), and writes
-the study archive (`study.sweep.archive`) atomically at the end. Re-running the same study after an
-interruption (Ctrl-C, a killed worker or process) computes only the missing points. Points are
-keyed by a hash of their scene, outputs and the code (`results.code_fingerprint`), so an
-edited study reuses the points it shares, and a changed code computes them all again.
+`run_sweep(study, output)` computes the tasks of the study that are not finished yet
+(`study.sweep.tasks`: a point's outputs that read no ``dynamic.*`` field are one task shared by
+every point that differs only in fields they do not read, its dynamic and modal outputs
+another), stores each result as it arrives (one small file per task in ``.OUT.nc.parts/``,
+written atomically), and writes the study archive (`study.sweep.archive`) atomically at the
+end. The client holds only each task's status and scalars: the curves are read back from the
+part files of the tasks that produced them in bounded blocks while the archive is written, and
+dask releases each result once it is stored, so neither the client's nor the workers' memory
+grows with the study. A task dask could not compute (its worker died more often than
+`distributed.scheduler.allowed-failures` allows) leaves its points pending, its cause in the
+archive's message. Re-running the same study after an interruption (Ctrl-C, a killed worker
+or process) computes only the missing tasks. Tasks are keyed by a hash of the scene fields
+they read, their outputs and the code (`results.code_fingerprint`), so an edited study reuses
+the tasks it shares, and a changed code computes them all again.
 
 Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)
@@ -18,6 +27,7 @@ can import this package.
 """
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import dataclasses
 import itertools
@@ -31,6 +41,8 @@ import sys
 import time
 import traceback
 import uuid
+import warnings
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,7 +52,8 @@ from study.errors import BudgetError
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
-from study.sweep.outputs import STATUS, Outputs, analysis_of
+from study.sweep.outputs import CURVES, Outputs, analysis_of
+from study.sweep.tasks import plan, point_result
 
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
@@ -119,10 +132,10 @@ def invalid_result(point: Point, outputs: Outputs) -> dict:
             "scalars": {k: math.nan for k in outputs.scalars}, "curves": {}}
 
 
-# ---------------------------------------------------------------- finished points on disk
+# ---------------------------------------------------------------- finished tasks on disk
 
 class PartStore:
-    """Finished points of a study, one pickle per point key, each written atomically."""
+    """Finished tasks of a study, one pickle per task key, each written atomically."""
 
     def __init__(self, folder: str | Path):
         self.folder = Path(folder)
@@ -178,8 +191,13 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
             yield client
         return
     n = workers or os.cpu_count() or 1
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR, env=dict(WORKER_ENV)) as cluster, Client(cluster) as client:
+    # the scheduler's HTTP endpoint (health, metrics; no dashboard) moves to a free port when
+    # 8787 is taken, another user's cluster say: not worth a warning
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Port 8787 is already in use", category=UserWarning)
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.ERROR, env=dict(WORKER_ENV))
+    with cluster, Client(cluster) as client:
         yield client
 
 
@@ -204,42 +222,54 @@ def interleave(todo: dict) -> dict:
     return {k: todo[k] for k in order}
 
 
-def _in_process(todo: dict, outputs: Outputs):
+def _in_process(todo: dict, outputs: dict):
     for key, scene in todo.items():
-        yield key, run_point(scene, outputs)
+        yield key, run_point(scene, outputs[key])
 
 
-def _with_dask(todo: dict, outputs: Outputs, scheduler: str | None, workers: int | None):
+def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None):
     from distributed import as_completed
     with dask_client(scheduler, workers) as client:
-        futures = {client.submit(run_point, scene, outputs, key=f"lightgear-point-{key}", pure=False): key
+        futures = {client.submit(run_point, scene, outputs[key], key=f"lightgear-task-{key}", pure=False): key
                    for key, scene in todo.items()}
         try:
             for fut in as_completed(futures):
+                key = futures.pop(fut)
                 try:
-                    yield futures[fut], fut.result()
-                except Exception as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
-                    yield futures[fut], {"lost": f"{type(e).__name__}: {e}"}
+                    res = fut.result()
+                except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
+                    res = {"lost": lost_cause(e)}
+                fut.release()       # the worker drops the result: its memory does not grow with the study
+                yield key, res
         finally:
             client.cancel(list(futures))
+
+
+def lost_cause(e: BaseException) -> str:
+    """One line on why dask gave no result for a point (a worker died running it: KilledWorker)."""
+    text = str(e).strip().splitlines()[0] if str(e).strip() else ""
+    return f"{type(e).__name__}: {text[:300]}" if text else type(e).__name__
 
 
 # ---------------------------------------------------------------- the sweep
 
 @dataclass
 class SweepResult:
-    """What `run_sweep` did: the study archive and how its points were obtained."""
+    """What `run_sweep` did: the study archive and how its tasks were obtained (a task is one
+    point's dynamic run (with its modal outputs), or the static analysis shared by the points
+    that differ only in ``dynamic.*``: `study.sweep.tasks`)."""
     dataset: xr.Dataset
-    computed: int        # points computed by this call
-    reused: int          # finished points found on disk
-    invalid: int         # invalid combinations (recorded, not computed)
-    pending: int         # points still missing (lost tasks)
+    computed: int        # tasks computed by this call
+    reused: int          # finished tasks found on disk (or in the complete archive)
+    invalid: int         # invalid combinations (points recorded, not computed)
+    pending: int         # tasks still missing (lost)
     wall_time: float     # s
+    points: int = 0      # points of the study
 
 
 def run_sweep(study: Study, output: str | Path, workers: int | None = None, scheduler: str | None = None,
               progress: bool = True, keep_parts: bool = False) -> SweepResult:
-    """Compute the study's missing points, store each as it arrives, write the archive atomically.
+    """Compute the study's missing tasks, store each as it arrives, write the archive atomically.
 
     ``workers=0``: in this process; None: one dask worker per core; ``scheduler``: an existing
     dask cluster. The part files are removed once the archive holds every point (unless
@@ -252,45 +282,69 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     t0 = time.perf_counter()
     points = check_points(study)
     out = study.outputs
+    n_invalid = sum(p.scene is None for p in points)
+    tasks, of_point = plan(study, points)
     done = _complete_archive(study, points, output)
     if done is not None:
-        return SweepResult(done, 0, int((done["status"].values != STATUS.index("invalid")).sum()),
-                           int((done["status"].values == STATUS.index("invalid")).sum()), 0, time.perf_counter() - t0)
+        return SweepResult(done, 0, len(tasks), n_invalid, 0, time.perf_counter() - t0, len(points))
     store = PartStore(parts_folder(output))
     results, todo = {}, {}
-    n_invalid = 0
-    for p in points:
-        key = p.key(out)
-        if key in results or key in todo:
-            continue
-        if p.scene is None:
-            results[key] = invalid_result(p, out)
-            n_invalid += 1
-            continue
+    for key, task in tasks.items():
         found = store.get(key)
         if found is not None:
-            results[key] = found
+            results[key] = without_curves(found)
         else:
-            todo[key] = p.scene
-    reused = len(results) - n_invalid
+            todo[key] = task.scene
+    reused = len(results)
     lost = {}
     todo = interleave(todo)
     if todo:
-        run = _in_process(todo, out) if workers == 0 and not scheduler else _with_dask(todo, out, scheduler, workers)
-        with contextlib.closing(run), tqdm(total=len(todo), desc=study.title[:40], unit="point", disable=not progress,
+        outs = {k: tasks[k].outputs for k in todo}
+        run = _in_process(todo, outs) if workers == 0 and not scheduler else _with_dask(todo, outs, scheduler, workers)
+        with contextlib.closing(run), tqdm(total=len(todo), desc=study.title[:40], unit="task", disable=not progress,
                                            file=sys.stderr) as bar:
             for key, res in run:
                 if "lost" in res:
                     lost[key] = res["lost"]
                 else:
                     store.put(key, res)
-                    results[key] = res
+                    results[key] = without_curves(res)
                 bar.update(1)
-    ds = study_dataset(study, points, results)
-    write_netcdf(ds, output)
+    shared = Counter(k for keys in of_point.values() for k in keys)
+    per_point = {p.index: invalid_result(p, out) for p in points if p.scene is None}
+    lost_points = {}
+    for idx, keys in of_point.items():
+        r = point_result(keys, results, shared)
+        if r is not None:
+            per_point[idx] = r
+        elif causes := [lost[k] for k in keys if k in lost]:
+            lost_points[idx] = "; ".join(dict.fromkeys(causes))
+    ds = study_dataset(study, points, per_point, read=store.get, lost=lost_points)
+    import dask
+    with dask.config.set(scheduler="synchronous"):   # the curves are read from the part files here, block by block
+        write_netcdf(ds, output)
     if not lost and not keep_parts:
         store.clear()
-    return SweepResult(ds, len(todo) - len(lost), reused, n_invalid, len(lost), time.perf_counter() - t0)
+    return SweepResult(open_archive(output), len(todo) - len(lost), reused, n_invalid, len(lost),
+                       time.perf_counter() - t0, len(points))
+
+
+def without_curves(result: dict) -> dict:
+    """A task's record without its curves, only their names (they stay in its part file until
+    the merge)."""
+    out = {k: v for k, v in result.items() if k != "curves"}
+    out["curve_names"] = tuple(result.get("curves", ()))
+    return out
+
+
+def open_archive(path) -> xr.Dataset:
+    """A study archive with its per-point variables in memory; the curves (study dimensions x
+    their axis: the bulk of a large study) are read from the file when used."""
+    ds = xr.open_dataset(path, engine="netcdf4")
+    for name, var in ds.data_vars.items():
+        if name not in CURVES:
+            var.load()
+    return ds
 
 
 def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset | None:
@@ -298,9 +352,10 @@ def _complete_archive(study: Study, points: list[Point], output) -> xr.Dataset |
     if not Path(output).is_file() or parts_folder(output).exists():
         return None
     try:
-        with xr.open_dataset(output, engine="netcdf4") as ds:
-            if ds.attrs.get("study_key") == study_key(study, points) and not (ds["status"].values == 0).any():
-                return ds.load()
+        ds = open_archive(output)
     except (OSError, KeyError, ValueError):
-        pass
+        return None
+    if ds.attrs.get("study_key") == study_key(study, points) and "status" in ds and not (ds["status"].values == 0).any():
+        return ds
+    ds.close()
     return None

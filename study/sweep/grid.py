@@ -37,9 +37,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import hashlib
 import itertools
-import json
 import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -99,14 +97,7 @@ class Point:
     values: dict            # dotted path -> value
     scene: Scene | None     # None when the combination is invalid
     error: str = ""         # the SceneError text of an invalid combination
-
-    def key(self, outputs: Outputs) -> str:
-        """Content hash of what this point computes: same scene, outputs and code -> same key
-        (a resumed study never mixes points computed by two versions of the code)."""
-        from study.report.results import code_fingerprint
-        what = self.scene.to_toml() if self.scene is not None else json.dumps(self.values, sort_keys=True)
-        blob = json.dumps([what, list(outputs.scalars), list(outputs.curves), code_fingerprint()])
-        return hashlib.sha256(blob.encode()).hexdigest()[:24]
+    _keys: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)   # (outputs, code) -> its task keys
 
 
 @dataclass(frozen=True)

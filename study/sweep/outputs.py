@@ -10,6 +10,10 @@ FE body of the springs: root stress, NaN for a gear whose springs need no FE).
 
 The per-gear outputs of the run archive (`study.report.lightening`) are scalars named
 ``{variable}_gear{g}``: ``mass_gear2`` is ``mass.sel(gear=2)``.
+
+`ANALYSIS_FIELDS` says which scene fields (dotted paths) each analysis reads; it is the one
+place that rule lives. A sweep runs an analysis once per combination of the swept fields it
+reads and archives its outputs over those dimensions only (an STE is not stored over the speed).
 """
 from __future__ import annotations
 
@@ -71,6 +75,45 @@ CURVES = {
                            "spectrum of DTE after the ramp"),
 }
 
+# Scene fields each analysis reads: (prefixes read, prefixes not read); a prefix is a dotted path
+# that covers itself and every field under it, '' covers every field; the longest prefix that
+# covers a field decides. The sets nest: geometry < fe < static < modes < dynamic.
+#   geometry  mass and inertia: the gears' teeth and bodies, the backlash that thins the teeth, the
+#             density (solver.inertia.gear_mass via study.inputs.gearsetup)
+#   fe        root stress: the gears (springs included: 'uniform' runs no FE), the material, the
+#             backlash, the FE mesh and the torque that sets the FE load (gearsetup.reference_torque)
+#   static    STE: every field but the dynamic run's (study.run.run_static reads no 'dynamic.*')
+#   modes     the pair linearised at the mean load (its dampers given as ratios converted there):
+#             the static fields (damping included) and the mean load, the dynamic run's torque
+#             when it runs (study.setup.mean_load reads dynamic.enabled and dynamic.torque)
+#   dynamic   DTE: every field
+ANALYSIS_FIELDS = {
+    "geometry": (("gear1", "gear2", "pair", "material.density"), ("gear1.spring", "gear2.spring")),
+    "fe": (("gear1", "gear2", "pair", "material", "fe", "quasi_static.torque"), ()),
+    "static": (("",), ("dynamic", "title")),
+    "modes": (("", "dynamic.enabled", "dynamic.torque"), ("dynamic", "title")),
+    "dynamic": (("",), ("title",)),
+}
+ANALYSES = tuple(ANALYSIS_FIELDS)        # narrowest first
+
+
+def _under(path: str, prefix: str) -> bool:
+    return prefix == "" or path == prefix or path.startswith(prefix + ".")
+
+
+def reads(analysis: str, path: str) -> bool:
+    """True when ``analysis`` ('geometry', 'fe', 'static', 'modes', 'dynamic') reads the scene
+    field ``path``: the longest prefix of `ANALYSIS_FIELDS` that covers it is one it reads."""
+    read, not_read = ANALYSIS_FIELDS[analysis]
+    longest = max((len(p) for p in read if _under(path, p)), default=-1)
+    return longest > max((len(p) for p in not_read if _under(path, p)), default=-1)
+
+
+def reads_dynamic(analysis: str) -> bool:
+    """True when ``analysis`` reads a field of the dynamic run (``dynamic.*``): modes, dynamic."""
+    return reads(analysis, "dynamic.torque")
+
+
 # CF flag meanings, values 0..5; inaccurate: the dynamic run completed but its energy balance
 # does not close (`solver.mbs.dynamics.accuracy_check`): its scalars are kept, flagged
 STATUS = ("pending", "ok", "diverged", "invalid", "failed", "inaccurate")
@@ -106,6 +149,23 @@ class Outputs:
     def fe(self) -> bool:
         """True when an output needs the FE body of the springs (root stress)."""
         return any(analysis_of(x) == "fe" for x in self.scalars + self.curves)
+
+    @property
+    def widest(self) -> str:
+        """The analysis among the outputs' that reads the most scene fields (`ANALYSIS_FIELDS`)."""
+        return max((analysis_of(x) for x in self.scalars + self.curves), key=ANALYSES.index)
+
+    def parts(self) -> tuple[Outputs, ...]:
+        """The outputs split by what they read: the ones that read no ``dynamic.*`` field (static,
+        FE, geometry: one run per combination of the fields they read), then the ones that do
+        (dynamic; modes, which read the dynamic run's torque as the mean load); empty parts left out."""
+        out = []
+        for dyn in (False, True):
+            sc = tuple(x for x in self.scalars if reads_dynamic(analysis_of(x)) == dyn)
+            cu = tuple(x for x in self.curves if reads_dynamic(analysis_of(x)) == dyn)
+            if sc or cu:
+                out.append(Outputs(sc, cu))
+        return tuple(out)
 
 
 def outputs_from_table(table) -> Outputs:

@@ -45,7 +45,7 @@ def test_the_api_script_runs_a_scene_and_a_sweep_into_archives(tmp_path, monkeyp
     after = run["dte"].where(run["time"] >= run.attrs["spectrum_start_s"], drop=True).values
     assert math.isclose(float(pt["dte_rms"]), float(np.sqrt(np.mean((after - after.mean()) ** 2))), rel_tol=1e-12)
     # STE does not depend on the speed; the holes change the driven gear's inertia only (uniform springs)
-    np.testing.assert_array_equal(sw["ste_p2p"].sel(speed=50.0), sw["ste_p2p"].sel(speed=100.0))
+    assert sw["ste_p2p"].dims == ("n_holes",) and sw["dte_rms"].dims == ("n_holes", "speed")   # STE: no speed
     assert {"sweep_dte_rms.png", "sweep_ste_p2p.png"} <= {p.name for p in out.glob("*.png")}
 
 

@@ -111,11 +111,12 @@ def test_pareto_flags_over_the_grid_skip_failed_points_and_say_what_is_missing()
     assert set(with_study_tables(ds, ["a", "b"]).data_vars) >= {"pareto_ste_p2p", "sensitivity_share"}
 
 
-def test_a_solid_gear_without_a_stress_ratio_is_its_own_reference_in_the_pareto_set():
-    """The run leaves the ratio NaN for a solid gear (no FE); it is the stress reference (1)."""
+def test_a_point_without_a_stress_ratio_is_not_in_the_pareto_set():
+    """A ratio NaN (a lightened gear whose springs ran no FE) is unknown, not within the limit:
+    the point is left out even with the least TE; a solid gear carries its ratio 1 in the archive."""
     dims = ("a",)
-    ds = xr.Dataset({"mass_saving_gear2": (dims, [0.0, 20.0, 30.0]), "ste_p2p": (dims, [0.5, 0.7, 0.6]),
-                     "root_stress_ratio_gear2": (dims, [np.nan, 1.05, 1.3]), "status": (dims, np.ones(3, np.int8))},
-                    coords={"a": [0, 1, 2]})
-    # the solid point has the least TE; the 30 % point is over the stress limit
-    assert pareto_table(ds)["pareto_ste_p2p"].values.tolist() == [1, 1, 0]
+    ds = xr.Dataset({"mass_saving_gear2": (dims, [0.0, 20.0, 30.0, 25.0]), "ste_p2p": (dims, [0.5, 0.7, 0.6, 0.4]),
+                     "root_stress_ratio_gear2": (dims, [1.0, 1.05, 1.3, np.nan]),
+                     "status": (dims, np.ones(4, np.int8))}, coords={"a": [0, 1, 2, 3]})
+    # the 30 % point is over the stress limit, the 25 % one has no known stress
+    assert pareto_table(ds)["pareto_ste_p2p"].values.tolist() == [1, 1, 0, 0]

@@ -39,9 +39,12 @@ def test_lightened_gear_root_stress_from_the_spring_fe_cached_with_the_map(priva
     assert float(ds["root_stress_max"].sel(gear=2)) == sigma.max()
     solid = float(springs.root_stress(s2.solid(), teeth=[0])[0]) / 1e6
     assert float(ds["root_stress_ratio"].sel(gear=2)) == pytest.approx(sigma.max() / solid, rel=1e-12)
-    # the solid driver runs no FE for its springs: NaN and the reason
-    assert np.isnan(ds["root_stress"].sel(gear=1)).all() and np.isnan(float(ds["root_stress_ratio"].sel(gear=1)))
+    # the solid driver runs no FE for its springs: no stress (NaN and the reason), but it is its
+    # own stress reference, ratio 1 by definition
+    assert np.isnan(ds["root_stress"].sel(gear=1)).all() and np.isnan(float(ds["root_stress_max"].sel(gear=1)))
+    assert float(ds["root_stress_ratio"].sel(gear=1)) == 1.0
     assert "gear 1: solid body" in ds["root_stress_max"].attrs["not_computed"]
+    assert "1 by definition for a solid gear" in ds["root_stress_ratio"].attrs["comment"]
     for v in ds.data_vars:
         assert ds[v].attrs["source"] and ds[v].attrs["units"]
     assert ds["mass"].attrs["source"].startswith("geometry") and ds["root_stress"].attrs["source"].startswith("FE")
@@ -57,6 +60,8 @@ def test_no_fe_is_started_for_the_root_stress_alone(monkeypatch, private_fe_cach
     ds = lightening_dataset(small_scene(**{"gear2.spring.stiffness": "uniform"}))
     assert np.isnan(ds["root_stress_max"]).all()
     assert "gear 2: springs 'uniform'" in ds["root_stress_max"].attrs["not_computed"]
+    # a lightened gear is not its own reference: without the FE its ratio is unknown
+    assert ds["root_stress_ratio"].values.tolist()[0] == 1.0 and np.isnan(float(ds["root_stress_ratio"].sel(gear=2)))
     assert float(ds["mass_saving"].sel(gear=2)) > 10.0
 
 

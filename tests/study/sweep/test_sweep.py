@@ -13,6 +13,7 @@ from study.run import run_scene
 from study.scene import default_scene
 from study.sweep.engine import parts_folder, run_sweep
 from study.sweep.outputs import SCALARS, STATUS
+from study.sweep.tasks import plan
 
 # ---------------------------------------------------------------- the sweep
 
@@ -21,7 +22,8 @@ def test_sweep_equals_each_point_run_alone(swept):
     ds = res.dataset
     # dotted keys nest (TOML): gear2.* fields come first, then the quoted "dynamic.speed"
     assert ds["status"].dims == ("n_holes", "web_thickness", "speed") and (ds["status"] == STATUS.index("ok")).all()
-    assert res.computed == 8 and res.reused == 0
+    # 4 bodies: 4 static analyses, each shared by both speeds; 8 dynamic runs
+    assert res.points == 8 and res.computed == 4 + 8 and res.reused == 0
     base = default_scene().replace(**{k: v for k, v in _flat(loads_scene_data()).items()})
     for h in (0, 4):
         for w in (50.0, 100.0):
@@ -35,8 +37,12 @@ def test_sweep_equals_each_point_run_alone(swept):
                 np.testing.assert_allclose(pt["ste"].values, alone["ste"].values, rtol=1e-12)
                 np.testing.assert_allclose(pt["dte_amplitude"].values, alone["dte_amplitude"].values, rtol=1e-12)
     assert (ds["ste_p2p"] > 0).all() and (ds["dte_rms"] > 0).all()
-    # STE does not depend on the speed
-    np.testing.assert_array_equal(ds["ste"].sel(speed=50.0), ds["ste"].sel(speed=100.0))
+    # the static outputs do not lie over the speed (the points above each ran their own statics
+    # at their own speed: the shared one equals them), the dynamic ones do
+    assert ds["ste"].dims == ("n_holes", "web_thickness", "angle") and ds["ste_p2p"].dims == ("n_holes", "web_thickness")
+    assert ds["mass_gear2"].dims == ("n_holes", "web_thickness")
+    assert ds["dte_rms"].dims == ds["status"].dims and ds["dte_amplitude"].dims[:-1] == ds["status"].dims
+    assert ds["ste_p2p"].attrs["analysis"] == "static" and ds["dte_rms"].attrs["analysis"] == "dynamic"
 
 
 def loads_scene_data():
@@ -65,16 +71,16 @@ def test_changed_code_recomputes_every_point(swept, tmp_path, monkeypatch):
     part files nor from a complete archive."""
     from study.report import results
     res, out = swept
-    keys = [p.key(tiny_study().outputs) for p in tiny_study().points()]
+    keys = set(plan(tiny_study(), tiny_study().points())[0])
     monkeypatch.setattr(results, "code_fingerprint", lambda: "another-version")
-    assert not set(keys) & {p.key(tiny_study().outputs) for p in tiny_study().points()}
+    assert not keys & set(plan(tiny_study(), tiny_study().points())[0])
     calls = []
     monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or {"status": "failed", "message": "new code",
                                                                                "wall_time": 0.0, "scalars": {}, "curves": {}})
     copy = tmp_path / "copy.nc"
     copy.write_bytes(out.read_bytes())
     again = run_sweep(tiny_study(), copy, workers=0, progress=False)
-    assert again.reused == 0 and len(calls) == 8
+    assert again.reused == 0 and len(calls) == 12
 
 
 def test_interrupt_and_resume_give_the_same_archive(swept, tmp_path, monkeypatch):
@@ -101,7 +107,7 @@ def test_interrupt_and_resume_give_the_same_archive(swept, tmp_path, monkeypatch
     calls.clear()
     monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or real(s, o))
     again = run_sweep(tiny_study(), out, workers=0, progress=False)
-    assert len(calls) == 5 and again.computed == 5 and again.reused == 3
+    assert len(calls) == 9 and again.computed == 9 and again.reused == 3
     drop = ["wall_time"]
     xr.testing.assert_identical(again.dataset.drop_vars(drop).assign_attrs(created="", history=""),
                                 res.dataset.drop_vars(drop).assign_attrs(created="", history=""))
@@ -141,7 +147,8 @@ scalars = ["ste_p2p", "dte_rms"]
     assert "gear2.body.hole_radius" in msg[1] and "cut the rim" in msg[1]
     assert msg[2].startswith("RuntimeError: boom")
     assert "dynamic run stopped" in msg[3]
-    assert res.invalid == 1 and res.computed == 3
+    # one static analysis (the three valid points differ only in dynamic.*) and three dynamic runs
+    assert res.invalid == 1 and res.computed == 1 + 3
     # diverged: the dynamic numbers are withheld, the static ones kept
     assert np.isnan(ds["dte_rms"][3]) and np.isfinite(ds["ste_p2p"][3]) and np.isfinite(ds["dte_rms"][0])
     assert np.isnan(ds["dte_rms"][1:3]).all()
@@ -194,7 +201,7 @@ def test_dask_sweep_is_interruptible_closes_its_cluster_and_resumes(swept, tmp_p
     real = sweep.run_point
     monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or real(s, o))
     again = run_sweep(tiny_study(), out, workers=0, progress=False)
-    assert again.reused == 2 and len(calls) == 6
+    assert again.reused == 2 and len(calls) == 10
     xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created="", history=""),
                                 res.dataset.drop_vars("wall_time").assign_attrs(created="", history=""))
 
@@ -205,7 +212,7 @@ def test_cli_sweep_of_the_example_study(tmp_path, capsys):
     from study.cli import main
     out = tmp_path / "ex.nc"
     assert main(["sweep", "study/scenes/example_study.toml", "-o", str(out), "--workers", "0", "--no-progress"]) == 0
-    assert "computed 4" in capsys.readouterr().out
+    assert "4 points; analyses computed 6" in capsys.readouterr().out     # 2 static, 4 dynamic
     with xr.open_dataset(out, engine="netcdf4") as ds:
         assert ds["dte"].dims == ("n_holes", "speed", "time") and ds["time"].attrs["units"] == "s"
         assert (ds["status"] == STATUS.index("ok")).all()
@@ -234,7 +241,7 @@ def test_sensitivity_workflow_shrunk_to_a_tiny_grid(tmp_path, capsys):
 
 def test_points_sharing_a_body_are_queued_apart():
     st = tiny_study("[grid]\ngear2.body.holes = [0, 4]\n\"dynamic.speed\" = [50.0, 60.0, 70.0]")
-    todo = {p.key(st.outputs): p.scene for p in st.points()}
+    todo = {str(p.index): p.scene for p in st.points()}
     order = list(sweep.interleave(todo).values())
     holes = [s.gear2.body.holes for s in order]
     assert sorted(holes) == [0, 0, 0, 4, 4, 4]

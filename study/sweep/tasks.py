@@ -1,0 +1,107 @@
+"""The analyses a study runs, each once for all the points that agree on the fields it reads.
+
+A point's outputs split into at most two tasks (`Outputs.parts`): the outputs that read no
+``dynamic.*`` field (STE, root stress, mass properties) and the ones that do (DTE; the modal
+outputs, linearised at the dynamic run's torque). A task is keyed by a hash of the
+scene fields its widest analysis reads (`outputs.ANALYSIS_FIELDS`), its outputs and the code
+(`results.code_fingerprint`): the points of a study that differ only in ``dynamic.*`` share
+their static task, and an edited study or a resumed one reuses every task it has in common.
+
+`point_result` puts a point's tasks back together into the record `archive.study_dataset`
+reads: the worst status (`WORST_FIRST`), the messages of the tasks not ok, the scalars of both,
+their curves or, for a task held without them, the key of the part file that has them, and the
+point's share of the compute time (a shared task's time split equally over its points).
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from collections import Counter
+from dataclasses import dataclass
+
+from study.scene import Scene
+from study.sweep.grid import Point, Study
+from study.sweep.outputs import Outputs, reads
+
+# a point's status: the first any of its tasks has (inaccurate: a run that completed, its energy
+# balance not closed: worse than ok, better than one that stopped)
+WORST_FIRST = ("invalid", "failed", "diverged", "inaccurate", "ok")
+
+
+@dataclass(frozen=True)
+class Task:
+    key: str
+    scene: Scene          # the scene of the first point that runs it (the fields it reads are the same for all)
+    outputs: Outputs
+
+
+def flat_fields(data: dict, prefix: str = "") -> dict:
+    """Nested tables -> {dotted path: value}."""
+    out = {}
+    for k, v in data.items():
+        path = f"{prefix}.{k}" if prefix else k
+        out.update(flat_fields(v, path) if isinstance(v, dict) else {path: v})
+    return out
+
+
+def task_key(scene: Scene, outputs: Outputs) -> str:
+    """Content hash of a task: the scene fields its outputs read, the outputs, the code."""
+    from study.report.results import code_fingerprint
+    analysis = outputs.widest
+    fields = {k: v for k, v in flat_fields(dataclasses.asdict(scene)).items() if reads(analysis, k)}
+    blob = json.dumps([fields, list(outputs.scalars), list(outputs.curves), code_fingerprint()],
+                      sort_keys=True, default=str)
+    return hashlib.sha256(blob.encode()).hexdigest()[:24]
+
+
+def point_task_keys(point: Point, outputs: Outputs) -> tuple[str, ...]:
+    """The keys of the tasks a valid point needs (none for an invalid one), in the order of
+    ``outputs.parts()``; computed once per outputs and code (a sweep asks several times)."""
+    from study.report.results import code_fingerprint
+    if point.scene is None:
+        return ()
+    code = code_fingerprint()
+    if (outputs, code) not in point._keys:
+        point._keys[outputs, code] = tuple(task_key(point.scene, part) for part in outputs.parts())
+    return point._keys[outputs, code]
+
+
+def plan(study: Study, points: list[Point]) -> tuple[dict[str, Task], dict[tuple, tuple[str, ...]]]:
+    """The tasks of a study ({key: Task}, first point first) and each valid point's task keys
+    ({point index: keys})."""
+    tasks: dict[str, Task] = {}
+    of_point = {}
+    for p in points:
+        if p.scene is None:
+            continue
+        keys = point_task_keys(p, study.outputs)
+        for key, part in zip(keys, study.outputs.parts()):
+            tasks.setdefault(key, Task(key, p.scene, part))
+        of_point[p.index] = keys
+    return tasks, of_point
+
+
+def point_result(keys: tuple[str, ...], results: dict, shared: Counter) -> dict | None:
+    """A point's record from its tasks' results (None while one is missing: the point is pending).
+    ``shared``: how many points use each task (its compute time is split over them). A task's
+    result held without its curves (`engine.without_curves`: ``curve_names`` only) gives them as
+    ``curve_keys`` ({curve: task key}), read from its part file when the archive is written."""
+    parts = [results.get(k) for k in keys]
+    if not parts or any(r is None for r in parts):
+        return None
+    status = next(s for s in WORST_FIRST if any(r["status"] == s for r in parts))
+    messages = list(dict.fromkeys(r["message"] for r in parts if r["status"] != "ok"))
+    scalars, curves, curve_keys = {}, {}, {}
+    for k, r in zip(keys, parts):
+        scalars.update(r["scalars"])
+        if "curves" in r:
+            curves.update(r["curves"])
+        else:
+            curve_keys.update(dict.fromkeys(r.get("curve_names", ()), k))
+    out = {"status": status, "message": "; ".join(messages) if messages else "ok",
+           "wall_time": sum(r["wall_time"] / shared[k] for k, r in zip(keys, parts)),
+           "scalars": scalars, "curves": curves}
+    if curve_keys:
+        out["curve_keys"] = curve_keys
+    return out
