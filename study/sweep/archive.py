@@ -16,7 +16,7 @@ In the grid layout an output lies only over the swept dimensions its analysis re
 ``mass_gear2`` over the body fields only; ``status`` says which points are ok (an output is
 read with ``.where(ds.status == 1)``, which broadcasts it over every dimension). In the point
 layout every variable lies over ``point``. Archives of a split study open together with
-``xr.open_mfdataset(paths, combine="by_coords", data_vars="minimal")`` (outputs that do not lie
+``xr.open_mfdataset(paths, combine="by_coords", data_vars="minimal", compat="no_conflicts")`` (outputs that do not lie
 over the split dimension are then taken once, checked equal).
 Global attributes: title, the study TOML, the base scene TOML, the study key (a hash of all
 its points), software versions, machine and date (`results.provenance`).

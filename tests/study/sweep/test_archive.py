@@ -46,12 +46,12 @@ def test_archives_of_split_studies_open_together(swept, tmp_path):
         run_sweep(tiny_study(grid), p, workers=0, progress=False)
         paths.append(p)
     # the static outputs do not lie over the split dimension (speed): taken once, checked equal
-    with xr.open_mfdataset(paths, engine="netcdf4", combine="by_coords", data_vars="minimal") as both:
+    with xr.open_mfdataset(paths, engine="netcdf4", combine="by_coords", data_vars="minimal", compat="no_conflicts") as both:
         both = both.load()
     assert both["ste_p2p"].dims == ("n_holes", "web_thickness")
     xr.testing.assert_equal(both.drop_vars("wall_time"), res.dataset.drop_vars("wall_time"))
     # with every variable concatenated they gain the split dimension, the same value along it
-    with xr.open_mfdataset(paths, engine="netcdf4", combine="by_coords", data_vars="all") as every:
+    with xr.open_mfdataset(paths, engine="netcdf4", combine="by_coords", data_vars="all", compat="no_conflicts") as every:
         every = every.load()
     ste = every["ste_p2p"].transpose("n_holes", "web_thickness", "speed")
     xr.testing.assert_equal(ste, res.dataset["ste_p2p"].broadcast_like(ste).transpose(*ste.dims))
