@@ -62,7 +62,8 @@ def main_effects_figure(ds: xr.Dataset, var: str, swept: list[str], path):
     for k in range(n, nrow * ncol):
         axes[k // ncol, k % ncol].set_visible(False)
     axes[0, 0].legend(fontsize=8, loc="best")
-    kept_n, total = int(kept(ds, var).notnull().sum()), int(np.prod([ds.sizes[d] for d in ds[var].dims]))
+    ok = kept(ds, var)         # over every point: an output over fewer dims is broadcast by the status
+    kept_n, total = int(ok.notnull().sum()), int(ok.size)
     note = "" if kept_n == total else f" ({kept_n} of {total} points ok)"
     figure_title(fig, ds, f"Main effects on {var}: {ds[var].attrs.get('long_name', var)}{note}",
                  width=int(9 * (3.6 * ncol + 0.6)))

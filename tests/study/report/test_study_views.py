@@ -1,5 +1,6 @@
 """Study views of a 5-dimension archive shaped like study/scenes/sensitivity.toml's grid, with
 synthetic outputs (no solver): every view is written, for any number of swept dimensions."""
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import xarray as xr
@@ -76,3 +77,26 @@ def test_the_tables_pass_cf_and_the_ranking_finds_what_the_synthetic_study_built
     assert set(flags.dims) == set(GRID) and flags.dtype == np.int8 and 2 <= int(flags.sum()) < 40
     assert float(ds["root_stress_ratio_gear2"].where(flags == 1).max()) <= 1.15
     assert flags.attrs["flag_meanings"] == "not_pareto pareto"
+
+
+def test_main_effects_count_points_of_an_output_stored_over_fewer_dimensions(tmp_path, monkeypatch):
+    """An STE stored over the body fields only (not over speed) is counted over every point of
+    the study, as the status that selects it is: one failed point of six is "5 of 6"."""
+    from study.report import study_views
+    titles = []
+
+    def keep_title(fig, path):
+        titles.append(fig._suptitle.get_text())
+        plt.close(fig)
+        return path
+    monkeypatch.setattr(study_views, "save_figure", keep_title)
+    ds = xr.Dataset({"ste_p2p": ("n_holes", np.array([1.0, 1.2, 1.5]), {"units": "um"})},
+                    coords={"n_holes": [0, 3, 6], "speed": [100.0, 200.0]})
+    status = np.ones((3, 2), np.int8)
+    status[1, 0] = 4
+    ds["status"] = (("n_holes", "speed"), status)
+    study_views.main_effects_figure(ds, "ste_p2p", ["n_holes", "speed"], tmp_path / "me.png")
+    assert "(5 of 6 points ok)" in titles[0]
+    ds["status"][:] = 1
+    study_views.main_effects_figure(ds, "ste_p2p", ["n_holes", "speed"], tmp_path / "me.png")
+    assert "points ok" not in titles[1]
