@@ -86,7 +86,8 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
                 mesh_harmonics: int = 5, hole_harmonics: int = 2, unexplained: int = 4,
                 min_order: float = 0.5) -> list[Peak]:
     """The amplitude found at each named order and the ``unexplained`` largest local maxima that
-    lie outside every named order's main lobe (names "other 1", ...; NaN when fewer).
+    lie outside every named order's main lobe and off the higher mesh harmonics kZ (and kZ+-N)
+    the table does not name (names "other 1", ...; NaN when fewer).
 
     A named order's amplitude is the largest value within the Hann main lobe (+-2 resolution
     bins) of the nominal order, but no nearer to another named order (or to order 0) than half
@@ -118,6 +119,11 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
     is_max = np.zeros(amp.size, bool)
     is_max[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] > amp[2:])
     is_max &= order >= min_order
+    # mesh harmonics beyond the named ones (and their hole sidebands) are explained too
+    if np.isfinite(mesh_order) and mesh_order > 0 and order.size:
+        k = np.arange(mesh_harmonics + 1, int(order.max() / mesh_order) + 2)
+        side = hole_order if np.isfinite(hole_order) and hole_order > 0 else 0.0
+        nominal = np.concatenate([nominal, k * mesh_order, k * mesh_order - side, k * mesh_order + side])
     if nominal.size:
         is_max &= np.min(np.abs(order[:, None] - nominal[None, :]), axis=1) > tol
     idx = np.flatnonzero(is_max)

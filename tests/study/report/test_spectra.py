@@ -73,7 +73,9 @@ def test_named_peaks_find_mesh_hole_sidebands_and_the_unexplained():
     z, n = 30, 5
     o = np.arange(0, 200, 0.125)
     amp = np.full(o.size, 1e-4)
-    for order, a in ((n, 0.2), (z, 1.0), (2 * z, 0.3), (z + n, 0.05), (47.0, 0.4), (101.0, 0.1)):
+    # 6Z and 6Z+N lie beyond the named table (5 mesh harmonics): still mesh orders, not "other"
+    for order, a in ((n, 0.2), (z, 1.0), (2 * z, 0.3), (z + n, 0.05), (47.0, 0.4), (101.0, 0.1), (6 * z, 0.5),
+                     (6 * z + n, 0.45)):
         amp[np.argmin(abs(o - order))] = a
     peaks = {p.name: p for p in named_peaks(o, amp, n, z, resolution=0.5)}
     assert peaks["Z"].amplitude == 1.0 and peaks["Z"].order == z
