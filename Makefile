@@ -28,7 +28,8 @@ $(STAMP): pyproject.toml requirements.lock | sysdeps
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -r requirements.lock
-	$(PY) -m pip install -q --no-deps -e .
+	@# -qq: setuptools prints a notice on every editable install (any mode), not a problem of this package
+	$(PY) -m pip install -qq --no-deps -e .
 	touch $(STAMP)
 
 # Off-screen rendering (pyvista/VTK) and gmsh need a few shared libraries from the OS.
