@@ -5,7 +5,7 @@ the most mass while its STE peak-to-peak and its DTE RMS at the given speed stay
 factors of the solid gear's (no holes, web as thick as the face) and its largest root stress
 within a limit (relative to the solid gear's, and optionally in MPa):
 
-    python -m workflows.lightest_gear [SCENE.toml] [--ste-factor 2.0] [--dte-factor 2.0]
+    python -m workflows.lightest_gear [SCENE.toml] [--ste-factor 2.0] [--dte-factor 4.0]
         [--stress-ratio 1.15] [--stress-max MPA] [--speed 100] [--grid gear2.body.holes=3,6,9 ...]
         [--refine 2] [-o results/lightest_gear] [--workers N]
 
@@ -23,7 +23,9 @@ within a limit (relative to the solid gear's, and optionally in MPa):
 
 The default factors are wide because the solid paper gear's STE is small (0.33 um peak-to-peak):
 every body of the default grid raises it by at least 45 % (its web, 10 mm or less of the 17 mm
-face, softens every tooth), most by more than 80 %.
+face, softens every tooth), most by more than 80 %. The DTE factor is wider still: damped at 5 %
+of critical on its mesh mode (the scene default), the solid gear's DTE RMS at 100 rad/s is only
+0.084 um, and the holes add their own orders: every body of the grid raises it 2.5 to 10 times.
 
 Exit codes: 0 an answer; 1 no body of the grid meets the limits (the nearest miss is printed)
 or points lost to failed workers; 2 invalid options or scene fields (one line naming them).
@@ -67,7 +69,7 @@ SCALARS = ["ste_p2p", "dte_rms", "mass_gear2", "mass_saving_gear2", "inertia_gea
 @dataclass(frozen=True)
 class Limits:
     ste_factor: float = 2.0           # STE p2p over the solid gear's [1]
-    dte_factor: float = 2.0           # DTE RMS over the solid gear's [1]
+    dte_factor: float = 4.0           # DTE RMS over the solid gear's [1]
     stress_ratio: float = 1.15        # largest root stress over the solid gear's [1]
     stress_max: float = math.inf      # largest root stress [MPa]
 
@@ -240,7 +242,7 @@ def run(args) -> int:
     mask = feasible(table, solid, limits)
     order = ranked(table, mask)
     figure = tradeoff(table, solid_table, limits, order[0] if order else None, out / "tradeoff.png",
-                      f"lightest driven gear at {args.speed:g} rad/s: {scene.title}")
+                      f"lightest driven-gear body at {args.speed:g} rad/s (bodies varied from the scene: {scene.title})")
     if order:
         text = answer(_row(table, order[0]), solid, args.speed)
     else:
