@@ -7,6 +7,12 @@ Phase 1 (pre-search, O(1) per tooth pair): a gear-1 tooth can touch its neighbou
 Phase 2 (detailed search): closed-form flank-to-flank penetration along the common tangent
 of the moved base circles, or tip corner to flank (see `contact.py`).
 
+Profile modifications (`solver.modification`, gear_par columns DEV_*): the penetration of a
+contact point is reduced by each flank's deviation at that point's roll parameter (the tip
+corner: the deviation at the tip). Small-deviation approximation: the force keeps the
+involutes' line of action; the gradient of a flank-flank contact takes the deviation's slope
+(d u/d theta = s on both gears), a tip-corner contact's keeps the rigid one.
+
 State: theta1, theta2 hub angles [rad] (counter-clockwise positive), phi[Z1+Z2] tooth
 rotations about their pivots relative to the hub [rad], gear-1 teeth first.
 """
@@ -66,20 +72,37 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _record(rec, nc, hit, own, ids, frame, vel, lp):
+def flank_deviation(row, u):
+    """Deviation [m] of the flanks of the gear whose gear_par row is ``row`` at roll parameter
+    u (linear on the DEV grid, constant beyond its ends) and its slope d deviation / d u [m]."""
+    x = (u - row[L.DEV_U0]) / row[L.DEV_DU]
+    last = L.N_DEV - 1
+    if x <= 0.0:
+        return row[L.DEV0], 0.0
+    if x >= last:
+        return row[L.DEV0 + last], 0.0
+    i = int(x)
+    a = row[L.DEV0 + i]
+    b = row[L.DEV0 + i + 1]
+    return a + (x - i) * (b - a), (b - a) / row[L.DEV_DU]
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _record(rec, nc, hit, own, ids, frame, vel, lp, dg):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
     flank-flank case), -1 when gear 2 does; ids = (gear-1 tooth, gear-2 tooth, kind);
     frame = (O1, pivot A, O2, pivot B) as x, y pairs [m]; vel = (theta1', phi_A', theta2',
     phi_B') [rad/s]. The gradient G = d delta/d(theta1, phi_A, theta2, phi_B): the owner's
-    entries +(x - centre) x n, the other gear's negative."""
+    entries +(x - centre) x n, the other gear's negative, plus dg = (gear 1's, gear 2's)
+    change of the flank deviations per radian [m]."""
     delta, px, py, nx, ny = hit
     o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
     w1, wa, w2, wb = vel
-    g1 = own * cross(px - o1x, py - o1y, nx, ny)
-    ga = own * cross(px - pvax, py - pvay, nx, ny)
-    g2 = -own * cross(px - o2x, py - o2y, nx, ny)
-    gb = -own * cross(px - pvbx, py - pvby, nx, ny)
+    g1 = own * cross(px - o1x, py - o1y, nx, ny) + dg[0]
+    ga = own * cross(px - pvax, py - pvay, nx, ny) + dg[0]
+    g2 = -own * cross(px - o2x, py - o2y, nx, ny) + dg[1]
+    gb = -own * cross(px - pvbx, py - pvby, nx, ny) + dg[1]
     ddelta = g1 * w1 + ga * wa + g2 * w2 + gb * wb
     f = contact_force(delta, ddelta, lp[L.K_CON], lp[L.M1], lp[L.C_CON], lp[L.M2], lp[L.M3])
     rec[nc, L.C_DELTA] = delta
@@ -116,6 +139,9 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     # phase 1b: rigid gap bound
     te = gp[0, L.RB] * theta1 + gp[1, L.RB] * theta2
     bound = s * te - pp[L.JN_HALF] + abs(pa) * gp[0, L.R_BND] + abs(pb) * gp[1, L.R_BND]
+    modified = gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0
+    if modified:
+        bound += gp[0, L.DEV_NEG] + gp[1, L.DEV_NEG]
     if bound <= 0.0:
         return nc
     o1x, o1y = gp[0, L.CX], gp[0, L.CY]
@@ -133,9 +159,15 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
+        dg = (0.0, 0.0)
+        if modified:
+            da, sa = flank_deviation(gp[0], ua)
+            db, sb = flank_deviation(gp[1], ub)
+            delta -= da + db
+            dg = (-s * sa, -s * sb)
         if delta > 0.0 and nc < rec.shape[0]:
             # owner A (gear 1)
-            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp)
+            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg)
             nc += 1
         return nc
     flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
@@ -148,9 +180,11 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             qx, qy = tip_corner(cx, cy, rb, b, s, gp[g, L.U_HI])
             cx, cy, rb, b = flanks[f]
             d, uf, mx, my = point_flank(qx, qy, cx, cy, rb, b, s)
+            if modified:
+                d -= flank_deviation(gp[g], gp[g, L.U_HI])[0] + flank_deviation(gp[f], uf)[0]
             if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
                 _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
-                        frame, vel, lp)
+                        frame, vel, lp, (0.0, 0.0))
                 nc += 1
     return nc
 

@@ -6,6 +6,9 @@ K = sum_c k_t G G^T + diag(spring tangents), with continuation from the previous
 a backtracking line search on the residual. The spring tangent n*k*|phi|^(n-1) vanishes at
 phi = 0 for n > 1, so a tiny diagonal term (1e-9 of the tooth's k_phi) regularises teeth
 that carry no load; the residual, and so the solution, is exact.
+
+The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
+the gear_par columns DEV_* (`solver.modification`).
 """
 
 import numpy as np
