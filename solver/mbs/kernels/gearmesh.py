@@ -9,9 +9,10 @@ of the moved base circles, or tip corner to flank (see `contact.py`).
 
 Profile modifications (`solver.modification`, gear_par columns DEV_*): the penetration of a
 contact point is reduced by each flank's deviation at that point's roll parameter (the tip
-corner: the deviation at the tip). Small-deviation approximation: the force keeps the
-involutes' line of action; the gradient of a flank-flank contact takes the deviation's slope
-(d u/d theta = s on both gears), a tip-corner contact's keeps the rigid one.
+corner: the deviation at the tip), less the second-order shift of the touching point along the
+flanks (`deviation_gap`). Small-deviation approximation: the force keeps the involutes' line of
+action; the gradient of a flank-flank contact takes the deviation's slope (d u/d theta = s on
+both gears), a tip-corner contact's keeps the rigid one.
 
 State: theta1, theta2 hub angles [rad] (counter-clockwise positive), phi[Z1+Z2] tooth
 rotations about their pivots relative to the hub [rad], gear-1 teeth first.
@@ -88,6 +89,27 @@ def flank_deviation(row, u):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
+def deviation_gap(gp, ua, ub):
+    """Separation [m] that both flanks' deviations add at a flank-flank contact at rolls ua, ub
+    of the involutes, and the deviations' slopes d dev/d u [m] of gear 1 and gear 2.
+
+    To second order: near the contact the involutes part as kappa*x**2/2 along their common
+    tangent (kappa = 1/rho_a + 1/rho_b, rho = rb*u the radii of curvature) while the deviations
+    change at sigma = dev_a'/rho_a - dev_b'/rho_b per unit of x (the contact runs up flank A and
+    down flank B): the modified flanks first touch at x = sigma/kappa, sigma**2/(2*kappa) closer
+    than the deviations at the involutes' contact point."""
+    da, sa = flank_deviation(gp[0], ua)
+    db, sb = flank_deviation(gp[1], ub)
+    gap = da + db
+    ra = gp[0, L.RB] * ua
+    rb = gp[1, L.RB] * ub
+    if ra > 0.0 and rb > 0.0:
+        sig = sa / ra - sb / rb
+        gap -= 0.5 * sig * sig * ra * rb / (ra + rb)
+    return gap, sa, sb
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
 def _record(rec, nc, hit, own, ids, frame, vel, lp, dg):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
@@ -161,9 +183,8 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
         dg = (0.0, 0.0)
         if modified:
-            da, sa = flank_deviation(gp[0], ua)
-            db, sb = flank_deviation(gp[1], ub)
-            delta -= da + db
+            gap, sa, sb = deviation_gap(gp, ua, ub)
+            delta -= gap
             dg = (-s * sa, -s * sb)
         if delta > 0.0 and nc < rec.shape[0]:
             # owner A (gear 1)
