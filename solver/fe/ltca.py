@@ -36,9 +36,8 @@ TE = rb1*theta1 + rb2*theta2 of the hubs = jn/2 + w (rigid teeth in drive contac
 backlash offset jn/2), the same convention and zero as the pseudo-rigid model.
 
 Profile modifications (`solver.modification`) add each flank's deviation at the contact
-point's roll parameter (a tip corner: at the tip) to the initial separation e_i, less the
-second-order shift of the touching point, as in the contact search of the pseudo-rigid model
-(`solver.mbs.kernels.gearmesh.deviation_gap`).
+point's roll parameter (a tip corner: at the tip) to the initial separation e_i, as in the
+contact search of the pseudo-rigid model (first order: `solver.mbs.kernels.gearmesh`).
 
 Approximation: corner contacts are loaded along the line of action at the tip-corner roll
 (their true normal turns by a few degrees); their moment arm is taken as the base radius.
@@ -58,7 +57,7 @@ from solver.fe.body import BodyModel, LoadCase, load_case
 from solver.geometry import GearGeometry
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.contact import point_flank, tip_corner
-from solver.mbs.kernels.gearmesh import candidate_pairs, deviation_gap, flank_deviation
+from solver.mbs.kernels.gearmesh import candidate_pairs, flank_deviation
 from solver.mbs.model import Model
 
 # ------------------------------------------------------------------ influence coefficients
@@ -289,10 +288,7 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
     a = np.array(rows, dtype=float).reshape(-1, 6)
     gap = np.maximum(a[:, 4], 0.0)
     for i in range(a.shape[0]):
-        if a[i, 5] == 1:
-            gap[i] += deviation_gap(gp, a[i, 2], a[i, 3])[0]
-        else:
-            gap[i] += flank_deviation(gp[0], a[i, 2])[0] + flank_deviation(gp[1], a[i, 3])[0]
+        gap[i] += flank_deviation(gp[0], a[i, 2])[0] + flank_deviation(gp[1], a[i, 3])[0]
     return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int))
 
 

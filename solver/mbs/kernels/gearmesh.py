@@ -9,10 +9,13 @@ of the moved base circles, or tip corner to flank (see `contact.py`).
 
 Profile modifications (`solver.modification`, gear_par columns DEV_*): the penetration of a
 contact point is reduced by each flank's deviation at that point's roll parameter (the tip
-corner: the deviation at the tip), less the second-order shift of the touching point along the
-flanks (`deviation_gap`). Small-deviation approximation: the force keeps the involutes' line of
-action; the gradient of a flank-flank contact takes the deviation's slope (d u/d theta = s on
-both gears), a tip-corner contact's keeps the rigid one.
+corner: the deviation at the tip). First order in the deviations: the force keeps the
+involutes' line of action, and the modified flanks touch where the involutes do (the true
+first touch is closer by sigma**2/(2*kappa), sigma the deviations' slope per length of flank,
+kappa the relative curvature: tens of nm for a 10 um relief; a kinked profile gives no smooth
+term to add). The gradient of a flank-flank contact carries the deviations' change with the
+roll parameters, which the tooth rotations also change by turning the line of action; a
+tip-corner contact's keeps the rigid one.
 
 State: theta1, theta2 hub angles [rad] (counter-clockwise positive), phi[Z1+Z2] tooth
 rotations about their pivots relative to the hub [rad], gear-1 teeth first.
@@ -89,24 +92,10 @@ def flank_deviation(row, u):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def deviation_gap(gp, ua, ub):
-    """Separation [m] that both flanks' deviations add at a flank-flank contact at rolls ua, ub
-    of the involutes, and the deviations' slopes d dev/d u [m] of gear 1 and gear 2.
-
-    To second order: near the contact the involutes part as kappa*x**2/2 along their common
-    tangent (kappa = 1/rho_a + 1/rho_b, rho = rb*u the radii of curvature) while the deviations
-    change at sigma = dev_a'/rho_a - dev_b'/rho_b per unit of x (the contact runs up flank A and
-    down flank B): the modified flanks first touch at x = sigma/kappa, sigma**2/(2*kappa) closer
-    than the deviations at the involutes' contact point."""
-    da, sa = flank_deviation(gp[0], ua)
-    db, sb = flank_deviation(gp[1], ub)
-    gap = da + db
-    ra = gp[0, L.RB] * ua
-    rb = gp[1, L.RB] * ub
-    if ra > 0.0 and rb > 0.0:
-        sig = sa / ra - sb / rb
-        gap -= 0.5 * sig * sig * ra * rb / (ra + rb)
-    return gap, sa, sb
+def _tangent_turn(dx, dy, length, kc, ddx, ddy):
+    """Change of the common tangent's angle ta [rad] of two base circles whose centre offset
+    (dx, dy) [m] (length [m]) changes by (ddx, ddy) [m]; kc = (rb_a + rb_b)/(L**2 sqrt(1 - c**2))."""
+    return (dx * ddy - dy * ddx) / (length * length) - kc * (dx * ddx + dy * ddy) / length
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -116,15 +105,15 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg):
     flank-flank case), -1 when gear 2 does; ids = (gear-1 tooth, gear-2 tooth, kind);
     frame = (O1, pivot A, O2, pivot B) as x, y pairs [m]; vel = (theta1', phi_A', theta2',
     phi_B') [rad/s]. The gradient G = d delta/d(theta1, phi_A, theta2, phi_B): the owner's
-    entries +(x - centre) x n, the other gear's negative, plus dg = (gear 1's, gear 2's)
-    change of the flank deviations per radian [m]."""
+    entries +(x - centre) x n, the other gear's negative, plus dg, the same four of the flank
+    deviations' part [m]."""
     delta, px, py, nx, ny = hit
     o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
     w1, wa, w2, wb = vel
     g1 = own * cross(px - o1x, py - o1y, nx, ny) + dg[0]
-    ga = own * cross(px - pvax, py - pvay, nx, ny) + dg[0]
-    g2 = -own * cross(px - o2x, py - o2y, nx, ny) + dg[1]
-    gb = -own * cross(px - pvbx, py - pvby, nx, ny) + dg[1]
+    ga = own * cross(px - pvax, py - pvay, nx, ny) + dg[1]
+    g2 = -own * cross(px - o2x, py - o2y, nx, ny) + dg[2]
+    gb = -own * cross(px - pvbx, py - pvby, nx, ny) + dg[3]
     ddelta = g1 * w1 + ga * wa + g2 * w2 + gb * wb
     f = contact_force(delta, ddelta, lp[L.K_CON], lp[L.M1], lp[L.C_CON], lp[L.M2], lp[L.M3])
     rec[nc, L.C_DELTA] = delta
@@ -181,11 +170,24 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
-        dg = (0.0, 0.0)
+        dg = (0.0, 0.0, 0.0, 0.0)
         if modified:
-            gap, sa, sb = deviation_gap(gp, ua, ub)
-            delta -= gap
-            dg = (-s * sa, -s * sb)
+            da, sa = flank_deviation(gp[0], ua)
+            db, sb = flank_deviation(gp[1], ub)
+            delta -= da + db
+            # d(da + db)/dq = sa*dua/dq + sb*dub/dq, ua = s*(beta_a - ta), ub = s*(beta_b - ta - pi):
+            # the tangent angle ta turns as the tooth rotations move the base-circle centres
+            dx, dy = cbx - cax, cby - cay
+            ln = math.sqrt(dx * dx + dy * dy)
+            c = (rba + rbb) / ln
+            kc = s * (rba + rbb) / (ln * ln * math.sqrt(1.0 - c * c))
+            ra, rb_ = gp[0, L.R_PV], gp[1, L.R_PV]
+            t1 = _tangent_turn(dx, dy, ln, kc, ra * (math.sin(axa) - math.sin(axa + pa)), ra * (math.cos(axa + pa) - math.cos(axa)))
+            ta_ = _tangent_turn(dx, dy, ln, kc, -ra * math.sin(axa + pa), ra * math.cos(axa + pa))
+            t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (math.sin(axb + pb) - math.sin(axb)), rb_ * (math.cos(axb) - math.cos(axb + pb)))
+            tb = _tangent_turn(dx, dy, ln, kc, rb_ * math.sin(axb + pb), -rb_ * math.cos(axb + pb))
+            dg = (-s * (sa * (1.0 - t1) - sb * t1), -s * (sa * (1.0 - ta_) - sb * ta_),
+                  -s * (-sa * t2 + sb * (1.0 - t2)), -s * (-sa * tb + sb * (1.0 - tb)))
         if delta > 0.0 and nc < rec.shape[0]:
             # owner A (gear 1)
             _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg)
@@ -205,7 +207,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
                 d -= flank_deviation(gp[g], gp[g, L.U_HI])[0] + flank_deviation(gp[f], uf)[0]
             if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
                 _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
-                        frame, vel, lp, (0.0, 0.0))
+                        frame, vel, lp, (0.0, 0.0, 0.0, 0.0))
                 nc += 1
     return nc
 

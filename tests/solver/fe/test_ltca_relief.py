@@ -40,9 +40,8 @@ def test_reference_and_statics_agree_on_a_relieved_pair():
 
 
 def test_reference_gaps_hold_the_deviations():
-    """The LTCA's initial separation of a flank contact grows by the relief at the contact roll,
-    less the second-order shift of the touching point sigma**2/(2*kappa) (sigma the relief's
-    slope per unit length of flank, kappa the flanks' relative curvature)."""
+    """The LTCA's initial separation of a flank contact grows by the relief at the contact roll
+    (to within the rounding of the relief's kink by the deviation table)."""
     plain = small_scene()
     s = plain.replace(**{"gear1.modification.tip_relief": 10.0, "gear1.modification.tip_length": 4.0})
     m0, m1 = geometry_model(plain), geometry_model(s)
@@ -53,11 +52,8 @@ def test_reference_gaps_hold_the_deviations():
         a, b = mesh_points(m0, th), mesh_points(m1, th)
         np.testing.assert_array_equal(a.u1, b.u1)
         dev = mod.deviation(b.u1, g.u_form, g.u_tip)
-        slope = (mod.deviation(b.u1 + 1e-7, g.u_form, g.u_tip) - mod.deviation(b.u1 - 1e-7, g.u_form, g.u_tip)) / 2e-7
-        rho1, rho2 = g.base_radius * b.u1, m1.geometry[1].base_radius * b.u2
-        shift = (slope / rho1) ** 2 / (2 * (1 / rho1 + 1 / rho2))     # where the modified flanks first touch
         flank = b.kind == 1
         table = 10e-6 / (4e-3 / g.base_radius) * m1.gear_par[0, L.DEV_DU] / 4    # the table's rounding of the kink
-        np.testing.assert_allclose((b.gap - a.gap)[flank], (dev - shift)[flank], atol=table + 1e-12, rtol=0)
+        np.testing.assert_allclose((b.gap - a.gap)[flank], dev[flank], atol=table + 1e-12, rtol=0)
         seen = max(seen, float(np.max(dev[flank], initial=0.0)))
     assert seen > 1e-6                          # a relieved contact was among them
