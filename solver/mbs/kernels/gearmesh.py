@@ -78,7 +78,9 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
 @njit(cache=True, no_cfunc_wrapper=True)
 def flank_deviation(row, u):
     """Deviation [m] of the flanks of the gear whose gear_par row is ``row`` at roll parameter
-    u (linear on the DEV grid, constant beyond its ends) and its slope d deviation / d u [m]."""
+    u, and its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV
+    grid, so that the slope is continuous (Newton in the statics does not chatter across grid
+    nodes) and linear stretches are exact; constant beyond the grid's ends."""
     x = (u - row[L.DEV_U0]) / row[L.DEV_DU]
     last = L.N_DEV - 1
     if x <= 0.0:
@@ -86,9 +88,16 @@ def flank_deviation(row, u):
     if x >= last:
         return row[L.DEV0 + last], 0.0
     i = int(x)
-    a = row[L.DEV0 + i]
-    b = row[L.DEV0 + i + 1]
-    return a + (x - i) * (b - a), (b - a) / row[L.DEV_DU]
+    t = x - i
+    p1 = row[L.DEV0 + i]
+    p2 = row[L.DEV0 + i + 1]
+    m1 = p2 - p1 if i == 0 else 0.5 * (p2 - row[L.DEV0 + i - 1])
+    m2 = p2 - p1 if i + 1 == last else 0.5 * (row[L.DEV0 + i + 2] - p1)
+    t2 = t * t
+    t3 = t2 * t
+    dev = (2.0 * t3 - 3.0 * t2 + 1.0) * p1 + (t3 - 2.0 * t2 + t) * m1 + (3.0 * t2 - 2.0 * t3) * p2 + (t3 - t2) * m2
+    dx = (6.0 * t2 - 6.0 * t) * (p1 - p2) + (3.0 * t2 - 4.0 * t + 1.0) * m1 + (3.0 * t2 - 2.0 * t) * m2
+    return dev, dx / row[L.DEV_DU]
 
 
 @njit(cache=True, no_cfunc_wrapper=True)

@@ -30,7 +30,7 @@ C_BODY = 20     # body spring damping [N m s/rad] (linear)
 DEV_ON = 21     # 1: the gear has a nonzero deviation (0: the search skips it)
 DEV_U0 = 22     # roll parameter of the first grid point [-]
 DEV_DU = 23     # grid step [-]
-DEV_NEG = 24    # largest material addition (-min deviation, >= 0) [m]
+DEV_NEG = 24    # bound on the material addition (-min deviation, >= 0, plus the cubic's undershoot) [m]
 DEV0 = 25       # first of the N_DEV deviations [m]
 N_DEV = 257
 N_GEAR_PAR = DEV0 + N_DEV
