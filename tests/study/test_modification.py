@@ -87,3 +87,21 @@ def test_bad_modifications_name_the_field(over, field, words):
     with pytest.raises(SceneError) as e:
         default_scene().replace(**over)
     assert e.value.field == field and words in e.value.reason
+
+
+def test_relief_scene_and_study_load():
+    """The embedded relief scene relieves both tips by its stated amount over the double-contact
+    stretch of the path of contact; its study builds its 48 points without error."""
+    from pathlib import Path
+
+    from study.scene import load_scene
+    from study.sweep.grid import load_study
+    here = Path(__file__).resolve().parents[2] / "study" / "scenes"
+    s = load_scene(here / "paper_relief.toml")
+    m = geometry_model(s)
+    length = (m.pair.contact_ratio - 1.0) * m.pair.base_pitch * 1e3
+    for g in (1, 2):
+        mod = s.gear(g).modification
+        assert mod.tip_relief == 2.0 and mod.tip_length == pytest.approx(length, abs=0.01)
+    st = load_study(here / "relief_study.toml")
+    assert len(st.points()) == 48 and all(p.scene is not None for p in st.points())
