@@ -23,6 +23,7 @@ from solver import units
 from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
 from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
+from study.modification import ModificationSection, modification_spec
 from study.toml_writer import dumps_toml
 
 
@@ -88,6 +89,7 @@ class GearSection:
     pivot_radius: float = _f(0.0, "mm", "radius of the tooth pivot on the tooth axis; 0 = root circle", 0.0)
     body: BodySection = field(default_factory=BodySection)
     spring: SpringSection = field(default_factory=SpringSection)
+    modification: ModificationSection = field(default_factory=ModificationSection)
 
 
 @dataclass(frozen=True)
@@ -202,6 +204,10 @@ class Scene:
         gs = self.gear(g)
         return gs.body.holes > 0 or (gs.body.web_height > 0 and gs.body.web_thickness < gs.face_width)
 
+    def modification_spec(self, g: int):
+        """Gear g's profile modification in SI (`solver.modification`), None for perfect involutes."""
+        return modification_spec(self.gear(g).modification, gear_geometry(self.tooth_spec(g)), f"gear{g}.modification")
+
     def pivot_radius(self, g: int) -> float:
         """Tooth pivot radius [m]; the root circle when the scene gives 0."""
         r = self.gear(g).pivot_radius
@@ -223,6 +229,10 @@ class Scene:
 
 def _coerce(value, typ, path):
     """``value`` as ``typ`` (bool, int, float or str), else SceneError; a bool is no number."""
+    if typ == tuple[float, ...]:    # a list of numbers (a table's column)
+        if not isinstance(value, list | tuple):
+            raise SceneError(path, f"must be a list of numbers, got {value!r}")
+        return tuple(_coerce(x, float, path) for x in value)
     number = isinstance(value, int | float) and not isinstance(value, bool)
     if (typ is bool and isinstance(value, bool)) or (typ is str and isinstance(value, str)):
         return value
@@ -261,7 +271,7 @@ def _build(cls, table, path: str):
         if md.get("choices") and v not in md["choices"]:
             raise SceneError(where, f"must be one of {', '.join(map(repr, md['choices']))}, got {v!r}")
         lo, hi = md.get("lo"), md.get("hi")
-        if lo is not None and (v < lo or (md.get("lo_open") and v == lo)):
+        if lo is not None and not isinstance(v, tuple) and (v < lo or (md.get("lo_open") and v == lo)):
             rel = ">" if md.get("lo_open") else ">="
             raise SceneError(where, f"must be {rel} {lo}{unit}, got {v}{unit}")
         if hi is not None and v > hi:
@@ -282,6 +292,7 @@ def check_scene(scene: Scene) -> None:
             gs = scene.gear(g)
             if gs.pivot_radius > 0 and not (geo.base_radius * 0.5 < gs.pivot_radius * units.MM < geo.tip_radius):
                 raise GeometryError(f"gear{g}.pivot_radius", f"must lie between half the base radius and the tip radius ({geo.tip_radius * 1e3:.4g} mm), got {gs.pivot_radius} mm")
+            modification_spec(gs.modification, geo, f"gear{g}.modification")
         pair_geometry(*geoms)
     except GeometryError as e:
         raise SceneError(e.field, e.reason) from None

@@ -35,6 +35,10 @@ adding the most violated gap and dropping negative forces until both conditions 
 TE = rb1*theta1 + rb2*theta2 of the hubs = jn/2 + w (rigid teeth in drive contact read the
 backlash offset jn/2), the same convention and zero as the pseudo-rigid model.
 
+Profile modifications (`solver.modification`) add each flank's deviation at the contact
+point's roll parameter (a tip corner: at the tip) to the initial separation e_i, as in the
+contact search of the pseudo-rigid model (first order: `solver.mbs.kernels.gearmesh`).
+
 Approximation: corner contacts are loaded along the line of action at the tip-corner roll
 (their true normal turns by a few degrees); their moment arm is taken as the base radius.
 
@@ -53,7 +57,7 @@ from solver.fe.body import BodyModel, LoadCase, load_case
 from solver.geometry import GearGeometry
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.contact import point_flank, tip_corner
-from solver.mbs.kernels.gearmesh import candidate_pairs
+from solver.mbs.kernels.gearmesh import candidate_pairs, flank_deviation
 from solver.mbs.model import Model
 
 # ------------------------------------------------------------------ influence coefficients
@@ -247,8 +251,10 @@ class MeshPoints:
 
 def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoints:
     """Candidate drive-side contacts at driver angle theta1 [rad] with the rigid bodies at the
-    zero-load drive contact (TE = jn/2); pairs separated by more than ``max_gap`` [m] are left out."""
+    zero-load drive contact (TE = jn/2); pairs separated by more than ``max_gap`` [m] are left out
+    (plus the largest flank deviation of either gear: a relieved tip is still a candidate)."""
     gp, pp = model.gear_par, model.pair_par
+    max_gap += float(np.abs(gp[:, L.DEV0:L.DEV0 + L.N_DEV]).max())
     jn2 = float(pp[L.JN_HALF])
     theta2 = float(model.theta2_for_te(theta1, jn2))
     pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
@@ -280,8 +286,10 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
             if gp[0, L.U_LO] <= uf <= gp[0, L.U_HI] and -d < max_gap:
                 rows.append((k, j, uf, gp[1, L.U_HI], -d, 3))
     a = np.array(rows, dtype=float).reshape(-1, 6)
-    return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], np.maximum(a[:, 4], 0.0),
-                      a[:, 5].astype(int))
+    gap = np.maximum(a[:, 4], 0.0)
+    for i in range(a.shape[0]):
+        gap[i] += flank_deviation(gp[0], a[i, 2])[0] + flank_deviation(gp[1], a[i, 3])[0]
+    return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int))
 
 
 # ------------------------------------------------------------------ contact problem

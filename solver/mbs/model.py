@@ -27,6 +27,7 @@ from solver.geometry import (
 )
 from solver.inertia import body_inertia, hole_inertia, tooth_inertia
 from solver.mbs.kernels import layout as L
+from solver.modification import ProfileModification, sample
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,7 @@ class GearInput:
     body_stiffness: float = math.inf    # hub -> rim torsion spring, N·m/rad (inf: rigid body)
     body_damping_ratio: float = 0.02    # of critical on the body mode (as the teeth's 2 %)
     tooth_compliance: np.ndarray | None = None  # (Z, Z) rad/(N·m): teeth coupled through the body
+    modification: ProfileModification | None = None  # flank deviation (relief, table); None: perfect involutes
 
 
 @dataclass(frozen=True)
@@ -179,6 +181,9 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
         gp[i, L.N_C] = gi.n_c
         gp[i, L.TOOTH0] = tooth0[i]
         gp[i, L.NZ] = g.teeth
+        if gi.modification is not None:
+            gi.modification.check(g.u_form, g.u_tip, ("gear1", "gear2")[i])
+        sample(gi.modification, g.u_form, g.u_tip, gp[i])
         if gi.body_stiffness != math.inf:
             if not gi.body_stiffness > 0:
                 raise ValueError(f"{('gear1', 'gear2')[i]}: body torsion stiffness must be positive, got {gi.body_stiffness}")

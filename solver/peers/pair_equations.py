@@ -106,6 +106,8 @@ class PairEquations:
                  load_table: np.ndarray | None = None):
         if model.coupled:
             raise ValueError("coupling.model: the scipy peer has no body-torsion coupling; use the explicit integrator")
+        if np.any(model.gear_par[:, L.DEV_ON] > 0):
+            raise ValueError("gearN.modification: the scipy peer has perfect involutes; use the explicit integrator")
         gp = model.gear_par
         self.model = model
         self.speed, self.speed_ramp = float(speed), float(speed_ramp)

@@ -14,6 +14,9 @@ Energy bookkeeping (trapezoidal in time): work in (driver + load torque), kineti
 potential energy, dissipated energy; the balance closes to O(dt^2).
 
 Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy balance.
+
+The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
+the gear_par columns DEV_* (`solver.modification`).
 """
 import math
 

@@ -25,6 +25,9 @@ neighbours' moments give it (phi_i += sum_b C[i, b] M_b), and a tooth that leave
 back. A tooth that joins unloaded (from rest, as teeth come from the frozen set) so changes
 no spring moment, and a tooth that leaves keeps its own; the remaining teeth's moments move
 by the coupling of the leaving tooth's moment, small since it has just left the mesh.
+
+The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
+the gear_par columns DEV_* (`solver.modification`).
 """
 import math
 

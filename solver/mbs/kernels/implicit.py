@@ -28,6 +28,9 @@ Newton work arrays ``nw`` = (coef, q_old, pred, hpred, A, r, dx, loc, cl) (`newt
 the scheme's coefficients (K_* columns below), the forces of the last step, the Newmark
 predictors of the teeth and of theta2 (rows POS, RATE), the system, residual, correction,
 and the condensation's index maps.
+
+The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
+the gear_par columns DEV_* (`solver.modification`).
 """
 import math
 

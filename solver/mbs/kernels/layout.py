@@ -25,7 +25,15 @@ NZ = 17         # number of teeth (stored as float)
 K_BODY = 18     # body torsion stiffness hub -> rim [N m/rad]; 0 = rigid body (plain model)
 I_HUB = 19      # inertia on the hub side of the body spring [kg m^2] (the rim side: I_TOT - I_HUB)
 C_BODY = 20     # body spring damping [N m s/rad] (linear)
-N_GEAR_PAR = 21
+# profile modification (`solver.modification`): deviation of the flanks along their normal
+# [m] (positive: material removed) on N_DEV roll parameters from the form circle to the tip
+DEV_ON = 21     # 1: the gear has a nonzero deviation (0: the search skips it)
+DEV_U0 = 22     # roll parameter of the first grid point [-]
+DEV_DU = 23     # grid step [-]
+DEV_NEG = 24    # bound on the material addition (-min deviation, >= 0, plus the cubic's undershoot) [m]
+DEV0 = 25       # first of the N_DEV deviations [m]
+N_DEV = 257
+N_GEAR_PAR = DEV0 + N_DEV
 
 # law_par (contact law, eq. 1.3)
 K_CON = 0       # [N/m^m1]

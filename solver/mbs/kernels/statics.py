@@ -6,6 +6,9 @@ K = sum_c k_t G G^T + diag(spring tangents), with continuation from the previous
 a backtracking line search on the residual. The spring tangent n*k*|phi|^(n-1) vanishes at
 phi = 0 for n > 1, so a tiny diagonal term (1e-9 of the tooth's k_phi) regularises teeth
 that carry no load; the residual, and so the solution, is exact.
+
+The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
+the gear_par columns DEV_* (`solver.modification`).
 """
 
 import numpy as np
@@ -180,6 +183,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
         if a > 0:
             theta2 -= rb1 / rb2 * (theta1s[a] - theta1s[a - 1])
         it = 0
+        open_steps = 0      # iterations at this angle without contact
         converged = False
         fresh = False       # rec and pairs already hold the search at this very state
         while it < ipar[L.S_MAX_ITER]:
@@ -201,6 +205,12 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                     break
                 # no contact yet: close the gap rigidly, plus the contact-only penetration
                 dpen = (abs(torque) / rb2 / lp[L.K_CON]) ** (1.0 / lp[L.M1])
+                if gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0:
+                    # modified flanks: the gap may be up to both deviations; closed in 16ths of
+                    # them, one more at each iteration without contact (near the first touch)
+                    for g in range(2):
+                        dpen += open_steps / 16.0 * max(0.0, gp[g, L.DEV0:L.DEV0 + L.N_DEV].max())
+                    open_steps += 1
                 theta2 = ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
             # residual from the contacts just found (same state: no second search)
