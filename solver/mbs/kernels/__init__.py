@@ -1,15 +1,49 @@
 """The numba kernels of the multibody solver: arrays and scalars in, arrays out.
 
-Every kernel is compiled with ``@njit(cache=True, no_cfunc_wrapper=True)``: cached on disk
-(``$NUMBA_CACHE_DIR``), and without the C-callable wrapper numba otherwise builds beside the
-Python one for each function (nothing here takes a kernel's C address; the wrappers were
-about a tenth of the LLVM work of a first, uncached run). The Python wrapper stays, so every
-kernel can be called and tested from Python. The stepping loops also release the GIL
-(``nogil=True``), so that a progress bar can follow them from another thread. Column indices of the arrays are in `layout`.
+Every kernel is compiled with ``@njit(cache=True, no_cfunc_wrapper=True)``: cached on disk,
+and without the C-callable wrapper numba otherwise builds beside the Python one for each
+function (nothing here takes a kernel's C address; the wrappers were about a tenth of the LLVM
+work of a first, uncached run). The Python wrapper stays, so every kernel can be called and
+tested from Python. The stepping loops also release the GIL (``nogil=True``), so that a
+progress bar can follow them from another thread. Column indices of the arrays are in `layout`.
 
-numba's disk cache checks each file's own time stamp only, not those of the kernels it calls
-nor the `layout` constants compiled in: a change to `gearmesh`, `contact`, `laws` or `layout`
-must also change the files of the kernels that call them (`explicit`, `explicit_coupled`,
-`implicit`, `statics`), or the cache (``$NUMBA_CACHE_DIR``) be cleared, else a stale stepping
-loop runs the old contact search.
+The disk cache sits in a folder named after a hash of every kernel source,
+``$NUMBA_CACHE_DIR/kernels-<KERNELS_FINGERPRINT>`` (without ``NUMBA_CACHE_DIR``: this package's
+``__pycache__``): numba checks only the time stamp of a kernel's own file, not those of the
+kernels it calls nor the `layout` constants compiled into it, so an edit of `gearmesh` would
+otherwise leave a stepping loop cached with the old contact search. Any change to a kernel file
+compiles them all afresh; folders of older versions can be deleted (``make clean``).
 """
+import hashlib
+import importlib
+import os
+import pkgutil
+from pathlib import Path
+
+import numba
+
+_HERE = Path(__file__).resolve().parent
+
+
+def sources_fingerprint(folder: Path) -> str:
+    """A hash of the names and contents of the Python files in ``folder``."""
+    return hashlib.sha256(b"".join(p.name.encode() + b"\0" + p.read_bytes()
+                                   for p in sorted(Path(folder).glob("*.py")))).hexdigest()[:16]
+
+
+KERNELS_FINGERPRINT = sources_fingerprint(_HERE)
+
+
+def _load_kernels_with_their_cache() -> None:
+    """Import every kernel module while numba's cache folder is the fingerprinted one (numba
+    fixes a function's cache location when it is decorated); the user's setting is restored."""
+    user = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = os.path.join(user or str(_HERE / "__pycache__"), f"kernels-{KERNELS_FINGERPRINT}")
+    try:
+        for module in pkgutil.iter_modules([str(_HERE)]):
+            importlib.import_module(f"{__name__}.{module.name}")
+    finally:
+        numba.config.CACHE_DIR = user
+
+
+_load_kernels_with_their_cache()

@@ -143,3 +143,31 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code():
     assert not [ln for ln in lines if "Literal" in ln]
     assert not [ln for ln in lines if int(ln.split()[1]) > 1]
     assert "set_stiffness" not in names and "set_moment" not in names
+
+
+def test_the_kernel_cache_is_keyed_by_every_kernel_source(tmp_path):
+    """numba checks only a kernel's own file: the cache folder is named after all kernel sources,
+    so an edit of the contact search (called by the stepping loops) cannot leave a stale loop."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import solver.mbs.kernels as K
+    from solver.mbs.kernels.explicit import verlet
+    from solver.mbs.kernels.statics import static_sweep
+    for f in (verlet, static_sweep):
+        assert f"kernels-{K.KERNELS_FINGERPRINT}" in f._cache._cache_path
+    copy = tmp_path / "kernels"
+    shutil.copytree(Path(K.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    assert K.sources_fingerprint(copy) == K.KERNELS_FINGERPRINT
+    (copy / "gearmesh.py").write_text((copy / "gearmesh.py").read_text() + "\n# edited\n")
+    assert K.sources_fingerprint(copy) != K.KERNELS_FINGERPRINT
+    # the user's numba setting is left as it was
+    code = ("import numba, solver.mbs.kernels as K; from solver.mbs.kernels.explicit import verlet; "
+            "print(numba.config.CACHE_DIR); print(verlet._cache._cache_path)")
+    root = Path(__file__).resolve().parents[3]
+    env = {**__import__("os").environ, "NUMBA_CACHE_DIR": str(tmp_path / "nc"), "PYTHONPATH": str(root)}
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True, check=True)
+    user, path = out.stdout.split()
+    assert user == str(tmp_path / "nc") and path.startswith(str(tmp_path / "nc" / f"kernels-{K.KERNELS_FINGERPRINT}"))
