@@ -1,6 +1,7 @@
 """The numba kernels of the multibody solver: arrays and scalars in, arrays out.
 
-Every kernel is compiled with ``@njit(cache=True, no_cfunc_wrapper=True)``: cached on disk,
+Every kernel is compiled with this package's ``@njit(cache=True, no_cfunc_wrapper=True)`` (numba's, with
+the cache folder below): cached on disk,
 and without the C-callable wrapper numba otherwise builds beside the Python one for each
 function (nothing here takes a kernel's C address; the wrappers were about a tenth of the LLVM
 work of a first, uncached run). The Python wrapper stays, so every kernel can be called and
@@ -15,12 +16,8 @@ otherwise leave a stepping loop cached with the old contact search. Any change t
 compiles them all afresh; folders of older versions can be deleted (``make clean``).
 """
 import hashlib
-import importlib
 import os
-import pkgutil
 from pathlib import Path
-
-import numba
 
 _HERE = Path(__file__).resolve().parent
 
@@ -34,16 +31,18 @@ def sources_fingerprint(folder: Path) -> str:
 KERNELS_FINGERPRINT = sources_fingerprint(_HERE)
 
 
-def _load_kernels_with_their_cache() -> None:
-    """Import every kernel module while numba's cache folder is the fingerprinted one (numba
-    fixes a function's cache location when it is decorated); the user's setting is restored."""
-    user = numba.config.CACHE_DIR
-    numba.config.CACHE_DIR = os.path.join(user or str(_HERE / "__pycache__"), f"kernels-{KERNELS_FINGERPRINT}")
-    try:
-        for module in pkgutil.iter_modules([str(_HERE)]):
-            importlib.import_module(f"{__name__}.{module.name}")
-    finally:
-        numba.config.CACHE_DIR = user
+def njit(**options):
+    """``numba.njit(**options)`` whose disk cache (with ``cache=True``) is the fingerprinted
+    folder; every kernel module decorates with it. numba fixes a function's cache location when
+    it is decorated, so the folder is set for that moment and the user's setting restored.
+    numba itself is imported here, not when the package is (`layout` is plain constants)."""
+    import numba
 
-
-_load_kernels_with_their_cache()
+    def decorate(fn):
+        user = numba.config.CACHE_DIR
+        numba.config.CACHE_DIR = os.path.join(user or str(_HERE / "__pycache__"), f"kernels-{KERNELS_FINGERPRINT}")
+        try:
+            return numba.njit(**options)(fn)
+        finally:
+            numba.config.CACHE_DIR = user
+    return decorate

@@ -16,7 +16,7 @@ n = s*(-sin t, cos t). Its projection on n is n.C + rb*u, the "support" used bel
 """
 import math
 
-from numba import njit
+from solver.mbs.kernels import njit
 
 
 @njit(cache=True, no_cfunc_wrapper=True)

@@ -21,9 +21,9 @@ the gear_par columns DEV_* (`solver.modification`).
 import math
 
 import numpy as np
-from numba import njit
 
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import njit
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 from solver.mbs.kernels.mechanics import (
     arrowhead_accelerations,

@@ -32,9 +32,9 @@ the gear_par columns DEV_* (`solver.modification`).
 import math
 
 import numpy as np
-from numba import njit
 
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import njit
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 from solver.mbs.kernels.mechanics import dissipation_power, driver_acc_left, driver_motion, load_torque, mesh_energies
 from solver.mbs.kernels.stepping import OK, activate, end_step, initial_set, record_output

@@ -23,9 +23,9 @@ rotations about their pivots relative to the hub [rad], gear-1 teeth first.
 import math
 
 import numpy as np
-from numba import njit
 
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import njit
 from solver.mbs.kernels.contact import cross, flank_flank, moved_center, point_flank, tip_corner, wrap
 from solver.mbs.kernels.laws import contact_force, contact_tangent, spring_tangent, spring_torque
 

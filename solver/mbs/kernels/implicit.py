@@ -35,9 +35,9 @@ the gear_par columns DEV_* (`solver.modification`).
 import math
 
 import numpy as np
-from numba import njit
 
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import njit
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
 from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
 from solver.mbs.kernels.mechanics import (

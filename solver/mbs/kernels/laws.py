@@ -5,7 +5,7 @@ Torsion spring (eq. 1.2, T0 = 0, phi0 = 0):
 Contact (eq. 1.3), for delta > 0, clipped at zero (the damping term can pull otherwise):
     F = k*delta^m1 + c*sgn(ddelta)|ddelta|^m2 * delta^m3      [N]
 """
-from numba import njit
+from solver.mbs.kernels import njit
 
 
 @njit(cache=True, no_cfunc_wrapper=True)

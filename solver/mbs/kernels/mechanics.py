@@ -5,9 +5,8 @@ motion, the load torque, the arrowhead accelerations, the energies and the dissi
 (`layout` C_* columns); ``mdl`` the model arrays (gear_par, pair_par, law_par, k_phi,
 tooth_compliance) as the stepping kernels take them. SI units.
 """
-from numba import njit
-
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import njit
 from solver.mbs.kernels.laws import contact_energy, signed_pow, spring_energy
 
 

@@ -12,9 +12,9 @@ the gear_par columns DEV_* (`solver.modification`).
 """
 
 import numpy as np
-from numba import njit
 
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import njit
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
 from solver.mbs.kernels.toothcoupling import set_moment, set_stiffness
 

@@ -19,9 +19,9 @@ each step to `end_step`, which integrates them with the trapezoidal rule.
 import math
 
 import numpy as np
-from numba import njit
 
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import njit
 
 OK = 0
 NONFINITE = 1

@@ -17,8 +17,8 @@ The stepping loop keeps S in ``cset`` = (C, ks, lst, newl, inset, innew, mo, dmo
 per-tooth 0/1 flags of the current and the next set, ``mo``/``dmo`` scratch moments.
 """
 import numpy as np
-from numba import njit
 
+from solver.mbs.kernels import njit
 from solver.mbs.kernels.layout import MAX_CONTACTS
 
 
