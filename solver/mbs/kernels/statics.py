@@ -209,7 +209,10 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                     # modified flanks: the gap may be up to both deviations; closed in 16ths of
                     # them, one more at each iteration without contact (near the first touch)
                     for g in range(2):
-                        dpen += open_steps / 16.0 * max(0.0, gp[g, L.DEV0:L.DEV0 + L.N_DEV].max())
+                        dev_max = 0.0       # a loop, not .max(): numpy's max and take would compile too
+                        for k in range(L.DEV0, L.DEV0 + L.N_DEV):
+                            dev_max = max(dev_max, gp[g, k])
+                        dpen += open_steps / 16.0 * dev_max
                     open_steps += 1
                 theta2 = ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
