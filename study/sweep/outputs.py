@@ -130,25 +130,29 @@ class Outputs:
     scalars: tuple[str, ...]
     curves: tuple[str, ...] = ()
 
+    def needs(self, analysis: str) -> bool:
+        """True when an output needs ``analysis`` ('static', 'dynamic', 'modes', 'fe', 'geometry')."""
+        return any(analysis_of(x) == analysis for x in self.scalars + self.curves)
+
     @property
     def static(self) -> bool:
         """True when a quasi-static (STE) analysis is needed."""
-        return any(analysis_of(x) == "static" for x in self.scalars + self.curves)
+        return self.needs("static")
 
     @property
     def dynamic(self) -> bool:
         """True when a dynamic (DTE) analysis is needed."""
-        return any(analysis_of(x) == "dynamic" for x in self.scalars + self.curves)
+        return self.needs("dynamic")
 
     @property
     def modes(self) -> bool:
         """True when an output needs the modal analysis of the loaded pair."""
-        return any(analysis_of(x) == "modes" for x in self.scalars + self.curves)
+        return self.needs("modes")
 
     @property
     def fe(self) -> bool:
         """True when an output needs the FE body of the springs (root stress)."""
-        return any(analysis_of(x) == "fe" for x in self.scalars + self.curves)
+        return self.needs("fe")
 
     @property
     def widest(self) -> str:
