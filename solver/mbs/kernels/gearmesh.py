@@ -15,7 +15,15 @@ first touch is closer by sigma**2/(2*kappa), sigma the deviations' slope per len
 kappa the relative curvature: tens of nm for a 10 um relief; a kinked profile gives no smooth
 term to add). The gradient of a flank-flank contact carries the deviations' change with the
 roll parameters, which the tooth rotations also change by turning the line of action; a
-tip-corner contact's keeps the rigid one.
+tip-corner contact's keeps the rigid one but for the blend below.
+
+Where a modified flank's contact runs off its tip onto the tip corner, the first-order model
+has a kink: the flank contact's deviation changes with the roll parameter, the corner's is
+fixed. The real flanks pass smoothly (their contact point is shifted by sigma/kappa along the
+flank), and a kink at an equilibrium stalls the statics' Newton. The corner therefore takes
+the tip deviation plus slope*TIP_BLEND*(1 - exp(-(u - u_tip)/TIP_BLEND)), u the flank contact's
+roll parameter beyond the tip: the penetration is C1 across the switch and differs from the
+plain corner's by at most slope*TIP_BLEND (below 1 nm for any relief steeper than real ones).
 
 State: theta1, theta2 hub angles [rad] (counter-clockwise positive), phi[Z1+Z2] tooth
 rotations about their pivots relative to the hub [rad], gear-1 teeth first.
@@ -28,6 +36,9 @@ from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
 from solver.mbs.kernels.contact import cross, flank_flank, moved_center, point_flank, tip_corner, wrap
 from solver.mbs.kernels.laws import contact_force, contact_tangent, spring_tangent, spring_torque
+
+# roll-parameter length [-] over which a modified tip corner blends into its flank (see above)
+TIP_BLEND = 1e-6
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -108,14 +119,37 @@ def _tangent_turn(dx, dy, length, kc, ddx, ddy):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _record(rec, nc, hit, own, ids, frame, vel, lp, dg):
+def _deviation_gradient(sa, sb, s, centres, axes, gp):
+    """d(da + db)/d(theta1, phi_A, theta2, phi_B) [m] of the flank deviations whose slopes are
+    sa, sb [m] per unit roll at the flank-flank contact of side s; centres = (moved base-circle
+    centres A x, y, B x, y [m], base radii A, B [m]), axes = (tooth axis angle, rotation of
+    tooth A, the same of B) [rad]. With ua = s*(beta_a - ta), ub = s*(beta_b - ta - pi), the
+    common tangent's angle ta turns as the tooth rotations move the base-circle centres."""
+    cax, cay, cbx, cby, rba, rbb = centres
+    axa, pa, axb, pb = axes
+    dx, dy = cbx - cax, cby - cay
+    ln = math.sqrt(dx * dx + dy * dy)
+    c = (rba + rbb) / ln
+    kc = s * (rba + rbb) / (ln * ln * math.sqrt(1.0 - c * c))
+    ra, rb_ = gp[0, L.R_PV], gp[1, L.R_PV]
+    t1 = _tangent_turn(dx, dy, ln, kc, ra * (math.sin(axa) - math.sin(axa + pa)), ra * (math.cos(axa + pa) - math.cos(axa)))
+    ta_ = _tangent_turn(dx, dy, ln, kc, -ra * math.sin(axa + pa), ra * math.cos(axa + pa))
+    t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (math.sin(axb + pb) - math.sin(axb)), rb_ * (math.cos(axb) - math.cos(axb + pb)))
+    tb = _tangent_turn(dx, dy, ln, kc, rb_ * math.sin(axb + pb), -rb_ * math.cos(axb + pb))
+    return (-s * (sa * (1.0 - t1) - sb * t1), -s * (sa * (1.0 - ta_) - sb * ta_),
+            -s * (-sa * t2 + sb * (1.0 - t2)), -s * (-sa * tb + sb * (1.0 - tb)))
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
     flank-flank case), -1 when gear 2 does; ids = (gear-1 tooth, gear-2 tooth, kind);
     frame = (O1, pivot A, O2, pivot B) as x, y pairs [m]; vel = (theta1', phi_A', theta2',
     phi_B') [rad/s]. The gradient G = d delta/d(theta1, phi_A, theta2, phi_B): the owner's
     entries +(x - centre) x n, the other gear's negative, plus dg, the same four of the flank
-    deviations' part [m]."""
+    deviations' part [m]. blend = (c [1/m], v [-]): the curvature d2 delta/dq2 = c * v v^T of a
+    modified tip corner's blend into its flank (c = 0 otherwise), stored times the force."""
     delta, px, py, nx, ny = hit
     o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
     w1, wa, w2, wb = vel
@@ -138,6 +172,8 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg):
     rec[nc, L.C_NY] = ny
     rec[nc, L.C_KT] = contact_tangent(delta, lp[L.K_CON], lp[L.M1])
     rec[nc, L.C_TOOTH1], rec[nc, L.C_TOOTH2], rec[nc, L.C_KIND] = ids
+    rec[nc, L.C_KGEO] = f * blend[0]
+    rec[nc, L.C_DG1], rec[nc, L.C_DGA], rec[nc, L.C_DG2], rec[nc, L.C_DGB] = blend[1]
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -184,22 +220,10 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             da, sa = flank_deviation(gp[0], ua)
             db, sb = flank_deviation(gp[1], ub)
             delta -= da + db
-            # d(da + db)/dq = sa*dua/dq + sb*dub/dq, ua = s*(beta_a - ta), ub = s*(beta_b - ta - pi):
-            # the tangent angle ta turns as the tooth rotations move the base-circle centres
-            dx, dy = cbx - cax, cby - cay
-            ln = math.sqrt(dx * dx + dy * dy)
-            c = (rba + rbb) / ln
-            kc = s * (rba + rbb) / (ln * ln * math.sqrt(1.0 - c * c))
-            ra, rb_ = gp[0, L.R_PV], gp[1, L.R_PV]
-            t1 = _tangent_turn(dx, dy, ln, kc, ra * (math.sin(axa) - math.sin(axa + pa)), ra * (math.cos(axa + pa) - math.cos(axa)))
-            ta_ = _tangent_turn(dx, dy, ln, kc, -ra * math.sin(axa + pa), ra * math.cos(axa + pa))
-            t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (math.sin(axb + pb) - math.sin(axb)), rb_ * (math.cos(axb) - math.cos(axb + pb)))
-            tb = _tangent_turn(dx, dy, ln, kc, rb_ * math.sin(axb + pb), -rb_ * math.cos(axb + pb))
-            dg = (-s * (sa * (1.0 - t1) - sb * t1), -s * (sa * (1.0 - ta_) - sb * ta_),
-                  -s * (-sa * t2 + sb * (1.0 - t2)), -s * (-sa * tb + sb * (1.0 - tb)))
+            dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb), gp)
         if delta > 0.0 and nc < rec.shape[0]:
             # owner A (gear 1)
-            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg)
+            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg))
             nc += 1
         return nc
     flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
@@ -212,11 +236,25 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             qx, qy = tip_corner(cx, cy, rb, b, s, gp[g, L.U_HI])
             cx, cy, rb, b = flanks[f]
             d, uf, mx, my = point_flank(qx, qy, cx, cy, rb, b, s)
+            dg = (0.0, 0.0, 0.0, 0.0)
+            du = (0.0, 0.0, 0.0, 0.0)
+            blend = 0.0
             if modified:
-                d -= flank_deviation(gp[g], gp[g, L.U_HI])[0] + flank_deviation(gp[f], uf)[0]
+                # the tip's deviation, blended C1 into the flank's beyond the tip (TIP_BLEND)
+                last = L.DEV0 + L.N_DEV - 1
+                slope = (gp[g, last] - gp[g, last - 1]) / gp[g, L.DEV_DU]
+                w = math.exp(-(u[g] - gp[g, L.U_HI]) / TIP_BLEND)
+                d -= gp[g, last] + slope * TIP_BLEND * (1.0 - w) + flank_deviation(gp[f], uf)[0]
+                sw = slope * w
+                if w > 1e-12:
+                    # d delta/dq gains -sw*du/dq, d2 delta/dq2 gains (sw/TIP_BLEND)*(du/dq)(du/dq)^T
+                    du = _deviation_gradient(1.0 if g == 0 else 0.0, 1.0 if g == 1 else 0.0, s,
+                                             (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb), gp)
+                    dg = (sw * du[0], sw * du[1], sw * du[2], sw * du[3])
+                    blend = sw / TIP_BLEND
             if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
                 _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
-                        frame, vel, lp, (0.0, 0.0, 0.0, 0.0))
+                        frame, vel, lp, dg, (blend, du))
                 nc += 1
     return nc
 

@@ -65,7 +65,14 @@ C_KT = 11       # tangent stiffness dF/d delta [N/m]
 C_TOOTH1 = 12   # gear-1 tooth index (float)
 C_TOOTH2 = 13   # gear-2 tooth index (float)
 C_KIND = 14     # 1 flank-flank, 2 gear-1 tip corner, 3 gear-2 tip corner; sign = side (+drive, -coast)
-N_C_COLS = 15
+# a modified tip corner's blend into its flank (`gearmesh.TIP_BLEND`): the penetration's
+# curvature F * d2 delta/dq2 = C_KGEO * V V^T that its sharp blend adds to the tangent
+C_KGEO = 15     # [N/m]; 0 for other contacts
+C_DG1 = 16      # V: d(roll parameter of the blend)/d(theta1, phi_A, theta2, phi_B) [-], up to sign
+C_DGA = 17
+C_DG2 = 18
+C_DGB = 19
+N_C_COLS = 20
 MAX_CONTACTS = 64
 
 # ---- the time-stepping kernels (`stepping`, `explicit`, `explicit_coupled`, `implicit`)

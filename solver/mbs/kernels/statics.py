@@ -2,7 +2,8 @@
 
 Unknowns at each angle: the driven hub angle theta2 and the rotations of the teeth that the
 pre-search finds near the mesh (the others are unloaded: phi = 0). Newton on the tangent
-K = sum_c k_t G G^T + diag(spring tangents), with continuation from the previous angle and
+K = sum_c k_t G G^T + diag(spring tangents) (plus, for a modified tip corner, the curvature of
+its blend into the flank: `gearmesh.TIP_BLEND`), with continuation from the previous angle and
 a backtracking line search on the residual. The spring tangent n*k*|phi|^(n-1) vanishes at
 phi = 0 for n > 1, so a tiny diagonal term (1e-9 of the tooth's k_phi) regularises teeth
 that carry no load; the residual, and so the solution, is exact.
@@ -112,6 +113,13 @@ def _tangent(mdl, ks, ws, nc, nt, phi):
         for x in range(3):
             for y in range(3):
                 K[idx[x], idx[y]] += kt * gv[x] * gv[y]
+        kg = rec[c, L.C_KGEO]
+        if kg != 0.0:
+            # the sharp blend of a modified tip corner into its flank: its curvature matters
+            dv = (rec[c, L.C_DG2], rec[c, L.C_DGA], rec[c, L.C_DGB])
+            for x in range(3):
+                for y in range(3):
+                    K[idx[x], idx[y]] += kg * dv[x] * dv[y]
     if ks is not None:
         for m in range(nt):
             for m2 in range(nt):
@@ -123,6 +131,25 @@ def _tangent(mdl, ks, ws, nc, nt, phi):
     if K[0, 0] <= 0.0:
         K[0, 0] = 1e-9
     return K
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def newton_system(mdl, theta1, theta2, phi, torque):
+    """The plain model's Newton system at driver angle theta1 and driven angle theta2 [rad] with
+    the tooth rotations phi [rad] under the resisting torque [N m]: (tangent [N m/rad],
+    residual [N m], the unknown teeth), the unknowns being theta2 and those teeth, as the
+    sweep below builds them (for checks against finite differences)."""
+    gp, pp, lp, _kphi = mdl
+    n = phi.shape[0]
+    rec = np.zeros((L.MAX_CONTACTS, L.N_C_COLS))
+    pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
+    zeros = np.zeros(n)
+    ws = (rec, pairs, np.zeros(n + 2), zeros, np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), np.zeros(n + 1))
+    ph = phi.copy()
+    nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), ph, zeros, (gp, pp, lp), (rec, pairs))
+    nt = _unknown_set(ws, npair, gp, ph)
+    _unknown_forces(mdl, None, ws, nc, nt, ph, torque)
+    return _tangent(mdl, None, ws, nc, nt, ph), ws[6][:nt + 1].copy(), ws[5][:nt].copy()
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
