@@ -17,6 +17,11 @@ term to add). The gradient of a flank-flank contact carries the deviations' chan
 roll parameters, which the tooth rotations also change by turning the line of action; a
 tip-corner contact's keeps the rigid one.
 
+Pitch errors and eccentricity (`solver.errors`, the pair_par block E_*, present only when a
+gear has them): each tooth's axis turns by its offset eps about the teeth's centre, which sits
+off the bearing axis by the eccentricity; the flanks follow exactly, the moment arms of the hub
+rotations stay about the bearing axes, and the rigid gap bound grows by E_BOUND.
+
 State: theta1, theta2 hub angles [rad] (counter-clockwise positive), phi[Z1+Z2] tooth
 rotations about their pivots relative to the hub [rad], gear-1 teeth first.
 """
@@ -162,20 +167,32 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     modified = gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0
     if modified:
         bound += gp[0, L.DEV_NEG] + gp[1, L.DEV_NEG]
+    errs = pp.shape[0] > L.N_PAIR_PAR
+    if errs:
+        bound += pp[L.E_BOUND]
     if bound <= 0.0:
         return nc
     o1x, o1y = gp[0, L.CX], gp[0, L.CY]
     o2x, o2y = gp[1, L.CX], gp[1, L.CY]
     axa = theta1 + gp[0, L.GAMMA0] + k * gp[0, L.PITCH]
     axb = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
-    cax, cay = moved_center(o1x, o1y, gp[0, L.R_PV], axa, pa)
-    cbx, cby = moved_center(o2x, o2y, gp[1, L.R_PV], axb, pb)
+    # the teeth's centres: off the bearing axes O by the eccentricity (the moment arms stay about O)
+    e1x, e1y, e2x, e2y = 0.0, 0.0, 0.0, 0.0
+    if errs:
+        axa += pp[L.E_EPS + ia]
+        axb += pp[L.E_EPS + ib]
+        c1 = theta1 + gp[0, L.GAMMA0] + pp[L.E_ECC + 1]
+        c2 = theta2 + gp[1, L.GAMMA0] + pp[L.E_ECC + 3]
+        e1x, e1y = pp[L.E_ECC] * math.cos(c1), pp[L.E_ECC] * math.sin(c1)
+        e2x, e2y = pp[L.E_ECC + 2] * math.cos(c2), pp[L.E_ECC + 2] * math.sin(c2)
+    cax, cay = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], axa, pa)
+    cbx, cby = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], axb, pb)
     rba = gp[0, L.RB]
     rbb = gp[1, L.RB]
     ba = axa + pa + s * gp[0, L.PSI_B]
     bb = axb + pb + s * gp[1, L.PSI_B]
-    frame = (o1x, o1y, o1x + gp[0, L.R_PV] * math.cos(axa), o1y + gp[0, L.R_PV] * math.sin(axa),
-             o2x, o2y, o2x + gp[1, L.R_PV] * math.cos(axb), o2y + gp[1, L.R_PV] * math.sin(axb))
+    frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * math.cos(axa), o1y + e1y + gp[0, L.R_PV] * math.sin(axa),
+             o2x, o2y, o2x + e2x + gp[1, L.R_PV] * math.cos(axb), o2y + e2y + gp[1, L.R_PV] * math.sin(axb))
     vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
@@ -195,6 +212,9 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             ta_ = _tangent_turn(dx, dy, ln, kc, -ra * math.sin(axa + pa), ra * math.cos(axa + pa))
             t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (math.sin(axb + pb) - math.sin(axb)), rb_ * (math.cos(axb) - math.cos(axb + pb)))
             tb = _tangent_turn(dx, dy, ln, kc, rb_ * math.sin(axb + pb), -rb_ * math.cos(axb + pb))
+            if errs:    # a hub rotation also swings the eccentric centre about the bearing axis
+                t1 += _tangent_turn(dx, dy, ln, kc, e1y, -e1x)
+                t2 += _tangent_turn(dx, dy, ln, kc, -e2y, e2x)
             dg = (-s * (sa * (1.0 - t1) - sb * t1), -s * (sa * (1.0 - ta_) - sb * ta_),
                   -s * (-sa * t2 + sb * (1.0 - t2)), -s * (-sa * tb + sb * (1.0 - tb)))
         if delta > 0.0 and nc < rec.shape[0]:
