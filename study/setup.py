@@ -89,7 +89,8 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
                                k_phi=units.spring_stiffness_to_si(np.asarray(k_phi, float)),
                                n_k=n_k, c_phi=units.spring_damping_to_si(0.0 if math.isnan(sp.c_phi) else sp.c_phi),
                                n_c=sp.n_c, body_stiffness=k_body, tooth_compliance=cmat,
-                               modification=scene.modification_spec(setup.gear)))
+                               modification=scene.modification_spec(setup.gear),
+                               errors=scene.errors_spec(setup.gear)))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3)
