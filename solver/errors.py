@@ -85,6 +85,7 @@ class GearErrors:
 def closure_tolerance(f: np.ndarray) -> float:
     """Largest |sum f_pt| [m] taken as closed: rounding of the listed values (1e-3 um each) or
     1e-6 of their magnitude."""
+    f = np.asarray(f, float)
     return max(1e-9 * f.size, 1e-6 * float(np.abs(f).sum()))
 
 

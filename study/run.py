@@ -23,7 +23,16 @@ from study.report import results
 from study.report.lightening import lightening_variables
 from study.report.modes import modal_variables
 from study.scene import Scene
-from study.setup import build_scene_model, damping_ratios, load_table, mean_load, scene_springs, static_angles
+from study.setup import (
+    build_scene_model,
+    damping_ratios,
+    error_period,
+    load_table,
+    mean_load,
+    scene_springs,
+    static_angles,
+    static_rotation,
+)
 
 
 def run_static(scene: Scene, model: Model):
@@ -143,6 +152,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["static_status"] = getattr(st, "message", "ok")
         attrs["static_method"] = scene.quasi_static.method
         attrs["static_torque_N_m"] = scene.quasi_static.torque
+        if scene.has_errors:
+            attrs["static_rotation_deg"] = static_rotation(scene)
+            attrs["error_period_deg"] = error_period(scene)
         c, v = results.static_variables(st, model.backlash_offset)
         coords.update(c); data.update(v)
         c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes)

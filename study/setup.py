@@ -169,10 +169,34 @@ def geometry_model(scene: Scene) -> Model:
                                              (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2))), convert_damping=False)
 
 
+def error_period(scene: Scene) -> float:
+    """Driver rotation [deg] after which the TE of a scene with pitch errors or eccentricity
+    repeats: one revolution of the gear that has them (gear 2: Z2/Z1 driver revolutions), the
+    hunting period lcm(Z1, Z2)/Z1 driver revolutions when both have them; 0 without errors."""
+    z1, z2 = scene.gear1.teeth, scene.gear2.teeth
+    on = (not scene.gear1.errors.is_zero, not scene.gear2.errors.is_zero)
+    if on == (False, False):
+        return 0.0
+    if on == (True, True):
+        return 360.0 * math.lcm(z1, z2) / z1
+    return 360.0 if on[0] else 360.0 * z2 / z1
+
+
+def static_rotation(scene: Scene) -> float:
+    """Driver rotation [deg] of the quasi-static analysis: quasi_static.rotation, or with errors
+    whole periods of them (`error_period`, at least one) at the same angle step, so that the STE
+    and its spectrum hold every tooth pair."""
+    rot = scene.quasi_static.rotation
+    period = error_period(scene)
+    if period > 0:
+        rot = period * max(1, math.ceil(rot / period - 1e-9))
+    return rot
+
+
 def static_angles(scene: Scene) -> np.ndarray:
-    """Driver angles [rad] of the quasi-static analysis."""
+    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step)."""
     qs = scene.quasi_static
-    n = int(math.floor(qs.rotation / qs.angle_step + 1e-9)) + 1
+    n = int(math.floor(static_rotation(scene) / qs.angle_step + 1e-9)) + 1
     return np.radians(np.arange(n) * qs.angle_step)
 
 
