@@ -149,3 +149,25 @@ def test_grade_sets_hold_the_class_tolerances():
     assert np.ptp(err.cumulative(24)) > 0.5 * f_p
     assert scene.errors_spec(1) == err
     assert small(**{"gear1.errors.grade": 5, "gear1.errors.seed": 4}).errors_spec(1) != err
+
+
+def test_a_dynamic_run_with_errors_starts_touching_without_penetration():
+    """The rigid start of a run: perfect gears at jn/2; with an eccentric driver whose centre
+    points into the mesh at t = 0 the first touch comes earlier (a start at jn/2 would penetrate
+    by microns and kick the run): at the start TE no drive contact penetrates, 1 nm further one
+    does, and the start lies the driver's offset along the line of action, e*cos(gamma1 + phase
+    - psi_n), below jn/2 (first order: within 2 nm)."""
+    from solver.mbs.dynamics import start_te
+    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    scene = small(**{"gear1.errors.eccentricity": 5.0, "gear1.errors.eccentricity_phase": 20.0})
+    model = geometry_model(scene)
+    assert start_te(geometry_model(small()), 1.0) == model.backlash_offset
+    te0 = start_te(model, 1.0)
+    psi_n = math.pi / 2 - model.pair.pressure_angle
+    assert abs(model.backlash_offset - te0 - 5e-6 * math.cos(math.radians(20.0) - psi_n)) < 2e-9
+    rec, pairs = new_contact_buffer()
+    zeros = np.zeros(model.n_teeth)
+    for te, n in ((te0, 0), (te0 + 1e-9, 1)):
+        nc, _ = mesh_contacts((0.0, model.theta2_for_te(0.0, te), 0.0, 0.0), zeros, zeros,
+                              (model.gear_par, model.pair_par, model.law_par), (rec, pairs))
+        assert (nc > 0) == (n > 0)
