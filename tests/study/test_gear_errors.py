@@ -103,3 +103,9 @@ def test_a_study_sweeps_the_errors_like_any_field():
     assert sorted((s.gear1.errors.eccentricity, s.gear1.errors.grade) for s in scenes) == \
         [(0.0, 0), (0.0, 6), (5.0, 0), (5.0, 6)]
     assert sum(s.has_errors for s in scenes) == 3
+    # the errors move no mass and no FE body: those analyses are shared across them
+    from study.sweep.outputs import reads
+    for f in ("gear1.errors.eccentricity", "gear2.errors.grade"):
+        assert not reads("geometry", f) and not reads("fe", f)
+        assert reads("static", f) and reads("modes", f) and reads("dynamic", f)
+    assert reads("fe", "gear1.teeth") and reads("geometry", "gear1.modification.tip_relief")
