@@ -98,6 +98,11 @@ def run_command(args) -> int:
         check_dynamic_memory(scene)       # at once, before the solver is even loaded
     checked_output(args.output)
     max_time = checked_max_time(args)
+    if not args.no_static:
+        from study.estimate import error_period_note
+        note = error_period_note(scene)
+        if note:
+            print(note)
     from solver.mbs.dynamics import DivergenceError
     t0 = time.perf_counter()
     try:

@@ -115,6 +115,21 @@ def static_seconds(scene, model) -> float:
     return 0.0      # the transient's steps are counted like a dynamic run's by the caller when needed
 
 
+def error_period_note(scene) -> str | None:
+    """A line for the user when pitch errors or an eccentricity stretch the quasi-static range
+    beyond quasi_static.rotation (`study.setup.static_rotation`) by more than 1.5 times; None otherwise."""
+    from study.setup import static_angles, static_rotation
+    qs = scene.quasi_static
+    rot = static_rotation(scene)
+    if not qs.enabled or rot <= 1.5 * qs.rotation:
+        return None
+    n = static_angles(scene).size
+    sec = n * STATIC_S_PER_ANGLE_TOOTH * (scene.gear1.teeth + scene.gear2.teeth) if qs.method == "static" else float("nan")
+    return (f"quasi-static: the pitch errors and eccentricities repeat after {rot:.6g} deg of driver rotation: the STE "
+            f"covers that instead of quasi_static.rotation = {qs.rotation:.6g} deg ({n} angles at {qs.angle_step:g} deg, "
+            f"{rot / qs.rotation:.3g} x longer" + (f", about {duration_text(sec)})" if math.isfinite(sec) else ")"))
+
+
 def body_elements(setup) -> float:
     """Triangles of gear ``setup``'s FE body (`solver.fe.mesh`): outline size h over teeth and
     rim, h/2 on the fillets, about 5 h in web and hub (equilateral triangles, +10 %)."""

@@ -23,7 +23,16 @@ from study.report import results
 from study.report.lightening import lightening_variables
 from study.report.modes import modal_variables
 from study.scene import Scene
-from study.setup import build_scene_model, damping_ratios, load_table, mean_load, scene_springs, static_angles
+from study.setup import (
+    build_scene_model,
+    damping_ratios,
+    error_period,
+    load_table,
+    mean_load,
+    scene_springs,
+    static_angles,
+    static_rotation,
+)
 
 
 def run_static(scene: Scene, model: Model):
@@ -143,9 +152,13 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["static_status"] = getattr(st, "message", "ok")
         attrs["static_method"] = scene.quasi_static.method
         attrs["static_torque_N_m"] = scene.quasi_static.torque
+        if scene.has_errors:
+            attrs["static_rotation_deg"] = static_rotation(scene)
+            attrs["error_period_deg"] = error_period(scene)
         c, v = results.static_variables(st, model.backlash_offset)
         coords.update(c); data.update(v)
-        c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes)
+        c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes,
+                                              revolutions=scene.has_errors)
         coords.update(c); data.update(v)
     if dynamic:
         t0 = time.perf_counter()
@@ -154,7 +167,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         start = d.spectrum_start or 2 * d.ramp_time
         attrs["spectrum_start_s"] = start
         runup = d.speed_end > 0         # no spectrum over a changing speed: its order tracking instead
-        c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2)
+        c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2,
+                                            (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
         if runup and dy.status == 0:
             from study.report.order_tracking import order_tracking_variables

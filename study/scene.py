@@ -23,6 +23,7 @@ from solver import units
 from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
 from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
+from study.gear_errors import ErrorsSection, errors_spec
 from study.modification import ModificationSection, modification_spec
 from study.toml_writer import dumps_toml
 
@@ -90,6 +91,7 @@ class GearSection:
     body: BodySection = field(default_factory=BodySection)
     spring: SpringSection = field(default_factory=SpringSection)
     modification: ModificationSection = field(default_factory=ModificationSection)
+    errors: ErrorsSection = field(default_factory=ErrorsSection)
 
 
 @dataclass(frozen=True)
@@ -208,6 +210,15 @@ class Scene:
         """Gear g's profile modification in SI (`solver.modification`), None for perfect involutes."""
         return modification_spec(self.gear(g).modification, gear_geometry(self.tooth_spec(g)), f"gear{g}.modification")
 
+    def errors_spec(self, g: int):
+        """Gear g's pitch deviations and eccentricity in SI (`solver.errors`), None for a perfect gear."""
+        return errors_spec(self.gear(g).errors, gear_geometry(self.tooth_spec(g)), f"gear{g}.errors")
+
+    @property
+    def has_errors(self) -> bool:
+        """True when either gear has pitch deviations or an eccentricity."""
+        return not (self.gear1.errors.is_zero and self.gear2.errors.is_zero)
+
     def pivot_radius(self, g: int) -> float:
         """Tooth pivot radius [m]; the root circle when the scene gives 0."""
         r = self.gear(g).pivot_radius
@@ -293,6 +304,7 @@ def check_scene(scene: Scene) -> None:
             if gs.pivot_radius > 0 and not (geo.base_radius * 0.5 < gs.pivot_radius * units.MM < geo.tip_radius):
                 raise GeometryError(f"gear{g}.pivot_radius", f"must lie between half the base radius and the tip radius ({geo.tip_radius * 1e3:.4g} mm), got {gs.pivot_radius} mm")
             modification_spec(gs.modification, geo, f"gear{g}.modification")
+            errors_spec(gs.errors, geo, f"gear{g}.errors")
         pair_geometry(*geoms)
     except GeometryError as e:
         raise SceneError(e.field, e.reason) from None

@@ -89,7 +89,8 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
                                k_phi=units.spring_stiffness_to_si(np.asarray(k_phi, float)),
                                n_k=n_k, c_phi=units.spring_damping_to_si(0.0 if math.isnan(sp.c_phi) else sp.c_phi),
                                n_c=sp.n_c, body_stiffness=k_body, tooth_compliance=cmat,
-                               modification=scene.modification_spec(setup.gear)))
+                               modification=scene.modification_spec(setup.gear),
+                               errors=scene.errors_spec(setup.gear)))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3)
@@ -168,10 +169,34 @@ def geometry_model(scene: Scene) -> Model:
                                              (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2))), convert_damping=False)
 
 
+def error_period(scene: Scene) -> float:
+    """Driver rotation [deg] after which the TE of a scene with pitch errors or eccentricity
+    repeats: one revolution of the gear that has them (gear 2: Z2/Z1 driver revolutions), the
+    hunting period lcm(Z1, Z2)/Z1 driver revolutions when both have them; 0 without errors."""
+    z1, z2 = scene.gear1.teeth, scene.gear2.teeth
+    on = (not scene.gear1.errors.is_zero, not scene.gear2.errors.is_zero)
+    if on == (False, False):
+        return 0.0
+    if on == (True, True):
+        return 360.0 * math.lcm(z1, z2) / z1
+    return 360.0 if on[0] else 360.0 * z2 / z1
+
+
+def static_rotation(scene: Scene) -> float:
+    """Driver rotation [deg] of the quasi-static analysis: quasi_static.rotation, or with errors
+    whole periods of them (`error_period`, at least one) at the same angle step, so that the STE
+    and its spectrum hold every tooth pair."""
+    rot = scene.quasi_static.rotation
+    period = error_period(scene)
+    if period > 0:
+        rot = period * max(1, math.ceil(rot / period - 1e-9))
+    return rot
+
+
 def static_angles(scene: Scene) -> np.ndarray:
-    """Driver angles [rad] of the quasi-static analysis."""
+    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step)."""
     qs = scene.quasi_static
-    n = int(math.floor(qs.rotation / qs.angle_step + 1e-9)) + 1
+    n = int(math.floor(static_rotation(scene) / qs.angle_step + 1e-9)) + 1
     return np.radians(np.arange(n) * qs.angle_step)
 
 

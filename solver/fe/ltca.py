@@ -39,6 +39,10 @@ Profile modifications (`solver.modification`) add each flank's deviation at the 
 point's roll parameter (a tip corner: at the tip) to the initial separation e_i, as in the
 contact search of the pseudo-rigid model (first order: `solver.mbs.kernels.gearmesh`).
 
+Pitch errors and eccentricities (`solver.errors`) subtract each tooth pair's first-order
+approach along the line of action from e_i (`error_approach`); the candidate pairs and their
+rolls stay those of the perfect gears (the errors shift a roll by ~1e-4 rad).
+
 Approximation: corner contacts are loaded along the line of action at the tip-corner roll
 (their true normal turns by a few degrees); their moment arm is taken as the base radius.
 
@@ -255,6 +259,8 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
     (plus the largest flank deviation of either gear: a relieved tip is still a candidate)."""
     gp, pp = model.gear_par, model.pair_par
     max_gap += float(np.abs(gp[:, L.DEV0:L.DEV0 + L.N_DEV]).max())
+    if pp.size > L.N_PAIR_PAR:
+        max_gap += float(pp[L.E_BOUND])
     jn2 = float(pp[L.JN_HALF])
     theta2 = float(model.theta2_for_te(theta1, jn2))
     pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
@@ -289,7 +295,28 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
     gap = np.maximum(a[:, 4], 0.0)
     for i in range(a.shape[0]):
         gap[i] += flank_deviation(gp[0], a[i, 2])[0] + flank_deviation(gp[1], a[i, 3])[0]
+    if pp.size > L.N_PAIR_PAR:
+        gap -= error_approach(model, theta1, theta2, a[:, 0].astype(int), a[:, 1].astype(int))
     return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int))
+
+
+def error_approach(model: Model, theta1: float, theta2: float, tooth1, tooth2) -> np.ndarray:
+    """How much closer [m] the pitch errors and eccentricities (`solver.errors`) bring the drive
+    flanks of the tooth pairs (tooth1[i], tooth2[i]) at hub angles theta1, theta2 [rad], to first
+    order: each tooth's turn eps about the teeth's centre moves its flank rb*eps along the line of
+    action, and the centre offsets d1, d2 move the flanks by (d1 - d2).n, n the drive line of
+    action (gear 1's outward flank normal, at 90 deg - alpha in the pair frame; also used for
+    tip-corner contacts, whose normal turns by a few degrees)."""
+    gp, pp = model.gear_par, model.pair_par
+    psi_n = 0.5 * math.pi - pp[L.ALPHA]
+    z1 = model.teeth[0]
+    eps1 = pp[L.E_EPS + np.asarray(tooth1) % z1]
+    eps2 = pp[L.E_EPS + z1 + np.asarray(tooth2) % model.teeth[1]]
+    out = gp[0, L.RB] * eps1 + gp[1, L.RB] * eps2
+    for g, th, sign in ((0, theta1, 1.0), (1, theta2, -1.0)):
+        c = th + gp[g, L.GAMMA0] + pp[L.E_ECC + 2 * g + 1]
+        out = out + sign * pp[L.E_ECC + 2 * g] * math.cos(c - psi_n)
+    return out
 
 
 # ------------------------------------------------------------------ contact problem

@@ -149,6 +149,35 @@ def check_positive(**values: float) -> None:
             raise ValueError(f"{name}: must be positive, got {v}")
 
 
+def start_te(model: Model, side: float) -> float:
+    """TE [m] at t = 0: the rigid teeth touching on the flank side of the first load (sign).
+    Perfect gears touch at +-jn/2; with pitch errors or eccentricity (`solver.errors`) the first
+    touch at theta1 = 0 is found by bisection on the contact search within the errors' bound, so
+    that the run starts in contact without penetration (a penetration of microns would start it
+    with a kick)."""
+    s = 1.0 if side >= 0 else -1.0
+    te0 = s * model.backlash_offset
+    if model.pair_par.size <= L.N_PAIR_PAR:
+        return te0
+    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    rec, pairs = new_contact_buffer()
+    zeros = np.zeros(model.n_teeth)
+    geo = (model.gear_par, model.pair_par, model.law_par)
+
+    def touching(te):
+        nc, _ = mesh_contacts((0.0, model.theta2_for_te(0.0, te), 0.0, 0.0), zeros, zeros, geo, (rec, pairs))
+        return any(rec[c, L.C_KIND] * s > 0 for c in range(nc))
+
+    clear, touch = 0.0, 2.0 * model.pair_par[L.E_BOUND]    # approach from jn/2 - bound along side s
+    for _ in range(48):
+        mid = 0.5 * (clear + touch)
+        if touching(te0 - s * model.pair_par[L.E_BOUND] + s * mid):
+            touch = mid
+        else:
+            clear = mid
+    return te0 - s * model.pair_par[L.E_BOUND] + s * clear
+
+
 def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_teeth: bool = False,
                progress=None):
     """Run a stepping kernel from rest; returns (its 4 return values, output records).
@@ -172,7 +201,7 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     ip = np.zeros(L.N_IPAR, dtype=np.int64)
     ip[[L.N_STEPS, L.OUT_EVERY, L.MAX_ITER]] = n_steps, out_every, par.get("MAX_ITER", 0)
     hub = np.zeros((3, L.N_HUB))
-    hub[L.POS, L.H_TH2] = hub[L.POS, L.H_H2] = model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset)
+    hub[L.POS, L.H_TH2] = hub[L.POS, L.H_H2] = model.theta2_for_te(0.0, start_te(model, side))
     teeth = np.zeros((3, model.n_teeth))
     if all_teeth:
         teeth[L.POS] = 1e-300

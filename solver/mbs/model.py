@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from solver.errors import GearErrors, error_block
 from solver.geometry import (
     BodySpec,
     GearGeometry,
@@ -45,6 +46,7 @@ class GearInput:
     body_damping_ratio: float = 0.02    # of critical on the body mode (as the teeth's 2 %)
     tooth_compliance: np.ndarray | None = None  # (Z, Z) rad/(N·m): teeth coupled through the body
     modification: ProfileModification | None = None  # flank deviation (relief, table); None: perfect involutes
+    errors: GearErrors | None = None    # pitch deviations and eccentricity; None: a perfect gear
 
 
 @dataclass(frozen=True)
@@ -63,7 +65,7 @@ class Model:
     """Everything the kernels need, plus the derived geometry for reporting."""
 
     gear_par: np.ndarray            # (2, N_GEAR_PAR)
-    pair_par: np.ndarray            # (N_PAIR_PAR,)
+    pair_par: np.ndarray            # (N_PAIR_PAR,), plus the errors block E_* when a gear has errors
     law_par: np.ndarray             # (N_LAW_PAR,)
     k_phi: np.ndarray               # (Z1 + Z2,) N·m/rad^n_k
     geometry: tuple                 # (GearGeometry, GearGeometry)
@@ -198,6 +200,11 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
     pp[L.JN_HALF] = 0.5 * pair.normal_backlash
     pp[L.ALPHA] = pair.pressure_angle
     pp[L.MARGIN] = presearch_margin * max(geos[0].pitch_angle, geos[1].pitch_angle)
+    for name, gi, g in (("gear1", gear1, geos[0]), ("gear2", gear2, geos[1])):
+        if gi.errors is not None:
+            # limited to 0.1 module: a few % of a pitch, well inside the pre-search margin
+            gi.errors.check(g.teeth, g.spec.module, name)
+    pp = np.concatenate([pp, error_block((gear1.errors, gear2.errors), geos)])
     lp = np.array([law.k, law.m1, law.c, law.m2, law.m3], dtype=float)
     kphi = np.concatenate(own)
     ctooth = np.zeros((0, 0))

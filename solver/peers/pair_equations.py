@@ -108,6 +108,8 @@ class PairEquations:
             raise ValueError("coupling.model: the scipy peer has no body-torsion coupling; use the explicit integrator")
         if np.any(model.gear_par[:, L.DEV_ON] > 0):
             raise ValueError("gearN.modification: the scipy peer has perfect involutes; use the explicit integrator")
+        if model.pair_par.size > L.N_PAIR_PAR:
+            raise ValueError("gearN.errors: the scipy peer has perfect gears; use the explicit integrator")
         gp = model.gear_par
         self.model = model
         self.speed, self.speed_ramp = float(speed), float(speed_ramp)

@@ -100,7 +100,8 @@ def peak_variables(prefix: str, peaks, frequency_per_order: float | None = None)
     """A small table of named spectral peaks along dimension ``{prefix}_peak`` (names as coordinate)."""
     dim = f"{prefix}_peak"
     coords = {dim: _var(dim, np.array([p.name for p in peaks], dtype=object), "1",
-                        "peak name: N hole order, Z mesh order, kZ+-N sidebands, other k = k-th largest unexplained peak")}
+                        "peak name: N hole order, Z mesh order, kZ+-N sidebands, R1 and R2 the driver's and the driven "
+                        "gear's once-per-revolution orders (gears with errors), other k = k-th largest unexplained peak")}
     what = prefix.upper()
     data = {
         f"{dim}_nominal_order": _var(dim, np.array([p.nominal for p in peaks]), "1", f"nominal order of the named {what} peak (driven-gear revolutions)"),
@@ -112,8 +113,10 @@ def peak_variables(prefix: str, peaks, frequency_per_order: float | None = None)
     return coords, data
 
 
-def ste_spectrum_variables(angle_deg, ste_um, z1: int, z2: int, hole_order: float, pad: int = 4) -> tuple[dict, dict]:
-    """STE amplitude spectrum over orders per revolution of the driven gear, and its named peaks."""
+def ste_spectrum_variables(angle_deg, ste_um, z1: int, z2: int, hole_order: float, pad: int = 4,
+                           revolutions: bool = False) -> tuple[dict, dict]:
+    """STE amplitude spectrum over orders per revolution of the driven gear, and its named peaks
+    (``revolutions``: also each gear's once-per-revolution order, R1 = Z2/Z1 and R2 = 1)."""
     angle_deg = np.asarray(angle_deg, float)
     if angle_deg.size < 16:
         return {}, {}
@@ -124,13 +127,16 @@ def ste_spectrum_variables(angle_deg, ste_um, z1: int, z2: int, hole_order: floa
                                   window=WINDOW, resolution_orders=res, zero_padding=pad,
                                   record_driven_revolutions=1.0 / res,
                                   comment="driven rotation = driver rotation * z1/z2; NaN samples interpolated")}
-    c, d = peak_variables("ste", named_peaks(order, amp, hole_order, z2, res))
+    c, d = peak_variables("ste", named_peaks(order, amp, hole_order, z2, res,
+                                             revolution_orders=(z2 / z1, 1.0) if revolutions else None))
     coords.update(c); data.update(d)
     return coords, data
 
 
 def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_order: float = 0.0,
-                      mesh_order: float | None = None) -> tuple[dict, dict, dict]:
+                      mesh_order: float | None = None, revolution_orders: tuple | None = None) -> tuple[dict, dict, dict]:
+    """DTE and its spectrum after ``spectrum_start`` [s] with the named peaks (``revolution_orders``:
+    see `study.report.spectra.named_orders`)."""
     coords = {"time": _var("time", res.time, "s", "time",
                            comment="elapsed time from the start of the run, not a calendar time")}
     data = {
@@ -152,7 +158,8 @@ def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_orde
         data["dte_amplitude"] = _var("frequency", a, "um", "one-sided amplitude spectrum of DTE after the ramp",
                                      window=WINDOW, resolution_Hz=1.0 / (sel.sum() * dt), start_s=float(res.time[sel][0]))
         if f_rot > 0 and mesh_order:
-            peaks = named_peaks(f / f_rot, a, hole_order, mesh_order, 1.0 / (sel.sum() * dt) / f_rot)
+            peaks = named_peaks(f / f_rot, a, hole_order, mesh_order, 1.0 / (sel.sum() * dt) / f_rot,
+                                revolution_orders=revolution_orders)
             c, v = peak_variables("dte", peaks, f_rot)
             coords.update(c); data.update(v)
     attrs.update(dt_s=res.dt, steps=res.steps, omega_max_rad_s=res.omega_max, dynamic_status=res.message,

@@ -7,7 +7,8 @@ scalloping loss, at most 15 % for Hann between bins; exact at bin centres). Reso
 finely (it lowers the scalloping loss, not the resolution).
 
 Orders are counted per revolution of the driven gear: the hole order is the number of holes
-N of the driven gear, the mesh order its tooth count Z. STE is sampled over driver angle; its
+N of the driven gear, the mesh order its tooth count Z; with pitch errors or eccentricity the
+once-per-revolution orders of the driver (Z2/Z1, named R1) and of the driven gear (1, R2). STE is sampled over driver angle; its
 spectrum over driven-gear orders uses the driven rotation theta2 = theta1 * z1 / z2.
 """
 from __future__ import annotations
@@ -69,13 +70,17 @@ class Peak:
     amplitude: float   # amplitude there [signal units]
 
 
-def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 5, hole_harmonics: int = 2) -> list[tuple[str, float]]:
+def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 5, hole_harmonics: int = 2,
+                 revolution_orders: tuple | None = None) -> list[tuple[str, float]]:
     """(name, order) of the orders a lightened gear pair excites: hole order N and its harmonics,
     mesh order Z and its harmonics, and the sidebands kZ +- N. NaN orders when N = 0 (kept so
-    every scene has the same table)."""
+    every scene has the same table). ``revolution_orders`` = (driver, driven) once-per-revolution
+    orders (Z2/Z1 and 1 in driven-gear orders), given for gears with pitch errors or
+    eccentricity: named R1 and R2 first (none otherwise, so a perfect pair's table is unchanged)."""
     n = float(hole_order) if hole_order and hole_order > 0 else float("nan")
     z = float(mesh_order)
-    out = [("N" if h == 1 else f"{h}N", h * n) for h in range(1, hole_harmonics + 1)]
+    out = [] if revolution_orders is None else [("R1", float(revolution_orders[0])), ("R2", float(revolution_orders[1]))]
+    out += [("N" if h == 1 else f"{h}N", h * n) for h in range(1, hole_harmonics + 1)]
     for k in range(1, mesh_harmonics + 1):
         kz = "Z" if k == 1 else f"{k}Z"
         out += [(f"{kz}-N", k * z - n), (kz, k * z), (f"{kz}+N", k * z + n)]
@@ -84,7 +89,7 @@ def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 5, 
 
 def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resolution: float,
                 mesh_harmonics: int = 5, hole_harmonics: int = 2, unexplained: int = 4,
-                min_order: float = 0.5) -> list[Peak]:
+                min_order: float = 0.5, revolution_orders: tuple | None = None) -> list[Peak]:
     """The amplitude found at each named order and the ``unexplained`` largest local maxima that
     lie outside every named order's main lobe and off the higher mesh harmonics kZ (and kZ+-N)
     the table does not name (names "other 1", ...; NaN when fewer).
@@ -96,7 +101,7 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
     order = np.asarray(order, float)
     amp = np.asarray(amplitude, float)
     tol = max(HANN_MAIN_LOBE_BINS * resolution, 1e-9)
-    table = named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics)
+    table = named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics, revolution_orders)
     finite = np.array([0.0] + [o for _, o in table if np.isfinite(o)])
     is_peak = np.zeros(amp.size, bool)
     is_peak[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])

@@ -79,7 +79,7 @@ CURVES = {
 # that covers itself and every field under it, '' covers every field; the longest prefix that
 # covers a field decides. The sets nest: geometry < fe < static < modes < dynamic.
 #   geometry  mass and inertia: the gears' teeth and bodies, the backlash that thins the teeth, the
-#             density (solver.inertia.gear_mass via study.inputs.gearsetup)
+#             density (solver.inertia.gear_mass via study.inputs.gearsetup); not the gears' errors
 #   fe        root stress: the gears (springs included: 'uniform' runs no FE), the material, the
 #             backlash, the FE mesh and the torque that sets the FE load (gearsetup.reference_torque)
 #   static    STE: every field but the dynamic run's (study.run.run_static reads no 'dynamic.*')
@@ -87,9 +87,10 @@ CURVES = {
 #             the static fields (damping included) and the mean load, the dynamic run's torque
 #             when it runs (study.setup.mean_load reads dynamic.enabled and dynamic.torque)
 #   dynamic   DTE: every field
+ERRORS = ("gear1.errors", "gear2.errors")    # pitch errors and runout: no part of a gear's mass or FE body
 ANALYSIS_FIELDS = {
-    "geometry": (("gear1", "gear2", "pair", "material.density"), ("gear1.spring", "gear2.spring")),
-    "fe": (("gear1", "gear2", "pair", "material", "fe", "quasi_static.torque"), ()),
+    "geometry": (("gear1", "gear2", "pair", "material.density"), ("gear1.spring", "gear2.spring", *ERRORS)),
+    "fe": (("gear1", "gear2", "pair", "material", "fe", "quasi_static.torque"), ERRORS),
     "static": (("",), ("dynamic", "title")),
     "modes": (("", "dynamic.enabled", "dynamic.torque"), ("dynamic", "title")),
     "dynamic": (("",), ("title",)),

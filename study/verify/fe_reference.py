@@ -23,14 +23,15 @@ from solver.fe.ltca import ltca_sweep, mesh_points
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
 from study.scene import Scene, SceneError
-from study.setup import geometry_model
+from study.setup import geometry_model, static_rotation
 
 
 def static_angles(scene: Scene, step_deg: float | None = None) -> np.ndarray:
-    """Driver angles [rad]: the scene's quasi-static rotation at its step (or ``step_deg``)."""
+    """Driver angles [rad]: the scene's quasi-static rotation (whole periods of its pitch errors
+    and eccentricities: `study.setup.static_rotation`) at its step (or ``step_deg``)."""
     qs = scene.quasi_static
     step = qs.angle_step if step_deg is None else step_deg
-    n = int(math.floor(qs.rotation / step + 1e-9)) + 1
+    n = int(math.floor(static_rotation(scene) / step + 1e-9)) + 1
     return np.radians(np.arange(n) * step)
 
 

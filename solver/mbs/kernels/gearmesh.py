@@ -25,6 +25,11 @@ the tip deviation plus slope*TIP_BLEND*(1 - exp(-(u - u_tip)/TIP_BLEND)), u the 
 roll parameter beyond the tip: the penetration is C1 across the switch and differs from the
 plain corner's by at most slope*TIP_BLEND (below 1 nm for any relief steeper than real ones).
 
+Pitch errors and eccentricity (`solver.errors`, the pair_par block E_*, present only when a
+gear has them): each tooth's axis turns by its offset eps about the teeth's centre, which sits
+off the bearing axis by the eccentricity; the flanks follow exactly, the moment arms of the hub
+rotations stay about the bearing axes, and the rigid gap bound grows by E_BOUND.
+
 State: theta1, theta2 hub angles [rad] (counter-clockwise positive), phi[Z1+Z2] tooth
 rotations about their pivots relative to the hub [rad], gear-1 teeth first.
 """
@@ -119,11 +124,12 @@ def _tangent_turn(dx, dy, length, kc, ddx, ddy):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _deviation_gradient(sa, sb, s, centres, axes, gp):
+def _deviation_gradient(sa, sb, s, centres, axes, ecc, gp):
     """d(da + db)/d(theta1, phi_A, theta2, phi_B) [m] of the flank deviations whose slopes are
     sa, sb [m] per unit roll at the flank-flank contact of side s; centres = (moved base-circle
     centres A x, y, B x, y [m], base radii A, B [m]), axes = (tooth axis angle, rotation of
-    tooth A, the same of B) [rad]. With ua = s*(beta_a - ta), ub = s*(beta_b - ta - pi), the
+    tooth A, the same of B) [rad], ecc = the teeth's centres' offsets from the bearing axes
+    (gear 1 x, y, gear 2 x, y) [m]. With ua = s*(beta_a - ta), ub = s*(beta_b - ta - pi), the
     common tangent's angle ta turns as the tooth rotations move the base-circle centres."""
     cax, cay, cbx, cby, rba, rbb = centres
     axa, pa, axb, pb = axes
@@ -136,6 +142,11 @@ def _deviation_gradient(sa, sb, s, centres, axes, gp):
     ta_ = _tangent_turn(dx, dy, ln, kc, -ra * math.sin(axa + pa), ra * math.cos(axa + pa))
     t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (math.sin(axb + pb) - math.sin(axb)), rb_ * (math.cos(axb) - math.cos(axb + pb)))
     tb = _tangent_turn(dx, dy, ln, kc, rb_ * math.sin(axb + pb), -rb_ * math.cos(axb + pb))
+    e1x, e1y, e2x, e2y = ecc
+    if e1x != 0.0 or e1y != 0.0 or e2x != 0.0 or e2y != 0.0:
+        # a hub rotation also swings the eccentric centre about the bearing axis
+        t1 += _tangent_turn(dx, dy, ln, kc, e1y, -e1x)
+        t2 += _tangent_turn(dx, dy, ln, kc, -e2y, e2x)
     return (-s * (sa * (1.0 - t1) - sb * t1), -s * (sa * (1.0 - ta_) - sb * ta_),
             -s * (-sa * t2 + sb * (1.0 - t2)), -s * (-sa * tb + sb * (1.0 - tb)))
 
@@ -198,20 +209,32 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     modified = gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0
     if modified:
         bound += gp[0, L.DEV_NEG] + gp[1, L.DEV_NEG]
+    errs = pp.shape[0] > L.N_PAIR_PAR
+    if errs:
+        bound += pp[L.E_BOUND]
     if bound <= 0.0:
         return nc
     o1x, o1y = gp[0, L.CX], gp[0, L.CY]
     o2x, o2y = gp[1, L.CX], gp[1, L.CY]
     axa = theta1 + gp[0, L.GAMMA0] + k * gp[0, L.PITCH]
     axb = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
-    cax, cay = moved_center(o1x, o1y, gp[0, L.R_PV], axa, pa)
-    cbx, cby = moved_center(o2x, o2y, gp[1, L.R_PV], axb, pb)
+    # the teeth's centres: off the bearing axes O by the eccentricity (the moment arms stay about O)
+    e1x, e1y, e2x, e2y = 0.0, 0.0, 0.0, 0.0
+    if errs:
+        axa += pp[L.E_EPS + ia]
+        axb += pp[L.E_EPS + ib]
+        c1 = theta1 + gp[0, L.GAMMA0] + pp[L.E_ECC + 1]
+        c2 = theta2 + gp[1, L.GAMMA0] + pp[L.E_ECC + 3]
+        e1x, e1y = pp[L.E_ECC] * math.cos(c1), pp[L.E_ECC] * math.sin(c1)
+        e2x, e2y = pp[L.E_ECC + 2] * math.cos(c2), pp[L.E_ECC + 2] * math.sin(c2)
+    cax, cay = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], axa, pa)
+    cbx, cby = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], axb, pb)
     rba = gp[0, L.RB]
     rbb = gp[1, L.RB]
     ba = axa + pa + s * gp[0, L.PSI_B]
     bb = axb + pb + s * gp[1, L.PSI_B]
-    frame = (o1x, o1y, o1x + gp[0, L.R_PV] * math.cos(axa), o1y + gp[0, L.R_PV] * math.sin(axa),
-             o2x, o2y, o2x + gp[1, L.R_PV] * math.cos(axb), o2y + gp[1, L.R_PV] * math.sin(axb))
+    frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * math.cos(axa), o1y + e1y + gp[0, L.R_PV] * math.sin(axa),
+             o2x, o2y, o2x + e2x + gp[1, L.R_PV] * math.cos(axb), o2y + e2y + gp[1, L.R_PV] * math.sin(axb))
     vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
@@ -220,7 +243,8 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             da, sa = flank_deviation(gp[0], ua)
             db, sb = flank_deviation(gp[1], ub)
             delta -= da + db
-            dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb), gp)
+            dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb),
+                                     (e1x, e1y, e2x, e2y), gp)
         if delta > 0.0 and nc < rec.shape[0]:
             # owner A (gear 1)
             _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg))
@@ -249,7 +273,8 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
                 if w > 1e-12:
                     # d delta/dq gains -sw*du/dq, d2 delta/dq2 gains (sw/TIP_BLEND)*(du/dq)(du/dq)^T
                     du = _deviation_gradient(1.0 if g == 0 else 0.0, 1.0 if g == 1 else 0.0, s,
-                                             (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb), gp)
+                                             (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb),
+                                             (e1x, e1y, e2x, e2y), gp)
                     dg = (sw * du[0], sw * du[1], sw * du[2], sw * du[3])
                     blend = sw / TIP_BLEND
             if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:

@@ -48,6 +48,11 @@ JN_HALF = 0     # half the normal backlash [m]
 ALPHA = 1       # pressure angle [rad]
 MARGIN = 2      # pre-search margin on the roll parameter [rad]
 N_PAIR_PAR = 3
+# pitch errors and eccentricity (`solver.errors`): a block after N_PAIR_PAR, present only when
+# either gear has errors (the kernels test the length of pair_par)
+E_BOUND = 3     # bound on the penetration the errors can add [m]
+E_ECC = 4       # gear g: eccentricity [m] at E_ECC + 2g, its phase from tooth 0's axis [rad] at E_ECC + 2g + 1
+E_EPS = 8       # first of the Z1 + Z2 tooth angular offsets about the teeth's centre [rad], gear 1 first
 
 # contact record columns (one row per active contact)
 C_DELTA = 0     # penetration [m]

@@ -9,7 +9,8 @@ phi = 0 for n > 1, so a tiny diagonal term (1e-9 of the tooth's k_phi) regularis
 that carry no load; the residual, and so the solution, is exact.
 
 The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
-the gear_par columns DEV_* (`solver.modification`).
+the gear_par columns DEV_* (`solver.modification`) and the pitch errors and eccentricities
+from the pair_par block E_* (`solver.errors`).
 """
 
 import numpy as np
@@ -232,14 +233,18 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                     break
                 # no contact yet: close the gap rigidly, plus the contact-only penetration
                 dpen = (abs(torque) / rb2 / lp[L.K_CON]) ** (1.0 / lp[L.M1])
-                if gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0:
-                    # modified flanks: the gap may be up to both deviations; closed in 16ths of
-                    # them, one more at each iteration without contact (near the first touch)
+                errs = pp.shape[0] > L.N_PAIR_PAR
+                if gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0 or errs:
+                    # modified flanks: the gap may be up to both deviations (and the pitch errors
+                    # and eccentricities); closed in 16ths of them, one more at each iteration
+                    # without contact (near the first touch)
                     for g in range(2):
                         dev_max = 0.0       # a loop, not .max(): numpy's max and take would compile too
                         for k in range(L.DEV0, L.DEV0 + L.N_DEV):
                             dev_max = max(dev_max, gp[g, k])
                         dpen += open_steps / 16.0 * dev_max
+                    if errs:
+                        dpen += open_steps / 16.0 * pp[L.E_BOUND]
                     open_steps += 1
                 theta2 = ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue

@@ -31,8 +31,16 @@ def modified_flanks(scene, model, g, theta, n=1500):
     """Drive flanks of the teeth of gear g near the mesh in the pair frame, sampled densely with
     the deviation applied along the normal (material removed): an independent construction
     from `GearGeometry.flank_point`, the gear centre and the tooth axes, the involute's normal. Returns points (m, 2) [m] and outward normals (m, 2). Points 4 um apart on
-    flanks of curvature radius > 5 mm: the nearest point's signed distance is off by < 1 nm."""
+    flanks of curvature radius > 5 mm: the nearest point's signed distance is off by < 1 nm.
+    Also a mask, False at each flank's end samples (there the projection on the sample's normal
+    says nothing about points beyond the end, as next to a tip corner). Pitch errors and eccentricity (``gearN.errors``): tooth k's axis turned by F_p,k/r (r the
+    reference radius, F_p,k the sum of the single pitch deviations of teeth 1..k) about the
+    teeth's centre, which sits e from the gear centre at theta + gamma0 + phase."""
     geo = model.geometry[g]
+    err = scene.errors_spec(g + 1)
+    eps = np.zeros(geo.teeth)
+    if err is not None and len(err.pitch):
+        eps = np.cumsum(np.concatenate([[0.0], err.pitch[1:]])) / geo.pitch_radius
     mod = scene.modification_spec(g + 1)
     u = np.linspace(geo.u_form, geo.u_tip, n)
     x, y = geo.flank_point(u, 1)     # both gears' "+" flanks carry the drive side
@@ -43,33 +51,42 @@ def modified_flanks(scene, model, g, theta, n=1500):
     pts, nrm = [], []
     z = geo.teeth
     cx, cy = model.gear_par[g, L.CX], model.gear_par[g, L.CY]
+    if err is not None:
+        c = theta + model.gear_par[g, L.GAMMA0] + err.eccentricity_phase
+        cx, cy = cx + err.eccentricity * math.cos(c), cy + err.eccentricity * math.sin(c)
     for k in range(z):
-        ax = theta + model.gear_par[g, L.GAMMA0] + k * geo.pitch_angle
+        ax = theta + model.gear_par[g, L.GAMMA0] + k * geo.pitch_angle + eps[k]
         c, s = math.cos(ax), math.sin(ax)
         px, py = cx + c * x - s * y, cy + s * x + c * y
         if np.min(np.hypot(px - model.pair.center_distance / 2, py)) > 3 * geo.spec.module:
             continue                 # far from the mesh
         pts.append(np.column_stack([px, py]))
         nrm.append(np.column_stack([c * nx - s * ny, s * nx + c * ny]))
-    return np.vstack(pts), np.vstack(nrm)
+    pts, nrm = np.vstack(pts), np.vstack(nrm)
+    inner = np.ones(pts.shape[0], bool)     # False at each flank's two end samples
+    inner[::n] = inner[n - 1::n] = False
+    return pts, nrm, inner
 
 
 def kinematic_te(scene, model, theta1):
     """TE [m] at which the rigid driven gear, turned back from a clear position, first touches
     the driver: bisection on the smallest signed distance between the sampled flank points."""
     rb1, rb2 = model.base_radii
-    lo, hi = model.backlash_offset - 1e-6, model.backlash_offset + 25e-6
-    p1, n1 = modified_flanks(scene, model, 0, theta1)
+    lo, hi = model.backlash_offset - 25e-6, model.backlash_offset + 25e-6
+    p1, n1, in1 = modified_flanks(scene, model, 0, theta1)
     tree1 = cKDTree(p1)
 
     def clearance(te):
         th2 = (te - rb1 * theta1) / rb2
-        p2, n2 = modified_flanks(scene, model, 1, th2)
+        p2, n2, in2 = modified_flanks(scene, model, 1, th2)
         d12, i12 = tree1.query(p2)
         s12 = np.einsum("ij,ij->i", p2 - p1[i12], n1[i12])          # gear-2 points outside gear 1's flanks
         d21, i21 = cKDTree(p2).query(p1)
         s21 = np.einsum("ij,ij->i", p1 - p2[i21], n2[i21])
-        near = np.concatenate([s12[d12 < 1e-4], s21[d21 < 1e-4]])
+        # nearest to a flank's inner sample: beyond a flank's end the projection on the last
+        # sample's normal says nothing (a point past a tip corner would read as inside); a tip
+        # corner itself is caught as a point of its own flank inside the mating one
+        near = np.concatenate([s12[(d12 < 1e-4) & in1[i12]], s21[(d21 < 1e-4) & in2[i21]]])
         return near.min() if near.size else 1.0
 
     for _ in range(32):
@@ -91,14 +108,14 @@ def first_order_shift(scene, model, theta1):
         return mods[g].deviation(u, geo[g].u_form, geo[g].u_tip)
 
     best = None
-    for u1, u2, kind in zip(mp.u1, mp.u2, mp.kind):
+    for u1, u2, kind, gap in zip(mp.u1, mp.u2, mp.kind, mp.gap):
         if kind != 1:
             continue
         s1 = (dev(0, u1 + 1e-7) - dev(0, u1 - 1e-7)) / 2e-7
         s2 = (dev(1, u2 + 1e-7) - dev(1, u2 - 1e-7)) / 2e-7
         r1, r2 = geo[0].base_radius * u1, geo[1].base_radius * u2
         sigma = s1 / r1 - s2 / r2           # the contact runs up flank 1 and down flank 2
-        gap = dev(0, u1) + dev(1, u2)
+        # the contact of least initial separation: the deviations, less any pitch errors' approach
         if best is None or gap < best[0]:
             best = (gap, sigma**2 / (2 * (1 / r1 + 1 / r2)))
     return best[1]

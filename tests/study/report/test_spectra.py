@@ -112,3 +112,23 @@ def test_dte_spectrum_in_the_archive_has_orders_and_named_peaks():
     freq = dict(zip(names, data["dte_peak_frequency"].values))
     assert freq["Z"] == pytest.approx(found["Z"] * f_rot)
     assert data["dte_amplitude"].attrs["window"] == "hann"
+
+
+def test_once_per_revolution_orders_of_gears_with_errors_are_named():
+    """An STE over twelve driver revolutions of a 20/30 pair with a once-per-driver-revolution
+    tone (1.0 um: order Z2/Z1 = 1.5 of the driven gear) and a once-per-driven-revolution tone
+    (0.4 um: order 1) reads them as R1 and R2; without revolution orders the table is the
+    perfect pair's, and the tones are unexplained peaks."""
+    step = 0.25
+    theta = np.radians(np.arange(0.0, 12 * 360.0, step))
+    ste = 1.0 * np.cos(theta + 0.2) + 0.4 * np.cos(theta * 20 / 30 - 0.5) + 0.1 * np.cos(20 * theta)
+    c, d = results.ste_spectrum_variables(np.degrees(theta), ste, 20, 30, 0.0, revolutions=True)
+    names = list(c["ste_peak"].values)
+    assert names[:2] == ["R1", "R2"]
+    np.testing.assert_allclose(d["ste_peak_nominal_order"].values[:2], [1.5, 1.0])
+    np.testing.assert_allclose(d["ste_peak_amplitude"].values[:2], [1.0, 0.4], rtol=0.02)
+    c0, d0 = results.ste_spectrum_variables(np.degrees(theta), ste, 20, 30, 0.0)
+    assert "R1" not in list(c0["ste_peak"].values)
+    assert list(c0["ste_peak"].values) == names[2:]
+    others = d0["ste_peak_order"].values[[n.startswith("other") for n in c0["ste_peak"].values]]
+    assert np.any(np.abs(others - 1.5) < 0.1) and np.any(np.abs(others - 1.0) < 0.1)
