@@ -27,11 +27,13 @@ from study.setup import build_scene_model, damping_ratios, load_table, mean_load
 
 
 def run_static(scene: Scene, model: Model):
-    """STE by equilibrium at each angle, or by the paper's slow-ramp transient."""
+    """STE by equilibrium at each angle, or by the paper's slow-ramp transient. Flank friction
+    in the equilibria slides as the rigid pair rolling at quasi_static.speed (the transient's
+    speed: both methods regularise it alike; the static analysis reads no dynamic.* field)."""
     qs = scene.quasi_static
     angles = static_angles(scene)
     if qs.method == "static":
-        return solve_static(model, angles, qs.torque, raise_on_failure=False)
+        return solve_static(model, angles, qs.torque, raise_on_failure=False, friction_speed=qs.speed)
     # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles
     from solver.mbs.dynamics import at_driver_angles, slow_ramp_window
     from solver.mbs.statics import StaticResult
