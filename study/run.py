@@ -158,6 +158,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         runup = d.speed_end > 0         # no spectrum over a changing speed: its order tracking instead
         c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2)
         coords.update(c); data.update(v); attrs.update(a)
+        if scene.contact.friction > 0 and not runup and load_table(scene) is None:
+            data.update(results.efficiency_variable(dy, d.torque, d.speed, start))
         if runup and dy.status == 0:
             from study.report.order_tracking import order_tracking_variables
             c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
