@@ -1,5 +1,6 @@
 """Sliding friction on the flanks: the closed-form loss, the regularised law, the energy
 balance, the frictionless limit and the scene's checks."""
+import dataclasses
 import math
 import re
 
@@ -11,6 +12,7 @@ from solver.mbs.dynamics import simulate
 from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+from solver.mbs.model import build_model
 from solver.mbs.statics import solve_static
 from study.errors import SceneError
 from study.setup import build_scene_model
@@ -107,14 +109,24 @@ def test_without_friction_nothing_depends_on_the_friction_velocity():
         assert np.array_equal(x, y)
 
 
-@pytest.mark.parametrize("method", ["explicit", "implicit"])
+def with_body_springs(model, k_body=(1.5e6, 1.0e6)):
+    """``model`` with body-torsion springs [N m/rad] (the explicit coupled loop)."""
+    g1, g2, law, mat = model.inputs
+    return build_model(dataclasses.replace(g1, body_stiffness=k_body[0]), dataclasses.replace(g2, body_stiffness=k_body[1]),
+                       law, mat)
+
+
+@pytest.mark.parametrize("method", ["explicit", "implicit", "coupled"])
 def test_energy_balance_with_friction(paper_solid_model, method):
     """Work in = kinetic + potential change + dissipation, the friction's mu*F*|v_s| included:
     the balance closes as tightly as without friction, and friction adds to the dissipation."""
     m = build_scene_model(solid_scene(**{"contact.friction": 0.1}))
-    run = simulate if method == "explicit" else simulate_implicit
+    m0 = paper_solid_model
+    if method == "coupled":
+        m, m0 = with_body_springs(m), with_body_springs(m0)
+    run = simulate_implicit if method == "implicit" else simulate
     r = run(m, 100.0, 0.002, 50.0, 0.002, 0.005)
-    r0 = run(paper_solid_model, 100.0, 0.002, 50.0, 0.002, 0.005)
+    r0 = run(m0, 100.0, 0.002, 50.0, 0.002, 0.005)
     assert r.status == 0 and r0.status == 0
     assert np.max(np.abs(r.energy_error)) < 1e-3 * r.work[-1]
     # at least half the friction loss mu*H_V (H_V about 0.077 here) of the work put in
