@@ -36,11 +36,13 @@ from study.setup import (
 
 
 def run_static(scene: Scene, model: Model):
-    """STE by equilibrium at each angle, or by the paper's slow-ramp transient."""
+    """STE by equilibrium at each angle, or by the paper's slow-ramp transient. Flank friction
+    in the equilibria slides as the rigid pair rolling at quasi_static.speed (the transient's
+    speed: both methods regularise it alike; the static analysis reads no dynamic.* field)."""
     qs = scene.quasi_static
     angles = static_angles(scene)
     if qs.method == "static":
-        return solve_static(model, angles, qs.torque, raise_on_failure=False)
+        return solve_static(model, angles, qs.torque, raise_on_failure=False, friction_speed=qs.speed)
     # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles
     from solver.mbs.dynamics import at_driver_angles, slow_ramp_window
     from solver.mbs.statics import StaticResult
@@ -170,6 +172,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2,
                                             (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
+        if scene.contact.friction > 0 and not runup and load_table(scene) is None:
+            data.update(results.efficiency_variable(dy, d.torque, d.speed, start))
         if runup and dy.status == 0:
             from study.report.order_tracking import order_tracking_variables
             c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)

@@ -28,9 +28,9 @@ from study.modification import ModificationSection, modification_spec
 from study.toml_writer import dumps_toml
 
 
-def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None, optional=False):
+def _f(default, unit: str, doc: str, lo=None, hi=None, lo_open=False, choices=None, optional=False, hi_open=False):
     return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=lo_open, choices=choices,
-                                                optional=optional))
+                                                optional=optional, hi_open=hi_open))
 
 
 @dataclass(frozen=True)
@@ -114,6 +114,16 @@ class ContactSection:
     EXCLUSIVE = ("c_con", "damping_ratio", MESH_DAMPING_RATIO, None)    # m2 = 1 checked where c_con carries it
     m2: float = _f(1.0, "1", "damping (velocity) exponent", 0.5, 2.0)
     m3: float = _f(1.5, "1", "indentation exponent of the damping term", 0.0, 3.0)
+    # Sliding friction on the flanks: mu_eff = friction*tanh(v_s/friction_velocity), v_s the
+    # sliding speed of the flanks at the contact point (it reverses at the pitch point). The
+    # default 10 mm/s spreads the reversal over 0.05 mm of the 8 mm path of contact of the
+    # paper's pair at 100 rad/s (v_s = (w1 + w2)*s: 200 rad/s x 0.05 mm). Statics take the
+    # kinematic sliding speed at quasi_static.speed (study/run.py, run_static): at its 1 rad/s
+    # the reversal spreads over 5 mm, most of the path; give the running speed there.
+    friction: float = _f(0.0, "1", "Coulomb coefficient of sliding friction on the flanks (0 = frictionless, the paper)",
+                         0.0, 0.5, hi_open=True)
+    friction_velocity: float = _f(10.0, "mm/s", "sliding speed over which the friction force reverses (regularisation: "
+                                  "mu*tanh(v_s/friction_velocity))", 0.0, lo_open=True)
 
 
 @dataclass(frozen=True)
@@ -123,7 +133,8 @@ class QuasiStaticSection:
     torque: float = _f(50.0, "N*m", "resisting torque on gear 2")
     rotation: float = _f(120.0, "deg", "driver rotation covered", 0, lo_open=True)
     angle_step: float = _f(0.1, "deg", "driver angle resolution", 0, lo_open=True)
-    speed: float = _f(1.0, "rad/s", "driver speed of the slow-ramp transient", 0, lo_open=True)
+    speed: float = _f(1.0, "rad/s", "driver speed of the slow-ramp transient; with flank friction, also the speed whose "
+                      "rolling kinematics set the equilibria's sliding speed", 0, lo_open=True)
     ramp_time: float = _f(1e-3, "s", "speed and torque ramp time of the slow-ramp transient", 0, lo_open=True)
 
 
@@ -285,8 +296,9 @@ def _build(cls, table, path: str):
         if lo is not None and not isinstance(v, tuple) and (v < lo or (md.get("lo_open") and v == lo)):
             rel = ">" if md.get("lo_open") else ">="
             raise SceneError(where, f"must be {rel} {lo}{unit}, got {v}{unit}")
-        if hi is not None and v > hi:
-            raise SceneError(where, f"must be <= {hi}{unit}, got {v}{unit}")
+        if hi is not None and (v > hi or (md.get("hi_open") and v == hi)):
+            rel = "<" if md.get("hi_open") else "<="
+            raise SceneError(where, f"must be {rel} {hi}{unit}, got {v}{unit}")
         kwargs[name] = v
     resolve_exclusive(cls, kwargs, path)
     return cls(**kwargs)

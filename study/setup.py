@@ -93,7 +93,8 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
                                errors=scene.errors_spec(setup.gear)))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
-                     units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3)
+                     units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3,
+                     mu=c.friction, friction_velocity=c.friction_velocity * units.MM)
     model = build_model(gears[0], gears[1], law, setups[0].material)
     return damping_from_ratios(scene, model) if convert_damping else model
 

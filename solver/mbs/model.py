@@ -51,13 +51,23 @@ class GearInput:
 
 @dataclass(frozen=True)
 class ContactLaw:
-    """Eq. (1.3) in SI: k [N/m^m1], c [N/((m/s)^m2 m^m3)]."""
+    """Eq. (1.3) in SI: k [N/m^m1], c [N/((m/s)^m2 m^m3)]; sliding friction on the flanks:
+    Coulomb coefficient mu [-] (0: none), regularised as mu*tanh(v_s/friction_velocity) with
+    the sliding speed v_s [m/s] (`kernels.gearmesh`)."""
 
     k: float
     m1: float
     c: float = 0.0
     m2: float = 1.0
     m3: float = 1.5
+    mu: float = 0.0
+    friction_velocity: float = 0.01     # m/s
+
+    def __post_init__(self):
+        if not 0.0 <= self.mu < 0.5:
+            raise ValueError(f"contact.friction: the Coulomb coefficient must lie in [0, 0.5), got {self.mu}")
+        if not self.friction_velocity > 0.0 or not math.isfinite(self.friction_velocity):
+            raise ValueError(f"contact.friction_velocity: must be positive and finite, got {self.friction_velocity}")
 
 
 @dataclass
@@ -205,7 +215,8 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
             # limited to 0.1 module: a few % of a pitch, well inside the pre-search margin
             gi.errors.check(g.teeth, g.spec.module, name)
     pp = np.concatenate([pp, error_block((gear1.errors, gear2.errors), geos)])
-    lp = np.array([law.k, law.m1, law.c, law.m2, law.m3], dtype=float)
+    lp = np.zeros(L.N_LAW_PAR)
+    lp[[L.K_CON, L.M1, L.C_CON, L.M2, L.M3, L.MU, L.V_REG]] = law.k, law.m1, law.c, law.m2, law.m3, law.mu, law.friction_velocity
     kphi = np.concatenate(own)
     ctooth = np.zeros((0, 0))
     if gear1.tooth_compliance is not None or gear2.tooth_compliance is not None:

@@ -20,12 +20,16 @@ from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tan
 from solver.mbs.model import Model
 
 
-def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False):
+def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False,
+                      friction: bool = False):
     """Mass and tangent stiffness over the free DOFs (theta2, then the teeth near the mesh).
 
     Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF. With
     ``damping`` also the damping tangent at rest, (M, K, C, dof_teeth): spring dampers and
-    contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1).
+    contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1); with
+    ``friction``, also the flank friction's slope at zero sliding, mu*F/v_reg along the lever
+    arms H (the step bound wants it; a modal damping would not: the flanks slide but at the
+    pitch point).
     The damping laws run as plain Python here (``.py_func``, a few dozen calls): compiling
     them would add to the first run's compile time for nothing.
     """
@@ -62,6 +66,11 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
         _kd, cd = contact_damping_tangents.py_func(rec[c, L.C_DELTA], 0.0, max(rec[c, L.C_FORCE], 1e-300),
                                            lp[L.C_CON], lp[L.M2], lp[L.M3])
         C[np.ix_(idx, idx)] += cd * np.outer(g, g)
+        if friction and lp[L.MU] > 0:
+            # flank friction at rest: its slope mu*F/v_reg in the sliding speed, a stiff damper
+            # along the lever arms H (the symmetric part; it sets the explicit step)
+            hv = np.array([rec[c, L.C_H2], rec[c, L.C_HA], rec[c, L.C_HB]])
+            C[np.ix_(idx, idx)] += rec[c, L.C_DFT] * np.outer(hv, hv)
     if damping:
         return M, K, C, teeth
     return M, K, teeth
@@ -76,7 +85,8 @@ def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[f
     K x = w² M x gives the frequencies. Each mode i, with its modal damping ratio
     zeta_i = x_i^T C x_i / (2 w_i) (mass-normalised x_i), limits the step to
     2/w_i * (sqrt(1 + zeta_i²) - zeta_i): velocity Verlet with damping forces evaluated at the
-    predicted velocity is stable up to there (2/w_i undamped). A deep, damped contact (m3 > 1)
+    predicted velocity is stable up to there (2/w_i undamped). Flank friction enters C with
+    its slope at zero sliding (the stiffest it gets, near the pitch point). A deep, damped contact (m3 > 1)
     can make a lower but overdamped mode the limit. The equilibria come from one static sweep
     with continuation (tooth rotations carried from angle to angle); positions where it does
     not converge are left out.
@@ -84,7 +94,7 @@ def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[f
     wmax = 0.0
     dt_crit = math.inf
     for eq in loaded_equilibria(model, torque, positions):
-        M, K, C, _t = linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True)
+        M, K, C, _t = linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True, friction=True)
         lam, x = scipy.linalg.eigh(K, M)
         w = np.sqrt(np.maximum(lam, 0.0))
         h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]

@@ -10,6 +10,12 @@ constant wind-ups: the kernel solves the mesh in rim angles and the hubs' TE add
 rb1*M1/k_body1 + rb2*T/k_body2. Teeth coupled through the body (``Model.teeth_coupled``,
 the compliance model) take their spring moments from the compliance matrix of the teeth
 near the mesh (`kernels.toothcoupling`).
+
+Flank friction (``ContactLaw.mu`` > 0): the equilibrium of a pair whose driver turns in its
+positive sense at ``friction_speed`` [rad/s] (the friction's direction and regularisation are
+those of the rigid rolling kinematics at that speed; the contact damping is left out, as it
+sees no motion in statics). The driver's torque (`driver_torque`) then exceeds the output's
+rb1/rb2 share by the friction loss.
 """
 from __future__ import annotations
 
@@ -43,6 +49,7 @@ class StaticResult:
     torque: float              # resisting torque [N·m]
     phi_last: np.ndarray       # tooth rotations at the last angle [rad] (Z1 + Z2)
     message: str = "ok"        # why angles count as not converged ("ok": all converged)
+    driver_torque: np.ndarray | None = None    # torque the driver applies [N·m] (None: not computed)
 
     @property
     def converged(self) -> np.ndarray:
@@ -51,10 +58,12 @@ class StaticResult:
 
 def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_iter: int = 60,
                  phi0: np.ndarray | None = None, te0: float | None = None,
-                 raise_on_failure: bool = True) -> StaticResult:
+                 raise_on_failure: bool = True, friction_speed: float = 1.0) -> StaticResult:
     """Equilibrium under ``torque`` [N·m] on gear 2 at driver angles ``angles`` [rad].
 
     ``tol`` is relative to the torque (residual torques below tol*|torque| count as converged).
+    ``friction_speed`` [rad/s]: the driver speed whose rigid kinematics set the sliding speed
+    of the flank friction (unused without friction).
     """
     angles = np.ascontiguousarray(angles, dtype=float)
     if angles.ndim != 1 or angles.size == 0:
@@ -77,8 +86,14 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     # teeth coupled through the bodies: their springs act through the compliance matrix alone
     kphi = np.zeros_like(model.k_phi) if model.teeth_coupled else model.k_phi
     ctooth = model.tooth_compliance if model.teeth_coupled else None    # None: the plain kernel
-    mdl = (model.gear_par, model.pair_par, model.law_par, kphi)
-    ctl = (np.array([float(torque), theta2, tol]), np.array([max_iter], dtype=np.int64))
+    lp, w1 = model.law_par, 0.0
+    if lp[L.MU] > 0:
+        if not friction_speed > 0:
+            raise ValueError(f"friction_speed: the driver speed of the friction's kinematics must be positive, got {friction_speed}")
+        lp, w1 = lp.copy(), float(friction_speed)
+        lp[L.C_CON] = 0.0
+    mdl = (model.gear_par, model.pair_par, lp, kphi)
+    ctl = (np.array([float(torque), theta2, tol, w1]), np.array([max_iter], dtype=np.int64))
     static_sweep(mdl, ctooth, ctl, rim_angles, phi, out, f1)
     te, th2 = out[:, L.S_TE].copy(), out[:, L.S_TH2].copy()
     nc, it = out[:, L.S_NC].astype(np.int64), out[:, L.S_ITER].astype(np.int64)
@@ -91,7 +106,7 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     deep = (it > 0) & ~(approach <= bound)
     it[deep] = -it[deep]
     bad = np.flatnonzero(it < 0)
-    res = StaticResult(angles, te, th2, nc, f1, it, float(torque), phi)
+    res = StaticResult(angles, te, th2, nc, f1, it, float(torque), phi, driver_torque=out[:, L.S_T1].copy())
     if bad.size:
         res.message = f"static equilibrium not reached at {bad.size} of {n} angles, first at {np.degrees(angles[bad[0]]):.3f} deg"
         if deep.any():

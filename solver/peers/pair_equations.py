@@ -110,6 +110,8 @@ class PairEquations:
             raise ValueError("gearN.modification: the scipy peer has perfect involutes; use the explicit integrator")
         if model.pair_par.size > L.N_PAIR_PAR:
             raise ValueError("gearN.errors: the scipy peer has perfect gears; use the explicit integrator")
+        if model.law_par[L.MU] > 0:
+            raise ValueError("contact.friction: the scipy peer has frictionless flanks; use the explicit integrator")
         gp = model.gear_par
         self.model = model
         self.speed, self.speed_ramp = float(speed), float(speed_ramp)
@@ -120,7 +122,7 @@ class PairEquations:
         self.n = 1 + self.nt
         self.gp = gp
         self.pp = model.pair_par
-        k, m1, c, m2, m3 = model.law_par
+        k, m1, c, m2, m3 = model.law_par[[L.K_CON, L.M1, L.C_CON, L.M2, L.M3]]
         self.law = (float(k), float(m1), float(c), float(m2), float(m3))
         self.kphi = np.asarray(model.k_phi, float)
         g_of = np.r_[np.zeros(self.z1, int), np.ones(self.z2, int)]

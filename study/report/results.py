@@ -7,6 +7,7 @@ The run archive of one scene holds:
   dte(time)                dynamic transmission error [um]
   contact_force_max(time)  largest contact force over each output interval [N]
   dte_contacts(time), driver_torque(time), energy_balance_error(time)
+  mesh_efficiency                  work out over work in after the ramp (with flank friction) [1]
   dte_amplitude(frequency) amplitude spectrum of DTE after the ramp [um], coordinate order
   dte_peak_*(dte_peak)     named peaks of that spectrum (hole order N, mesh order Z, harmonics,
                            sidebands kZ+-N, the largest unexplained ones): order, frequency, amplitude
@@ -165,6 +166,22 @@ def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_orde
     attrs.update(dt_s=res.dt, steps=res.steps, omega_max_rad_s=res.omega_max, dynamic_status=res.message,
                  max_active_teeth=res.max_active_teeth)
     return coords, data, attrs
+
+
+def efficiency_variable(res, torque: float, speed: float, start: float) -> dict:
+    """``mesh_efficiency``: output over input work of the dynamic run ``res`` after ``start``
+    [s], at the constant driver speed ``speed`` [rad/s] and resisting torque ``torque`` [N·m]:
+    torque*|theta2 change| / (speed * integral of the driver torque). NaN without a window."""
+    sel = res.time >= start
+    eta = float("nan")
+    if sel.sum() >= 2 and res.status in (0, INACCURATE):
+        t, tq = res.time[sel], res.driver_torque[sel]
+        w_in = speed * float(np.sum(0.5 * (tq[1:] + tq[:-1]) * np.diff(t)))
+        eta = abs(torque) * abs(float(res.theta2[sel][-1] - res.theta2[sel][0])) / w_in if w_in > 0 else eta
+    return {"mesh_efficiency": _var((), eta, "1", "mesh efficiency: work out over work in after the ramp",
+                                    comment="driven torque times driven rotation over driver speed times the integral "
+                                            "of the driver torque; its loss is the flank friction's plus the dampers'",
+                                    start_s=float(start))}
 
 
 def stiffness_variables(k_nmm: tuple, ratio: tuple) -> tuple[dict, dict]:

@@ -27,6 +27,7 @@ def summarize(ds: xr.Dataset) -> dict:
         out["dte_rms"] = float(np.sqrt(np.mean((dte - dte.mean()) ** 2))) if dte.size else nan
         out["dte_p2p"] = float(np.ptp(dte)) if dte.size else nan
         out["tooth_force_max"] = float(np.max(ds["contact_force_max"].values)) if dte.size else nan
+        out["mesh_efficiency"] = float(ds["mesh_efficiency"]) if "mesh_efficiency" in ds else nan
     if "dte_amplitude" in ds:
         z = ds.attrs["mesh_order"]
         for name, order in (("mesh", z), ("mesh2", 2 * z), ("mesh3", 3 * z), ("hole", ds.attrs["hole_order"])):
@@ -67,6 +68,8 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         w(f"  DTE after {ds.attrs['spectrum_start_s']:.3g} s: mean {s['dte_mean']:.3f} um, RMS {s['dte_rms']:.3f} um, "
           f"peak-to-peak {s['dte_p2p']:.3f} um, max tooth force {s['tooth_force_max']:.1f} N "
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
+        if np.isfinite(s["mesh_efficiency"]):
+            w(f"  mesh efficiency after the ramp {s['mesh_efficiency'] * 100:.3f} % (flank friction and dampers)\n")
         for f, o, a in results.largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
     if "mesh_mode_frequency_hz" in ds.attrs:

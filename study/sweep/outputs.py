@@ -48,6 +48,8 @@ SCALARS = {
     "amp_mesh3_order": Scalar("um", "DTE amplitude at three times the mesh order", "dynamic"),
     "amp_hole_order": Scalar("um", "DTE amplitude at the hole order N (NaN for a gear without holes)", "dynamic"),
     "tooth_force_max": Scalar("N", "largest tooth contact force of the dynamic run after the ramp", "dynamic"),
+    "mesh_efficiency": Scalar("1", "work out over work in of the dynamic run after the ramp (NaN without flank "
+                                   "friction, a run-up or a load change)", "dynamic"),
     "mesh_mode_frequency": Scalar("Hz", "natural frequency of the mesh mode at the mean load (mean over the mesh period)", "modes"),
     "mesh_mode_damping": Scalar("1", "damping ratio of the mesh mode (modal, mean over the mesh period)", "modes"),
     "mesh_mode_damping_decay": Scalar("1", "damping ratio of the mesh mode from its simulated free decay", "dynamic"),

@@ -30,6 +30,14 @@ gear has them): each tooth's axis turns by its offset eps about the teeth's cent
 off the bearing axis by the eccentricity; the flanks follow exactly, the moment arms of the hub
 rotations stay about the bearing axes, and the rigid gap bound grows by E_BOUND.
 
+Sliding friction (law_par MU > 0; `_friction`): Coulomb, regularised, mu_eff =
+mu*tanh(v_s/v_reg), with v_s = (v_A - v_B).t the sliding speed of the gear-1 tooth's material
+point over the gear-2 tooth's at the contact point (hub rotation about its centre plus the tooth
+rotation about its pivot), t the normal turned by +90 deg. The force mu_eff*F acts along -t on
+gear 1 and +t on gear 2; its generalised forces are -mu_eff*F*H, H = d v_s/d(theta1', phi_A',
+theta2', phi_B') (the lever arms of t), the sign of t dropping out. With MU = 0 the friction
+columns of the records stay zero and nothing is computed.
+
 State: theta1, theta2 hub angles [rad] (counter-clockwise positive), phi[Z1+Z2] tooth
 rotations about their pivots relative to the hub [rad], gear-1 teeth first.
 """
@@ -152,6 +160,28 @@ def _deviation_gradient(sa, sb, s, centres, axes, ecc, gp):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
+def _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp):
+    """Friction columns (`layout` C_VS .. C_HB) of contact record nc with normal force f [N]
+    at the point (px, py) [m] with unit normal (nx, ny); frame, vel as `_record`."""
+    tx, ty = -ny, nx
+    o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
+    w1, wa, w2, wb = vel
+    h1 = cross(px - o1x, py - o1y, tx, ty)
+    ha = cross(px - pvax, py - pvay, tx, ty)
+    h2 = -cross(px - o2x, py - o2y, tx, ty)
+    hb = -cross(px - pvbx, py - pvby, tx, ty)
+    vs = h1 * w1 + ha * wa + h2 * w2 + hb * wb
+    th = math.tanh(vs / lp[L.V_REG])
+    rec[nc, L.C_VS] = vs
+    rec[nc, L.C_FT] = lp[L.MU] * f * th
+    rec[nc, L.C_DFT] = lp[L.MU] * f * (1.0 - th * th) / lp[L.V_REG]
+    rec[nc, L.C_H1] = h1
+    rec[nc, L.C_HA] = ha
+    rec[nc, L.C_H2] = h2
+    rec[nc, L.C_HB] = hb
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
 def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
@@ -185,6 +215,8 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend):
     rec[nc, L.C_TOOTH1], rec[nc, L.C_TOOTH2], rec[nc, L.C_KIND] = ids
     rec[nc, L.C_KGEO] = f * blend[0]
     rec[nc, L.C_DG1], rec[nc, L.C_DGA], rec[nc, L.C_DG2], rec[nc, L.C_DGB] = blend[1]
+    if lp[L.MU] > 0.0:
+        _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -303,7 +335,8 @@ def mesh_contacts(state, phi, dphi, geo, buf):
 def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
     """Generalised forces: q[0] on theta1, q[1] on theta2, q[2 + i] on tooth i.
 
-    Contacts: Q = -F * G; springs: eq. (1.2) on the active teeth; the resisting torque
+    Contacts: Q = -F * G, plus -F_t * H where a friction force F_t is recorded; springs:
+    eq. (1.2) on the active teeth; the resisting torque
     ``torque2`` [N m] acts counter-clockwise on gear 2 (it opposes the driven rotation).
     Only entries of active teeth are written (others are left at zero).
     """
@@ -321,6 +354,12 @@ def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
         q[2 + ia] -= f * rec[c, L.C_GA]
         q[1] -= f * rec[c, L.C_G2]
         q[2 + ib] -= f * rec[c, L.C_GB]
+        ft = rec[c, L.C_FT]
+        if ft != 0.0:
+            q[0] -= ft * rec[c, L.C_H1]
+            q[2 + ia] -= ft * rec[c, L.C_HA]
+            q[1] -= ft * rec[c, L.C_H2]
+            q[2 + ib] -= ft * rec[c, L.C_HB]
 
 
 @njit(cache=True, no_cfunc_wrapper=True)

@@ -16,7 +16,9 @@ of the speed ramp falls on a step boundary).
 
 Newton on x_{n+1} with the tangent M/(beta dt^2) + (1+alpha)(K + gamma/(beta dt) C), where
 K = sum_c k_t G G^T + spring tangents and C = sum_c dF/d(ddelta) G G^T + spring damping
-tangents (the geometric term F dG/dx is left out: it changes only the convergence rate).
+tangents (the geometric term F dG/dx is left out: it changes only the convergence rate). Flank
+friction (a recorded friction force F_t = mu*tanh(v_s/v_reg)*F along the lever arms H) adds
+H (F_t/F) dF/dx and H dF_t/dv_s H^T, nonsymmetric: the friction is implicit like the rest.
 Teeth without a loaded contact are condensed out of each Newton system, so its cost stays
 that of the few teeth in the mesh even when every tooth is integrated.
 Converged when the last correction moves no flank point by more than newton_tol [m]; the
@@ -106,6 +108,16 @@ def _contact_rows(mdl, rec, nc, loc, A, coef):
         A[i2, 0] += w * g2 * g0
         A[i2, i1] += w * g2 * g1
         A[i2, i2] += w * g2 * g2
+        if lp[L.MU] > 0.0:
+            # friction: d(F_t H)/dx through F (the ratio F_t/F) and through v_s
+            rf = rec[c, L.C_FT] / rec[c, L.C_FORCE] * w
+            cf = coef[K_CC] * rec[c, L.C_DFT]
+            idx = (0, i1, i2)
+            gv = (g0, g1, g2)
+            hv = (rec[c, L.C_H2], rec[c, L.C_HA], rec[c, L.C_HB])
+            for x in range(3):
+                for y in range(3):
+                    A[idx[x], idx[y]] += hv[x] * (rf * gv[y] + cf * hv[y])
 
 
 @njit(cache=True, no_cfunc_wrapper=True)

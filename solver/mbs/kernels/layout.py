@@ -41,7 +41,10 @@ M1 = 1
 C_CON = 2       # [N s^m2 / m^(m2+m3)]
 M2 = 3
 M3 = 4
-N_LAW_PAR = 5
+# sliding friction on the flanks (Coulomb, regularised): mu_eff = MU*tanh(v_s/V_REG); MU = 0: off
+MU = 5          # Coulomb coefficient [-]
+V_REG = 6       # sliding speed of the regularisation [m/s]
+N_LAW_PAR = 7
 
 # pair_par
 JN_HALF = 0     # half the normal backlash [m]
@@ -77,7 +80,15 @@ C_DG1 = 16      # V: d(roll parameter of the blend)/d(theta1, phi_A, theta2, phi
 C_DGA = 17
 C_DG2 = 18
 C_DGB = 19
-N_C_COLS = 20
+# friction (written only when law_par[MU] > 0, else left at zero): tangent t = n turned +90 deg
+C_VS = 20       # sliding speed v_s = (v_A - v_B).t of the gear-1 over the gear-2 tooth at the point [m/s]
+C_FT = 21       # friction force mu*F*tanh(v_s/v_reg) [N], acting along -t on gear 1, +t on gear 2
+C_DFT = 22      # d C_FT / d v_s [N s/m]
+C_H1 = 23       # d v_s / d theta1' [m]: lever arm of t about O1
+C_HA = 24       # d v_s / d phi' of the gear-1 tooth [m]
+C_H2 = 25       # d v_s / d theta2' [m]
+C_HB = 26       # d v_s / d phi' of the gear-2 tooth [m]
+N_C_COLS = 27
 MAX_CONTACTS = 64
 
 # ---- the time-stepping kernels (`stepping`, `explicit`, `explicit_coupled`, `implicit`)
@@ -144,7 +155,8 @@ N_TSET = 3
 S_TORQUE = 0        # resisting torque on gear 2 [N m]
 S_THETA2 = 1        # driven angle at the first driver angle, the start guess [rad]
 S_TOL = 2           # residual tolerance relative to the torque [-]
-N_S_PAR = 3
+S_W1 = 3            # driver speed [rad/s] that sets the kinematic sliding speed of the friction (0: none)
+N_S_PAR = 4
 # control integers: int array ``ipar``
 S_MAX_ITER = 0      # Newton iterations per angle
 N_S_IPAR = 1
@@ -153,4 +165,5 @@ S_TE = 0            # transmission error [m]
 S_TH2 = 1           # driven angle [rad]
 S_NC = 2            # loaded contacts [-]
 S_ITER = 3          # Newton iterations (negative: not converged) [-]
-N_S_OUT = 4
+S_T1 = 4            # torque the contacts take from the driver (its rim) [N m]
+N_S_OUT = 5

@@ -105,7 +105,8 @@ def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def dissipation_power(dphi, act, nact, mdl, rec, nc):
-    """Power [W] of the tooth-spring dampers at the rates dphi and of the contact dampers."""
+    """Power [W] of the tooth-spring dampers at the rates dphi, of the contact dampers and of
+    the flank friction (F_t*v_s >= 0, where a friction force F_t is recorded)."""
     gp, lp = mdl[0], mdl[2]
     tz2 = int(gp[1, L.TOOTH0])
     p = 0.0
@@ -119,4 +120,7 @@ def dissipation_power(dphi, act, nact, mdl, rec, nc):
         if d > 0.0:
             fel = lp[L.K_CON] * d ** lp[L.M1]
             p += (rec[c, L.C_FORCE] - fel) * rec[c, L.C_DDELTA]
+        ft = rec[c, L.C_FT]
+        if ft != 0.0:
+            p += ft * rec[c, L.C_VS]
     return p

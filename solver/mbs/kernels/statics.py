@@ -8,6 +8,13 @@ a backtracking line search on the residual. The spring tangent n*k*|phi|^(n-1) v
 phi = 0 for n > 1, so a tiny diagonal term (1e-9 of the tooth's k_phi) regularises teeth
 that carry no load; the residual, and so the solution, is exact.
 
+Flank friction (law_par MU > 0): statics has no velocity, so the contact search sees the
+rigid rolling kinematics at the driver speed par[S_W1] [rad/s] (theta2' = -rb1/rb2*theta1',
+teeth at rest on their hubs): the sliding direction of a pair whose driver turns in its
+positive sense, regularised as in dynamics at that speed. The caller zeroes the contact
+damping (it would see the kinematic penetration rate). The tangent carries the friction's
+change through the normal force (H (F_t/F) k_t G^T, nonsymmetric).
+
 The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
 the gear_par columns DEV_* (`solver.modification`) and the pitch errors and eccentricities
 from the pair_par block E_* (`solver.errors`).
@@ -129,6 +136,20 @@ def _tangent(mdl, ks, ws, nc, nt, phi):
         for m in range(nt):
             i = lst[m]
             K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
+    if mdl[2][L.MU] > 0.0:
+        for c in range(nc):
+            kt = rec[c, L.C_KT]
+            if kt <= 0.0 or rec[c, L.C_FORCE] <= 0.0:
+                continue
+            ia = int(rec[c, L.C_TOOTH1]) + int(gp[0, L.TOOTH0])
+            ib = int(rec[c, L.C_TOOTH2]) + int(gp[1, L.TOOTH0])
+            idx = (0, pos[ia], pos[ib])
+            rf = rec[c, L.C_FT] / rec[c, L.C_FORCE] * kt
+            gv = (rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB])
+            hv = (rec[c, L.C_H2], rec[c, L.C_HA], rec[c, L.C_HB])
+            for x in range(3):
+                for y in range(3):
+                    K[idx[x], idx[y]] += rf * hv[x] * gv[y]
     if K[0, 0] <= 0.0:
         K[0, 0] = 1e-9
     return K
@@ -156,17 +177,21 @@ def newton_system(mdl, theta1, theta2, phi, torque):
 @njit(cache=True, no_cfunc_wrapper=True)
 def _store(out, force1, a, rec, nc, row):
     """Results at the a-th angle: row = (TE [m], theta2 [rad], signed Newton iterations) and,
-    from the contacts rec[:nc], the loaded ones and the force on each gear-1 tooth [N]."""
+    from the contacts rec[:nc], the loaded ones, the force on each gear-1 tooth [N] and the
+    driver torque [N m] (their moments about O1, friction included)."""
     out[a, L.S_TE], out[a, L.S_TH2], out[a, L.S_ITER] = row
     nload = 0
+    t1 = 0.0
     for k in range(force1.shape[1]):
         force1[a, k] = 0.0
     for c in range(nc):
         f = rec[c, L.C_FORCE]
+        t1 += f * rec[c, L.C_G1] + rec[c, L.C_FT] * rec[c, L.C_H1]
         if f > 0.0:
             nload += 1
             force1[a, int(rec[c, L.C_TOOTH1])] += f
     out[a, L.S_NC] = nload
+    out[a, L.S_T1] = t1
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -203,6 +228,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     rb2 = gp[1, L.RB]
     tol_abs = par[L.S_TOL] * max(abs(torque), 1e-3)
     theta2 = par[L.S_THETA2]
+    w1 = par[L.S_W1] if par.shape[0] > L.S_W1 else 0.0
+    w2 = -rb1 / rb2 * w1 if w1 != 0.0 else 0.0
     failures = 0
     nc = np.int64(0)        # not a literal 0: numba would compile the callees once more for it
     npair = np.int64(0)
@@ -217,7 +244,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
         while it < ipar[L.S_MAX_ITER]:
             it += 1
             if not fresh:
-                nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, pp, lp), (rec, pairs))
+                nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
             fresh = False
             # the unknowns: the teeth the pre-search finds at the current iterate
             nt = _unknown_set(ws, npair, gp, phi)
@@ -266,7 +293,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                     phi[lst[m]] = ph_old[m] + step * dx[m + 1]
                 # (written out, not a helper kernel: a kernel around mesh_contacts costs its own
                 # optimisation of the whole contact search at compile time)
-                nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, pp, lp), (rec, pairs))
+                nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
                 rn2 = _unknown_forces(mdl, ks, ws, nc, nt, phi, torque)
                 if rn2 < rn or rn2 < tol_abs:
                     break
@@ -277,7 +304,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                 break
         # outputs at the solution: a converged iteration ended on a search at this very state
         if not converged:
-            nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, pp, lp), (rec, pairs))
+            nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
             failures += 1
         _store(out, force1, a, rec, nc, (rb1 * theta1 + rb2 * theta2, theta2, float(it if converged else -it)))
     return failures
