@@ -114,6 +114,8 @@ def dissipation_power(dphi, act, nact, mdl, rec, nc):
         g = 1 if i >= tz2 else 0
         if gp[g, L.C_PHI] != 0.0:
             p += gp[g, L.C_PHI] * signed_pow(dphi[i], gp[g, L.N_C]) * dphi[i]
+    if lp[L.C_CON] == 0.0:      # no contact damper: the force is the elastic one, exactly
+        return p
     for c in range(nc):
         d = rec[c, L.C_DELTA]
         if d > 0.0:
