@@ -168,14 +168,18 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     o2x, o2y = gp[1, L.CX], gp[1, L.CY]
     axa = theta1 + gp[0, L.GAMMA0] + k * gp[0, L.PITCH]
     axb = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
-    cax, cay = moved_center(o1x, o1y, gp[0, L.R_PV], axa, pa)
-    cbx, cby = moved_center(o2x, o2y, gp[1, L.R_PV], axb, pb)
+    # the sines and cosines of the tooth axes, once for the moved centres, the pivots and the
+    # deviations' gradient
+    ca, sa = math.cos(axa), math.sin(axa)
+    cb, sb = math.cos(axb), math.sin(axb)
+    cax, cay, cpa, spa = moved_center(o1x, o1y, gp[0, L.R_PV], (ca, sa), axa, pa)
+    cbx, cby, cpb, spb = moved_center(o2x, o2y, gp[1, L.R_PV], (cb, sb), axb, pb)
     rba = gp[0, L.RB]
     rbb = gp[1, L.RB]
     ba = axa + pa + s * gp[0, L.PSI_B]
     bb = axb + pb + s * gp[1, L.PSI_B]
-    frame = (o1x, o1y, o1x + gp[0, L.R_PV] * math.cos(axa), o1y + gp[0, L.R_PV] * math.sin(axa),
-             o2x, o2y, o2x + gp[1, L.R_PV] * math.cos(axb), o2y + gp[1, L.R_PV] * math.sin(axb))
+    frame = (o1x, o1y, o1x + gp[0, L.R_PV] * ca, o1y + gp[0, L.R_PV] * sa,
+             o2x, o2y, o2x + gp[1, L.R_PV] * cb, o2y + gp[1, L.R_PV] * sb)
     vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
@@ -191,10 +195,10 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             c = (rba + rbb) / ln
             kc = s * (rba + rbb) / (ln * ln * math.sqrt(1.0 - c * c))
             ra, rb_ = gp[0, L.R_PV], gp[1, L.R_PV]
-            t1 = _tangent_turn(dx, dy, ln, kc, ra * (math.sin(axa) - math.sin(axa + pa)), ra * (math.cos(axa + pa) - math.cos(axa)))
-            ta_ = _tangent_turn(dx, dy, ln, kc, -ra * math.sin(axa + pa), ra * math.cos(axa + pa))
-            t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (math.sin(axb + pb) - math.sin(axb)), rb_ * (math.cos(axb) - math.cos(axb + pb)))
-            tb = _tangent_turn(dx, dy, ln, kc, rb_ * math.sin(axb + pb), -rb_ * math.cos(axb + pb))
+            t1 = _tangent_turn(dx, dy, ln, kc, ra * (sa - spa), ra * (cpa - ca))
+            ta_ = _tangent_turn(dx, dy, ln, kc, -ra * spa, ra * cpa)
+            t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (spb - sb), rb_ * (cb - cpb))
+            tb = _tangent_turn(dx, dy, ln, kc, rb_ * spb, -rb_ * cpb)
             dg = (-s * (sa * (1.0 - t1) - sb * t1), -s * (sa * (1.0 - ta_) - sb * ta_),
                   -s * (-sa * t2 + sb * (1.0 - t2)), -s * (-sa * tb + sb * (1.0 - tb)))
         if delta > 0.0 and nc < rec.shape[0]:
