@@ -189,8 +189,11 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     phi_quiet = 0.0 if all_teeth else par["PHI_QUIET"]
     omega_tooth = math.sqrt(model.k_phi.max() / model.gear_par[:, L.I_P].min())
     p = np.zeros(L.N_PAR)
+    rate_quiet = 0.0 if all_teeth else par.get("RATE_QUIET", phi_quiet)
     for name, v in dict(par, SPEED=speed, SPEED_RAMP=speed_ramp, TORQUE=torque, TORQUE_RAMP=torque_ramp, DT=dt,
-                        PHI_QUIET=phi_quiet, DPHI_QUIET=phi_quiet * omega_tooth).items():
+                        PHI_QUIET=phi_quiet, DPHI_QUIET=rate_quiet * omega_tooth).items():
+        if name == "RATE_QUIET":
+            continue
         if name != "MAX_ITER":
             p[getattr(L, name)] = v
     ip = np.zeros(L.N_IPAR, dtype=np.int64)
@@ -310,8 +313,13 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step)
     table, torque, side = run_loads(load_table, torque)
     imex = implicit_dampers_apply(model) if implicit_dampers is None else bool(implicit_dampers)
+    rate = {}
     if phi_quiet is None:
         phi_quiet = default_phi_quiet(model)
+        # the rate bound stays PHI_QUIET * omega_tooth: a tooth frozen while it still moves
+        # relative to its hub takes its share of the kinetic energy (I_cpl*w*dphi at hub speed
+        # w) out of the balance unbooked
+        rate = dict(RATE_QUIET=PHI_QUIET)
     if imex and not implicit_dampers_apply(model):
         raise ValueError("implicit_dampers: needs linear tooth-root dampers (n_c = 1, c_phi > 0) on the plain pair "
                          "(no body coupling)")
@@ -329,7 +337,7 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
         from solver.mbs.kernels.explicit_coupled import verlet_coupled as kernel
     else:
         kernel = verlet
-    par = dict(DELTA_MAX=float(delta_max), PHI_QUIET=phi_quiet, ENERGY_TOL=float(energy_tol), IMEX=float(imex))
+    par = dict(DELTA_MAX=float(delta_max), PHI_QUIET=phi_quiet, ENERGY_TOL=float(energy_tol), IMEX=float(imex), **rate)
     fraction = safety if safety is not None else (IMEX_SAFETY if imex else SAFETY)
     for attempt in range(4):
         grid = step_grid(dt, output_step, duration)
