@@ -5,8 +5,8 @@
   its default step and active set);
 * its max TE error <= 0.01 um against a tight reference: the all-teeth explicit model (every
   tooth free, every force explicit) at 1/8 of the all-explicit stability step;
-* first-call compile <= 10 s CPU (fresh numba cache, new process: a 10-angle STE and a 0.2 ms
-  dynamic run, as bench_solver);
+* first-call compile <= 10 s CPU (fresh numba cache, new process: imports, the model build, a
+  10-angle STE and a 0.2 ms dynamic run, as bench_solver; all of the process's CPU time);
 * the standard sensitivity study (study/scenes/sensitivity.toml) from empty FE and numba caches
   <= 60 s wall on 2 local workers (left out with --quick: it takes minutes).
 The paper-case rows carry the ratio of the peers' CPU time per simulated second to
@@ -71,10 +71,12 @@ def compile_row() -> dict:
     from bench_solver import run_first_call
     with tempfile.TemporaryDirectory() as cache:
         cold, wall = run_first_call(cache)
-    cpu = cold["cpu_static"] + cold["cpu_dynamic"]
+    # the whole process: the model build compiles the statics kernels (the damping ratio's modal
+    # analysis solves a static equilibrium), so the STE call alone no longer shows them
+    cpu = cold["cpu_total"]
     return dict(target="first-call compile, fresh numba cache", measured=cpu, unit="s CPU", limit=10.0, met=cpu <= 10.0,
-                note=f"STE kernels {cold['cpu_static']:.1f} s + dynamic {cold['cpu_dynamic']:.1f} s; whole process "
-                     f"{wall:.1f} s wall")
+                note=f"whole first process: imports and model build {cold['cpu_imports']:.1f} s, 10-angle STE "
+                     f"{cold['cpu_static']:.1f} s, 0.2 ms dynamic {cold['cpu_dynamic']:.1f} s; {wall:.1f} s wall from outside")
 
 
 def sensitivity_row() -> dict:
