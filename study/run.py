@@ -78,7 +78,10 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
             res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha, load_table=table,
                                     progress=watch)
         else:
-            res = simulate(*args, dt=choice.dt, output_step=d.output_step, load_table=table, progress=watch)
+            # a step from the stability estimate: simulate estimates it again (the same) and checks it
+            # against the contact forces the run reaches
+            res = simulate(*args, dt=None if choice.estimated else choice.dt, output_step=d.output_step,
+                           load_table=table, progress=watch)
     finally:
         if bar is not None:
             bar.close()

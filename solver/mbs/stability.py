@@ -20,8 +20,17 @@ from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tan
 from solver.mbs.model import Model
 
 
+def implicit_dampers_apply(model: Model) -> bool:
+    """Whether the explicit kernel can take the tooth-root dampers implicitly (IMEX, see
+    `solver.mbs.kernels.explicit`): the plain pair (no body coupling) with linear dampers
+    (n_c = 1) on both gears, at least one of them nonzero."""
+    gp = model.gear_par
+    return (not model.coupled and not model.teeth_coupled and bool(np.all(gp[:, L.N_C] == 1.0))
+            and bool(np.any(gp[:, L.C_PHI] != 0.0)))
+
+
 def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False,
-                      friction: bool = False):
+                      friction: bool = False, spring_dampers: bool = True):
     """Mass and tangent stiffness over the free DOFs (theta2, then the teeth near the mesh).
 
     Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF. With
@@ -29,7 +38,8 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
     contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1); with
     ``friction``, also the flank friction's slope at zero sliding, mu*F/v_reg along the lever
     arms H (the step bound wants it; a modal damping would not: the flanks slide but at the
-    pitch point).
+    pitch point); without ``spring_dampers`` the contact dampers (and the friction) only (those
+    the explicit kicks take explicitly when the tooth-root dampers are implicit).
     The damping laws run as plain Python here (``.py_func``, a few dozen calls): compiling
     them would add to the first run's compile time for nothing.
     """
@@ -53,7 +63,8 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
             M[0, i] = M[i, 0] = gp[1, L.I_CPL]
         if not model.teeth_coupled:
             K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
-        C[i, i] += spring_damping_tangent.py_func(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
+        if spring_dampers:
+            C[i, i] += spring_damping_tangent.py_func(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
     if model.teeth_coupled:     # the springs of the teeth near the mesh: (C[S, S])^-1
         K[1:, 1:] += np.linalg.inv(model.tooth_compliance[np.ix_(teeth, teeth)])
     for c in range(nc):
@@ -76,7 +87,8 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
     return M, K, teeth
 
 
-def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[float, float]:
+def stability_limit(model: Model, torque: float, positions: int = 12,
+                    implicit_dampers: bool = False) -> tuple[float, float]:
     """(critical Verlet step [s], highest natural frequency [rad/s]) of the loaded pair over one
     mesh cycle.
 
@@ -89,12 +101,15 @@ def stability_limit(model: Model, torque: float, positions: int = 12) -> tuple[f
     its slope at zero sliding (the stiffest it gets, near the pitch point). A deep, damped contact (m3 > 1)
     can make a lower but overdamped mode the limit. The equilibria come from one static sweep
     with continuation (tooth rotations carried from angle to angle); positions where it does
-    not converge are left out.
+    not converge are left out. ``implicit_dampers``: the tooth-root dampers are taken implicitly
+    (IMEX kicks, `implicit_dampers_apply`), which are stable at any damping: only the contact
+    dampers count then.
     """
     wmax = 0.0
     dt_crit = math.inf
     for eq in loaded_equilibria(model, torque, positions):
-        M, K, C, _t = linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True, friction=True)
+        M, K, C, _t = linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True, friction=True,
+                                        spring_dampers=not implicit_dampers)
         lam, x = scipy.linalg.eigh(K, M)
         w = np.sqrt(np.maximum(lam, 0.0))
         h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
@@ -123,10 +138,14 @@ def body_frequency(model: Model) -> float:
     return w
 
 
-def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[float, float]:
+def stable_time_step(model: Model, torque: float, safety: float | None = None,
+                     implicit_dampers: bool = False) -> tuple[float, float]:
     """(dt [s], omega_max [rad/s]) for the explicit integrator: safety times the critical step
-    of `stability_limit` (2/omega_max without damping)."""
-    dt_crit, w = stability_limit(model, torque)
+    of `stability_limit` (2/omega_max without damping); ``implicit_dampers`` as there.
+    ``safety`` None: SAFETY, or IMEX_SAFETY with implicit dampers (see there)."""
+    if safety is None:
+        safety = IMEX_SAFETY if implicit_dampers else SAFETY
+    dt_crit, w = stability_limit(model, torque, implicit_dampers=implicit_dampers)
     if model.coupled:   # the body modes are not in the mesh linearisation
         wb = body_frequency(model)
         w = max(w, wb)
@@ -134,3 +153,36 @@ def stable_time_step(model: Model, torque: float, safety: float = 0.5) -> tuple[
     if not w > 0:
         raise ValueError("no loaded contact found to estimate the highest natural frequency")
     return safety * dt_crit, w
+
+
+# Fraction of the critical step the explicit kernel runs at by default. Every force explicit:
+# half of it (the damped bound is an estimate of a damped, nonlinear system). Tooth-root
+# dampers implicit: the bound is the undamped 2/omega_max of the loaded, linearised pair, and
+# `load_covered` checks after the run that the contact forces reached keep the step below it.
+SAFETY = 0.5
+IMEX_SAFETY = 0.9
+
+
+def stiffening_exponent(model: Model) -> float:
+    """e [-] such that every tangent stiffness of the pair grows at most as (force ratio)^e:
+    the contact tangent k*m1*delta^(m1-1) as F^((m1-1)/m1), a tooth spring's as
+    T^((n_k-1)/n_k); 0 for linear laws."""
+    gp, lp = model.gear_par, model.law_par
+    laws = [lp[L.M1]] + [float(n) for n in gp[:, L.N_K]]
+    return max([0.0] + [(n - 1.0) / n for n in laws if n > 0])
+
+
+def load_covered(model: Model, torque: float, safety: float, force_max: float) -> bool:
+    """Whether a step of ``safety`` times the critical step estimated under ``torque`` [N·m]
+    (1 N·m if zero) stays below the critical step of a run whose largest contact force was
+    ``force_max`` [N].
+
+    The estimate's largest contact force is about |torque|/r_b2 (one pair carrying the load,
+    at the positions of single contact). Where the run's forces exceed it by a ratio r, every
+    tangent stiffness grows at most by r^e (`stiffening_exponent`), so by the Rayleigh quotient
+    omega_max by at most r^(e/2): the step stays stable (omega*dt < 2 for the linearised pair)
+    while safety * r^(e/2) < 1.
+    """
+    load = abs(torque) if abs(torque) > 1e-9 else 1.0
+    ratio = max(1.0, force_max * model.base_radii[1] / load)
+    return safety * ratio ** (0.5 * stiffening_exponent(model)) < 1.0

@@ -163,14 +163,16 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
 
 def simulate_explicit_all_teeth(model: Model, speed: float, speed_ramp: float, torque: float,
                                 torque_ramp: float, duration: float, dt: float,
-                                output_step: float = 1e-5, load_table=None) -> DynamicResult:
+                                output_step: float = 1e-5, load_table=None,
+                                implicit_dampers: bool = False) -> DynamicResult:
     """The explicit Verlet kernel on the same model as the scipy peer: every tooth free.
 
     `solver.mbs.dynamics.simulate` freezes idle teeth rigid to their hub (its active set); here
     all teeth start active (phi = 1e-300 rad, numerically zero) and none is ever frozen, so
     the two solvers integrate identical equations and can be compared step against
     tolerance. ``dt`` [s] is rounded down to divide ``output_step`` [s]; ``load_table`` as in
-    `solver.mbs.dynamics.simulate`.
+    `solver.mbs.dynamics.simulate`. Every force explicit by default (the scheme the reference
+    runs have always used); ``implicit_dampers``: the IMEX kicks of `simulate`.
     """
     return simulate(model, speed, speed_ramp, torque, torque_ramp, duration, dt=dt, output_step=output_step,
-                    load_table=load_table, all_teeth=True)
+                    load_table=load_table, all_teeth=True, implicit_dampers=implicit_dampers)

@@ -4,7 +4,10 @@ scene, the solver ladders on them (one `Spec` per solver setting) and their refe
 Dynamic case (DTE over a window of a few ms, SI units): velocity Verlet at fractions of its
 stability step, HHT-alpha at multiples of it, the scipy stiff solvers at several relative
 tolerances, every one on the scipy peer's equations (every tooth free); plus ``explicit,
-active set``, the production path. Reference: DOP853 at rtol 1e-10; cross-check: Verlet at
+active set`` (every force explicit, quiet threshold 1e-9 rad: the production path before the
+implicit tooth-root dampers), and where the scene's tooth-root dampers are linear ``explicit,
+implicit dampers`` (every tooth free, IMEX kicks, at fractions of their stability step) and
+``explicit, production`` (`simulate` with its defaults: IMEX kicks, its own step and active set). Reference: DOP853 at rtol 1e-10; cross-check: Verlet at
 1/32 of the stability step.
 
 Quasi-static case (STE over a rotation of the driver): the static Newton solver at several
@@ -19,10 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver import units
-from solver.mbs.dynamics import at_driver_angles, simulate, slow_ramp_window
+from solver.mbs.dynamics import at_driver_angles, simulate, slow_ramp_window, step_grid
 from solver.mbs.implicit import simulate_implicit
 from solver.mbs.model import Model
-from solver.mbs.stability import stable_time_step
+from solver.mbs.stability import implicit_dampers_apply, stable_time_step
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
 from solver.peers.scipy_statics import solve_static_scipy
@@ -98,7 +101,16 @@ def dynamic_specs(model: Model, case: DynamicCase, explicit_fractions=(1, 2, 4, 
                              lambda dt: _dyn(simulate_explicit_all_teeth(model, *L, dt=dt, output_step=o)))
     if active_set:
         specs += fixed_step_specs("explicit, active set", explicit_steps,
-                                  lambda dt: _dyn(simulate(model, *L, dt=dt, output_step=o)))
+                                  lambda dt: _dyn(simulate(model, *L, dt=dt, output_step=o, phi_quiet=1e-9,
+                                                           implicit_dampers=False)))
+    if implicit_dampers_apply(model):
+        dt_i, _w = stable_time_step(model, case.torque, implicit_dampers=True)
+        specs += fixed_step_specs("explicit, implicit dampers", [dt_i / f for f in explicit_fractions],
+                                  lambda dt: _dyn(simulate_explicit_all_teeth(model, *L, dt=dt, output_step=o,
+                                                                              implicit_dampers=True)))
+        if active_set:
+            specs.append(Spec("explicit, production", step_grid(dt_i, o, case.duration)[0], math.nan,
+                              lambda: _dyn(simulate(model, *L, output_step=o))))
     for a in alphas:
         specs += fixed_step_specs(f"implicit alpha={a:g}", [min(dt_b * k, o) for k in implicit_multiples],
                                   lambda dt, a=a: _dyn(simulate_implicit(model, *L, dt=dt, output_step=o,

@@ -83,16 +83,27 @@ def test_a_contact_too_stiff_for_its_step_is_flagged_inaccurate(paper_solid_mode
     it misses the contact events (force spikes of ~30 x the static force) and the energy
     balance error grows to the size of the mesh's potential energy: flagged, not silent.
     (Lightly damped, with the raw coefficients: the default damping ratio makes the step
-    small enough to follow these contacts.)"""
+    small enough to follow these contacts.) The default step (0.9 of the bound with the
+    tooth-root dampers implicit) does not stay there: its guards see the force spikes and the
+    energy balance, and the run is repeated at a smaller step, which completes."""
     from solver.mbs.dynamics import INACCURATE, simulate
+    from solver.mbs.stability import stable_time_step
     from study.setup import build_scene_model
     from tests.conftest import RAW_DAMPING, solid_scene
     stiff = build_scene_model(solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9}))
-    r = simulate(stiff, 100.0, 0.01, 50.0, 0.01, 0.02)
+    dt_static, _w = stable_time_step(stiff, 50.0)
+    r = simulate(stiff, 100.0, 0.01, 50.0, 0.01, 0.02, dt=dt_static)
     assert r.status == INACCURATE and r.message.startswith("inaccurate: energy balance error")
     assert np.max(r.force_max) > 10 * 50.0 / stiff.base_radii[1]
+    guarded = simulate(stiff, 100.0, 0.01, 50.0, 0.01, 0.02)
+    assert guarded.status == 0 and guarded.dt < stable_time_step(stiff, 50.0, implicit_dampers=True)[0]
+    # the paper model at its default step (0.9 of the bound, tooth-root dampers implicit) reads
+    # 0.16 of its potential energy (0.009 at half the bound, 0.0005 all-explicit at half the
+    # damped bound): near the bound the energy Verlet reads at the step instants of the
+    # tooth-on-contact mode exceeds its conserved one by up to a/(1 - a), a = (w dt/2)² = 0.81:
+    # 4x that mode's share; TE stays within 0.002 um of a tight reference
     ok = simulate(paper_solid_model, 100.0, 0.01, 50.0, 0.01, 0.02)
-    assert ok.status == 0 and np.max(np.abs(ok.energy_error)) < 0.1 * np.max(ok.potential)
+    assert ok.status == 0 and np.max(np.abs(ok.energy_error)) < 0.25 * np.max(ok.potential)
 
 
 def test_auto_takes_the_explicit_integrator(small_model):
@@ -156,10 +167,14 @@ def test_soft_tooth_springs_are_refused_before_the_statics(k_phi, small_scene, t
 
 
 def test_a_sweep_point_whose_run_is_inaccurate_keeps_its_scalars_flagged():
+    from solver.mbs.stability import stable_time_step
+    from study.setup import build_scene_model
     from study.sweep.engine import run_point
     from study.sweep.outputs import Outputs
     from tests.conftest import RAW_DAMPING, solid_scene
     sc = solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9, "dynamic.duration": 0.021})
+    # the step of the static linearisation, given (the default step's load guard would repair it)
+    sc = sc.replace(**{"dynamic.time_step": stable_time_step(build_scene_model(sc), 50.0)[0]})
     r = run_point(sc, Outputs(scalars=("dte_rms", "tooth_force_max")))
     assert r["status"] == "inaccurate" and r["message"].startswith("inaccurate: energy balance error")
     assert np.isfinite(r["scalars"]["dte_rms"]) and r["scalars"]["tooth_force_max"] > 10 * 1062.0

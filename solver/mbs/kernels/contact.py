@@ -82,10 +82,17 @@ def tip_corner(c_x, c_y, rb, beta, s, u_tip):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def moved_center(ox, oy, r_pv, axis, phi):
-    """Base-circle centre of a tooth whose axis is at angle ``axis`` rotated by phi about its pivot."""
-    return (ox + r_pv * (math.cos(axis) - math.cos(axis + phi)),
-            oy + r_pv * (math.sin(axis) - math.sin(axis + phi)))
+def moved_center(ox, oy, r_pv, cs_axis, axis, phi):
+    """Base-circle centre [m] of a tooth whose axis is at angle ``axis`` [rad] rotated by phi
+    [rad] about its pivot, and (cos, sin) of axis + phi; cs_axis: (cos, sin) of axis (the
+    caller has them). A tooth at rest on its hub (phi = 0) costs no trigonometry: the centre
+    is then exactly the gear's."""
+    ca, sa = cs_axis
+    if phi == 0.0:
+        return ox, oy, ca, sa
+    cm = math.cos(axis + phi)
+    sm = math.sin(axis + phi)
+    return ox + r_pv * (ca - cm), oy + r_pv * (sa - sm), cm, sm
 
 
 @njit(cache=True, no_cfunc_wrapper=True)

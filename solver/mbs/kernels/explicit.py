@@ -10,6 +10,17 @@ Active set: teeth of the pre-search candidates; a tooth outside it stays integra
 |phi| < phi_quiet and |dphi| < dphi_quiet, then it is frozen at exactly zero.
 
 Damping forces use the predicted velocity v_half + dt/2*a_old, which keeps second order.
+With par[IMEX] = 1 (linear tooth-root dampers, n_c = 1 on both gears) the tooth-root damper
+torque -c_phi*dphi is instead taken implicitly (IMEX), at the mean of the rates each half kick
+starts and ends with: the kick over h = dt/2 solves (M + h/2*C) dv = h*(Q - C*v), an
+arrowhead again, with the tooth inertia I_P + dt/4*c_phi in place of I_P
+(`arrowhead_accelerations` on a copy of gear_par). The damper then acts by the trapezoidal
+rule in each kick (A-stable, second order over the symmetric step; the same with the damper at
+the kick's end rate alone would be first order): the step is limited by the stiffness alone,
+not by the damping (`solver.mbs.stability`). The second kick ends the step; the generalised
+forces at the new position are then taken with the new rates for the next step's first kick
+(the damper is linear, so that is q - c_phi*dv, and a second arrowhead solve). Contact
+dampers stay explicit (predicted velocity).
 Energy bookkeeping (trapezoidal in time): work in (driver + load torque), kinetic and
 potential energy, dissipated energy; the balance closes to O(dt^2).
 
@@ -57,15 +68,21 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
     rec, pairs, q, vpred, tset, book = ws
     act = tset[L.T_ACT]
+    imex = par[L.IMEX] != 0.0
+    # the arrowhead of the kicks: the tooth inertia I_P + dt/4*c_phi with implicit dampers
+    gpk = gp.copy()
+    if imex:
+        for g in range(2):
+            gpk[g, L.I_P] += 0.25 * dt * gp[g, L.C_PHI]
     theta2, w2 = hub[L.POS, L.H_TH2], hub[L.RATE, L.H_TH2]
     th1, w1, acc1 = driver_motion(0.0, speed, ramp)
     tl = load_torque(0.0, par[L.TORQUE], par[L.TORQUE_RAMP], table)
     nc, npair = mesh_contacts((th1, theta2, w1, w2), phi, dphi, (gp, pp, lp), (rec, pairs))
     nact = initial_set(tset, teeth, pairs, npair, tz2)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
-    a2, s1, r1 = arrowhead_accelerations(q, act, nact, gp, acc)
+    a2, s1, r1 = arrowhead_accelerations(q, act, nact, gpk, acc)
     react = s1 * acc1 + r1
-    cr1 = gp[0, L.I_CPL] / gp[0, L.I_P]
+    cr1 = gpk[0, L.I_CPL] / gpk[0, L.I_P]
     ke, pe = mesh_energies(0.5 * gp[0, L.I_TOT] * w1 * w1 + 0.5 * gp[1, L.I_TOT] * w2 * w2, 0.0, w1, w2,
                            teeth, act, nact, mdl, rec, nc)
     book[L.B_E0] = ke + pe
@@ -107,20 +124,26 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
             vpred[act[a]] = 0.0
         for i in range(q.shape[0]):
             q[i] = 0.0
-        generalized_forces(rec, nc, phi, vpred, act, nact, kphi, gp, tl, q)
-        a2, s1, r1 = arrowhead_accelerations(q, act, nact, gp, acc)
+        # (implicit dampers: at the rates the first kick ended with, where the second starts)
+        generalized_forces(rec, nc, phi, dphi if imex else vpred, act, nact, kphi, gp, tl, q)
+        a2, s1, r1 = arrowhead_accelerations(q, act, nact, gpk, acc)
         react = s1 * acc1 + r1
         # second half kick
         w2 = w2h + 0.5 * dt * a2
         for a in range(nact):
             i = act[a]
+            v0 = dphi[i]
             dphi[i] += 0.5 * dt * acc[i]
             if i < tz2:
                 dphi[i] -= cr1 * dw_b
+            if imex:    # the damper torque at the new rate, for the next first kick
+                q[2 + i] -= gp[1 if i >= tz2 else 0, L.C_PHI] * (dphi[i] - v0)
         # one-sided driver torques where the speed ramp ends on this instant
         p_in_left = (s1 * driver_acc_left(t, speed, ramp) + r1) * w1 + tl * w2
-        p_d = dissipation_power(vpred, act, nact, mdl, rec, nc)
+        p_d = dissipation_power(dphi if imex else vpred, act, nact, mdl, rec, nc)
         status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * w2, p_d), par, status)
+        if imex:    # the next first kick: its accelerations with the dampers at the new rates
+            a2, _s, _r = arrowhead_accelerations(q, act, nact, gpk, acc)
         max_act = max(max_act, nact)
         if step % ipar[L.OUT_EVERY] == 0:
             o += 1

@@ -259,14 +259,17 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
         c2 = theta2 + gp[1, L.GAMMA0] + pp[L.E_ECC + 3]
         e1x, e1y = pp[L.E_ECC] * math.cos(c1), pp[L.E_ECC] * math.sin(c1)
         e2x, e2y = pp[L.E_ECC + 2] * math.cos(c2), pp[L.E_ECC + 2] * math.sin(c2)
-    cax, cay = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], axa, pa)
-    cbx, cby = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], axb, pb)
+    # the sines and cosines of the tooth axes, once for the moved centres and the pivots
+    ca, sa = math.cos(axa), math.sin(axa)
+    cb, sb = math.cos(axb), math.sin(axb)
+    cax, cay, _cpa, _spa = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], (ca, sa), axa, pa)
+    cbx, cby, _cpb, _spb = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], (cb, sb), axb, pb)
     rba = gp[0, L.RB]
     rbb = gp[1, L.RB]
     ba = axa + pa + s * gp[0, L.PSI_B]
     bb = axb + pb + s * gp[1, L.PSI_B]
-    frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * math.cos(axa), o1y + e1y + gp[0, L.R_PV] * math.sin(axa),
-             o2x, o2y, o2x + e2x + gp[1, L.R_PV] * math.cos(axb), o2y + e2y + gp[1, L.R_PV] * math.sin(axb))
+    frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * ca, o1y + e1y + gp[0, L.R_PV] * sa,
+             o2x, o2y, o2x + e2x + gp[1, L.R_PV] * cb, o2y + e2y + gp[1, L.R_PV] * sb)
     vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:

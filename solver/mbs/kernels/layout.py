@@ -104,7 +104,8 @@ DELTA_MAX = 7       # penetration bound [m]
 ENERGY_TOL = 8      # relative energy growth that stops a run [-]
 HHT_ALPHA = 9       # HHT-alpha parameter [-]
 NEWTON_TOL = 10     # Newton stops when no flank point moves more than this [m]
-N_PAR = 11
+IMEX = 11           # 1: the linear tooth-root dampers taken implicitly in the Verlet kicks (`explicit`)
+N_PAR = 12
 # control integers: int array ``ipar``
 N_STEPS = 0
 OUT_EVERY = 1       # steps per output record

@@ -115,9 +115,10 @@ def dissipation_power(dphi, act, nact, mdl, rec, nc):
         g = 1 if i >= tz2 else 0
         if gp[g, L.C_PHI] != 0.0:
             p += gp[g, L.C_PHI] * signed_pow(dphi[i], gp[g, L.N_C]) * dphi[i]
+    damped = lp[L.C_CON] != 0.0     # without a contact damper the force is the elastic one, exactly
     for c in range(nc):
         d = rec[c, L.C_DELTA]
-        if d > 0.0:
+        if damped and d > 0.0:
             fel = lp[L.K_CON] * d ** lp[L.M1]
             p += (rec[c, L.C_FORCE] - fel) * rec[c, L.C_DDELTA]
         ft = rec[c, L.C_FT]

@@ -26,7 +26,8 @@ def model(scene):
 
 @pytest.fixture(scope="module")
 def dyn(scene, model):
-    """1 ms window (ramps end at 0.5 ms): explicit at 1 and 1/2 of the stability step, the
+    """1 ms window (ramps end at 0.5 ms): explicit (all explicit, and with implicit tooth-root
+    dampers) at 1 and 1/2 of its stability step, the production path, the
     implicit one at 1 and 4 times it (the scipy stiff solvers take minutes here: they run in
     the workflow, their code path is tested in tests/solver/peers/test_scipy_dynamics.py)."""
     return dynamic_study(scene, model, duration=0.001, repeats=1, explicit_fractions=(1, 2),
@@ -34,13 +35,14 @@ def dyn(scene, model):
 
 
 def test_dynamic_dataset_contract(dyn):
-    assert dict(dyn.sizes) == {"run": 6, "norm": 3}
+    assert dict(dyn.sizes) == {"run": 9, "norm": 3}
     assert list(dyn["norm"].values) == ["final", "l2", "linf"]
     assert dyn["te_error"].attrs["units"] == "um" and dyn["wall_time"].attrs["units"] == "s"
     assert dyn["step"].attrs["units"] == "s"
     for key in ("reference", "cross_check", "machine", "case", "reference_difference_linf_um"):
         assert key in dyn.attrs
-    assert set(dyn["method"].values) == {"explicit", "explicit, active set", "implicit alpha=0"}
+    assert set(dyn["method"].values) == {"explicit", "explicit, active set", "implicit alpha=0",
+                                         "explicit, implicit dampers", "explicit, production"}
     assert np.all(dyn["status"].values == "ok"), dyn["message"].values
     e = dyn["te_error"].values
     assert np.all(e[:, 1] <= e[:, 2] + 1e-15)          # rms <= max
@@ -61,7 +63,9 @@ def test_errors_fall_with_the_step_at_least_at_second_order(dyn):
     m = dyn["method"].values
     ex = e[m == "explicit"]
     im = e[m == "implicit alpha=0"]
+    imex = e[m == "explicit, implicit dampers"]
     assert ex[0] / ex[1] > 3.0                          # halved step: error / 4 or better
+    assert imex[0] / imex[1] > 3.0
     assert im[0] > 8 * im[1]                            # 4x smaller step: error / 16
 
 
