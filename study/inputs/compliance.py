@@ -50,7 +50,8 @@ def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFI
     stages = {}              # wall and CPU seconds of each stage (CPU: all threads of the process)
 
     def build():
-        mesh = mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body")
+        mesh = mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body",
+                     grading=setup.mesh_grading)
         stages.update(mesh_wall_s=time.perf_counter() - t0, mesh_cpu_s=time.process_time() - c0)
         model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, setup.material)
         stages.update(assembly_wall_s=model.assembly_time, assembly_cpu_s=model.assembly_cpu,

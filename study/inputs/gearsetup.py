@@ -37,6 +37,7 @@ class GearSetup:
     mesh_size_setting: float | None   # fe.mesh_size [m]; None: the default from the module
     force: float                # FE reference load at the pitch point [N]
     hertz_half_width: float     # Hertz half-width of the pitch-point contact under ``force`` [m]
+    mesh_grading: str = "graded"   # fe.mesh_grading (`solver.fe.mesh.GRADINGS`)
 
     @property
     def teeth(self) -> int:
@@ -60,13 +61,16 @@ class GearSetup:
     @property
     def settings(self) -> dict:
         """Everything the FE of this gear depends on (geometry, body, material, pivot, mesh
-        size, load, code version): the content of the cache keys."""
+        size and grading, load, code version): the content of the cache keys."""
         body = self.body
         if body.holes == 0:  # hole sizes do not matter without holes: one cache entry for all of them
             body = dataclasses.replace(body, hole_radius=0.0, hole_circle_radius=0.0, hole_phase=0.0)
-        return dict(tooth=dataclasses.asdict(self.tooth), body=dataclasses.asdict(body),
-                    material=dataclasses.asdict(self.material), pivot=self.pivot_radius,
-                    size=self.mesh_size_setting, force=self.force, version=FE_VERSION)
+        out = dict(tooth=dataclasses.asdict(self.tooth), body=dataclasses.asdict(body),
+                   material=dataclasses.asdict(self.material), pivot=self.pivot_radius,
+                   size=self.mesh_size_setting, force=self.force, version=FE_VERSION)
+        if self.mesh_grading != "fine":   # the fine mesh keeps the keys it had before the grading existed
+            out["grading"] = self.mesh_grading
+        return out
 
     @property
     def key(self) -> str:
@@ -104,7 +108,7 @@ def gear_setups(scene: Scene) -> tuple[GearSetup, GearSetup]:
         force = torque / geo.base_radius
         out.append(GearSetup(g, geo.spec, geo, scene.body_spec(g), material, scene.pivot_radius(g), scene.gear(g).spring,
                              scene.is_lightened(g), pair.u_sap[g - 1], size, force,
-                             hertz_half_width(*geos, material, geo.spec.face_width, force)))
+                             hertz_half_width(*geos, material, geo.spec.face_width, force), scene.fe.mesh_grading))
     return out[0], out[1]
 
 

@@ -47,7 +47,8 @@ def fe_stiffness(setup: GearSetup, teeth=None, keep_fields: bool = False):
         if k is not None:
             return k
     geo, body = setup.geometry, setup.body
-    mesh = mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body")
+    mesh = mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body",
+                     grading=setup.mesh_grading)
     model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, setup.material)
     k, U = fe.tooth_stiffness(model, geo, setup.pivot_radius, tooth_list, setup.force, setup.patch)
     stress = fe.fillet_stress(model, geo, U, tooth_list)
@@ -148,7 +149,8 @@ def identify_spring(setup: GearSetup, radii: int = 7, levels=(0.25, 0.5, 1.0)):
 
     geo = setup.geometry
     u = np.linspace(setup.sap_roll, geo.u_tip, radii + 2)[1:-1]
-    mesh = mesh_body(geo, setup.body, setup.mesh_size, prefix=f"{setup.prefix}.body")
+    mesh = mesh_body(geo, setup.body, setup.mesh_size, prefix=f"{setup.prefix}.body",
+                     grading=setup.mesh_grading)
     model = fe.assemble(mesh, geo.spec.face_width, setup.body.web_thickness, setup.material)
     comp, t = [], []
     for ui in u:

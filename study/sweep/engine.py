@@ -23,7 +23,9 @@ the tasks it shares, and a changed code computes them all again.
 Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)
 that is always closed, or an existing scheduler (``scheduler="tcp://host:8786"``) whose workers
-can import this package.
+can import this package. On dask the FE spring maps the tasks read go first, each once
+(`study.sweep.bodies`), and each task waits for its maps: no two workers compute the same map,
+and no task holds a worker up with a map in the middle of the study.
 """
 from __future__ import annotations
 
@@ -227,11 +229,28 @@ def _in_process(todo: dict, outputs: dict):
         yield key, run_point(scene, outputs[key])
 
 
+def run_after(scene: Scene, outputs: Outputs, *maps) -> dict:
+    """`run_point`, once the FE maps it reads (``maps``: their futures' results) are cached."""
+    return run_point(scene, outputs)
+
+
 def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None):
     from distributed import as_completed
+
+    from study.sweep.bodies import compute_map, spring_maps
     with dask_client(scheduler, workers) as client:
-        futures = {client.submit(run_point, scene, outputs[key], key=f"lightgear-task-{key}", pure=False): key
+        # each FE map once, ahead of the tasks (higher priority), and each task after its maps
+        maps, after = {}, {}
+        for key, scene in todo.items():
+            for fe_key, setup, teeth in spring_maps(scene):
+                if fe_key not in maps:
+                    maps[fe_key] = client.submit(compute_map, setup, teeth, key=f"lightgear-fe-{fe_key}", pure=False,
+                                                 priority=1)
+                after.setdefault(key, []).append(maps[fe_key])
+        futures = {client.submit(run_after, scene, outputs[key], *after.get(key, ()), key=f"lightgear-task-{key}",
+                                 pure=False): key
                    for key, scene in todo.items()}
+        del maps, after     # the tasks hold the maps' futures now; dask forgets each map once its tasks ran
         try:
             for fut in as_completed(futures):
                 key = futures.pop(fut)

@@ -61,8 +61,10 @@ def test_estimates_scale_with_the_work():
     from study.inputs.gearsetup import gear_setups
     s2 = gear_setups(sc)[1]
     fine = gear_setups(sc.replace(**{"fe.mesh_size": s2.mesh_size * 1e3 / 2}))[1]
-    # the paper body has 39 700 triangles (gmsh); halving the size quadruples them
-    assert estimate.body_elements(s2) == pytest.approx(39700, rel=0.25)
+    ungraded = gear_setups(sc.replace(**{"fe.mesh_grading": "fine"}))[1]
+    # the paper body has 21 200 triangles graded, 39 700 fine (gmsh); halving the size quadruples them
+    assert estimate.body_elements(s2) == pytest.approx(21200, rel=0.25)
+    assert estimate.body_elements(ungraded) == pytest.approx(39700, rel=0.25)
     assert estimate.body_elements(fine) == pytest.approx(4 * estimate.body_elements(s2), rel=1e-9)
     assert estimate.dynamic_records(sc) == 20001
 

@@ -1,0 +1,91 @@
+"""FE spring maps of a study: each listed once per distinct body, computed first on dask, and the
+sweep's numbers unchanged by it."""
+import numpy as np
+import pytest
+from conftest import SMALL_PAIR
+
+from study.inputs.cache import FE_CACHE
+from study.inputs.gearsetup import gear_setup
+from study.inputs.springs import tooth_springs
+from study.sweep.bodies import compute_map, spring_maps
+from study.sweep.engine import run_sweep
+from study.sweep.grid import loads_study
+from study.sweep.outputs import STATUS
+from study.sweep.tasks import plan
+
+pytestmark = pytest.mark.usefixtures("private_fe_cache")
+
+SCENE = "\n".join(f'"{k}" = {v!r}' if not isinstance(v, str) else f'"{k}" = "{v}"' for k, v in {
+    **SMALL_PAIR, "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
+    "quasi_static.rotation": 6.0, "quasi_static.angle_step": 1.0, "dynamic.duration": 0.004,
+    "dynamic.ramp_time": 0.001, "fe.mesh_size": 1.5}.items())
+# 3 lightened bodies (holes and/or a 12 mm web) and the solid one (no holes, 20 mm web): the
+# lightened ones share one solid reference (same rim), so 4 maps for the 9 tasks that read them
+STUDY = f"""title = "maps"
+[scene]
+{SCENE}
+[grid]
+"gear2.body.holes" = [0, 4]
+"gear2.body.web_thickness" = [12.0, 20.0]
+"dynamic.speed" = [50.0, 60.0]
+[outputs]
+scalars = ["ste_p2p", "dte_rms", "root_stress_max_gear2"]
+"""
+
+
+def maps_of(study):
+    tasks, _ = plan(study, list(study.points()))
+    return {key: spring_maps(t.scene) for key, t in tasks.items()}
+
+
+def test_each_lightened_body_needs_its_map_and_the_shared_solid_reference():
+    st = loads_study(STUDY)
+    per_task = maps_of(st)
+    distinct = {k for maps in per_task.values() for k, _, _ in maps}
+    lightened = [t for t, maps in per_task.items() if maps]
+    assert len(per_task) == 4 * 3 and len(lightened) == 3 * 3     # 4 bodies: a static task and 2 speeds each
+    assert all(len(maps) == 2 for t, maps in per_task.items() if maps)   # the body's map and the solid reference
+    assert len(distinct) == 3 + 1
+    # a map already on disk is not listed again
+    key, setup, teeth = next(iter(per_task[lightened[0]]))
+    compute_map(setup, teeth)
+    assert key not in {k for maps in maps_of(st).values() for k, _, _ in maps}
+    # uniform springs read no map
+    uniform = loads_study(STUDY.replace("[grid]", '"gear2.spring.stiffness" = "uniform"\n[grid]'))
+    assert not any(maps_of(uniform).values())
+
+
+def test_a_dask_sweep_computes_each_map_once_before_the_tasks_that_read_it(tmp_path, monkeypatch):
+    import distributed
+    st = loads_study(STUDY)
+    submitted = []
+    real = distributed.Client.submit
+
+    def submit(self, func, *args, **kw):
+        future = real(self, func, *args, **kw)
+        submitted.append((func.__name__, future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
+        return future
+    monkeypatch.setattr(distributed.Client, "submit", submit)
+    res = run_sweep(st, tmp_path / "dask.nc", workers=2, progress=False)
+    maps = [key for name, key, _ in submitted if name == "compute_map"]
+    assert len(maps) == len(set(maps)) == 4
+    waits = {key: after for name, key, after in submitted if name == "run_after"}
+    assert len(waits) == 12 and sum(bool(a) for a in waits.values()) == 9
+    assert all(set(a) <= set(maps) and len(a) == 2 for a in waits.values() if a)
+    assert (res.dataset["status"] == STATUS.index("ok")).all()
+    # the same numbers as the study run in this process from an empty FE cache (the maps then
+    # computed by the tasks themselves)
+    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "another cache"))
+    FE_CACHE.clear()
+    alone = run_sweep(st, tmp_path / "alone.nc", workers=0, progress=False)
+    for name in ("ste_p2p", "dte_rms", "root_stress_max_gear2"):
+        np.testing.assert_array_equal(res.dataset[name].values, alone.dataset[name].values)
+
+
+def test_the_listed_maps_are_the_ones_the_springs_read():
+    st = loads_study(STUDY)
+    scene = next(p.scene for p in st.points() if p.scene.gear2.body.holes == 4)
+    listed = {k for k, _, _ in spring_maps(scene)}
+    tooth_springs(gear_setup(scene, 2))          # the springs compute (and cache) what they read
+    assert set(FE_CACHE.stiffness) == listed and len(listed) == 2
+    assert spring_maps(scene) == []              # now on disk
