@@ -20,6 +20,7 @@ _PRETTY_UNITS = {"um": "µm", "degree": "°", "N mm rad-1": "N·mm/rad", "N m ra
                  "N m": "N·m", "1": "–", "Hz": "Hz", "s": "s", "N": "N", "J": "J", "mm": "mm",
                  "rad s-1": "rad/s", "MPa": "MPa"}
 C_LIGHT, C_SOLID, C_HOLE, C_SIDE, C_OTHER = "#c0392b", "#2c3e50", "#2980b9", "#27ae60", "#7d3c98"
+C_REV = "#d68910"     # once-per-revolution orders of gears with pitch errors or eccentricity
 
 
 def pretty_unit(unit: str | None) -> str:

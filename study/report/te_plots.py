@@ -18,7 +18,18 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from study.report.plot_style import C_HOLE, C_LIGHT, C_OTHER, C_SIDE, C_SOLID, archive_scene, figure_title, need, save_figure
+from study.report.plot_style import (
+    C_HOLE,
+    C_LIGHT,
+    C_OTHER,
+    C_REV,
+    C_SIDE,
+    C_SOLID,
+    archive_scene,
+    figure_title,
+    need,
+    save_figure,
+)
 
 
 def _runs(mask: np.ndarray):
@@ -185,7 +196,10 @@ def _peak_table(ds, prefix):
     return list(zip(names, ds[f"{dim}_nominal_order"].values, ds[f"{dim}_order"].values, ds[f"{dim}_amplitude"].values))
 
 
-def _spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
+def spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
+    """One spectrum on ``ax``: amplitude [um] against order [-] up to xmax, with the named
+    orders of ``peaks`` (name, nominal order, found order, amplitude [um]) drawn as lines and
+    listed in a table beside the axes; ``what`` names the signal (DTE, STE) on the y axis."""
     from matplotlib.lines import Line2D
     sel = (order > 0) & (order <= xmax)
     ax.semilogy(order[sel], np.maximum(amp[sel], 1e-12), color=C_SOLID, lw=0.8)
@@ -199,18 +213,26 @@ def _spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
         ax.annotate(f"{o:.1f}", (o, a), xytext=(0, 8 + 11 * (i % 3)), textcoords="offset points", ha="center",
                     fontsize=8, color=C_OTHER)
     table = []
+    rev = {name: nominal for name, nominal, _o, _a in peaks if name in ("R1", "R2")}
+    same_rev = len(rev) == 2 and abs(rev["R1"] - rev["R2"]) < 1e-9     # a 1:1 pair: one order, one line
     for name, nominal, o, a in peaks:
         if name.startswith("other") or not np.isfinite(nominal) or nominal > xmax:
             continue
+        if same_rev and name == "R2":
+            continue
+        if same_rev and name == "R1":
+            name = "R1=R2"
         hole = name.endswith("N") and "Z" not in name
-        mesh = "N" not in name
-        color = C_HOLE if hole else (C_LIGHT if mesh else C_SIDE)
-        ax.axvline(nominal, color=color, lw=1.0 if (hole or mesh) else 0.7, ls="-" if (hole or mesh) else ":", alpha=0.8)
+        once = name.startswith("R")
+        mesh = "N" not in name and not once
+        color = C_REV if once else (C_HOLE if hole else (C_LIGHT if mesh else C_SIDE))
+        main_line = hole or mesh or once
+        ax.axvline(nominal, color=color, lw=1.0 if main_line else 0.7, ls="-" if main_line else ":", alpha=0.8)
         ax.text(nominal, 0.99, f" {name}", transform=ax.get_xaxis_transform(), rotation=90, va="top",
                 ha="right", fontsize=8, color=color)
         if np.isfinite(a):
             table.append(f"{name:>5s}: {a:.3g}")
-            if hole or mesh:
+            if main_line:
                 ax.plot(o, a, "o", mfc="none", color=color, ms=7)
     ax.set_xlim(0, xmax)
     ax.set_ylabel(f"{what} amplitude [µm]")
@@ -218,6 +240,8 @@ def _spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
     handles = [Line2D([], [], color=C_HOLE, label="hole order N, 2N"), Line2D([], [], color=C_LIGHT, label="mesh order kZ"),
                Line2D([], [], color=C_SIDE, ls=":", label="sidebands kZ ± N"),
                Line2D([], [], color=C_OTHER, marker="v", ls="", label="largest unexplained peaks (order)")]
+    if rev:
+        handles.insert(0, Line2D([], [], color=C_REV, label="once per revolution: R1 driver, R2 driven"))
     leg = ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False)
     leg.set_in_layout(True)
     ax.text(1.01, 0.55, "peak amplitude [µm]\n" + ("\n".join(table) if table else "(none resolved)"),
@@ -250,7 +274,7 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
         a = ds["dte_amplitude"].attrs
         res = a.get("resolution_Hz", float("nan"))
         f_rot = float(ds.attrs.get("driven_speed_rad_s", 0.0)) / (2 * np.pi)
-        _spectrum_panel(axes[i, 0], order, amp, peaks, xmax, "DTE",
+        spectrum_panel(axes[i, 0], order, amp, peaks, xmax, "DTE",
                         f"{a.get('window', '?')} window, resolution {res:.3g} Hz = {res / f_rot:.3g} orders, "
                         f"from {a.get('start_s', float('nan')) * 1e3:.3g} ms" if f_rot > 0 else "")
         ax = axes[i, 0]
@@ -265,7 +289,7 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
         amp = ds["ste_amplitude"].values
         a = ds["ste_amplitude"].attrs
         xmax = min(float(np.nanmax(order)), 3.3 * z)
-        _spectrum_panel(axes[i, 0], order, amp, _peak_table(ds, "ste"), xmax, "STE",
+        spectrum_panel(axes[i, 0], order, amp, _peak_table(ds, "ste"), xmax, "STE",
                         f"{a.get('window', '?')} window, resolution {a.get('resolution_orders', float('nan')):.3g} orders "
                         f"({a.get('record_driven_revolutions', float('nan')):.3g} driven revolutions), "
                         f"zero padding x{a.get('zero_padding', 1)}")

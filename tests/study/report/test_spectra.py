@@ -132,3 +132,27 @@ def test_once_per_revolution_orders_of_gears_with_errors_are_named():
     assert list(c0["ste_peak"].values) == names[2:]
     others = d0["ste_peak_order"].values[[n.startswith("other") for n in c0["ste_peak"].values]]
     assert np.any(np.abs(others - 1.5) < 0.1) and np.any(np.abs(others - 1.0) < 0.1)
+
+
+def test_spectrum_panel_draws_one_revolution_line_for_a_one_to_one_pair():
+    """Gears with errors: the once-per-revolution orders R1 (driver) and R2 (driven) get their
+    own colour; on a 1:1 pair they are one order and the panel draws one line, named R1=R2, and
+    one table row (two lines and rows otherwise)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from study.report.te_plots import spectrum_panel
+    order = np.linspace(0.0, 100.0, 2001)
+    amp = np.full_like(order, 1e-3)
+    for r2 in (1.0, 1.5):
+        peaks = [("R1", 1.0, 1.0, 2.0), ("R2", r2, r2, 2.0), ("Z", 67.0, 67.0, 0.1)]
+        fig, ax = plt.subplots()
+        spectrum_panel(ax, order, amp, peaks, 100.0, "STE", "")
+        labels = [t.get_text().strip() for t in ax.texts]
+        plt.close(fig)
+        if r2 == 1.0:
+            assert "R1=R2" in labels and "R1" not in labels and "R2" not in labels
+            assert sum("R1=R2:" in t for t in labels) == 1           # the peak table's row
+        else:
+            assert "R1" in labels and "R2" in labels and "R1=R2" not in labels
