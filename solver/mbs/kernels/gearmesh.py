@@ -132,24 +132,25 @@ def _tangent_turn(dx, dy, length, kc, ddx, ddy):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _deviation_gradient(sa, sb, s, centres, axes, ecc, gp):
+def _deviation_gradient(sa, sb, s, centres, trig, ecc, gp):
     """d(da + db)/d(theta1, phi_A, theta2, phi_B) [m] of the flank deviations whose slopes are
     sa, sb [m] per unit roll at the flank-flank contact of side s; centres = (moved base-circle
-    centres A x, y, B x, y [m], base radii A, B [m]), axes = (tooth axis angle, rotation of
-    tooth A, the same of B) [rad], ecc = the teeth's centres' offsets from the bearing axes
+    centres A x, y, B x, y [m], base radii A, B [m]), trig = (cos, sin of tooth A's axis angle,
+    cos, sin of that angle plus its rotation, the same four of B) as `moved_center` gives
+    them, ecc = the teeth's centres' offsets from the bearing axes
     (gear 1 x, y, gear 2 x, y) [m]. With ua = s*(beta_a - ta), ub = s*(beta_b - ta - pi), the
     common tangent's angle ta turns as the tooth rotations move the base-circle centres."""
     cax, cay, cbx, cby, rba, rbb = centres
-    axa, pa, axb, pb = axes
+    ca, sna, cpa, spa, cb, snb, cpb, spb = trig
     dx, dy = cbx - cax, cby - cay
     ln = math.sqrt(dx * dx + dy * dy)
     c = (rba + rbb) / ln
     kc = s * (rba + rbb) / (ln * ln * math.sqrt(1.0 - c * c))
     ra, rb_ = gp[0, L.R_PV], gp[1, L.R_PV]
-    t1 = _tangent_turn(dx, dy, ln, kc, ra * (math.sin(axa) - math.sin(axa + pa)), ra * (math.cos(axa + pa) - math.cos(axa)))
-    ta_ = _tangent_turn(dx, dy, ln, kc, -ra * math.sin(axa + pa), ra * math.cos(axa + pa))
-    t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (math.sin(axb + pb) - math.sin(axb)), rb_ * (math.cos(axb) - math.cos(axb + pb)))
-    tb = _tangent_turn(dx, dy, ln, kc, rb_ * math.sin(axb + pb), -rb_ * math.cos(axb + pb))
+    t1 = _tangent_turn(dx, dy, ln, kc, ra * (sna - spa), ra * (cpa - ca))
+    ta_ = _tangent_turn(dx, dy, ln, kc, -ra * spa, ra * cpa)
+    t2 = _tangent_turn(dx, dy, ln, kc, rb_ * (spb - snb), rb_ * (cb - cpb))
+    tb = _tangent_turn(dx, dy, ln, kc, rb_ * spb, -rb_ * cpb)
     e1x, e1y, e2x, e2y = ecc
     if e1x != 0.0 or e1y != 0.0 or e2x != 0.0 or e2y != 0.0:
         # a hub rotation also swings the eccentric centre about the bearing axis
@@ -259,17 +260,19 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
         c2 = theta2 + gp[1, L.GAMMA0] + pp[L.E_ECC + 3]
         e1x, e1y = pp[L.E_ECC] * math.cos(c1), pp[L.E_ECC] * math.sin(c1)
         e2x, e2y = pp[L.E_ECC + 2] * math.cos(c2), pp[L.E_ECC + 2] * math.sin(c2)
-    # the sines and cosines of the tooth axes, once for the moved centres and the pivots
-    ca, sa = math.cos(axa), math.sin(axa)
-    cb, sb = math.cos(axb), math.sin(axb)
-    cax, cay, _cpa, _spa = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], (ca, sa), axa, pa)
-    cbx, cby, _cpb, _spb = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], (cb, sb), axb, pb)
+    # the sines and cosines of the tooth axes, once for the moved centres, the pivots and the
+    # deviations' gradient
+    ca, sna = math.cos(axa), math.sin(axa)
+    cb, snb = math.cos(axb), math.sin(axb)
+    cax, cay, cpa, spa = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], (ca, sna), axa, pa)
+    cbx, cby, cpb, spb = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], (cb, snb), axb, pb)
+    trig = (ca, sna, cpa, spa, cb, snb, cpb, spb)
     rba = gp[0, L.RB]
     rbb = gp[1, L.RB]
     ba = axa + pa + s * gp[0, L.PSI_B]
     bb = axb + pb + s * gp[1, L.PSI_B]
-    frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * ca, o1y + e1y + gp[0, L.R_PV] * sa,
-             o2x, o2y, o2x + e2x + gp[1, L.R_PV] * cb, o2y + e2y + gp[1, L.R_PV] * sb)
+    frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * ca, o1y + e1y + gp[0, L.R_PV] * sna,
+             o2x, o2y, o2x + e2x + gp[1, L.R_PV] * cb, o2y + e2y + gp[1, L.R_PV] * snb)
     vel = (w1, dphi[ia], w2, dphi[ib])
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
@@ -278,8 +281,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             da, sa = flank_deviation(gp[0], ua)
             db, sb = flank_deviation(gp[1], ub)
             delta -= da + db
-            dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb),
-                                     (e1x, e1y, e2x, e2y), gp)
+            dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
         if delta > 0.0 and nc < rec.shape[0]:
             # owner A (gear 1)
             _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg))
@@ -308,8 +310,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
                 if w > 1e-12:
                     # d delta/dq gains -sw*du/dq, d2 delta/dq2 gains (sw/TIP_BLEND)*(du/dq)(du/dq)^T
                     du = _deviation_gradient(1.0 if g == 0 else 0.0, 1.0 if g == 1 else 0.0, s,
-                                             (cax, cay, cbx, cby, rba, rbb), (axa, pa, axb, pb),
-                                             (e1x, e1y, e2x, e2y), gp)
+                                             (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
                     dg = (sw * du[0], sw * du[1], sw * du[2], sw * du[3])
                     blend = sw / TIP_BLEND
             if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
