@@ -62,6 +62,15 @@ def solve_dense(a, b):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
+def _workspace(ntooth):
+    """Work arrays ``ws`` of the Newton for ntooth teeth: (contact records, candidate pairs,
+    generalised forces, zero tooth rates, the unknowns' positions and list, residual)."""
+    return (np.zeros((L.MAX_CONTACTS, L.N_C_COLS)), np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64),
+            np.zeros(ntooth + 2), np.zeros(ntooth), np.zeros(ntooth, dtype=np.int64),
+            np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth + 1))
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
 def _unknown_set(ws, npair, gp, phi):
     """Number the teeth of the npair candidate pairs 1.. in ws's pos (0 is theta2; -1: not an
     unknown) and list them in lst; the other teeth are unloaded (phi = 0). Returns their number."""
@@ -106,8 +115,9 @@ def _tangent(mdl, ks, ws, nc, nt, phi):
     """Newton tangent [N m/rad] over theta2 and the nt unknown teeth: the contacts rec[:nc]
     plus the tooth springs (the set stiffness ks of a coupled model, else each tooth's own
     tangent, regularised where it vanishes at phi = 0)."""
-    gp, _pp, _lp, kphi = mdl
+    gp, _pp, lp, kphi = mdl
     rec, _pairs, _q, _zeros, pos, lst, _r = ws
+    friction = lp[L.MU] > 0.0
     n = nt + 1
     K = np.zeros((n, n))
     for c in range(nc):
@@ -128,6 +138,13 @@ def _tangent(mdl, ks, ws, nc, nt, phi):
             for x in range(3):
                 for y in range(3):
                     K[idx[x], idx[y]] += kg * dv[x] * dv[y]
+        if friction and rec[c, L.C_FORCE] > 0.0:
+            # the friction force F_t = (F_t/F)*F along H changes with the normal force
+            rf = rec[c, L.C_FT] / rec[c, L.C_FORCE] * kt
+            hv = (rec[c, L.C_H2], rec[c, L.C_HA], rec[c, L.C_HB])
+            for x in range(3):
+                for y in range(3):
+                    K[idx[x], idx[y]] += rf * hv[x] * gv[y]
     if ks is not None:
         for m in range(nt):
             for m2 in range(nt):
@@ -136,20 +153,6 @@ def _tangent(mdl, ks, ws, nc, nt, phi):
         for m in range(nt):
             i = lst[m]
             K[m + 1, m + 1] += tooth_spring_tangent(i, phi, kphi, gp) + 1e-9 * kphi[i]
-    if mdl[2][L.MU] > 0.0:
-        for c in range(nc):
-            kt = rec[c, L.C_KT]
-            if kt <= 0.0 or rec[c, L.C_FORCE] <= 0.0:
-                continue
-            ia = int(rec[c, L.C_TOOTH1]) + int(gp[0, L.TOOTH0])
-            ib = int(rec[c, L.C_TOOTH2]) + int(gp[1, L.TOOTH0])
-            idx = (0, pos[ia], pos[ib])
-            rf = rec[c, L.C_FT] / rec[c, L.C_FORCE] * kt
-            gv = (rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB])
-            hv = (rec[c, L.C_H2], rec[c, L.C_HA], rec[c, L.C_HB])
-            for x in range(3):
-                for y in range(3):
-                    K[idx[x], idx[y]] += rf * hv[x] * gv[y]
     if K[0, 0] <= 0.0:
         K[0, 0] = 1e-9
     return K
@@ -162,11 +165,8 @@ def newton_system(mdl, theta1, theta2, phi, torque):
     residual [N m], the unknown teeth), the unknowns being theta2 and those teeth, as the
     sweep below builds them (for checks against finite differences)."""
     gp, pp, lp, _kphi = mdl
-    n = phi.shape[0]
-    rec = np.zeros((L.MAX_CONTACTS, L.N_C_COLS))
-    pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
-    zeros = np.zeros(n)
-    ws = (rec, pairs, np.zeros(n + 2), zeros, np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), np.zeros(n + 1))
+    ws = _workspace(phi.shape[0])
+    rec, pairs, zeros = ws[0], ws[1], ws[3]
     ph = phi.copy()
     nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), ph, zeros, (gp, pp, lp), (rec, pairs))
     nt = _unknown_set(ws, npair, gp, ph)
@@ -199,8 +199,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     """Equilibrium at each driver angle theta1s[a] [rad].
 
     mdl: (gear_par, pair_par, law_par, k_phi); ctl: (par, ipar) with the `layout` S_*
-    columns (resisting torque [N m], start guess of theta2 [rad], tolerance; Newton
-    iterations). ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth
+    columns (resisting torque [N m], start guess of theta2 [rad], tolerance, driver speed of
+    the friction's sliding [rad/s]; Newton iterations). ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth
     are coupled through the body (`toothcoupling`; its k_phi are then zero), or None. The
     coupled code sits under ``if ctooth is not None`` (and ``ks``) so that numba prunes it
     from the plain model's compiled version (a switch inside a tuple would not be pruned).
@@ -214,12 +214,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     par, ipar = ctl
     torque = par[L.S_TORQUE]
     ntooth = phi.shape[0]
-    zeros = np.zeros(ntooth)
-    rec = np.zeros((L.MAX_CONTACTS, L.N_C_COLS))
-    pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
-    ws = (rec, pairs, np.zeros(ntooth + 2), zeros, np.zeros(ntooth, dtype=np.int64),
-          np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth + 1))
-    lst, r = ws[5], ws[6]
+    ws = _workspace(ntooth)
+    rec, pairs, zeros, lst, r = ws[0], ws[1], ws[3], ws[5], ws[6]
     if ctooth is None:
         ks = None
     else:
@@ -228,8 +224,20 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     rb2 = gp[1, L.RB]
     tol_abs = par[L.S_TOL] * max(abs(torque), 1e-3)
     theta2 = par[L.S_THETA2]
-    w1 = par[L.S_W1] if par.shape[0] > L.S_W1 else 0.0
+    w1 = par[L.S_W1]
     w2 = -rb1 / rb2 * w1 if w1 != 0.0 else 0.0
+    # how far an open mesh may be from its first touch beyond the rigid gap: both flanks'
+    # largest deviations, the pitch errors and eccentricities (a loop, not .max(): numpy's max
+    # and take would compile too)
+    open_gap = 0.0
+    for g in range(2):
+        dev_max = 0.0
+        if gp[g, L.DEV_ON] > 0.0:
+            for k in range(L.DEV0, L.DEV0 + L.N_DEV):
+                dev_max = max(dev_max, gp[g, k])
+        open_gap += dev_max
+    if pp.shape[0] > L.N_PAIR_PAR:
+        open_gap += pp[L.E_BOUND]
     failures = 0
     nc = np.int64(0)        # not a literal 0: numba would compile the callees once more for it
     npair = np.int64(0)
@@ -260,19 +268,10 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                     break
                 # no contact yet: close the gap rigidly, plus the contact-only penetration
                 dpen = (abs(torque) / rb2 / lp[L.K_CON]) ** (1.0 / lp[L.M1])
-                errs = pp.shape[0] > L.N_PAIR_PAR
-                if gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0 or errs:
-                    # modified flanks: the gap may be up to both deviations (and the pitch errors
-                    # and eccentricities); closed in 16ths of them, one more at each iteration
-                    # without contact (near the first touch)
-                    for g in range(2):
-                        dev_max = 0.0       # a loop, not .max(): numpy's max and take would compile too
-                        for k in range(L.DEV0, L.DEV0 + L.N_DEV):
-                            dev_max = max(dev_max, gp[g, k])
-                        dpen += open_steps / 16.0 * dev_max
-                    if errs:
-                        dpen += open_steps / 16.0 * pp[L.E_BOUND]
-                    open_steps += 1
+                # modified flanks or errors: the gap may be up to open_gap more; closed in 16ths
+                # of it, one more at each iteration without contact (near the first touch)
+                dpen += open_steps / 16.0 * open_gap
+                open_steps += 1
                 theta2 = ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
             # residual from the contacts just found (same state: no second search)
