@@ -341,7 +341,8 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     """
     check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step)
     table, torque, side = run_loads(load_table, torque)
-    imex = implicit_dampers_apply(model) if implicit_dampers is None else bool(implicit_dampers)
+    applies = implicit_dampers_apply(model)
+    imex = applies if implicit_dampers is None else bool(implicit_dampers)
     rate = {}
     if phi_quiet is None:
         phi_quiet = default_phi_quiet(model)
@@ -349,7 +350,7 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
         # relative to its hub takes its share of the kinetic energy (I_cpl*w*dphi at hub speed
         # w) out of the balance unbooked
         rate = dict(RATE_QUIET=PHI_QUIET)
-    if imex and not implicit_dampers_apply(model):
+    if imex and not applies:
         raise ValueError("implicit_dampers: needs linear tooth-root dampers (n_c = 1, c_phi > 0) on the plain pair "
                          "(no body coupling)")
     omega_max = float("nan")
