@@ -46,3 +46,13 @@ def spring_stiffness_to_si(k_phi_nmm: float) -> float:
 def spring_damping_to_si(c_phi_nmm: float) -> float:
     """c_phi [N·mm/(rad/s)^n_c] -> [N·m/(rad/s)^n_c]."""
     return c_phi_nmm * NMM
+
+
+def stiffness_n_per_um(k_n_per_m):
+    """Stiffness N/m -> N/um (a mesh or tooth stiffness as gear engineers quote it)."""
+    return k_n_per_m * UM
+
+
+def stiffness_per_width(k_n_per_m, width_m):
+    """Stiffness N/m over a face width [m] -> N/(mm·um) (ISO 6336-1's c' and c_gamma_alpha)."""
+    return k_n_per_m * UM / (width_m * MM_PER_M)

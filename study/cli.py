@@ -295,6 +295,26 @@ def checked_archive(name) -> Path:
     return path
 
 
+# ---------------------------------------------------------------- export
+
+def export_arguments(p) -> None:
+    p.add_argument("archive", help="run or sweep archive (NetCDF)")
+    p.add_argument("-o", "--output", default=None, help="directory for the CSV files (default: ARCHIVE_csv beside it)")
+
+
+def export_command(args) -> int:
+    import xarray as xr
+
+    from study.report.export import export_csv
+    path = checked_archive(args.archive)
+    outdir = Path(args.output) if args.output else path.with_name(f"{path.stem}_csv")
+    writable_folder(outdir)
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        for p in export_csv(ds, outdir):
+            print(f"  csv: {p}")
+    return 0
+
+
 # ---------------------------------------------------------------- precision
 
 def precision_arguments(p, output: str = "results/work_precision.nc") -> None:
@@ -378,6 +398,8 @@ COMMANDS = {
     "fit-contact": ("fit the contact law k_con*delta^m1 to Weber's contact deflection", fit_contact_arguments,
                     fit_contact_command),
     "render": ("plots and renders (PNG) of a run or sweep archive", render_arguments, render_command),
+    "export": ("an archive's variables as CSV (one file per dimension group, units in the header)", export_arguments,
+               export_command),
     "precision": ("work-precision study: TE error against wall time for every solver of a scene", precision_arguments,
                   precision_command),
     "reference": ("FE reference STE and load sharing (loaded-tooth-contact analysis)", reference_arguments,

@@ -91,7 +91,7 @@ def check_dynamic_memory(scene) -> None:
     if not scene.dynamic.enabled:
         return
     n = dynamic_records(scene)
-    need = OUTPUT_COPIES * n * L.N_OUT * 8.0
+    need = OUTPUT_COPIES * n * (L.N_OUT + L.CONTACT_SLOTS * L.O_CONTACT_COLS) * 8.0
     have = available_memory()
     if need > 0.8 * have:
         raise BudgetError("dynamic.duration", f"the run's outputs need about {bytes_text(need)} ({n:.3g} records of "

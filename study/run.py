@@ -15,12 +15,14 @@ from solver import units
 from solver.mbs.dynamics import run_loads, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.kernels.layout import R_PV
+from solver.mbs.mesh_stiffness import mesh_states
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study import estimate
 from study.inputs.gearsetup import gear_setups
 from study.report import results
 from study.report.lightening import lightening_variables
+from study.report.mesh_outputs import dynamic_force_variables, mesh_variables
 from study.report.modes import modal_variables
 from study.scene import Scene
 from study.setup import (
@@ -91,6 +93,18 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
     return res
 
 
+def static_force_max(scene: Scene, model: Model) -> float:
+    """Largest static tooth force [N] under the dynamic run's torque over a whole revolution of
+    either gear at the scene's angle step (every tooth of both gears meets the mesh): the
+    reference of the dynamic factor K_v. NaN where the statics do not converge."""
+    d, qs = scene.dynamic, scene.quasi_static
+    z1, z2 = model.teeth
+    angles = np.arange(0.0, 2 * math.pi * max(1.0, z2 / z1), math.radians(qs.angle_step))
+    st = solve_static(model, angles, d.torque, raise_on_failure=False, friction_speed=max(d.speed, d.speed_end))
+    f = st.tooth_force[st.converged]
+    return float(np.max(f)) if f.size and st.converged.all() else float("nan")
+
+
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
               max_time: float | None = None, progress: bool = False) -> xr.Dataset:
     """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive.
@@ -129,7 +143,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     d = scene.dynamic
     driven_speed = d.speed * z1 / z2
     attrs = {
-        "title": scene.title or "lightgear run",
+        "title": results.scene_title(scene),
         "scene": scene.to_toml(),
         "backlash_offset_um": model.backlash_offset * units.UM_PER_M,
         "contact_ratio": model.pair.contact_ratio,
@@ -165,6 +179,11 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes,
                                               revolutions=scene.has_errors)
         coords.update(c); data.update(v)
+        t0 = time.perf_counter()
+        states = mesh_states(model, st.angle, scene.quasi_static.torque)
+        c, v = mesh_variables(states, model, scene, scene.quasi_static.torque)
+        coords.update(c); data.update(v)
+        attrs["wall_time_mesh_stiffness_s"] = time.perf_counter() - t0
     if dynamic:
         t0 = time.perf_counter()
         dy = run_dynamic(scene, model, choice, progress)
@@ -175,6 +194,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2,
                                             (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
+        c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model))
+        coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(results.efficiency_variable(dy, d.torque, d.speed, start))
         if runup and dy.status == 0:

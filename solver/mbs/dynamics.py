@@ -78,6 +78,10 @@ class DynamicResult:
     message: str
     omega_max: float            # highest natural frequency used for the step [rad/s]
     max_active_teeth: int
+    # (record, slot, `layout` OC_* column): the loaded contacts at each output instant (gear-1
+    # tooth, gear-2 tooth, normal force [N], moment on the driven gear [N m]); set by the
+    # runs (`contact_records`), None where a result has none
+    contacts = None
 
     @property
     def energy_error(self) -> np.ndarray:
@@ -232,7 +236,7 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     teeth = np.zeros((3, model.n_teeth))
     if all_teeth:
         teeth[L.POS] = 1e-300
-    out = np.zeros((n_out, L.N_OUT))
+    out = np.zeros((n_out, L.N_OUT + L.CONTACT_SLOTS * L.O_CONTACT_COLS))
     mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance)
     args = (mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out, work_arrays(model.n_teeth))
     ret = kernel(*args) if progress is None else watched(kernel, args, out, progress)
@@ -284,6 +288,11 @@ def result_fields(out: np.ndarray) -> tuple:
     fields = [out[:, c].copy() for c in cols]
     fields[4] = fields[4].astype(int)
     return tuple(fields)
+
+
+def contact_records(out: np.ndarray) -> np.ndarray:
+    """The loaded contacts of a run's output records, (record, slot, `layout` OC_* column)."""
+    return out[:, L.N_OUT:].reshape(out.shape[0], -1, L.O_CONTACT_COLS).copy()
 
 
 def at_driver_angles(res: DynamicResult, speed: float, ramp: float, angles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -382,6 +391,7 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
             continue
         res = DynamicResult(*result_fields(out), grid[0], int(step), int(status),
                             status_message(status, step, grid[0], delta_max), omega_max, int(max_act))
+        res.contacts = contact_records(out)
         if not covered:
             res.status = INACCURATE
             res.message = (f"inaccurate: the largest contact force {peak:.4g} N makes the pair stiffer than the step "

@@ -21,6 +21,7 @@ from solver.mbs.dynamics import (
     DynamicResult,
     accuracy_check,
     check_positive,
+    contact_records,
     result_fields,
     run_kernel,
     run_loads,
@@ -90,9 +91,10 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
                                                      float(torque_ramp), table, side), grid, par, all_teeth,
                                                      progress)
     msg = status_message(status, step, grid[0], delta_max, raise_on_failure)
-    return accuracy_check(ImplicitResult(*result_fields(out), grid[0], int(step), int(status), msg, omega_max,
-                                         int(max_act), alpha=float(alpha), newton_max=out[:, L.O_NEWTON].astype(np.int64),
-                                         newton_total=int(total)), alpha)
+    res = ImplicitResult(*result_fields(out), grid[0], int(step), int(status), msg, omega_max, int(max_act),
+                         alpha=float(alpha), newton_max=out[:, L.O_NEWTON].astype(np.int64), newton_total=int(total))
+    res.contacts = contact_records(out)
+    return accuracy_check(res, alpha)
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ import numpy as np
 import xarray as xr
 
 # dimensions of a single run archive; any other dimension is a swept parameter
-RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "ste_order", "ste_peak", "dte_peak",
+RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "driven_tooth", "contact_slot", "ste_order", "ste_peak", "dte_peak",
             "mode", "mesh_position", "excitation", "runup_speed", "tracked_order"}
 TABLE_DIMS = {"output", "term"}          # the study's sensitivity table (`study.report.effects`)
 

@@ -79,6 +79,28 @@ def provenance() -> dict:
     }
 
 
+def scene_title(scene) -> str:
+    """A title that says what the scene as run is (never its free-text title, which an
+    override leaves behind): teeth and module, each body, load and speed, coupling model."""
+    g1, g2 = scene.gear1, scene.gear2
+
+    def body(name, g, n):
+        b = g.body
+        if not scene.is_lightened(n):
+            return f"{name} solid"
+        holes = f"{b.holes} holes of R_h {b.hole_radius:g} mm" if b.holes else "no holes"
+        return f"{name} {holes}, web {b.web_thickness:g} mm, rim {b.rim_height:g} mm"
+    parts = [f"z {g1.teeth}/{g2.teeth}, m {g1.module:g} mm", body("driver", g1, 1), body("driven", g2, 2)]
+    d, qs = scene.dynamic, scene.quasi_static
+    load = f"{(d.torque if d.enabled else qs.torque):g} N·m"
+    if d.enabled:
+        load += f", {d.speed:g} rad/s" if d.speed_end <= 0 else f", run-up 0-{d.speed_end:g} rad/s"
+    parts.append(load)
+    if scene.coupling.model != "none":
+        parts.append(f"coupling {scene.coupling.model}")
+    return "; ".join(parts)
+
+
 def _var(dims, data, unit, long_name, **attrs):
     return xr.Variable(dims, data, {"units": unit, "long_name": long_name, **attrs})
 
@@ -193,7 +215,9 @@ def stiffness_variables(k_nmm: tuple, ratio: tuple) -> tuple[dict, dict]:
         R[g, : len(ratio[g])] = ratio[g]
     coords = {"gear": _var("gear", np.array([1, 2]), "1", "gear (1 driver, 2 driven)"),
               "tooth": _var("tooth", np.arange(zmax), "1", "tooth index (counter-clockwise from tooth 0)")}
-    data = {"tooth_stiffness": _var(("gear", "tooth"), K, "N mm rad-1", "torsion spring stiffness k_phi of each tooth"),
+    data = {"tooth_stiffness": _var(("gear", "tooth"), K, "N mm rad-n_k", "torsion spring stiffness k_phi of each tooth",
+                                    comment="T = k_phi |phi|^n_k: the unit is N·mm/rad^n_k (n_k of each gear in its "
+                                            "scene section); tooth_stiffness_pitch gives the linear stiffness in N/um"),
             "stiffness_ratio": _var(("gear", "tooth"), R, "1", "tooth stiffness relative to the solid gear (FE)")}
     return coords, data
 

@@ -19,6 +19,10 @@ def summarize(ds: xr.Dataset) -> dict:
         out["ste_mean"] = float(np.nanmean(ste))
         out["ste_elastic_mean"] = float(np.nanmean(ste) - off)
         out["ste_p2p"] = float(np.nanmax(ste) - np.nanmin(ste))
+    for name in ("mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
+                 "c_gamma_alpha_iso6336", "loaded_contact_ratio", "dynamic_factor"):
+        if name in ds:
+            out[name] = float(ds[name])
     if "dte" in ds:
         t = ds["time"].values
         sel = t >= ds.attrs.get("spectrum_start_s", 0.0)
@@ -26,7 +30,7 @@ def summarize(ds: xr.Dataset) -> dict:
         out["dte_mean"] = float(np.mean(dte)) if dte.size else nan
         out["dte_rms"] = float(np.sqrt(np.mean((dte - dte.mean()) ** 2))) if dte.size else nan
         out["dte_p2p"] = float(np.ptp(dte)) if dte.size else nan
-        out["tooth_force_max"] = float(np.max(ds["contact_force_max"].values)) if dte.size else nan
+        out["tooth_force_max"] = float(np.max(ds["contact_force_max"].values[sel])) if dte.size else nan
         out["mesh_efficiency"] = float(ds["mesh_efficiency"]) if "mesh_efficiency" in ds else nan
     if "dte_amplitude" in ds:
         z = ds.attrs["mesh_order"]
@@ -60,18 +64,38 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
     s = summarize(ds)
     w = sys.stdout.write
     w(f"{ds.attrs.get('title', '')}\n  archive: {path}\n")
-    w(f"  contact ratio {ds.attrs['contact_ratio']:.3f}, backlash offset {ds.attrs['backlash_offset_um']:.3f} um\n")
+    line = f"  contact ratio {ds.attrs['contact_ratio']:.3f} (geometric)"
+    if "loaded_contact_ratio" in s:
+        line += f", {s['loaded_contact_ratio']:.3f} loaded (mean loaded pairs, tip corners included)"
+    w(line + f", backlash offset {ds.attrs['backlash_offset_um']:.3f} um\n")
     if "ste" in s or "ste_mean" in s:
         w(f"  STE: mean {s['ste_mean']:.3f} um (elastic part {s['ste_elastic_mean']:.3f} um), "
           f"peak-to-peak {s['ste_p2p']:.3f} um over {float(ds['angle'][-1]):.4g} deg\n")
-    if "dte_rms" in s:
+    if "mesh_stiffness_mean" in s:
+        w(f"  mesh stiffness (tangent, along the line of action): mean {s['mesh_stiffness_mean']:.1f} N/um, "
+          f"peak-to-peak {s['mesh_stiffness_p2p']:.1f} N/um\n")
+        w("    per face width [N/(mm·um)]   model   ISO 6336-1 B   ratio\n")
+        for name, what in (("c_prime", "c' single pair"), ("c_gamma_alpha", "c_gamma_alpha mesh")):
+            m, iso = s[name], s[f"{name}_iso6336"]
+            w(f"    {what:<28s} {m:6.2f}   {iso:12.2f}   {m / iso:5.3f}\n")
+    if "tooth_stiffness_pitch" in ds:
+        k = ds["tooth_stiffness_pitch"]
+        w("  tooth stiffness at the pitch point [N/um]: " + ", ".join(
+            f"gear {g} {float(k.sel(gear=g).min()):.1f}-{float(k.sel(gear=g).max()):.1f}" for g in (1, 2)) + "\n")
+    runup = "order_amplitude" in ds
+    if "dte_rms" in s and not runup:
         w(f"  DTE after {ds.attrs['spectrum_start_s']:.3g} s: mean {s['dte_mean']:.3f} um, RMS {s['dte_rms']:.3f} um, "
-          f"peak-to-peak {s['dte_p2p']:.3f} um, max tooth force {s['tooth_force_max']:.1f} N "
+          f"peak-to-peak {s['dte_p2p']:.3f} um, largest contact force {s['tooth_force_max']:.1f} N "
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         if np.isfinite(s["mesh_efficiency"]):
             w(f"  mesh efficiency after the ramp {s['mesh_efficiency'] * 100:.3f} % (flank friction and dampers)\n")
         for f, o, a in results.largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
+    if "dynamic_factor" in s:
+        fm = ds["dte_tooth_force_max"]
+        w(f"  dynamic tooth force after {ds.attrs.get('spectrum_start_s', 0.0):.3g} s: largest "
+          f"{float(fm.sel(gear=1).max()):.1f} N on the driver, {float(fm.sel(gear=2).max()):.1f} N on the driven gear; "
+          f"dynamic factor K_v {s['dynamic_factor']:.3f} ({ds['dynamic_factor'].attrs.get('comment', '')})\n")
     if "mesh_mode_frequency_hz" in ds.attrs:
         a = ds.attrs
         line = (f"  mesh mode: {a['mesh_mode_frequency_hz']:.0f} Hz, damping {a['mesh_mode_damping']:.4f} of critical "
@@ -89,8 +113,9 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         for k in (1, 2, 3):
             sel = np.abs(order - k * z) <= 0.5
             cut = amp[:, sel].max(axis=1)
-            parts.append(f"{k}Z {cut.max():.3g} um at {sp[np.argmax(cut)]:.0f} rad/s")
-        w(f"  run-up {sp[0]:.0f}-{sp[-1]:.0f} rad/s, largest order amplitudes: " + ", ".join(parts) + "\n")
+            parts.append(f"{k}Z at {sp[np.argmax(cut)]:.0f} rad/s {cut.max():.3g} um")
+        w(f"  run-up {sp[0]:.0f}-{sp[-1]:.0f} rad/s ({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us), "
+          "resonance peaks (order, driver speed, DTE amplitude): " + ", ".join(parts) + "\n")
     if "mass" in ds:
         for g in (1, 2):
             line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "

@@ -40,6 +40,13 @@ SCALARS = {
     "ste_mean": Scalar("um", "mean static transmission error", "static"),
     "ste_elastic_mean": Scalar("um", "mean static transmission error less the rigid backlash offset", "static"),
     "ste_p2p": Scalar("um", "peak-to-peak static transmission error", "static"),
+    "mesh_stiffness_mean": Scalar("N um-1", "mean tangent mesh stiffness along the line of action over the STE", "static"),
+    "mesh_stiffness_p2p": Scalar("N um-1", "peak-to-peak of the tangent mesh stiffness over the STE", "static"),
+    "c_prime": Scalar("N mm-1 um-1", "single stiffness c' of a tooth pair per face width (largest over the STE)", "static"),
+    "c_gamma_alpha": Scalar("N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width (mean over the STE)", "static"),
+    "c_prime_iso6336": Scalar("N mm-1 um-1", "single stiffness c' by ISO 6336-1 Method B", "static"),
+    "c_gamma_alpha_iso6336": Scalar("N mm-1 um-1", "mesh stiffness c_gamma_alpha by ISO 6336-1 Method B", "static"),
+    "loaded_contact_ratio": Scalar("1", "loaded contact ratio: mean number of loaded tooth pairs in the STE", "static"),
     "dte_mean": Scalar("um", "mean dynamic transmission error after the ramp", "dynamic"),
     "dte_rms": Scalar("um", "RMS of the dynamic transmission error about its mean after the ramp", "dynamic"),
     "dte_p2p": Scalar("um", "peak-to-peak dynamic transmission error after the ramp", "dynamic"),
@@ -48,6 +55,8 @@ SCALARS = {
     "amp_mesh3_order": Scalar("um", "DTE amplitude at three times the mesh order", "dynamic"),
     "amp_hole_order": Scalar("um", "DTE amplitude at the hole order N (NaN for a gear without holes)", "dynamic"),
     "tooth_force_max": Scalar("N", "largest tooth contact force of the dynamic run after the ramp", "dynamic"),
+    "dynamic_factor": Scalar("1", "dynamic factor K_v: largest dynamic tooth force after the ramp over the largest "
+                                  "static one at the same torque", "dynamic"),
     "mesh_efficiency": Scalar("1", "work out over work in of the dynamic run after the ramp (NaN without flank "
                                    "friction, a run-up or a load change)", "dynamic"),
     "mesh_mode_frequency": Scalar("Hz", "natural frequency of the mesh mode at the mean load (mean over the mesh period)", "modes"),

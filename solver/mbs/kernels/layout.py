@@ -135,6 +135,14 @@ O_DISS = 8          # dissipated energy [J]
 O_THETA2 = 9        # driven hub angle [rad]
 O_NEWTON = 10       # most Newton iterations in a step of the interval (implicit) [-]
 N_OUT = 11
+# after the N_OUT columns, when ``out`` is wider: the loaded contacts at the output instant,
+# O_CONTACT_COLS columns each (as many as fit; unused slots hold tooth -1 and force 0)
+OC_TOOTH1 = 0       # gear-1 tooth index
+OC_TOOTH2 = 1       # gear-2 tooth index
+OC_FORCE = 2        # normal contact force [N]
+OC_MOMENT = 3       # its moment on the driven gear, force * d(penetration)/d(theta2) [N m]
+O_CONTACT_COLS = 4
+CONTACT_SLOTS = 6   # contact slots the dynamic runs record (a loaded pair has at most 4 at once)
 
 # running sums of a run: float array ``book``
 B_WORK = 0          # work in [J]

@@ -128,12 +128,36 @@ def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
+def record_contacts(out, o, rec, nc):
+    """The loaded contacts of rec[:nc] into the slots of record o beyond the N_OUT columns
+    (`layout` OC_*; none when ``out`` has no more columns): teeth, force [N], and moment on
+    the driven gear [N m]; the slots left over hold tooth -1 and force 0."""
+    slots = (out.shape[1] - L.N_OUT) // L.O_CONTACT_COLS
+    k = 0
+    for c in range(nc):
+        if rec[c, L.C_FORCE] > 0.0 and k < slots:
+            base = L.N_OUT + k * L.O_CONTACT_COLS
+            out[o, base + L.OC_TOOTH1] = rec[c, L.C_TOOTH1]
+            out[o, base + L.OC_TOOTH2] = rec[c, L.C_TOOTH2]
+            out[o, base + L.OC_FORCE] = rec[c, L.C_FORCE]
+            out[o, base + L.OC_MOMENT] = rec[c, L.C_FORCE] * rec[c, L.C_G2]
+            k += 1
+    for s in range(k, slots):
+        base = L.N_OUT + s * L.O_CONTACT_COLS
+        out[o, base + L.OC_TOOTH1] = -1.0
+        out[o, base + L.OC_TOOTH2] = -1.0
+        out[o, base + L.OC_FORCE] = 0.0
+        out[o, base + L.OC_MOMENT] = 0.0
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
 def record_output(out, o, row, book, rec, nc, finite, par, status):
     """Write output record o (`layout` O_* columns) and check the state; returns the status.
 
     row = (time [s], TE [m], driven hub angle [rad], driver torque [N m], kinetic and
     potential energy [J]); with the largest contact force since the last record [N] (then
-    reset), the loaded contacts of rec[:nc], and the work and dissipated energy [J] of
+    reset), the loaded contacts of rec[:nc] (their count, and each in a slot when ``out`` has
+    them: `record_contacts`), and the work and dissipated energy [J] of
     ``book``. Status NONFINITE when the state is not ``finite`` or the energies are not,
     ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
     [J] above par[ENERGY_TOL] times the energy scale, else ``status`` unchanged.
@@ -153,6 +177,7 @@ def record_output(out, o, row, book, rec, nc, finite, par, status):
     out[o, L.O_WORK] = book[L.B_WORK]
     out[o, L.O_DISS] = book[L.B_DISS]
     out[o, L.O_THETA2] = theta2
+    record_contacts(out, o, rec, nc)
     book[L.B_FMAX] = 0.0
     if not (finite and math.isfinite(ke + pe)):
         return NONFINITE

@@ -1,0 +1,146 @@
+"""What the mesh does under load, as archive variables: tangent mesh stiffness over the STE
+angle with ISO 6336-1 Method B beside it, each tooth's stiffness at the pitch point, the
+loaded contact ratio, the static tooth forces of both gears and which teeth meet, and the
+dynamic tooth forces with the dynamic factor.
+
+Units as gear engineers quote them: stiffness in N/um (per face width N/(mm·um)), forces in N.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from solver import units
+from solver.peers import iso6336
+
+
+def _var(dims, data, unit, long_name, **attrs):
+    return xr.Variable(dims, data, {"units": unit, "long_name": long_name, **attrs})
+
+
+def iso_stiffness(scene, contact_ratio: float) -> tuple[float, float, float]:
+    """(c', c_gamma_alpha [N/(mm·um)], C_R [1]) of the scene's pair by ISO 6336-1 Method B:
+    no profile shift, C_M 0.8, the basic-rack factor of gear 1, the gear-blank factor C_R of
+    each gear's web (mean of the two; the standard has no holes), c_gamma_alpha = c'
+    (0.75 eps_alpha + 0.25) with the geometric transverse contact ratio eps_alpha."""
+    g1, g2 = scene.gear1, scene.gear2
+    c_r = 0.5 * sum(iso6336.blank_factor(g.body.web_thickness, g.face_width, g.body.rim_height, g.module)
+                    for g in (g1, g2))
+    c1 = iso6336.single_stiffness(g1.teeth, g2.teeth, g1.dedendum, g1.pressure_angle, c_r)
+    return c1, c1 * (0.75 * contact_ratio + 0.25), c_r
+
+
+def whole_periods(angle_deg, z1: int) -> np.ndarray:
+    """Mask of the angles within the largest whole number of mesh periods (360/z1 deg) from
+    the first angle (all of them when the range is shorter than one period)."""
+    a = np.asarray(angle_deg, float)
+    period = 360.0 / z1
+    span = a[-1] - a[0] + (a[1] - a[0] if a.size > 1 else 0.0)
+    n = math.floor(span / period + 1e-9)
+    return a < a[0] + n * period - 1e-9 if n >= 1 else np.ones(a.size, bool)
+
+
+def mesh_variables(states, model, scene, torque: float) -> tuple[dict, dict]:
+    """Archive variables of `solver.mbs.mesh_stiffness.mesh_states` over the STE angles
+    (``states`` at ``torque`` [N·m]) for the pair ``model`` of ``scene``."""
+    from solver.mbs.mesh_stiffness import pitch_point_stiffness
+    z1, z2 = model.teeth
+    angle = np.degrees(states.angle)
+    width = min(g.spec.face_width for g in model.geometry)
+    k = units.stiffness_n_per_um(states.stiffness)
+    sel = whole_periods(angle, z1) & np.isfinite(k)
+    mean = float(np.mean(k[sel])) if sel.any() else float("nan")
+    p2p = float(np.ptp(k[sel])) if sel.any() else float("nan")
+    loaded = states.loaded_pairs()
+    eps_loaded = float(np.mean(loaded[sel & states.converged])) if (sel & states.converged).any() else float("nan")
+    c1 = float(units.stiffness_per_width(np.nanmax(states.pair_stiffness), width)) if states.converged.any() else float("nan")
+    cga = float(units.stiffness_per_width(mean / units.UM, width))
+    eps = model.pair.contact_ratio
+    c1_iso, cga_iso, c_r = iso_stiffness(scene, eps)
+    load_note = f"at static equilibrium under {torque:g} N·m"
+    coords = {"driven_tooth": _var("driven_tooth", np.arange(z2), "1", "driven tooth index (counter-clockwise from tooth 0)")}
+    data = {
+        "mesh_stiffness": _var("angle", k, "N um-1", "tangent mesh stiffness along the line of action",
+                               comment=f"dF/dTE {load_note}, the pair linearised as for the modes "
+                                       "(solver.mbs.mesh_stiffness): the driver hub prescribed, every tooth at its "
+                                       "static response; F = driven torque / rb2"),
+        "mesh_stiffness_mean": _var((), mean, "N um-1", "mean tangent mesh stiffness over whole mesh periods of the STE"),
+        "mesh_stiffness_p2p": _var((), p2p, "N um-1", "peak-to-peak of the tangent mesh stiffness over the STE"),
+        "c_prime": _var((), c1, "N mm-1 um-1", "single stiffness c' of a tooth pair per face width (largest over the STE)",
+                        comment="each loaded pair's share of the tangent mesh stiffness (the pair as if alone in mesh), "
+                                f"its largest value over the STE angles, over the face width {width * 1e3:g} mm"),
+        "c_gamma_alpha": _var((), cga, "N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width (mean over the STE)"),
+        "c_prime_iso6336": _var((), c1_iso, "N mm-1 um-1", "single stiffness c' by ISO 6336-1 Method B",
+                                comment=f"C_M 0.8, C_R {c_r:.4f} (mean of the two webs; holes are not in the standard), "
+                                        "C_B of the basic rack, no profile shift; the standard states a spread of about 20 %"),
+        "c_gamma_alpha_iso6336": _var((), cga_iso, "N mm-1 um-1", "mesh stiffness c_gamma_alpha by ISO 6336-1 Method B",
+                                      comment=f"c' (0.75 eps_alpha + 0.25), eps_alpha = {eps:.4f} (geometric)"),
+        "loaded_contact_ratio": _var((), eps_loaded, "1", "loaded contact ratio: mean number of loaded tooth pairs",
+                                     comment=f"{load_note}, over whole mesh periods of the STE, tip-corner contacts "
+                                             f"included; the geometric transverse contact ratio is {eps:.4f}"),
+        "ste_tooth_force_gear2": _var(("angle", "driven_tooth"), states.tooth_force[:, z1:], "N",
+                                      "normal contact force on each driven tooth", comment=load_note),
+        "ste_mate_tooth": _var("driver_tooth", _mates(states.mate, z1), "1",
+                               "driven tooth that each driver tooth meets in the STE (-1: none)"),
+    }
+    kt = units.stiffness_n_per_um(pitch_point_stiffness(model, torque / model.base_radii[1]))
+    zmax = max(z1, z2)
+    K = np.full((2, zmax), np.nan)
+    K[0, :z1], K[1, :z2] = kt[:z1], kt[z1:]
+    data["tooth_stiffness_pitch"] = _var(("gear", "tooth"), K, "N um-1",
+                                         "tooth stiffness at the pitch point along the line of action",
+                                         comment=f"tangent of the tooth's spring under the whole load {torque:g} N·m / rb "
+                                                 "at the pitch point, n_k k_phi phi^(n_k-1) / h^2, h the lever arm of "
+                                                 "the line of action about the pivot (solver.mbs.mesh_stiffness)")
+    return coords, data
+
+
+def _mates(mate: np.ndarray, z1: int) -> np.ndarray:
+    """The driven tooth each driver tooth meets most often over the angles (-1: never)."""
+    out = np.full(z1, -1, dtype=np.int32)
+    for a in range(z1):
+        m = mate[:, a]
+        m = m[m >= 0]
+        if m.size:
+            out[a] = int(np.bincount(m).argmax())
+    return out
+
+
+def dynamic_force_variables(res, start: float, z1: int, z2: int, static_force_max: float) -> tuple[dict, dict]:
+    """The loaded contacts of a dynamic run over ``time`` (slots: teeth, force), each tooth's
+    largest force after ``start`` [s] on both gears, and the dynamic factor K_v: the largest
+    dynamic tooth force over the largest static one (``static_force_max`` [N], at the same
+    torque over a whole revolution, `study.run.static_force_max`)."""
+    from solver.mbs.kernels import layout as L
+    c = res.contacts
+    if c is None:
+        return {}, {}
+    t1 = c[:, :, L.OC_TOOTH1].astype(np.int32)
+    t2 = c[:, :, L.OC_TOOTH2].astype(np.int32)
+    f = c[:, :, L.OC_FORCE]
+    coords = {"contact_slot": _var("contact_slot", np.arange(c.shape[1]), "1", "slot of a loaded contact at an instant")}
+    data = {
+        "dte_contact_tooth1": _var(("time", "contact_slot"), t1, "1", "driver tooth of each loaded contact (-1: empty slot)"),
+        "dte_contact_tooth2": _var(("time", "contact_slot"), t2, "1", "driven tooth of each loaded contact (-1: empty slot)"),
+        "dte_contact_force": _var(("time", "contact_slot"), f, "N", "normal force of each loaded contact",
+                                  comment="at the output instant; a tooth's force is the sum over the slots naming it"),
+    }
+    sel = res.time >= start
+    fmax = np.full((2, max(z1, z2)), np.nan)
+    for g, (t, z) in enumerate(((t1, z1), (t2, z2))):
+        per = np.zeros((int(sel.sum()), z))
+        rows = np.nonzero(sel)[0]
+        for s in range(c.shape[1]):
+            ok = t[rows, s] >= 0
+            np.add.at(per, (np.nonzero(ok)[0], t[rows, s][ok]), f[rows, s][ok])
+        fmax[g, :z] = per.max(axis=0) if per.shape[0] else np.nan
+    data["dte_tooth_force_max"] = _var(("gear", "tooth"), fmax, "N", "largest dynamic force on each tooth",
+                                       comment=f"over the steady part from {start:g} s (output instants)", start_s=float(start))
+    fdyn = float(np.nanmax(fmax)) if np.isfinite(fmax).any() else float("nan")
+    kv = fdyn / static_force_max if static_force_max > 0 else float("nan")
+    data["dynamic_factor"] = _var((), kv, "1", "dynamic factor K_v: largest dynamic over largest static tooth force",
+                                  comment=f"largest dynamic tooth force {fdyn:.1f} N after {start:g} s, largest static "
+                                          f"{static_force_max:.1f} N (static, the same torque, over a whole revolution)")
+    return coords, data
