@@ -198,11 +198,12 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(results.efficiency_variable(dy, d.torque, d.speed, start))
+        if runup:
+            attrs["runup_speed_end_rad_s"] = d.speed_end
         if runup and dy.status == 0:
             from study.report.order_tracking import order_tracking_variables
             c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
             coords.update(c); data.update(v)
-            attrs["runup_speed_end_rad_s"] = d.speed_end
         attrs["dynamic_method"] = dy.choice.method
         attrs["dynamic_method_reason"] = dy.choice.reason
         attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")

@@ -54,18 +54,31 @@ def archive_scene(ds: xr.Dataset):
     return loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
 
 
+def archive_title(ds: xr.Dataset) -> str:
+    """The title of what the archive holds: for a run archive made from the scene it stores
+    (`study.report.results.scene_title`: the scene as run, not its free text); else its
+    ``title`` attribute (a study's title)."""
+    sc = archive_scene(ds)
+    if sc is not None:
+        from study.report.results import scene_title
+        return scene_title(sc)
+    return str(ds.attrs.get("title", ""))
+
+
 def save_figure(fig, path) -> Path:
-    """Write the figure as PNG at ``DPI`` (parent folders made), close it, return the path."""
+    """Write the figure as PNG at ``DPI`` (parent folders made), close it, return the path.
+    The figure's title goes into the PNG's ``Title`` text field too."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI)
+    title = fig._suptitle.get_text() if getattr(fig, "_suptitle", None) is not None else ""
+    fig.savefig(path, dpi=DPI, metadata={"Title": title.replace("\n", " / ")} if title else None)
     plt.close(fig)
     return path
 
 
 def figure_title(fig, ds, what: str, width: int | None = None) -> None:
     """Figure title: what is shown, then the archive's title; wrapped to ``width`` characters."""
-    t = ds.attrs.get("title", "")
+    t = archive_title(ds)
     text = f"{what}\n{t}" if t else what
     if width:
         text = "\n".join(textwrap.fill(line, width) for line in text.split("\n"))

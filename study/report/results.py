@@ -304,12 +304,16 @@ def write_netcdf(ds: xr.Dataset, path) -> None:
 
 
 def largest_peaks(ds: xr.Dataset, n: int = 5, min_order: float = 0.5):
-    """The n largest local maxima of dte_amplitude: list of (frequency Hz, order, amplitude um)."""
+    """The n largest local maxima of dte_amplitude: list of (frequency Hz, order, amplitude um),
+    from ``min_order`` and beyond the window's main lobe of DC (leakage of the mean)."""
     if "dte_amplitude" not in ds:
         return []
+    from study.report.spectra import HANN_MAIN_LOBE_BINS
     a = ds["dte_amplitude"].values
     f = ds["frequency"].values
     o = ds["order"].values
-    idx = [i for i in range(1, a.size - 1) if a[i] >= a[i - 1] and a[i] >= a[i + 1] and o[i] >= min_order]
+    lobe = HANN_MAIN_LOBE_BINS * float(ds["dte_amplitude"].attrs.get("resolution_Hz", 0.0))
+    min_order = max(min_order, float(np.nanmax(o[f <= lobe])) if np.any(f <= lobe) else 0.0)
+    idx = [i for i in range(1, a.size - 1) if a[i] >= a[i - 1] and a[i] >= a[i + 1] and o[i] > min_order]
     idx.sort(key=lambda i: -a[i])
     return [(float(f[i]), float(o[i]), float(a[i])) for i in idx[:n]]

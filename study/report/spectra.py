@@ -70,20 +70,42 @@ class Peak:
     amplitude: float   # amplitude there [signal units]
 
 
+def sideband_orders(hole_order: float, mesh_order: float, resolution: float | None = None) -> int:
+    """How many hole sidebands kZ +- jN (j = 1..J) a record resolves on each side of a mesh
+    order: those up to half way to the next mesh harmonic (J = Z / (2N), at least 1), when
+    the record's ``resolution`` [orders] keeps the main lobes of tones N apart from
+    overlapping (N >= 2 x HANN_MAIN_LOBE_BINS x resolution); 0 when it does not (``None``:
+    resolved). A gear without holes keeps J = 1 (NaN entries)."""
+    n = float(hole_order) if hole_order and hole_order > 0 else 0.0
+    if n <= 0:
+        return 1
+    if resolution is not None and n < 2 * HANN_MAIN_LOBE_BINS * resolution:
+        return 0
+    return max(1, int(0.5 * float(mesh_order) / n + 1e-9))
+
+
+def sideband_name(kz: str, j: int, sign: str) -> str:
+    return f"{kz}{sign}N" if j == 1 else f"{kz}{sign}{j}N"
+
+
 def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 5, hole_harmonics: int = 2,
-                 revolution_orders: tuple | None = None) -> list[tuple[str, float]]:
-    """(name, order) of the orders a lightened gear pair excites: hole order N and its harmonics,
-    mesh order Z and its harmonics, and the sidebands kZ +- N. NaN orders when N = 0 (kept so
-    every scene has the same table). ``revolution_orders`` = (driver, driven) once-per-revolution
-    orders (Z2/Z1 and 1 in driven-gear orders), given for gears with pitch errors or
-    eccentricity: named R1 and R2 first (none otherwise, so a perfect pair's table is unchanged)."""
+                 revolution_orders: tuple | None = None, sidebands: int = 1) -> list[tuple[str, float]]:
+    """(name, order) of the orders a lightened gear pair excites: hole order N and its harmonics
+    (up to the larger of ``hole_harmonics`` and ``sidebands``), mesh order Z and its
+    harmonics, and the sidebands kZ +- jN, j = 1..``sidebands`` (`sideband_orders`). NaN
+    orders when N = 0 (kept so every scene has the same table). ``revolution_orders`` =
+    (driver, driven) once-per-revolution orders (Z2/Z1 and 1 in driven-gear orders), given
+    for gears with pitch errors or eccentricity: named R1 and R2 first (none otherwise, so a
+    perfect pair's table is unchanged)."""
     n = float(hole_order) if hole_order and hole_order > 0 else float("nan")
     z = float(mesh_order)
     out = [] if revolution_orders is None else [("R1", float(revolution_orders[0])), ("R2", float(revolution_orders[1]))]
-    out += [("N" if h == 1 else f"{h}N", h * n) for h in range(1, hole_harmonics + 1)]
+    out += [("N" if h == 1 else f"{h}N", h * n) for h in range(1, max(hole_harmonics, sidebands) + 1)]
     for k in range(1, mesh_harmonics + 1):
         kz = "Z" if k == 1 else f"{k}Z"
-        out += [(f"{kz}-N", k * z - n), (kz, k * z), (f"{kz}+N", k * z + n)]
+        out += [(sideband_name(kz, j, "-"), k * z - j * n) for j in range(sidebands, 0, -1)]
+        out.append((kz, k * z))
+        out += [(sideband_name(kz, j, "+"), k * z + j * n) for j in range(1, sidebands + 1)]
     return out
 
 
@@ -97,11 +119,15 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
     A named order's amplitude is the largest value within the Hann main lobe (+-2 resolution
     bins) of the nominal order, but no nearer to another named order (or to order 0) than half
     way; it is NaN when that largest value is not a local maximum (no peak, or only the skirt
-    of a neighbouring peak the record is too short to resolve)."""
+    of a neighbouring peak the record is too short to resolve). The sidebands kZ +- jN named
+    are those the record resolves (`sideband_orders`); none when the hole order is closer
+    than a main lobe's width. Maxima on DC's main lobe (window leakage of the mean) are never
+    unexplained peaks."""
     order = np.asarray(order, float)
     amp = np.asarray(amplitude, float)
     tol = max(HANN_MAIN_LOBE_BINS * resolution, 1e-9)
-    table = named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics, revolution_orders)
+    sidebands = sideband_orders(hole_order, mesh_order, resolution)
+    table = named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics, revolution_orders, sidebands)
     finite = np.array([0.0] + [o for _, o in table if np.isfinite(o)])
     is_peak = np.zeros(amp.size, bool)
     is_peak[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
@@ -123,12 +149,13 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
     nominal = np.asarray(nominal)
     is_max = np.zeros(amp.size, bool)
     is_max[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] > amp[2:])
-    is_max &= order >= min_order
+    is_max &= (order >= min_order) & (order > tol)      # not on the window's lobe of DC (leakage of the mean)
     # mesh harmonics beyond the named ones (and their hole sidebands) are explained too
     if np.isfinite(mesh_order) and mesh_order > 0 and order.size:
         k = np.arange(mesh_harmonics + 1, int(order.max() / mesh_order) + 2)
         side = hole_order if np.isfinite(hole_order) and hole_order > 0 else 0.0
-        nominal = np.concatenate([nominal, k * mesh_order, k * mesh_order - side, k * mesh_order + side])
+        j = np.arange(-sidebands, sidebands + 1) * side
+        nominal = np.concatenate([nominal, (k[:, None] * mesh_order + j[None, :]).ravel()])
     if nominal.size:
         is_max &= np.min(np.abs(order[:, None] - nominal[None, :]), axis=1) > tol
     idx = np.flatnonzero(is_max)

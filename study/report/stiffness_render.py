@@ -19,6 +19,7 @@ import xarray as xr
 
 from solver import units
 from solver.geometry import gear_geometry
+from study.report.plot_style import archive_title
 from study.report.render_canvas import NAN_COLOR, WINDOW, RenderResult, fit_parallel, plotter, project, write_png
 from study.report.render_geometry import extrude, placement
 from study.report.render_inputs import pair_bodies, required_scene, tooth_stiffness
@@ -54,7 +55,7 @@ def gear_pair_render(ds: xr.Dataset, path, fields: dict | None = None) -> Render
         val = np.where(b.tooth >= 0, k[np.clip(b.tooth, 0, None)], np.nan) if g in coloured else np.full(len(b.tooth), np.nan)
         rot, centre = placement(sc, g)
         meshes[g] = extrude(b, rot, centre, val, "k_phi")
-    title = "tooth spring stiffness k_phi [N·mm/rad]"
+    title = "tooth spring stiffness k_phi [N·mm/rad^n_k]"
     bar = dict(title=title, n_labels=5, fmt="%.4g", color="black", vertical=False, width=0.6, height=0.07,
                position_x=0.2, position_y=0.04, title_font_size=22, label_font_size=18)
     for row, lit in ((0, True), (1, False)):
@@ -85,18 +86,18 @@ def gear_pair_render(ds: xr.Dataset, path, fields: dict | None = None) -> Render
             xy = centre + r_mid * np.array([math.cos(a), math.sin(a)])
             zt = sc.gear(g).face_width / 2
             probes.append((*project(p, (1, 0), (xy[0], xy[1], zt)), float(k[t])))
-    return RenderResult(write_png(p, path), (lo, hi), "k_phi", "N mm rad-1", probes)
+    return RenderResult(write_png(p, path), (lo, hi), "k_phi", "N mm rad-n_k", probes)
 
 
 def _pair_caption(ds, sc, coloured) -> str:
-    lines = [ds.attrs.get("title", "gear pair")[:90], "gear 1 (driver) left, gear 2 (driven) right; grey: body below the teeth"]
+    lines = [(archive_title(ds) or "gear pair"), "gear 1 (driver) left, gear 2 (driven) right; grey: body below the teeth"]
     for g in (1, 2):
         b = sc.gear(g).body
         k = tooth_stiffness(ds, g)
         desc = f"{b.holes} holes R {b.hole_radius:g} mm, web {b.web_thickness:g} mm" if sc.is_lightened(g) else "solid"
         kk = f"k_phi {k.min():.4g} .. {k.max():.4g}" if np.ptp(k) > 0 else f"every tooth k_phi {k[0]:.4g}"
         grey = "" if g in coloured else " (outside the colour range: grey)"
-        lines.append(f"gear {g}: {sc.gear(g).teeth} teeth, {desc}; {kk} N·mm/rad{grey}")
+        lines.append(f"gear {g}: {sc.gear(g).teeth} teeth, {desc}; {kk} N·mm/rad^{sc.gear(g).spring.n_k:g}{grey}")
     return "\n".join(lines)
 
 

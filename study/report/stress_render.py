@@ -38,8 +38,10 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
     (or ``teeth``), one row each, the loaded tooth turned to point up, the view on the teeth and
     rim around it (with the top of the hole below it):
 
-    left, von Mises stress [MPa] on one linear scale for both rows (0 .. the larger peak fillet
-    stress; the contact spot under the load goes beyond and is clipped); right, displacement
+    left, von Mises stress [MPa] (element means) on one linear scale for both rows (0 .. the
+    larger peak fillet stress of the element means; the contact spot under the load goes
+    beyond and is clipped), with the archive's fillet stress ``root_stress`` of the tooth (the
+    largest at the fillet vertices: above the element means) in the text; right, displacement
     magnitude [um] on the shape magnified so the largest displacement in view reads 0.5 mm,
     undeformed outline in grey. The arrow is the load on the drive flank at the pitch circle."""
     import pyvista as pv
@@ -66,8 +68,11 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
     n = len(fields)
     vw, vh = 1000, 560
     p = plotter(shape=(n, 2), size=(2 * vw, vh * n))
-    bar = dict(title="von Mises stress [MPa]", n_labels=5, fmt="%.0f", color="black", vertical=False,
-               width=0.7, height=0.1, position_x=0.15, position_y=0.02, title_font_size=20, label_font_size=16)
+    # the bars sit in a band below the image (bottom margin of the last row) with their labels;
+    # what they show is said in the panel's text (a VTK bar title overlaps its tick labels)
+    bar = dict(title="", n_labels=5, fmt="%.0f", color="black", vertical=False,
+               width=0.7, height=0.08, position_x=0.15, position_y=0.03, label_font_size=16)
+    stress = archive_root_stress(ds, g)
     crops, views = [], []
     for f in fields:
         b = fe_body(f)
@@ -81,9 +86,8 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
     u_cell = [um[f.triangles].mean(axis=1) for um, f in zip(u_mag, fields)]
     u_hi = float(max(uc[v].max() for uc, v in zip(u_cell, views)))
     magnify = 0.5 / (u_hi * units.UM / units.MM)                                   # largest -> 0.5 mm
-    ubar = dict(title=f"displacement [um] (shape magnified x{magnify:.0f})", n_labels=5, fmt="%.2f", color="black",
-                vertical=False, width=0.7, height=0.1, position_x=0.15, position_y=0.02, title_font_size=20,
-                label_font_size=16)
+    ubar = dict(title="", n_labels=5, fmt="%.2f", color="black",
+                vertical=False, width=0.7, height=0.08, position_x=0.15, position_y=0.03, label_font_size=16)
     corners = np.array([[r_tip * math.sin(t), r_tip * math.cos(t)] for t in np.linspace(-half, half, 9)]
                        + [[r_in * math.sin(t), r_in * math.cos(t)] for t in np.linspace(-half, half, 9)])
     for j, f in enumerate(fields):
@@ -102,13 +106,16 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
         z = sc.gear(g).face_width
         p.add_mesh(pv.Arrow(start=(lp[0] - L * d[0], lp[1] - L * d[1], z), direction=(d[0], d[1], 0), scale=L,
                             tip_length=0.3, tip_radius=0.12, shaft_radius=0.04), color="#00b4ff", lighting=False)
-        fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.2 if last else 0.0, top_margin=0.12)
+        fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.3 if last else 0.0, top_margin=0.16)
         where = ""
         if n_holes:
             where = (" (over a hole" if abs(off[f.tooth]) < 0.5 * _hole_half_pitches(sc, g) else " (between holes") + \
                 f", {off[f.tooth]:+.1f} pitches from a hole centre)"
+        archived = f"{stress[f.tooth]:.1f} MPa" if np.isfinite(stress[f.tooth]) else "not in the archive"
         p.add_text(f"gear {g}: {f.load_N:.0f} N on tooth {f.tooth}{where}\n"
-                   f"k_phi {k[f.tooth]:.4g} N·mm/rad; peak fillet stress {peaks[j]:.0f} MPa",
+                   f"k_phi {k[f.tooth]:.4g} N·mm/rad^{sc.gear(g).spring.n_k:g}; fillet stress (root_stress, largest at "
+                   f"the fillet vertices) {archived}\n"
+                   f"colour: von Mises stress [MPa], element means (largest in the fillet {peaks[j]:.0f} MPa)",
                    position="upper_left", font_size=10, color="black")
         # displacement on the magnified shape, undeformed outline in grey
         p.subplot(j, 1)
@@ -122,10 +129,19 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
         ref = flat.extract_feature_edges(boundary_edges=True, feature_edges=False, manifold_edges=False,
                                          non_manifold_edges=False)
         p.add_mesh(ref, color="#606060", line_width=1.0, lighting=False)
-        fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.2 if last else 0.0, top_margin=0.12)
-        p.add_text(f"tooth {f.tooth}: displacement, largest in view {u_cell[j][views[j]].max():.2f} um",
+        fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.3 if last else 0.0, top_margin=0.16)
+        p.add_text(f"tooth {f.tooth}: displacement, largest in view {u_cell[j][views[j]].max():.2f} um\n"
+                   f"colour: displacement magnitude [um] on the shape magnified x{magnify:.0f} (grey: undeformed)",
                    position="upper_left", font_size=10, color="black")
     return RenderResult(write_png(p, path), (lo, hi), "von_mises", "MPa")
+
+
+def archive_root_stress(ds: xr.Dataset, g: int) -> np.ndarray:
+    """The archive's fillet stress ``root_stress`` [MPa] of gear g's teeth (NaN without it)."""
+    z = int(np.isfinite(tooth_stiffness(ds, g)).sum())
+    if "root_stress" not in ds:
+        return np.full(z, np.nan)
+    return np.asarray(ds["root_stress"].sel(gear=g).values[:z], float)
 
 
 def _hole_half_pitches(sc, g) -> float:

@@ -30,6 +30,7 @@ from study.report.plot_style import (
     need,
     save_figure,
 )
+from study.report.spectra import HANN_MAIN_LOBE_BINS, sideband_orders
 
 
 def _runs(mask: np.ndarray):
@@ -39,8 +40,8 @@ def _runs(mask: np.ndarray):
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
 
 
-_ZONES = {2: ("double contact", "#f5cba7"), 3: ("triple contact", "#e59866")}
-_ZONE_WORD = {1: "single", 2: "double", 3: "triple"}
+_ZONES = {2: ("2 loaded contacts", "#f5cba7"), 3: ("3 or more loaded contacts", "#e59866")}
+_ZONE_WORD = {1: "1", 2: "2", 3: "3"}
 
 
 def _shade_contacts(ax, angle, contacts, words: bool = False) -> None:
@@ -81,22 +82,26 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     zones, and (with a solid-gear STE) the difference lightened - solid, the hole effect."""
     need(ds, "ste", "angle")
     ang = ds["angle"].values
-    ste = ds["ste"].values
+    off = float(ds.attrs.get("backlash_offset_um", 0.0))
+    ste = ds["ste"].values - off            # the elastic part: the rigid half-backlash offset taken out
     contacts = ds["ste_contacts"].values if "ste_contacts" in ds else None
-    solid = ds["ste_solid"].values if "ste_solid" in ds else None
+    solid = ds["ste_solid"].values - off if "ste_solid" in ds else None
     holes = hole_mesh_angles(ds, ang[-1])
     nrow = 3 if solid is not None else 2
     fig, axes = plt.subplots(nrow, 1, figsize=(11, 3.0 * nrow + 1.2), constrained_layout=True)
-    figure_title(fig, ds, "Static transmission error (STE)")
+    eps = ds.attrs.get("contact_ratio", float("nan"))
+    loaded = f"loaded contact ratio {float(ds['loaded_contact_ratio']):.3f}, " if "loaded_contact_ratio" in ds else ""
+    figure_title(fig, ds, f"Static transmission error (STE), elastic part: STE less the {off:.3f} µm half-backlash offset; "
+                          f"shading: loaded contacts ({loaded}geometric {eps:.3f}; tip corners count)", width=130)
     ax = axes[0]
     if contacts is not None:
         _shade_contacts(ax, ang, contacts)
     ax.plot(ang, ste, color=C_LIGHT, lw=1.0, label="lightened pair")
     if solid is not None:
         ax.plot(ang, solid, color=C_SOLID, lw=0.9, alpha=0.8, label="solid driven gear")
-    _mark_holes(ax, holes)
+    _mark_holes(ax, holes, ang[0], ang[-1])
     ax.set_xlabel("driver rotation [°]")
-    ax.set_ylabel("STE [µm]")
+    ax.set_ylabel(f"STE − {off:.3f} µm [µm]")
     ax.set_xlim(ang[0], ang[-1])
     ax.legend(loc="upper right", fontsize=9, ncol=4, framealpha=0.9)
     ax.grid(alpha=0.3)
@@ -111,8 +116,8 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     ax.plot(ang[sel], ste[sel], color=C_LIGHT, lw=1.5, marker=".", ms=3, label="lightened pair")
     if solid is not None:
         ax.plot(ang[sel], solid[sel], color=C_SOLID, lw=1.2, alpha=0.8, label="solid driven gear")
-    ax.set_xlabel(f"driver rotation [°] (zoom: three mesh periods of {period:.3f}°)")
-    ax.set_ylabel("STE [µm]")
+    ax.set_xlabel(f"driver rotation [°] (zoom: three mesh periods of {period:.3f}°; numbers: loaded contacts)")
+    ax.set_ylabel(f"STE − {off:.3f} µm [µm]")
     ax.set_xlim(ang[sel][0], ang[sel][-1])
     ax.grid(alpha=0.3)
     if solid is not None:
@@ -126,7 +131,7 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
             ma = np.convolve(d, np.ones(n) / n, mode="same")
             ma[: n // 2] = np.nan; ma[-(n // 2):] = np.nan
             ax.plot(ang, ma, color=C_HOLE, lw=2.0, label="mean over one mesh period")
-        _mark_holes(ax, holes)
+        _mark_holes(ax, holes, ang[0], ang[-1])
         ax.set_xlabel("driver rotation [°]")
         ax.set_ylabel("STE difference [µm]")
         ax.set_xlim(ang[0], ang[-1])
@@ -136,10 +141,10 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     return save_figure(fig, path)
 
 
-def _mark_holes(ax, angles) -> None:
-    for i, a in enumerate(angles):
-        ax.axvline(a, color=C_HOLE, ls="--", lw=1.2, label="hole centre in mesh" if i == 0 else None)
-        ax.text(a, 0.98, " hole", transform=ax.get_xaxis_transform(), color=C_HOLE, fontsize=8, va="top")
+def _mark_holes(ax, angles, lo: float, hi: float) -> None:
+    inside = [a for a in angles if lo < a < hi]     # a line on the frame would leave only its legend entry
+    for i, a in enumerate(inside):
+        ax.axvline(a, color=C_HOLE, ls="--", lw=1.2, label="hole centre of the driven gear in mesh" if i == 0 else None)
 
 
 # ------------------------------------------------------------------ DTE
@@ -154,8 +159,16 @@ def dte_plot(ds: xr.Dataset, path) -> Path:
     fig, axes = plt.subplots(2, 1, figsize=(11, 7.5), constrained_layout=True)
     figure_title(fig, ds, "Dynamic transmission error (DTE)")
     ax = axes[0]
-    ax.axvspan(t[0], ramp, color="#f9e79f", alpha=0.7, lw=0, label=f"speed and torque ramp (0–{ramp * 1e3:.3g} ms)")
-    ax.axvline(start, color="0.3", ls=":", lw=1.2, label=f"spectrum from {start * 1e3:.3g} ms")
+    speed_end = float(ds.attrs.get("runup_speed_end_rad_s", 0.0))
+    if speed_end > 0:      # a run-up: one speed ramp over the whole run, no steady spectrum
+        ax.axvspan(t[0], ramp, color="#f9e79f", alpha=0.7, lw=0, label=f"torque ramp (0–{ramp * 1e3:.3g} ms)")
+        ax.plot([], [], " ", label=f"driver speed 0 → {speed_end:.0f} rad/s linearly over the run (top axis)")
+        rate = speed_end / t[-1]
+        sec = ax.secondary_xaxis("top", functions=(lambda x: x * rate, lambda w: w / rate))
+        sec.set_xlabel("driver speed [rad/s]")
+    else:
+        ax.axvspan(t[0], ramp, color="#f9e79f", alpha=0.7, lw=0, label=f"speed and torque ramp (0–{ramp * 1e3:.3g} ms)")
+        ax.axvline(start, color="0.3", ls=":", lw=1.2, label=f"spectrum from {start * 1e3:.3g} ms")
     ax.plot(t, dte, color=C_LIGHT, lw=0.6, label="DTE")
     if "ste" in ds:
         ax.axhline(float(np.nanmean(ds["ste"].values)), color=C_SOLID, ls="--", lw=1.0, label="mean STE")
@@ -169,7 +182,9 @@ def dte_plot(ds: xr.Dataset, path) -> Path:
     f_rot = float(ds.attrs.get("driven_speed_rad_s", 0.0)) / (2 * np.pi)
     n_h = float(ds.attrs.get("hole_order", 0.0))
     z = float(ds.attrs.get("mesh_order", 0.0))
-    if f_rot > 0 and n_h > 0:
+    if speed_end > 0:
+        span, what = 0.05 * (t[-1] - t[0]), f"last 5 %, {0.95 * speed_end:.0f}–{speed_end:.0f} rad/s"
+    elif f_rot > 0 and n_h > 0:
         span, what = 2.0 / (n_h * f_rot), "two hole passes"
     elif f_rot > 0 and z > 0:
         span, what = 20.0 / (z * f_rot), "20 mesh periods"
@@ -194,6 +209,9 @@ def _peak_table(ds, prefix):
         return []
     names = [str(n) for n in ds[dim].values]
     return list(zip(names, ds[f"{dim}_nominal_order"].values, ds[f"{dim}_order"].values, ds[f"{dim}_amplitude"].values))
+
+
+TABLE_ROWS = 14      # named peaks listed beside a spectrum, largest first
 
 
 def spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
@@ -231,20 +249,22 @@ def spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
         ax.text(nominal, 0.99, f" {name}", transform=ax.get_xaxis_transform(), rotation=90, va="top",
                 ha="right", fontsize=8, color=color)
         if np.isfinite(a):
-            table.append(f"{name:>5s}: {a:.3g}")
+            table.append((a, f"{name:>6s}: {a:.3g}"))
             if main_line:
                 ax.plot(o, a, "o", mfc="none", color=color, ms=7)
     ax.set_xlim(0, xmax)
     ax.set_ylabel(f"{what} amplitude [µm]")
     ax.grid(alpha=0.3, which="both")
     handles = [Line2D([], [], color=C_HOLE, label="hole order N, 2N"), Line2D([], [], color=C_LIGHT, label="mesh order kZ"),
-               Line2D([], [], color=C_SIDE, ls=":", label="sidebands kZ ± N"),
+               Line2D([], [], color=C_SIDE, ls=":", label="hole sidebands kZ ± jN"),
                Line2D([], [], color=C_OTHER, marker="v", ls="", label="largest unexplained peaks (order)")]
     if rev:
         handles.insert(0, Line2D([], [], color=C_REV, label="once per revolution: R1 driver, R2 driven"))
     leg = ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False)
     leg.set_in_layout(True)
-    ax.text(1.01, 0.55, "peak amplitude [µm]\n" + ("\n".join(table) if table else "(none resolved)"),
+    shown = sorted(table, key=lambda r: -r[0])[:TABLE_ROWS]
+    more = f"\n(+{len(table) - len(shown)} smaller)" if len(table) > len(shown) else ""
+    ax.text(1.01, 0.55, "largest named peaks [µm]\n" + ("\n".join(r[1] for r in shown) + more if table else "(none resolved)"),
             transform=ax.transAxes, ha="left", va="top", fontsize=8, family="monospace",
             bbox=dict(fc="white", ec="0.7"))
     ax.text(0.995, 0.02, res_text, transform=ax.transAxes, ha="right", va="bottom", fontsize=8, color="0.3",
@@ -255,7 +275,7 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
     """Amplitude spectra (log) against the driven gear's order: DTE (after the ramp) and STE.
 
     Blue lines: hole order N and harmonics; red: mesh order Z and harmonics; green dotted:
-    sidebands kZ +- N; purple triangles: the largest peaks no named order explains."""
+    sidebands kZ +- jN (those the record resolves); purple triangles: the largest peaks no named order explains."""
     has_dte = "dte_amplitude" in ds and "order" in ds.coords
     has_ste = "ste_amplitude" in ds
     if not (has_dte or has_ste):
@@ -289,10 +309,19 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
         amp = ds["ste_amplitude"].values
         a = ds["ste_amplitude"].attrs
         xmax = min(float(np.nanmax(order)), 3.3 * z)
+        res = float(a.get("resolution_orders", float("nan")))
+        n_h = float(ds.attrs.get("hole_order", 0.0))
+        note = ""
+        if n_h > 0 and sideband_orders(n_h, z, res) == 0:
+            sc = archive_scene(ds)
+            ratio = sc.gear2.teeth / sc.gear1.teeth if sc else 1.0
+            need_deg = 360.0 * 2 * HANN_MAIN_LOBE_BINS / n_h * ratio
+            note = (f"\nhole sidebands kZ ± jN not resolved: their main lobes (± {HANN_MAIN_LOBE_BINS * res:.3g} orders) "
+                    f"overlap at N = {n_h:g}; an STE over {need_deg:.0f}° of driver rotation or more resolves them")
         spectrum_panel(axes[i, 0], order, amp, _peak_table(ds, "ste"), xmax, "STE",
-                        f"{a.get('window', '?')} window, resolution {a.get('resolution_orders', float('nan')):.3g} orders "
+                        f"{a.get('window', '?')} window, resolution {res:.3g} orders "
                         f"({a.get('record_driven_revolutions', float('nan')):.3g} driven revolutions), "
-                        f"zero padding x{a.get('zero_padding', 1)}")
+                        f"zero padding x{a.get('zero_padding', 1)}" + note)
         axes[i, 0].set_xlabel("order of the driven gear's rotation [–]")
         axes[i, 0].set_title("STE (quasi-static)", fontsize=10, loc="left")
     return save_figure(fig, path)

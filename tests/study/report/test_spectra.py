@@ -5,7 +5,14 @@ import numpy as np
 import pytest
 
 from study.report import results
-from study.report.spectra import amplitude_spectrum, named_orders, named_peaks, ste_order_spectrum
+from study.report.spectra import (
+    HANN_MAIN_LOBE_BINS,
+    amplitude_spectrum,
+    named_orders,
+    named_peaks,
+    sideband_orders,
+    ste_order_spectrum,
+)
 
 HANN_SCALLOP = 1 - (np.sinc(0.5) / (1 - 0.5**2))   # 15.1 %: Hann loss half-way between bins
 
@@ -74,18 +81,18 @@ def test_named_peaks_find_mesh_hole_sidebands_and_the_unexplained():
     o = np.arange(0, 200, 0.125)
     amp = np.full(o.size, 1e-4)
     # 6Z and 6Z+N lie beyond the named table (5 mesh harmonics): still mesh orders, not "other"
-    for order, a in ((n, 0.2), (z, 1.0), (2 * z, 0.3), (z + n, 0.05), (47.0, 0.4), (101.0, 0.1), (6 * z, 0.5),
+    for order, a in ((n, 0.2), (z, 1.0), (2 * z, 0.3), (z + n, 0.05), (47.0, 0.4), (103.5, 0.1), (6 * z, 0.5),
                      (6 * z + n, 0.45)):
         amp[np.argmin(abs(o - order))] = a
     peaks = {p.name: p for p in named_peaks(o, amp, n, z, resolution=0.5)}
     assert peaks["Z"].amplitude == 1.0 and peaks["Z"].order == z
     assert peaks["N"].amplitude == 0.2 and peaks["2Z"].amplitude == 0.3
     assert peaks["Z+N"].amplitude == 0.05 and peaks["Z-N"].amplitude == pytest.approx(1e-4)
-    assert peaks["other 1"].order == 47.0 and peaks["other 2"].order == 101.0
+    assert peaks["other 1"].order == 47.0 and peaks["other 2"].order == 103.5
     assert np.isnan(peaks["other 1"].nominal)
-    # a solid gear (N = 0) keeps the same table with NaN hole entries
+    # a solid gear (N = 0) keeps the table of one sideband a side, NaN hole entries
     solid = named_peaks(o, amp, 0, z, resolution=0.5)
-    assert [p.name for p in solid] == list(peaks)
+    assert [p.name for p in solid] == [nm for nm, _ in named_orders(0, z)] + [f"other {k}" for k in range(1, 5)]
     assert np.isnan({p.name: p for p in solid}["N"].amplitude)
     assert [nm for nm, _ in named_orders(6, 67)][:5] == ["N", "2N", "Z-N", "Z", "Z+N"]
 
@@ -156,3 +163,26 @@ def test_spectrum_panel_draws_one_revolution_line_for_a_one_to_one_pair():
             assert sum("R1=R2:" in t for t in labels) == 1           # the peak table's row
         else:
             assert "R1" in labels and "R2" in labels and "R1=R2" not in labels
+
+
+def test_every_resolved_hole_sideband_is_named_and_dc_leakage_is_no_peak():
+    """kZ +- jN for every j up to half way to the next mesh harmonic (the 8-hole gear's
+    kZ +- 2N at 51, 118, 185 and 217 included), and nothing of them when the record cannot
+    resolve the hole order; the window's lobe of DC never reads as an unexplained peak."""
+    z, n, res = 67, 8, 0.35
+    o = np.arange(0, 360, res / 4)
+    amp = np.full(o.size, 1e-5)
+    for order, a in ((z, 1.0), (51, 0.2), (118, 0.1), (185, 0.15), (217, 0.05), (2 * z + 4 * n, 0.07)):
+        amp[np.argmin(abs(o - order))] = a
+    amp[:4] = [0.5, 0.3, 0.1, 0.05]                 # leakage of the mean into the first bins
+    amp[5] = 0.06                                   # a maximum inside DC's main lobe
+    peaks = {p.name: p for p in named_peaks(o, amp, n, z, resolution=res)}
+    assert sideband_orders(n, z) == 4
+    for name, order in (("Z-2N", 51), ("2Z-2N", 118), ("3Z-2N", 185), ("3Z+2N", 217), ("2Z+4N", 2 * z + 4 * n)):
+        assert peaks[name].order == pytest.approx(order, abs=res) and peaks[name].amplitude > 0.01
+    others = [p for k, p in peaks.items() if k.startswith("other") and np.isfinite(p.order)]
+    assert all(p.order > HANN_MAIN_LOBE_BINS * res for p in others)
+    # 3-order resolution (120 deg of STE): tones 8 orders apart overlap, no sideband is named
+    assert sideband_orders(n, z, 3.0) == 0
+    coarse = [p.name for p in named_peaks(o, amp, n, z, resolution=3.0)]
+    assert "Z" in coarse and not any("Z-" in nm or "Z+" in nm for nm in coarse)
