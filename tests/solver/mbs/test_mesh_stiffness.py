@@ -1,0 +1,64 @@
+"""Tangent mesh stiffness from the modal linearisation, against finite differences of the
+statics; pair shares, the pitch-point lever arm and the condensation."""
+import numpy as np
+import pytest
+
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+from solver.mbs.mesh_stiffness import condense, mesh_states, pitch_lever, pitch_point_stiffness
+from solver.mbs.statics import solve_static
+
+
+def test_condensation_of_springs_in_series_and_a_free_dof():
+    # ground -k1- DOF 0 -k2- DOF 1 -k3- ground, DOF 2 without stiffness: K00* = k1 + k2 k3 / (k2 + k3)
+    k1, k2, k3 = 3.0, 5.0, 7.0
+    K = np.array([[k1 + k2, -k2, 0.0], [-k2, k2 + k3, 0.0], [0.0, 0.0, 0.0]])
+    k00, x = condense(K)
+    assert k00 == pytest.approx(k1 + k2 * k3 / (k2 + k3), rel=1e-14)
+    assert x[1] == pytest.approx(k2 / (k2 + k3)) and x[2] == 0.0
+
+
+def test_mesh_stiffness_is_the_slope_of_two_static_runs(paper_solid_model):
+    """k_m at 50 N·m against (F(55) - F(45)) / (TE(55) - TE(45)) over two mesh periods: the
+    mean within 2 %, and the tangent within 2 % at the angles away from a change of the
+    loaded contacts (where the secant spans a jump of the tangent); the pairs' shares add up."""
+    m = paper_solid_model
+    ang = np.radians(np.arange(0.0, 360.0 / 67 * 2, 0.05))
+    ms = mesh_states(m, ang, 50.0)
+    assert ms.converged.all()
+    rb2 = m.base_radii[1]
+    lo, hi = solve_static(m, ang, 45.0), solve_static(m, ang, 55.0)
+    secant = (10.0 / rb2) / (hi.te - lo.te)
+    assert ms.stiffness.mean() == pytest.approx(secant.mean(), rel=0.02)
+    same = (lo.n_contacts == hi.n_contacts) & (ms.loaded_pairs() == lo.n_contacts)
+    assert same.mean() > 0.8
+    np.testing.assert_allclose(ms.stiffness[same], secant[same], rtol=0.02)
+    np.testing.assert_allclose(ms.pair_stiffness.sum(axis=1), ms.stiffness, rtol=1e-9)
+    # the static tooth forces balance the torque along the line of action (tip corners aside)
+    np.testing.assert_allclose(ms.tooth_force[:, :67].sum(axis=1) * rb2, 50.0, rtol=0.01)
+    np.testing.assert_allclose(ms.tooth_force[:, :67].sum(axis=1), ms.tooth_force[:, 67:].sum(axis=1), rtol=1e-12)
+
+
+def test_pitch_lever_is_the_contact_gradient_at_the_pitch_point(paper_solid_model):
+    """The lever arm of the line of action about the tooth pivot equals d(penetration)/d(phi)
+    of the contact search at a contact on the pitch point; a linear spring reads k/h^2."""
+    m = paper_solid_model
+    rec, pairs = new_contact_buffer()
+    z = np.zeros(m.n_teeth)
+    rp = m.geometry[0].pitch_radius
+    best = (np.inf, 0.0)
+    for th in np.radians(np.linspace(-3.0, 3.0, 601)):
+        nc, _ = mesh_contacts((th, m.theta2_for_te(th, m.backlash_offset + 2e-6), 0.0, 0.0), z, z,
+                              (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+        for c in range(nc):
+            d = np.hypot(rec[c, L.C_PX] - rp, rec[c, L.C_PY])
+            if d < best[0]:
+                best = (d, abs(rec[c, L.C_GA]))
+    assert best[0] < 1e-5
+    assert pitch_lever(m, 0) == pytest.approx(best[1], rel=2e-3)
+    k = pitch_point_stiffness(m, 1000.0)
+    n = m.gear_par[0, L.N_K]
+    # the tangent from a finite difference of the spring law along the line of action
+    h = pitch_lever(m, 0)
+    delta = lambda f: h * (f * h / m.k_phi[0]) ** (1 / n)          # noqa: E731
+    assert k[0] == pytest.approx(2.0 / (delta(1001.0) - delta(999.0)), rel=1e-6)
