@@ -147,6 +147,11 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
         else:     # nothing there, or only the skirt of a neighbour's lobe (not resolved)
             peaks.append(Peak(name, o, float("nan"), float("nan")))
     nominal = np.asarray(nominal)
+    if sidebands == 0 and np.isfinite(mesh_order) and mesh_order > 0:
+        # sidebands the record cannot resolve still explain what stands on the mesh lobes' skirts
+        j = np.arange(1, sideband_orders(hole_order, mesh_order) + 1) * float(hole_order)
+        k = np.arange(1, mesh_harmonics + 1)[:, None] * float(mesh_order)
+        nominal = np.concatenate([nominal, (k - j).ravel(), (k + j).ravel()])
     is_max = np.zeros(amp.size, bool)
     is_max[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] > amp[2:])
     is_max &= (order >= min_order) & (order > tol)      # not on the window's lobe of DC (leakage of the mean)

@@ -70,7 +70,7 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
     p = plotter(shape=(n, 2), size=(2 * vw, vh * n))
     # the bars sit in a band below the image (bottom margin of the last row) with their labels;
     # what they show is said in the panel's text (a VTK bar title overlaps its tick labels)
-    bar = dict(title="", n_labels=5, fmt="%.0f", color="black", vertical=False,
+    bar = dict(title=" ", n_labels=5, fmt="%.0f", color="black", vertical=False,
                width=0.7, height=0.08, position_x=0.15, position_y=0.03, label_font_size=16)
     stress = archive_root_stress(ds, g)
     crops, views = [], []
@@ -86,10 +86,11 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
     u_cell = [um[f.triangles].mean(axis=1) for um, f in zip(u_mag, fields)]
     u_hi = float(max(uc[v].max() for uc, v in zip(u_cell, views)))
     magnify = 0.5 / (u_hi * units.UM / units.MM)                                   # largest -> 0.5 mm
-    ubar = dict(title="", n_labels=5, fmt="%.2f", color="black",
+    ubar = dict(title="  ", n_labels=5, fmt="%.2f", color="black",
                 vertical=False, width=0.7, height=0.08, position_x=0.15, position_y=0.03, label_font_size=16)
     corners = np.array([[r_tip * math.sin(t), r_tip * math.cos(t)] for t in np.linspace(-half, half, 9)]
                        + [[r_in * math.sin(t), r_in * math.cos(t)] for t in np.linspace(-half, half, 9)])
+    y_cut = float(corners[:, 1].min())     # the view's lower edge: below it the colour bars, on white
     for j, f in enumerate(fields):
         b, keep = crops[j]
         rot = math.pi / 2 - f.tooth * geo.pitch_angle
@@ -97,7 +98,7 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
         last = j == n - 1
         # stress
         p.subplot(j, 0)
-        mesh = extrude(sub, rot, (0.0, 0.0), f.von_mises[keep] / units.MPA, "von_mises")
+        mesh = below_cut(extrude(sub, rot, (0.0, 0.0), f.von_mises[keep] / units.MPA, "von_mises"), y_cut)
         p.add_mesh(mesh, scalars="von_mises", cmap=STRESS_CMAP, clim=(lo, hi), lighting=False,
                    show_scalar_bar=last, scalar_bar_args=bar)
         lp = transform(np.asarray(f.load_point)[None, :] / units.MM, rot, np.zeros(2))[0]
@@ -120,7 +121,7 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
         # displacement on the magnified shape, undeformed outline in grey
         p.subplot(j, 1)
         moved = Body2D(b.points + magnify * f.displacement / units.MM, sub.triangles, sub.thickness, sub.tooth)
-        mesh = extrude(moved, rot, (0.0, 0.0), u_cell[j][keep], "displacement")
+        mesh = below_cut(extrude(moved, rot, (0.0, 0.0), u_cell[j][keep], "displacement"), y_cut)
         p.add_mesh(mesh, scalars="displacement", cmap=DISPLACEMENT_CMAP, clim=(0.0, u_hi), lighting=False,
                    show_scalar_bar=last, scalar_bar_args=ubar)
         p2 = transform(sub.points, rot, np.zeros(2))
@@ -128,12 +129,18 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
                            np.hstack([np.full((len(sub.triangles), 1), 3), sub.triangles]).ravel())
         ref = flat.extract_feature_edges(boundary_edges=True, feature_edges=False, manifold_edges=False,
                                          non_manifold_edges=False)
-        p.add_mesh(ref, color="#606060", line_width=1.0, lighting=False)
+        p.add_mesh(below_cut(ref, y_cut), color="#606060", line_width=1.0, lighting=False)
         fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.3 if last else 0.0, top_margin=0.16)
         p.add_text(f"tooth {f.tooth}: displacement, largest in view {u_cell[j][views[j]].max():.2f} um\n"
                    f"colour: displacement magnitude [um] on the shape magnified x{magnify:.0f} (grey: undeformed)",
                    position="upper_left", font_size=10, color="black")
     return RenderResult(write_png(p, path), (lo, hi), "von_mises", "MPa")
+
+
+def below_cut(mesh, y_cut: float):
+    """``mesh`` with what lies below y = y_cut [mm] (the view's lower edge) cut away, so that
+    the colour bars below the last row sit on white."""
+    return mesh.clip(normal=(0.0, 1.0, 0.0), origin=(0.0, y_cut, 0.0), invert=False)
 
 
 def archive_root_stress(ds: xr.Dataset, g: int) -> np.ndarray:

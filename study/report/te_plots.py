@@ -255,7 +255,7 @@ def spectrum_panel(ax, order, amp, peaks, xmax, what, res_text):
     ax.set_xlim(0, xmax)
     ax.set_ylabel(f"{what} amplitude [µm]")
     ax.grid(alpha=0.3, which="both")
-    handles = [Line2D([], [], color=C_HOLE, label="hole order N, 2N"), Line2D([], [], color=C_LIGHT, label="mesh order kZ"),
+    handles = [Line2D([], [], color=C_HOLE, label="hole orders jN"), Line2D([], [], color=C_LIGHT, label="mesh order kZ"),
                Line2D([], [], color=C_SIDE, ls=":", label="hole sidebands kZ ± jN"),
                Line2D([], [], color=C_OTHER, marker="v", ls="", label="largest unexplained peaks (order)")]
     if rev:
