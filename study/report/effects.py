@@ -41,6 +41,14 @@ def kept(ds: xr.Dataset, var: str) -> xr.DataArray:
     return da.where(np.isfinite(da))
 
 
+def varies(ds: xr.Dataset, var: str, rtol: float = 1e-9) -> bool:
+    """Whether ``var`` takes different values over the points kept: its spread exceeds ``rtol``
+    times its magnitude (a ratio converted to 0.05 +- 1e-14 does not vary)."""
+    v = kept(ds, var).values
+    v = v[np.isfinite(v)]
+    return v.size > 1 and float(np.ptp(v)) > rtol * max(float(np.max(np.abs(v))), 1e-300)
+
+
 def study_outputs(ds: xr.Dataset, swept: list[str]) -> list[str]:
     """The scalar outputs of a study archive: the requested ones (attribute ``outputs``) that are
     numeric and lie over swept dimensions only, else every such variable but the bookkeeping."""

@@ -115,11 +115,16 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
     beside the figures. They are computed here, from the points of the archive rendered, and
     not stored by ``lightgear sweep``: the archives of the parts of a split study open together
     as one (open_mfdataset), and a variance split or Pareto set of one part is wrong for the whole."""
-    from study.report.effects import pareto_table, sensitivity_table, study_outputs
+    from study.report.effects import pareto_table, sensitivity_table, study_outputs, varies
     from study.report.results import write_netcdf
     from study.report.study_views import main_effects_figure, sensitivity_figure, tradeoff_figure
     out, tables = [], []
     outputs = study_outputs(ds, swept)
+    constant = [v for v in outputs if not varies(ds, v)]
+    if constant:
+        skip("figures of outputs that do not vary", ", ".join(f"{v} = {_value(ds, v)}" for v in constant))
+    outputs = [v for v in outputs if v not in constant]
+    _status_table(ds)
     if swept == ["point"]:
         skip("main effects and sensitivity", "explicit study points (no factorial grid to average over)")
     elif not outputs:
@@ -146,13 +151,32 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
     return out
 
 
+def _value(ds, var) -> str:
+    from study.report.effects import kept
+    v = kept(ds, var).values
+    v = v[np.isfinite(v)]
+    return f"{v[0]:.4g} {ds[var].attrs.get('units', '')}".strip() if v.size else "NaN"
+
+
+def _status_table(ds) -> None:
+    """Print how many points end in each status flag (a flag is no quantity to draw)."""
+    if "status" not in ds:
+        return
+    names = str(ds["status"].attrs.get("flag_meanings", "")).split()
+    values = list(ds["status"].attrs.get("flag_values", range(len(names))))
+    st = ds["status"].values.ravel()
+    counts = [f"{n} {int(np.sum(st == v))}" for n, v in zip(names, values) if np.sum(st == v)]
+    print("  status of the points: " + ", ".join(counts))
+
+
 def _sweep_views(ds, swept, name, skip) -> list[Path]:
+    from study.report.effects import NOT_OUTPUTS, varies
     from study.report.sweep_view import sweep_view
     out = []
     for var in ds.data_vars:
         da = ds[var]
-        if str(var).startswith("pareto_"):
-            continue   # a flag, drawn in the trade-off view
+        if str(var).startswith("pareto_") or var in NOT_OUTPUTS or (da.dtype.kind in "fiu" and not varies(ds, var)):
+            continue   # a flag (trade-off view, status table), bookkeeping, or a value that does not vary
         dims = [d for d in swept if d in da.dims]
         if da.dtype.kind not in "fiu" or not dims or not set(da.dims) <= set(swept):
             continue   # (a static output lies only over the fields its analysis reads)
