@@ -64,7 +64,7 @@ def campbell_plot(ds: xr.Dataset, path):
     ax.set_xlabel("driver speed [rad/s]")
     ax.set_ylabel("frequency [Hz]")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.11), fontsize=7.5, frameon=False)
-    figure_title(fig, ds, "Campbell diagram: modes of the loaded pair and excitation orders")
+    figure_title(fig, ds, "Campbell diagram: modes of the loaded pair and excitation orders", width=95)
     fig.subplots_adjust(bottom=0.24)
     return save_figure(fig, path)
 
@@ -107,5 +107,5 @@ def order_map_plot(ds: xr.Dataset, path):
     ax2.set_xlabel("driver speed [rad/s]")
     ax2.set_ylabel("DTE amplitude [um]")
     ax2.legend(fontsize=8)
-    figure_title(fig, ds, "Run-up: computed order tracking of DTE, Campbell overlay and order cuts")
+    figure_title(fig, ds, "Run-up: computed order tracking of DTE, Campbell overlay and order cuts", width=100)
     return save_figure(fig, path)

@@ -122,7 +122,7 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
     outputs = study_outputs(ds, swept)
     constant = [v for v in outputs if not varies(ds, v)]
     if constant:
-        skip("figures of outputs that do not vary", ", ".join(f"{v} = {_value(ds, v)}" for v in constant))
+        skip("figures of outputs that take one value", ", ".join(f"{v} = {_value(ds, v)}" for v in constant))
     outputs = [v for v in outputs if v not in constant]
     _status_table(ds)
     if swept == ["point"]:
@@ -155,7 +155,8 @@ def _value(ds, var) -> str:
     from study.report.effects import kept
     v = kept(ds, var).values
     v = v[np.isfinite(v)]
-    return f"{v[0]:.4g} {ds[var].attrs.get('units', '')}".strip() if v.size else "NaN"
+    unit = str(ds[var].attrs.get("units", ""))
+    return f"{v[0]:.4g} {unit if unit not in ('1', '-') else ''}".strip() if v.size else "NaN at every point"
 
 
 def _status_table(ds) -> None:

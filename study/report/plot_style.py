@@ -18,7 +18,8 @@ import xarray as xr  # noqa: E402
 DPI = 110
 _PRETTY_UNITS = {"um": "µm", "degree": "°", "N mm rad-1": "N·mm/rad", "N m rad-1": "N·m/rad",
                  "N m": "N·m", "1": "–", "Hz": "Hz", "s": "s", "N": "N", "J": "J", "mm": "mm",
-                 "rad s-1": "rad/s", "MPa": "MPa"}
+                 "rad s-1": "rad/s", "MPa": "MPa", "N mm rad-n_k": "N·mm/rad^n_k", "N um-1": "N/µm",
+                 "N mm-1 um-1": "N/(mm·µm)"}
 C_LIGHT, C_SOLID, C_HOLE, C_SIDE, C_OTHER = "#c0392b", "#2c3e50", "#2980b9", "#27ae60", "#7d3c98"
 C_REV = "#d68910"     # once-per-revolution orders of gears with pitch errors or eccentricity
 
@@ -37,6 +38,28 @@ def axis_label(v: xr.DataArray, name: str | None = None) -> str:
     if len(ln) > 40 and " (" in ln:
         ln = ln.split(" (", 1)[0]
     return f"{ln} [{pretty_unit(v.attrs.get('units'))}]"
+
+
+def param_label(ds: xr.Dataset, dim: str, n: int = 38) -> str:
+    """The one label of a swept parameter on every study figure: 'long name [unit]', or, when
+    that is longer than ``n`` characters, its symbol and the dimension's name
+    ('N: n_holes [–]' for 'N: number of lightening holes in the web')."""
+    if dim not in ds.coords:
+        return dim
+    label = axis_label(ds[dim], dim)
+    if len(label) <= n:
+        return label
+    ln = str(ds[dim].attrs.get("long_name", ""))
+    symbol = f"{ln.split(':', 1)[0]}: " if ":" in ln and len(ln.split(":", 1)[0]) <= 6 else ""
+    return f"{symbol}{dim} [{pretty_unit(ds[dim].attrs.get('units'))}]"
+
+
+def integer_ticks(ax, values, axis: str = "x") -> None:
+    """Ticks at whole numbers only when ``values`` are counts (an integer coordinate)."""
+    import numpy as np
+    from matplotlib.ticker import MaxNLocator
+    if np.asarray(values).dtype.kind in "iu":
+        (ax.xaxis if axis == "x" else ax.yaxis).set_major_locator(MaxNLocator(integer=True))
 
 
 def need(ds: xr.Dataset, *names: str) -> None:

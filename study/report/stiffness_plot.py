@@ -31,7 +31,7 @@ def stiffness_plot(ds: xr.Dataset, path) -> Path:
         ok = np.isfinite(kg)
         m, c, lab = styles.get(int(g), ("o", None, f"gear {g}"))
         if np.ptp(kg[ok]) <= 1e-9 * abs(kg[ok]).max():
-            ax.plot([], [], " ", label=f"{lab}: every tooth {kg[ok][0]:.4g} N·mm/rad")
+            ax.plot([], [], " ", label=f"{lab}: every tooth {kg[ok][0]:.4g} {pretty_unit(k.attrs.get('units'))}")
             continue
         ax.plot(np.flatnonzero(ok), kg[ok], marker=m, ms=5, lw=1.2, color=c, label=lab)
         drawn.append(int(g))

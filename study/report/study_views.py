@@ -15,7 +15,17 @@ import numpy as np
 import xarray as xr
 
 from study.report.effects import MASS_SAVING, STRESS_RATIO, kept, main_effect
-from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, axis_label, figure_title, pretty_unit, save_figure
+from study.report.plot_style import (
+    C_HOLE,
+    C_LIGHT,
+    C_SOLID,
+    axis_label,
+    figure_title,
+    integer_ticks,
+    param_label,
+    pretty_unit,
+    save_figure,
+)
 
 STRESS = "root_stress_max_gear2"
 
@@ -28,12 +38,8 @@ def _positions(ds, dim):
     return np.arange(v.size, dtype=float), [str(s) for s in v]
 
 
-def _param_label(ds, dim: str, n: int = 38) -> str:
-    """'long name [unit]' of a swept parameter, or 'name [unit]' when that is too long for a panel."""
-    if dim not in ds.coords:
-        return dim
-    label = axis_label(ds[dim], dim)
-    return label if len(label) <= n else f"{dim} [{pretty_unit(ds[dim].attrs.get('units'))}]"
+def _param_label(ds, dim: str) -> str:
+    return param_label(ds, dim)
 
 
 def main_effects_figure(ds: xr.Dataset, var: str, swept: list[str], path):
@@ -55,6 +61,8 @@ def main_effects_figure(ds: xr.Dataset, var: str, swept: list[str], path):
             ax.set_xticks(x, labels)
         elif x.size <= 6:
             ax.set_xticks(x)
+        else:
+            integer_ticks(ax, ds[dim].values if dim in ds.coords else x)
         ax.set_xlabel(_param_label(ds, dim), fontsize=9)
         ax.grid(alpha=0.3)
         if k % ncol == 0:
@@ -116,6 +124,35 @@ def sensitivity_figure(ds: xr.Dataset, table: xr.Dataset, path):
     return save_figure(fig, path)
 
 
+STRESS_SPAN = 0.1      # the stress colour scale spans at least this fraction of its mid value
+
+
+def stress_norm(values):
+    """Colour scale of the root stress [MPa]: the points' range, widened to STRESS_SPAN of its
+    middle when narrower (a spread of a few % reads as one colour, not as the whole bar)."""
+    lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
+    mid, half = 0.5 * (lo + hi), 0.5 * max(hi - lo, STRESS_SPAN * abs(0.5 * (lo + hi)))
+    return plt.Normalize(mid - half, mid + half)
+
+
+def _label_dims(ds, *names) -> list[str]:
+    """The swept dimensions the archived variables ``names`` lie over (not those of the status)."""
+    dims = set().union(*(ds[n].dims for n in names))
+    return [str(d) for d in xr.broadcast(*(kept(ds, n) for n in names))[0].dims if d in dims]
+
+
+def point_labels(arrays, dims) -> np.ndarray:
+    """A short label of each point of ``arrays`` broadcast together (flattened in that order):
+    its values of the swept parameters ``dims`` ('/'-joined, in the order of the broadcast)."""
+    a = xr.broadcast(*arrays)[0]
+    if not a.dims:
+        return np.array([""], dtype=object)
+    st = a.stack(_p=a.dims)
+    cols = [st[d].values for d in a.dims if d in dims]
+    return np.array(["/".join(f"{v:g}" if isinstance(v, (int, float, np.number)) else str(v) for v in vals)
+                     for vals in zip(*cols)] if cols else [""] * st.size, dtype=object)
+
+
 def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path, te_limits: dict | None = None, chosen: int | None = None):
     """Mass saving against each TE measure with a ``pareto_<te>`` flag in ``pareto``; colour:
     root stress [MPa] when archived; hollow: over the stress limit; the Pareto set joined.
@@ -133,22 +170,38 @@ def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path, te_limits: dict | 
         g, c, r, f = (a.values.ravel() for a in xr.broadcast(gain, kept(ds, t), ratio, flag.astype(bool)))
         s = xr.broadcast(stress, gain)[0].values.ravel() if stress is not None else np.full(g.shape, np.nan)
         shown = np.isfinite(g) & np.isfinite(c)
+        solid = shown & (np.abs(g) < 1e-9)          # the solid driven gear: the reference of the trade
+        shown &= ~solid
         within = shown & (r <= limit)
         over = shown & ~(r <= limit)
         if stress is not None and np.isfinite(s[shown]).any():
-            norm = plt.Normalize(np.nanmin(s[shown]), np.nanmax(s[shown]))
+            norm = stress_norm(s[shown])
             coloured = within & np.isfinite(s)
-            sc = ax.scatter(c[coloured], g[coloured], c=s[coloured], cmap="viridis", norm=norm, s=28, zorder=3,
-                            label=f"stress ratio ≤ {limit:g}")
-            ax.scatter(c[over], g[over], facecolors="none", edgecolors=plt.get_cmap("viridis")(norm(s[over])),
-                       s=28, zorder=3, label=f"stress ratio > {limit:g} (or unknown)")
+            if coloured.any():
+                sc = ax.scatter(c[coloured], g[coloured], c=s[coloured], cmap="viridis", norm=norm, s=28, zorder=3,
+                                label=f"stress ratio ≤ {limit:g}")
+            if over.any():
+                ax.scatter(c[over], g[over], facecolors="none", edgecolors=plt.get_cmap("viridis")(norm(s[over])),
+                           s=28, zorder=3, label=f"stress ratio > {limit:g} (or unknown)")
             nostress = within & ~np.isfinite(s)
             if nostress.any():
                 ax.scatter(c[nostress], g[nostress], color="0.5", s=28, zorder=3, label="no root stress archived")
         else:
-            ax.scatter(c[within], g[within], color=C_LIGHT, s=28, zorder=3, label=f"stress ratio ≤ {limit:g}")
-            ax.scatter(c[over], g[over], facecolors="none", edgecolors=C_LIGHT, s=28, zorder=3,
-                       label=f"stress ratio > {limit:g} (or unknown)")
+            if within.any():
+                ax.scatter(c[within], g[within], color=C_LIGHT, s=28, zorder=3, label=f"stress ratio ≤ {limit:g}")
+            if over.any():
+                ax.scatter(c[over], g[over], facecolors="none", edgecolors=C_LIGHT, s=28, zorder=3,
+                           label=f"stress ratio > {limit:g} (or unknown)")
+        if solid.any():
+            ax.scatter(c[solid], g[solid], marker="s", s=45, color="k", zorder=4, label="solid driven gear (reference)")
+            ax.axvline(float(np.min(c[solid])), color="k", ls=":", lw=0.9, zorder=1)
+        labels = point_labels((gain, kept(ds, t), ratio, flag.astype(bool)), _label_dims(ds, MASS_SAVING, t))
+        done = set()
+        for i in np.flatnonzero((f | solid) if (shown | solid).sum() > 12 else (shown | solid)):
+            if (c[i], g[i]) not in done:     # points that differ only where neither quantity does: one label
+                done.add((c[i], g[i]))
+                ax.annotate(labels[i], (c[i], g[i]), xytext=(4, 3), textcoords="offset points", fontsize=6.5,
+                            color="0.25")
         order = np.argsort(c[f])
         ax.plot(c[f][order], g[f][order], color=C_SOLID, lw=1.2, zorder=2, drawstyle="steps-post")
         ax.scatter(c[f], g[f], s=110, facecolors="none", edgecolors=C_SOLID, lw=1.4, zorder=4,
@@ -162,7 +215,8 @@ def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path, te_limits: dict | 
         ax.set_ylabel(axis_label(ds[MASS_SAVING], MASS_SAVING))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="lower right")
-        ax.set_title(f"{MASS_SAVING} against {t}: up and left is better", fontsize=9)
+        ax.set_title(f"{MASS_SAVING} against {t}: up and left is better\npoint labels: "
+                     + ", ".join(_label_dims(ds, MASS_SAVING, t)), fontsize=9)
     if sc is not None:
         fig.colorbar(sc, ax=axes[0, -1], label=axis_label(ds[STRESS], STRESS))
     n_ok = int(np.isfinite(gain.values).sum())

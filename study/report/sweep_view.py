@@ -6,7 +6,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import xarray as xr
 
-from study.report.plot_style import C_LIGHT, axis_label, figure_title, pretty_unit, save_figure
+from study.report.plot_style import C_LIGHT, figure_title, integer_ticks, param_label, pretty_unit, save_figure
 
 
 def sweep_view(ds: xr.Dataset, var: str, x: str, hue: str | None = None, col: str | None = None,
@@ -64,13 +64,14 @@ def sweep_view(ds: xr.Dataset, var: str, x: str, hue: str | None = None, col: st
             if parts:
                 ax.set_title(", ".join(parts), fontsize=9)
             ax.grid(alpha=0.3)
+            integer_ticks(ax, xv.values)
             if i == nrow - 1:
-                ax.set_xlabel(axis_label(xv, x))
+                ax.set_xlabel(param_label(ds, x))
             if j == 0:   # the long name is in the title; the axis keeps the variable and its unit
                 ax.set_ylabel(f"{var} [{pretty_unit(da.attrs.get('units'))}]")
     if hue:
         handles, labels = axes[0, 0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="outside right center", fontsize=8, title=axis_label(ds[hue], hue))
+        fig.legend(handles, labels, loc="outside right center", fontsize=8, title=param_label(ds, hue))
     figure_title(fig, ds, f"{var}: {da.attrs.get('long_name', var)}, against {ds[x].attrs.get('long_name', x)}",
            width=int(8 * width))
     if path is None:
