@@ -116,7 +116,7 @@ def body_fields(setup: GearSetup, teeth) -> list:
 # ------------------------------------------------------------------ dataset
 
 def stiffness_dataset(scene: Scene):
-    """xarray Dataset: tooth_stiffness (N mm rad-1) and stiffness_ratio of both gears, with hole positions."""
+    """xarray Dataset: tooth_stiffness (N·mm/rad^n_k; CF unit N mm) and stiffness_ratio of both gears, with hole positions."""
     import xarray as xr
 
     from study.report import results

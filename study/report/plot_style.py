@@ -18,7 +18,7 @@ import xarray as xr  # noqa: E402
 DPI = 110
 _PRETTY_UNITS = {"um": "µm", "degree": "°", "N mm rad-1": "N·mm/rad", "N m rad-1": "N·m/rad",
                  "N m": "N·m", "1": "–", "Hz": "Hz", "s": "s", "N": "N", "J": "J", "mm": "mm",
-                 "rad s-1": "rad/s", "MPa": "MPa", "N mm rad-n_k": "N·mm/rad^n_k", "N um-1": "N/µm",
+                 "rad s-1": "rad/s", "MPa": "MPa", "N um-1": "N/µm",
                  "N mm-1 um-1": "N/(mm·µm)"}
 C_LIGHT, C_SOLID, C_HOLE, C_SIDE, C_OTHER = "#c0392b", "#2c3e50", "#2980b9", "#27ae60", "#7d3c98"
 C_REV = "#d68910"     # once-per-revolution orders of gears with pitch errors or eccentricity
@@ -31,13 +31,19 @@ def pretty_unit(unit: str | None) -> str:
     return _PRETTY_UNITS.get(unit, unit)
 
 
+def unit_text(v: xr.DataArray) -> str:
+    """The unit of a variable as printed: its ``unit_symbol`` where the CF unit cannot say it
+    (k_phi in N·mm/rad^n_k), else `pretty_unit` of ``units``."""
+    return str(v.attrs["unit_symbol"]) if "unit_symbol" in v.attrs else pretty_unit(v.attrs.get("units"))
+
+
 def axis_label(v: xr.DataArray, name: str | None = None) -> str:
     """'long name [unit]' of a variable or coordinate; a long name's remark in parentheses is
     left out (it belongs in the archive, not on an axis or a legend title)."""
     ln = str(v.attrs.get("long_name", name or v.name or ""))
     if len(ln) > 40 and " (" in ln:
         ln = ln.split(" (", 1)[0]
-    return f"{ln} [{pretty_unit(v.attrs.get('units'))}]"
+    return f"{ln} [{unit_text(v)}]"
 
 
 def param_label(ds: xr.Dataset, dim: str, n: int = 38) -> str:

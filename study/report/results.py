@@ -215,9 +215,11 @@ def stiffness_variables(k_nmm: tuple, ratio: tuple) -> tuple[dict, dict]:
         R[g, : len(ratio[g])] = ratio[g]
     coords = {"gear": _var("gear", np.array([1, 2]), "1", "gear (1 driver, 2 driven)"),
               "tooth": _var("tooth", np.arange(zmax), "1", "tooth index (counter-clockwise from tooth 0)")}
-    data = {"tooth_stiffness": _var(("gear", "tooth"), K, "N mm rad-n_k", "torsion spring stiffness k_phi of each tooth",
-                                    comment="T = k_phi |phi|^n_k: the unit is N·mm/rad^n_k (n_k of each gear in its "
-                                            "scene section); tooth_stiffness_pitch gives the linear stiffness in N/um"),
+    data = {"tooth_stiffness": _var(("gear", "tooth"), K, "N mm", "torsion spring stiffness k_phi of each tooth",
+                                    unit_symbol="N·mm/rad^n_k",
+                                    comment="T = k_phi |phi|^n_k: k_phi is in N·mm/rad^n_k (n_k of each gear in its scene "
+                                            "section; the radian is dimensionless, so the CF unit reads N mm); "
+                                            "tooth_stiffness_pitch gives the linear stiffness in N/um"),
             "stiffness_ratio": _var(("gear", "tooth"), R, "1", "tooth stiffness relative to the solid gear (FE)")}
     return coords, data
 

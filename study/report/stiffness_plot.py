@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, archive_scene, figure_title, need, pretty_unit, save_figure
+from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, archive_scene, figure_title, need, save_figure, unit_text
 
 
 def stiffness_plot(ds: xr.Dataset, path) -> Path:
@@ -31,7 +31,7 @@ def stiffness_plot(ds: xr.Dataset, path) -> Path:
         ok = np.isfinite(kg)
         m, c, lab = styles.get(int(g), ("o", None, f"gear {g}"))
         if np.ptp(kg[ok]) <= 1e-9 * abs(kg[ok]).max():
-            ax.plot([], [], " ", label=f"{lab}: every tooth {kg[ok][0]:.4g} {pretty_unit(k.attrs.get('units'))}")
+            ax.plot([], [], " ", label=f"{lab}: every tooth {kg[ok][0]:.4g} {unit_text(k)}")
             continue
         ax.plot(np.flatnonzero(ok), kg[ok], marker=m, ms=5, lw=1.2, color=c, label=lab)
         drawn.append(int(g))
@@ -50,7 +50,7 @@ def stiffness_plot(ds: xr.Dataset, path) -> Path:
                 ax.axvline(c, color=C_HOLE, ls="--", lw=0.8, label="hole centre" if first else None)
                 first = False
     ax.set_xlabel("tooth index [–] (tooth k's axis at k·360°/Z from tooth 0)")
-    ax.set_ylabel(f"spring stiffness k_φ [{pretty_unit(k.attrs.get('units'))}]")
+    ax.set_ylabel(f"spring stiffness k_φ [{unit_text(k)}]")
     zmax = int(np.isfinite(k.values).sum(axis=1).max())
     ax.set_xlim(-0.5, zmax - 0.5)
     ax.grid(alpha=0.3)

@@ -86,7 +86,7 @@ def gear_pair_render(ds: xr.Dataset, path, fields: dict | None = None) -> Render
             xy = centre + r_mid * np.array([math.cos(a), math.sin(a)])
             zt = sc.gear(g).face_width / 2
             probes.append((*project(p, (1, 0), (xy[0], xy[1], zt)), float(k[t])))
-    return RenderResult(write_png(p, path), (lo, hi), "k_phi", "N mm rad-n_k", probes)
+    return RenderResult(write_png(p, path), (lo, hi), "k_phi", "N mm", probes)
 
 
 def _pair_caption(ds, sc, coloured) -> str:
