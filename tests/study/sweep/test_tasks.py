@@ -67,10 +67,11 @@ def test_points_share_the_static_task_and_a_point_record_joins_its_tasks():
 
 def test_a_point_invalid_for_its_dynamics_only_keeps_the_statics_of_its_body(tmp_path):
     """Too short a run is invalid (no steady window), yet the body's STE is archived once, over
-    the hole count only; renders draw the static output against the one dimension it lies over."""
+    the hole count only; renders draw an output of the body against the one dimension it lies
+    over, and none of an output that takes one value (the STE of uniform springs)."""
     from study.report.figures import make_figures
     st = tiny_study('[grid]\n"dynamic.duration" = [0.003, 0.01]\ngear2.body.holes = [0, 4]\n'
-                    '[outputs]\nscalars = ["ste_p2p", "dte_rms"]')
+                    '[outputs]\nscalars = ["ste_p2p", "dte_rms", "mass_gear2"]')
     res = run_sweep(st, tmp_path / "short.nc", workers=0, progress=False)
     ds = res.dataset
     assert res.invalid == 2 and res.computed == 2 + 2
@@ -83,7 +84,8 @@ def test_a_point_invalid_for_its_dynamics_only_keeps_the_statics_of_its_body(tmp
     with xr.open_dataset(tmp_path / "short.nc", engine="netcdf4") as back:
         xr.testing.assert_identical(back.load(), ds)
     pngs = {p.name for p in make_figures(ds, tmp_path / "fig")}
-    assert {"sweep_ste_p2p.png", "sweep_dte_rms.png", "main_effects_ste_p2p.png"} <= pngs
+    assert {"sweep_mass_gear2.png", "sweep_dte_rms.png", "main_effects_mass_gear2.png"} <= pngs
+    assert float(np.ptp(ds["ste_p2p"].values)) == 0.0 and not {"sweep_ste_p2p.png", "main_effects_ste_p2p.png"} & pngs
 
 
 def test_modal_outputs_follow_the_dynamic_torque_and_join_the_dynamic_task():
