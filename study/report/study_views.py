@@ -107,7 +107,8 @@ def sensitivity_figure(ds: xr.Dataset, table: xr.Dataset, path):
         ax.barh(y, vals, color=[_term_colour(t, swept) for t in names], height=0.7)
         ax.set_yticks(y, names, fontsize=7.5)
         for yi, v in zip(y, vals):
-            ax.text(max(v, 0.0) + 0.02, yi, f"{100 * v:.0f} %", va="center", fontsize=7)
+            ax.text(max(v, 0.0) + 0.02, yi, f"{100 * v + 0.0:.0f} %" if abs(v) >= 0.005 else "0 %", va="center",
+                    fontsize=7)
         ax.set_xlim(min(0.0, vals.min() - 0.05), 1.18)
         ax.axvline(0.0, color="0.3", lw=0.6)
         npts = int(table["sensitivity_points"].sel(output=out)) if "sensitivity_points" in table else None
