@@ -106,13 +106,16 @@ def static_force_max(scene: Scene, model: Model) -> float:
 
 
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
-              max_time: float | None = None, progress: bool = False) -> xr.Dataset:
+              max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True) -> xr.Dataset:
     """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive.
 
     Before any work: a dynamic run whose output arrays do not fit in memory is refused
     (`study.errors.BudgetError`), and, with ``max_time`` [s], so is a run whose estimated
     time (FE bodies, statics, time steps; `study.estimate`) exceeds it, each before the part
-    it concerns starts. ``progress``: bars on stderr for the parts expected to be long."""
+    it concerns starts. ``progress``: bars on stderr for the parts expected to be long.
+    ``mesh_outputs``: also the linearised mesh over the STE (mesh stiffness, c', loaded contact
+    ratio, tooth forces of both gears; about 1 ms an angle) and the dynamic factor K_v (its static
+    reference over a revolution); a study leaves them out unless it asks for them."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
     if dynamic:
@@ -179,6 +182,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes,
                                               revolutions=scene.has_errors)
         coords.update(c); data.update(v)
+    if static and mesh_outputs:
         t0 = time.perf_counter()
         states = mesh_states(model, st.angle, scene.quasi_static.torque)
         c, v = mesh_variables(states, model, scene, scene.quasi_static.torque)
@@ -194,7 +198,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2,
                                             (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
-        c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model))
+        c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
         coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(results.efficiency_variable(dy, d.torque, d.speed, start))

@@ -54,7 +54,7 @@ from study.errors import BudgetError
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
-from study.sweep.outputs import CURVES, Outputs, analysis_of
+from study.sweep.outputs import CURVES, MESH_SCALARS, Outputs, analysis_of
 from study.sweep.tasks import plan, point_result
 
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
@@ -83,7 +83,8 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
         elif isinstance(scene, str):
             scene = loads_scene(scene)
         if outputs.static or outputs.dynamic or outputs.modes:
-            ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic)
+            ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic,
+                           mesh_outputs=bool(set(outputs.scalars) & set(MESH_SCALARS)))
         else:   # geometry (and root stress) only: no model, no solve
             from study.report.lightening import lightening_dataset
             ds = lightening_dataset(scene, stress=outputs.fe)
