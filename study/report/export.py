@@ -21,10 +21,11 @@ FLOAT_FORMAT = "%.15g"
 
 
 def header(name: str, var: xr.DataArray) -> str:
-    """``name [unit]`` of a column; a label (text) has no unit."""
+    """``name [unit]`` of a column (``unit_symbol`` where the CF unit cannot say it); a label
+    (text) has no unit."""
     if var.dtype.kind in "OSU":
         return str(name)
-    unit = str(var.attrs.get("units", "")).strip()
+    unit = str(var.attrs.get("unit_symbol", var.attrs.get("units", ""))).strip()
     return f"{name} [{'-' if unit in ('', '1') else unit}]"
 
 

@@ -60,6 +60,9 @@ def amplitude_at_order(ds: xr.Dataset, order: float, half_width: float = 0.5) ->
     return float(ds["dte_amplitude"].values[sel].max()) if sel.any() else float("nan")
 
 
+NAMED_SHOWN = 0.01      # named peaks printed: those above this fraction of the largest
+
+
 def print_summary(ds: xr.Dataset, path, wall: float) -> None:
     s = summarize(ds)
     w = sys.stdout.write
@@ -130,6 +133,10 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         if f"{what}_peak_amplitude" in ds:
             named = [(str(n), float(a)) for n, a in zip(ds[f"{what}_peak"].values, ds[f"{what}_peak_amplitude"].values)
                      if np.isfinite(a) and not str(n).startswith("other")]
-            w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in named) + "\n")
+            top = max((a for _, a in named), default=0.0)
+            shown = [(n, a) for n, a in named if a >= NAMED_SHOWN * top]
+            more = f" (and {len(named) - len(shown)} below {NAMED_SHOWN:.0%} of the largest: {what}_peak_*)" \
+                if len(shown) < len(named) else ""
+            w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in shown) + more + "\n")
     w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
       + f", total {wall:.2f} s\n")
