@@ -62,3 +62,16 @@ def test_pitch_lever_is_the_contact_gradient_at_the_pitch_point(paper_solid_mode
     h = pitch_lever(m, 0)
     delta = lambda f: h * (f * h / m.k_phi[0]) ** (1 / n)          # noqa: E731
     assert k[0] == pytest.approx(2.0 / (delta(1001.0) - delta(999.0)), rel=1e-6)
+
+
+def test_loaded_contact_ratio_falls_to_the_geometric_one_as_the_load_vanishes(paper_solid_model):
+    """Deflection brings teeth into contact before and after the geometric path (tip corners
+    included): the mean number of loaded pairs over whole mesh periods grows with the torque
+    and tends to the geometric transverse contact ratio as the load vanishes."""
+    from study.report.mesh_outputs import whole_periods
+    m = paper_solid_model
+    ang = np.radians(np.arange(0.0, 360.0 / 67 * 2, 0.02))
+    sel = whole_periods(np.degrees(ang), 67)
+    eps = [float(mesh_states(m, ang, t).loaded_pairs()[sel].mean()) for t in (0.5, 5.0, 50.0)]
+    assert eps[0] < eps[1] < eps[2]
+    assert eps[0] == pytest.approx(m.pair.contact_ratio, rel=0.03) and eps[2] > 1.1 * m.pair.contact_ratio
