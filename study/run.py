@@ -133,6 +133,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     choice = None
     if static:
         est.seconds["statics"] = estimate.static_seconds(scene, model)
+        if mesh_outputs:
+            est.seconds["mesh stiffness"] = estimate.mesh_seconds(scene)
     if dynamic:
         choice = dynamic_choice(scene, model)
         est.seconds[f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"] = \
