@@ -84,7 +84,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
             scene = loads_scene(scene)
         if outputs.static or outputs.dynamic or outputs.modes:
             ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic,
-                           mesh_outputs=bool(set(outputs.scalars) & set(MESH_SCALARS)))
+                           mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)))
         else:   # geometry (and root stress) only: no model, no solve
             from study.report.lightening import lightening_dataset
             ds = lightening_dataset(scene, stress=outputs.fe)

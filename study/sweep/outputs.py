@@ -76,14 +76,15 @@ for _g, _which in ((1, "driver"), (2, "driven gear")):
         f"root_stress_ratio_gear{_g}": Scalar("1", f"largest fillet stress of the {_which} relative to the same gear solid "
                                                    "(FE; NaN when its springs need no FE)", "fe"),
     })
-# the scalars of the linearised mesh and the tooth loads (`study.run.run_scene`'s mesh_outputs):
+# the outputs of the linearised mesh and the tooth loads (`study.run.run_scene`'s mesh_outputs):
 # a study that asks for none of them skips that part
-MESH_SCALARS = ("mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
+MESH_SCALARS = ("mesh_stiffness", "mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
                 "c_gamma_alpha_iso6336", "loaded_contact_ratio", "dynamic_factor")
 GEAR_VARIABLES = ("mass", "mass_saving", "inertia", "root_stress_max", "root_stress_ratio")   # scalars *_gear{g}
 
 CURVES = {
     "ste": Curve("angle", "static"),
+    "mesh_stiffness": Curve("angle", "static"),
     "dte": Curve("time", "dynamic"),
     "dte_amplitude": Curve("frequency", "dynamic",
                            "order of the driven gear's rotation = frequency / (speed * Z1 / Z2 / (2 pi)); "

@@ -170,6 +170,9 @@ def test_only_the_asked_analyses_run(monkeypatch):
     st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['mesh_stiffness_mean']")
     r = sweep.run_point(st.points()[0].scene, st.outputs)
     assert seen[-1] == {"static": True, "dynamic": False, "mesh_outputs": True} and r["scalars"]["mesh_stiffness_mean"] > 0
+    st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['ste_p2p']\ncurves = ['mesh_stiffness']")
+    r = sweep.run_point(st.points()[0].scene, st.outputs)
+    assert seen[-1]["mesh_outputs"] and r["curves"]["mesh_stiffness"][0] == "angle"
 
 
 # ---------------------------------------------------------------- dask
