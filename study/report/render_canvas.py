@@ -69,10 +69,18 @@ def fit_parallel(p, pts, vp_w: float, vp_h: float, margin: float = 1.04, bottom_
     cam.parallel_scale = scale
 
 
-def write_png(p, path) -> Path:
-    """Screenshot of plotter ``p`` to ``path`` (parent folders made); closes the plotter."""
+def write_png(p, path, title: str = "") -> Path:
+    """Screenshot of plotter ``p`` to ``path`` (parent folders made); closes the plotter. A
+    ``title`` goes into the PNG's ``Title`` text field (as the plots' titles do)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     p.screenshot(str(path))
     p.close()
+    if title:
+        from PIL import Image, PngImagePlugin
+        info = PngImagePlugin.PngInfo()
+        info.add_text("Title", title)
+        with Image.open(path) as im:
+            im.load()
+            im.save(path, pnginfo=info)
     return path

@@ -86,7 +86,8 @@ def gear_pair_render(ds: xr.Dataset, path, fields: dict | None = None) -> Render
             xy = centre + r_mid * np.array([math.cos(a), math.sin(a)])
             zt = sc.gear(g).face_width / 2
             probes.append((*project(p, (1, 0), (xy[0], xy[1], zt)), float(k[t])))
-    return RenderResult(write_png(p, path), (lo, hi), "k_phi", "N mm", probes)
+    png_title = f"Gear pair, teeth coloured by spring stiffness / {archive_title(ds)}"
+    return RenderResult(write_png(p, path, png_title), (lo, hi), "k_phi", "N mm", probes)
 
 
 def _pair_caption(ds, sc, coloured) -> str:

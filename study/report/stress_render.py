@@ -16,6 +16,7 @@ import xarray as xr
 
 from solver import units
 from solver.geometry import gear_geometry
+from study.report.plot_style import archive_title
 from study.report.render_canvas import RenderResult, fit_parallel, plotter, write_png
 from study.report.render_geometry import Body2D, extrude, fe_body, transform
 from study.report.render_inputs import fe_fields, required_scene, tooth_stiffness
@@ -134,7 +135,8 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
         p.add_text(f"tooth {f.tooth}: displacement, largest in view {u_cell[j][views[j]].max():.2f} um\n"
                    f"colour: displacement magnitude [um] on the shape magnified x{magnify:.0f} (grey: undeformed)",
                    position="upper_left", font_size=10, color="black")
-    return RenderResult(write_png(p, path), (lo, hi), "von_mises", "MPa")
+    title = f"FE stress and displacement of gear {g} under a tooth load / {archive_title(ds)}"
+    return RenderResult(write_png(p, path, title), (lo, hi), "von_mises", "MPa")
 
 
 def below_cut(mesh, y_cut: float):
