@@ -19,6 +19,7 @@ from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study import estimate
 from study.inputs.gearsetup import gear_setups
+from study.plausibility import critical_speed_warning, report_warnings, scene_warnings
 from study.report import results
 from study.report.lightening import lightening_variables
 from study.report.modes import modal_variables
@@ -92,15 +93,19 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
 
 
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
-              max_time: float | None = None, progress: bool = False) -> xr.Dataset:
+              max_time: float | None = None, progress: bool = False, warn: bool = True) -> xr.Dataset:
     """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive.
 
     Before any work: a dynamic run whose output arrays do not fit in memory is refused
     (`study.errors.BudgetError`), and, with ``max_time`` [s], so is a run whose estimated
     time (FE bodies, statics, time steps; `study.estimate`) exceeds it, each before the part
-    it concerns starts. ``progress``: bars on stderr for the parts expected to be long."""
+    it concerns starts. ``progress``: bars on stderr for the parts expected to be long.
+    Plausibility warnings (`study.plausibility.scene_warnings`, and a speed far above the
+    critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
+    warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
+    report_warnings(warnings, warn)
     if dynamic:
         estimate.check_dynamic_memory(scene)
     est = estimate.Estimate()
@@ -150,6 +155,13 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     coords.update(c); data.update(v); attrs.update(a)
     attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
     attrs["wall_time_modes_s"] = time.perf_counter() - t0
+    if dynamic and "critical_speed" in data:
+        cs = data["critical_speed"]
+        line = critical_speed_warning(scene, float(cs.values[list(coords["excitation"].values).index("1Z"), 0]))
+        if line:
+            report_warnings([line], warn)
+            warnings.append(line)
+    attrs["plausibility_warnings"] = "\n".join(warnings)
     if static:
         t0 = time.perf_counter()
         st = run_static(scene, model)
