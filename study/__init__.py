@@ -164,12 +164,12 @@ def run_scene(scene, static: bool | None = None, dynamic: bool | None = None, ma
     `BudgetError` before any work; ``progress``: bars on stderr for long parts. Plausibility
     warnings (see `plausibility_warnings`, and a speed far above the highest critical speed of
     the mesh orders) go to stderr and the archive's ``plausibility_warnings`` attribute."""
-    from study.run import run_scene
     _check_scene("run_scene", scene)
     for name, v in (("static", static), ("dynamic", dynamic)):
         _check(v is None or isinstance(v, bool), "run_scene", name, "True, False or None (as the scene says)", v)
     _check(max_time is None or (_number(max_time) and max_time > 0), "run_scene", "max_time",
            "a positive number of seconds or None", max_time)
+    from study.run import run_scene
     return run_scene(scene, static=static, dynamic=dynamic, max_time=max_time, progress=bool(progress))
 
 
@@ -247,7 +247,6 @@ def run_sweep(study, output, workers: int | None = None, scheduler: str | None =
     missing ones. The returned dataset is the archive as written, its curves read from the file
     when used.
     """
-    from study.sweep.engine import run_sweep
     from study.sweep.grid import Study
     _check(isinstance(study, Study), "run_sweep", "study", "a Study (study.make_study(scene, grid={...}) or "
            "study.load_study(path or name))", study)
@@ -255,6 +254,7 @@ def run_sweep(study, output, workers: int | None = None, scheduler: str | None =
     workers = _workers("run_sweep", workers)
     _check(scheduler is None or isinstance(scheduler, str), "run_sweep", "scheduler",
            "a dask scheduler address such as 'tcp://host:8786', or None", scheduler)
+    from study.sweep.engine import run_sweep
     return run_sweep(study, output, workers=workers, scheduler=scheduler, progress=bool(progress),
                      keep_parts=bool(keep_parts))
 

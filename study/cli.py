@@ -160,15 +160,10 @@ def stiffness_command(args) -> int:
     import numpy as np
 
     import study
-    from study import estimate
-    from study.inputs.springs import hole_offset, identify_spring, stiffness_dataset
-    from study.setup import gear_setup
+    from study.inputs.springs import hole_offset
     scene = args_scene(args)
     checked_output(args.output)
-    est = estimate.Estimate({"FE bodies": estimate.fe_seconds(scene)})
-    estimate.check_time(est, checked_max_time(args))
-    estimate.run_fe_bodies(scene)
-    ds = stiffness_dataset(scene)
+    ds = study.stiffness(scene, max_time=checked_max_time(args), progress=True)
     study.write(ds, args.output)
     print(f"tooth stiffness map -> {args.output} ({ds.attrs['wall_time_springs_s']:.2f} s)")
     for g in (1, 2):
@@ -181,10 +176,10 @@ def stiffness_command(args) -> int:
             print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
                   f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
         if args.identify:
-            fit, u, c = identify_spring(gear_setup(scene, g))
-            print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius * 1e3:.3f} mm, "
-                  f"k_phi {fit.k_phi * 1e3:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
-                  f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {u.size} load radii")
+            fit = study.identify_spring(scene, g)
+            print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius_mm:.3f} mm, "
+                  f"k_phi {fit.k_phi:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
+                  f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {fit.load_radii} load radii")
     return 0
 
 
@@ -249,20 +244,17 @@ def fit_contact_arguments(p) -> None:
 
 def fit_contact_command(args) -> int:
     """Weber's contact deflection fitted to F = k_con * delta**m1, against the scene's law."""
-    from solver import units
-    from solver.identify.weber import fit_contact
-    from study.setup import gear_setups
+    import study
     scene = args_scene(args)
-    g1, g2 = (setup.geometry for setup in gear_setups(scene))
-    f_ref = scene.quasi_static.torque / g1.base_radius
-    print(f"Weber contact deflection at the pitch point, plane strain, F_ref = {f_ref:.1f} N "
-          f"(quasi_static.torque / base radius), R = {fit_contact(g1, g2, scene.material_spec(), f_ref).radius * 1e3:.3f} mm")
-    for frac, note in ((0.5, "default: depth half-way to the tooth centreline"),
-                       (1.0, "depth to the tooth centreline (where the FE tooth spring is read)")):
-        f = fit_contact(g1, g2, scene.material_spec(), f_ref, depth_fraction=frac)
-        k = f.k_con / units.contact_stiffness_to_si(1.0, f.m1)
-        print(f"  {note}:\n    k_con = {k:.4g} N/mm^m1, m1 = {f.m1:.4f} "
-              f"(depth {f.depth[0] * 1e3:.3f} mm, load {f.force_range[0]:.0f}..{f.force_range[1]:.0f} N, "
+    fits = [(study.fit_contact(scene, frac), note) for frac, note in (
+        (0.5, "default: depth half-way to the tooth centreline"),
+        (1.0, "depth to the tooth centreline (where the FE tooth spring is read)"))]
+    f0 = fits[0][0]
+    print(f"Weber contact deflection at the pitch point, plane strain, F_ref = {f0.reference_force_N:.1f} N "
+          f"(quasi_static.torque / base radius), R = {f0.radius_mm:.3f} mm")
+    for f, note in fits:
+        print(f"  {note}:\n    k_con = {f.k_con:.4g} N/mm^m1, m1 = {f.m1:.4f} "
+              f"(depth {f.depth_mm:.3f} mm, load {f.force_range_N[0]:.0f}..{f.force_range_N[1]:.0f} N, "
               f"fit RMS {f.rms_log_error:.1e} in ln F)")
     c = scene.contact
     print(f"  scene: k_con = {c.k_con:.4g} N/mm^m1, m1 = {c.m1:.4f}")
@@ -322,11 +314,9 @@ def precision_command(args) -> int:
     import math
 
     import study
-    from study.setup import build_scene_model
-    from study.verify.precision import dynamic_study, plot, setting_label, static_study, table
+    from study.verify.precision import setting_label
     scene = args_scene(args)
     base = checked_output(args.output)
-    model = build_scene_model(scene)
 
     def progress(i, s, e, w, msg):
         setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
@@ -336,15 +326,11 @@ def precision_command(args) -> int:
         if args.only and args.only != kind:
             continue
         print(f"{kind} study ...", flush=True)
-        if kind == "dynamic":
-            ds = dynamic_study(scene, model, args.duration, args.ramp_fraction, args.repeats, progress)
-        else:
-            ds = static_study(scene, model, args.rotation, args.repeats, progress)
-        path = base.with_name(f"{base.stem}_{kind}.nc")
-        study.write(ds, path)
-        plot(ds, path.with_suffix(".png"))
-        print(table(ds))
-        print(f"  archive: {path}\n  plot: {path.with_suffix('.png')}", flush=True)
+        ds = study.precision(scene, base, args.duration, args.ramp_fraction, args.rotation, args.repeats, kind,
+                             progress)[kind]
+        path = ds.attrs["archive"]
+        print(study.precision_table(ds))
+        print(f"  archive: {path}\n  plot: {path[:-3]}.png", flush=True)
     return 0
 
 
@@ -361,15 +347,11 @@ def reference_command(args) -> int:
     import numpy as np
 
     import study
-    from study import estimate
-    from study.verify.fe_reference import reference_dataset, static_angles
     scene = args_scene(args)
     if args.step is not None and not args.step > 0:
         raise study.SceneError("--step", f"must be positive, got {args.step}")
     checked_output(args.output)
-    angles = static_angles(scene, args.step)
-    estimate.check_time(estimate.reference_estimate(scene, angles), checked_max_time(args))
-    ds = reference_dataset(scene, angles, progress=True)
+    ds = study.reference(scene, args.step, max_time=checked_max_time(args), progress=True)
     study.write(ds, args.output)
     ste = ds["ste"].values
     print(f"FE reference STE -> {args.output}")
