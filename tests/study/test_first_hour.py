@@ -16,7 +16,7 @@ def small(**over):
 def test_scenes_lists_the_embedded_scenes_and_studies_with_their_titles(capsys):
     assert main(["scenes"]) == 0
     out = capsys.readouterr().out
-    for name, (_path, kind, title) in study.scenes().items():
+    for name, (_path, _kind, title) in study.scenes().items():
         assert name in out and title in out
     assert "runup" in out and "sensitivity" in out
 
