@@ -71,7 +71,7 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
     choice = choice or dynamic_choice(scene, model)
     speed, speed_ramp = (d.speed_end, d.duration) if d.speed_end > 0 else (d.speed, d.ramp_time)   # a run-up: one ramp
     args = (model, speed, speed_ramp, d.torque, d.ramp_time, d.duration)
-    bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration), d.duration,
+    bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration, scene), d.duration,
                                 f"dynamic run ({choice.method})", "s", show=progress)
     watch = None if bar is None else (lambda t: bar.update(t - bar.n))
     try:
@@ -124,7 +124,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     if dynamic:
         choice = dynamic_choice(scene, model)
         est.seconds[f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"] = \
-            estimate.dynamic_seconds(model, choice, scene.dynamic.duration)
+            estimate.dynamic_seconds(model, choice, scene.dynamic.duration, scene)
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
