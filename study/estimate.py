@@ -37,10 +37,11 @@ RUNUP_RUNS = 3.0
 IMPLICIT_S_PER_STEP_TOOTH = 6e-7
 STATIC_S_PER_ANGLE_TOOTH = 2e-7   # Newton with continuation: 0.02 s for 1201 angles of 67/67 teeth
 # FE body: gmsh mesh, P2 assembly and the Z load cases: the paper's lightened driven gear and
-# its solid reference, 23 400 elements each by `body_elements`, 7.3 s for both; the README's
-# 20-tooth pair, 3 500 each, 2.8 s for both -> 1.4e-4 s per element, growing with the size of
-# the factorisation beyond FE_REF_ELEMENTS.
-FE_S_PER_ELEMENT = 1.4e-4
+# its solid reference, 23 400 elements each by `body_elements`, 6.7 s for both; the README's
+# 20-tooth pair, 3 500 each, 2.3 s for both -> 0.6 s a body (mesher, set-up, the cache file)
+# and 1.16e-4 s per element, growing with the size of the factorisation beyond FE_REF_ELEMENTS.
+FE_S_PER_BODY = 0.6
+FE_S_PER_ELEMENT = 1.16e-4
 FE_REF_ELEMENTS = 4e4
 OUTPUT_COPIES = 2.5               # the kernel's output array, the result's columns and the archive's
 
@@ -186,7 +187,7 @@ def body_elements(setup) -> float:
 def body_seconds(setup) -> float:
     """Estimated run time [s] of one FE body: mesh, assembly, factorisation and load cases."""
     n = body_elements(setup)
-    return FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25 * load_factor()
+    return (FE_S_PER_BODY + FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25) * load_factor()
 
 
 def fe_bodies(scene) -> list:

@@ -86,6 +86,7 @@ def test_embedded_scenes_and_studies_load_by_name(tmp_path, monkeypatch):
     assert names["runup"][1] == "scene" and names["sensitivity"][1] == "study"
     assert study.load_scene("runup").dynamic.speed_end > 0
     assert study.load_scene("runup.toml") == study.load_scene("runup")
+    assert study.load_scene("runup", {"gear2.body.holes": 3}) == study.load_scene("runup", ["gear2.body.holes=3"])
     assert study.load_study("sensitivity").title == names["sensitivity"][2]
     # a file of that name in the working directory wins over the embedded one
     (tmp_path / "runup.toml").write_text('title = "mine"\n')
