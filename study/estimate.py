@@ -30,6 +30,7 @@ PROGRESS_AFTER_S = 5.0            # runs expected to take longer than this show 
 # forces beyond the step's load, so its run is repeated at about half the step (measured on
 # study/scenes/runup.toml: 900 000 then 1 700 000 steps): counted as RUNUP_RUNS runs.
 # HHT-alpha: about 20 x a Verlet step per tooth of the pair (Newton).
+DYNAMIC_S_PER_RUN = 0.05         # the step estimate and the output arrays of a run (the small pair: 0.05 s in all)
 EXPLICIT_S_PER_STEP = 2.8e-6
 EXPLICIT_S_PER_STEP_TOOTH = 2.4e-8
 ACTIVE_TEETH_PER_GEAR = 10
@@ -134,11 +135,11 @@ def dynamic_seconds(model, choice, duration: float, scene=None) -> float:
     (``scene``: tells a run-up, whose teeth all stay active and whose run is repeated)."""
     steps = duration / choice.dt
     if choice.method == "implicit":
-        return steps * IMPLICIT_S_PER_STEP_TOOTH * model.n_teeth * load_factor()
+        return (DYNAMIC_S_PER_RUN + steps * IMPLICIT_S_PER_STEP_TOOTH * model.n_teeth) * load_factor()
     runup = scene is not None and scene.dynamic.speed_end > 0
     active = model.n_teeth if runup else min(model.n_teeth, 2 * ACTIVE_TEETH_PER_GEAR)
     per_step = EXPLICIT_S_PER_STEP + EXPLICIT_S_PER_STEP_TOOTH * active
-    return steps * per_step * (RUNUP_RUNS if runup else 1.0) * load_factor()
+    return (DYNAMIC_S_PER_RUN + steps * per_step) * (RUNUP_RUNS if runup else 1.0) * load_factor()
 
 
 def static_seconds(scene, model) -> float:
