@@ -9,7 +9,7 @@ other fields, ok points only). Any grid axis can be replaced to shrink or refine
         [--workers N | --scheduler ADDRESS]
 
 Cost on a 2-core machine: dominated by the FE spring maps of the 36 distinct driven-gear
-bodies (cached on disk: a second run with other speeds reuses them); see the README.
+bodies (cached on disk: a second run with other speeds reuses them); see docs/studies.md.
 """
 from __future__ import annotations
 
