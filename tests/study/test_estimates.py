@@ -24,7 +24,7 @@ def test_cached_fe_bodies_and_influence_coefficients_are_free(private_fe_cache):
     ds = study.reference(scene)
     after = estimate.reference_parts(scene, angles)
     assert after["gear 1 FE body"] == 0.0 and after["gear 2 FE body"] == 0.0
-    assert after["contact sweep"] == before["contact sweep"] > 0
+    assert after["contact sweep"] > 0       # the contact problems are solved each time
     # a finer angle step reads other teeth only if new ones enter the mesh: here none, still free
     assert estimate.reference_parts(scene, static_angles(scene, 0.25))["gear 2 FE body"] == 0.0
     assert ds.sizes["angle"] == angles.size

@@ -164,7 +164,7 @@ def test_only_the_asked_analyses_run(monkeypatch):
     monkeypatch.setattr(study.run, "run_scene", lambda s, **kw: seen.append(kw) or real(s, **kw))
     st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['ste_p2p']")
     r = sweep.run_point(st.points()[0].scene, st.outputs)
-    assert r["status"] == "ok" and seen == [{"static": True, "dynamic": False}]
+    assert r["status"] == "ok" and seen == [{"static": True, "dynamic": False, "warn": False}]   # the sweep warns once
     assert set(r["scalars"]) == {"ste_p2p"} and r["curves"] == {}
 
 
