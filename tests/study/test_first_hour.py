@@ -41,6 +41,9 @@ def test_fields_lists_units_defaults_and_ranges_from_the_declarations(capsys):
     assert main(["fields"]) == 0
     out = capsys.readouterr().out
     assert all(r.path in out for r in study.fields())
+    assert main(["fields", "--markdown"]) == 0
+    from study.docs import fields_markdown
+    assert capsys.readouterr().out == fields_markdown()
     assert main(["fields", "gear2.bdy"]) == 2
     assert "did you mean" in capsys.readouterr().err
     assert main(["outputs"]) == 0
