@@ -18,7 +18,9 @@ import study
 
 scene = study.load_study("example_study").base_scene()         # an embedded study's small 20-tooth pair, by name
 scene = scene.replace(**{"gear2.spring.stiffness": "fe-ratio",    # tooth springs from the FE body of the gear
-                         "gear2.body.holes": 4, "gear2.body.hole_radius": 1.8, "dynamic.duration": 0.03})
+                         "gear2.body.holes": 4, "gear2.body.hole_radius": 1.8,
+                         "quasi_static.rotation": 90.0,          # STE over one period of the four holes [deg]
+                         "dynamic.duration": 0.03})
 ds = study.run_scene(scene)                                      # STE, DTE and spectra
 study.write(ds, "results/api/run.nc")
 print(f"DTE RMS {study.summarize(ds)['dte_rms']:.3f} um")
@@ -57,9 +59,9 @@ def test_the_api_script_runs_a_scene_and_a_sweep_into_archives_from_any_director
     np.testing.assert_allclose(pt["dte"].values, run["dte"].values, rtol=1e-12)
     after = run["dte"].where(run["time"] >= run.attrs["spectrum_start_s"], drop=True).values
     assert math.isclose(float(pt["dte_rms"]), float(np.sqrt(np.mean((after - after.mean()) ** 2))), rel_tol=1e-12)
-    # the holes soften the teeth near them: the STE ripple grows by more than a fifth
+    # the holes soften the teeth near them: the STE ripple over a mesh period grows by a tenth
     assert sw["ste_p2p"].dims == ("n_holes",)
-    assert float(sw["ste_p2p"].sel(n_holes=4)) > 1.2 * float(sw["ste_p2p"].sel(n_holes=0))
+    assert float(sw["ste_p2p"].sel(n_holes=4)) > 1.08 * float(sw["ste_p2p"].sel(n_holes=0))
     assert (sw["dte_rms"].sel(n_holes=4) > 1.02 * sw["dte_rms"].sel(n_holes=0)).all()     # at both speeds
     assert {"sweep_dte_rms.png", "sweep_ste_p2p.png"} <= {p.name for p in out.glob("*.png")}
     # summarize on the sweep: its scalars over the swept dimensions
