@@ -70,11 +70,23 @@ def checked_max_time(args) -> float:
 
 def scene_arguments(p, output: str | None, output_help: str = "archive to write (NetCDF)") -> None:
     """The scene file, the archive (when the command writes one) and ``--set`` overrides."""
-    p.add_argument("scene", nargs="?", help="scene TOML (default: the embedded paper example)")
+    p.add_argument("scene", nargs="?", help="scene TOML, or the name of an embedded scene (`lightgear scenes`; "
+                                            "default: the embedded paper example)")
     if output is not None:
         p.add_argument("-o", "--output", default=output, help=output_help)
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene field by its dotted path, e.g. --set gear2.body.holes=3")
+
+
+def args_scene(args):
+    """The scene of a command's arguments; an override without '=' (``--set key value``) gets a
+    hint before the value is taken for a scene file."""
+    import study
+    for item in args.overrides:
+        if "=" not in item:
+            fix = f"--set {item}={args.scene}" if args.scene else f"--set {item}=VALUE"
+            raise UsageError("--set", f"{item!r} is not key=value: write {fix} (no space around '=')")
+    return study.load_scene(args.scene, args.overrides)
 
 
 # ---------------------------------------------------------------- run
@@ -92,7 +104,7 @@ def run_command(args) -> int:
     from study.estimate import check_dynamic_memory
     from study.plausibility import check_dynamic_window
     from study.report.summary import print_summary
-    scene = study.load_scene(args.scene, args.overrides)
+    scene = args_scene(args)
     if not args.no_dynamic:
         check_dynamic_window(scene)       # the summary needs a steady part after the ramps
         check_dynamic_memory(scene)       # at once, before the solver is even loaded
@@ -148,15 +160,10 @@ def stiffness_command(args) -> int:
     import numpy as np
 
     import study
-    from study import estimate
-    from study.inputs.springs import hole_offset, identify_spring, stiffness_dataset
-    from study.setup import gear_setup
-    scene = study.load_scene(args.scene, args.overrides)
+    from study.inputs.springs import hole_offset
+    scene = args_scene(args)
     checked_output(args.output)
-    est = estimate.Estimate({"FE bodies": estimate.fe_seconds(scene)})
-    estimate.check_time(est, checked_max_time(args))
-    estimate.run_fe_bodies(scene)
-    ds = stiffness_dataset(scene)
+    ds = study.stiffness(scene, max_time=checked_max_time(args), progress=True)
     study.write(ds, args.output)
     print(f"tooth stiffness map -> {args.output} ({ds.attrs['wall_time_springs_s']:.2f} s)")
     for g in (1, 2):
@@ -169,17 +176,18 @@ def stiffness_command(args) -> int:
             print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
                   f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
         if args.identify:
-            fit, u, c = identify_spring(gear_setup(scene, g))
-            print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius * 1e3:.3f} mm, "
-                  f"k_phi {fit.k_phi * 1e3:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
-                  f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {u.size} load radii")
+            fit = study.identify_spring(scene, g)
+            print(f"    identified spring of tooth 0: pivot radius {fit.pivot_radius_mm:.3f} mm, "
+                  f"k_phi {fit.k_phi:.4g} N mm/rad^n, n {fit.n:.3f} (linear FE body), "
+                  f"compliance fit RMS {fit.rms_rel_error * 100:.1f} % over {fit.load_radii} load radii")
     return 0
 
 
 # ---------------------------------------------------------------- sweep
 
 def sweep_arguments(p) -> None:
-    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]] + [outputs])")
+    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]] + [outputs]), or the name of an "
+                                 "embedded study (`lightgear scenes`)")
     p.add_argument("-o", "--output", help="archive to write (NetCDF; default results/<study name>.nc)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="address of an existing dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--workers", type=int, default=None,
@@ -237,20 +245,16 @@ def fit_contact_arguments(p) -> None:
 def fit_contact_command(args) -> int:
     """Weber's contact deflection fitted to F = k_con * delta**m1, against the scene's law."""
     import study
-    from solver import units
-    from solver.identify.weber import fit_contact
-    from study.setup import gear_setups
-    scene = study.load_scene(args.scene, args.overrides)
-    g1, g2 = (setup.geometry for setup in gear_setups(scene))
-    f_ref = scene.quasi_static.torque / g1.base_radius
-    print(f"Weber contact deflection at the pitch point, plane strain, F_ref = {f_ref:.1f} N "
-          f"(quasi_static.torque / base radius), R = {fit_contact(g1, g2, scene.material_spec(), f_ref).radius * 1e3:.3f} mm")
-    for frac, note in ((0.5, "default: depth half-way to the tooth centreline"),
-                       (1.0, "depth to the tooth centreline (where the FE tooth spring is read)")):
-        f = fit_contact(g1, g2, scene.material_spec(), f_ref, depth_fraction=frac)
-        k = f.k_con / units.contact_stiffness_to_si(1.0, f.m1)
-        print(f"  {note}:\n    k_con = {k:.4g} N/mm^m1, m1 = {f.m1:.4f} "
-              f"(depth {f.depth[0] * 1e3:.3f} mm, load {f.force_range[0]:.0f}..{f.force_range[1]:.0f} N, "
+    scene = args_scene(args)
+    fits = [(study.fit_contact(scene, frac), note) for frac, note in (
+        (0.5, "default: depth half-way to the tooth centreline"),
+        (1.0, "depth to the tooth centreline (where the FE tooth spring is read)"))]
+    f0 = fits[0][0]
+    print(f"Weber contact deflection at the pitch point, plane strain, F_ref = {f0.reference_force_N:.1f} N "
+          f"(quasi_static.torque / base radius), R = {f0.radius_mm:.3f} mm")
+    for f, note in fits:
+        print(f"  {note}:\n    k_con = {f.k_con:.4g} N/mm^m1, m1 = {f.m1:.4f} "
+              f"(depth {f.depth_mm:.3f} mm, load {f.force_range_N[0]:.0f}..{f.force_range_N[1]:.0f} N, "
               f"fit RMS {f.rms_log_error:.1e} in ln F)")
     c = scene.contact
     print(f"  scene: k_con = {c.k_con:.4g} N/mm^m1, m1 = {c.m1:.4f}")
@@ -330,11 +334,9 @@ def precision_command(args) -> int:
     import math
 
     import study
-    from study.setup import build_scene_model
-    from study.verify.precision import dynamic_study, plot, setting_label, static_study, table
-    scene = study.load_scene(args.scene, args.overrides)
+    from study.verify.precision import setting_label
+    scene = args_scene(args)
     base = checked_output(args.output)
-    model = build_scene_model(scene)
 
     def progress(i, s, e, w, msg):
         setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
@@ -344,15 +346,11 @@ def precision_command(args) -> int:
         if args.only and args.only != kind:
             continue
         print(f"{kind} study ...", flush=True)
-        if kind == "dynamic":
-            ds = dynamic_study(scene, model, args.duration, args.ramp_fraction, args.repeats, progress)
-        else:
-            ds = static_study(scene, model, args.rotation, args.repeats, progress)
-        path = base.with_name(f"{base.stem}_{kind}.nc")
-        study.write(ds, path)
-        plot(ds, path.with_suffix(".png"))
-        print(table(ds))
-        print(f"  archive: {path}\n  plot: {path.with_suffix('.png')}", flush=True)
+        ds = study.precision(scene, base, args.duration, args.ramp_fraction, args.rotation, args.repeats, kind,
+                             progress)[kind]
+        path = ds.attrs["archive"]
+        print(study.precision_table(ds))
+        print(f"  archive: {path}\n  plot: {path[:-3]}.png", flush=True)
     return 0
 
 
@@ -369,15 +367,11 @@ def reference_command(args) -> int:
     import numpy as np
 
     import study
-    from study import estimate
-    from study.verify.fe_reference import reference_dataset, static_angles
-    scene = study.load_scene(args.scene, args.overrides)
+    scene = args_scene(args)
     if args.step is not None and not args.step > 0:
         raise study.SceneError("--step", f"must be positive, got {args.step}")
     checked_output(args.output)
-    angles = static_angles(scene, args.step)
-    estimate.check_time(estimate.reference_estimate(scene, angles), checked_max_time(args))
-    ds = reference_dataset(scene, angles, progress=True)
+    ds = study.reference(scene, args.step, max_time=checked_max_time(args), progress=True)
     study.write(ds, args.output)
     ste = ds["ste"].values
     print(f"FE reference STE -> {args.output}")
@@ -385,6 +379,46 @@ def reference_command(args) -> int:
           f"peak-to-peak {np.ptp(ste):.3f} um over {float(ds['angle'][-1]):.4g} deg, {ste.size} angles")
     print(f"  wall time: compliance {ds.attrs['wall_time_compliance_s']:.2f} s, contact {ds.attrs['wall_time_contact_s']:.2f} s, "
           f"total {ds.attrs['wall_time_reference_s']:.2f} s")
+    return 0
+
+
+# ---------------------------------------------------------------- scenes, fields, outputs
+
+def scenes_arguments(p) -> None:
+    pass
+
+
+def scenes_command(args) -> int:
+    import study
+    rows = study.scenes()
+    width = max(len(n) for n in rows)
+    for name, (_path, kind, title) in rows.items():
+        print(f"{name:{width}s}  {kind:5s}  {title}")
+    from study.scene import SCENES_DIR
+    print(f"\n`lightgear run NAME` runs a scene, `lightgear sweep NAME` a study; their files are in {SCENES_DIR}")
+    return 0
+
+
+def fields_arguments(p) -> None:
+    p.add_argument("prefix", nargs="?", default="", help="only the fields under this dotted path, e.g. gear2.body")
+    p.add_argument("--markdown", action="store_true", help="as the Markdown tables of docs/scenes.md")
+
+
+def fields_command(args) -> int:
+    from study.docs import fields_markdown, fields_text
+    if args.markdown and args.prefix:
+        raise UsageError("--markdown", "writes the whole reference; give no prefix")
+    sys.stdout.write(fields_markdown() if args.markdown else fields_text(args.prefix))
+    return 0
+
+
+def outputs_arguments(p) -> None:
+    p.add_argument("--markdown", action="store_true", help="as the Markdown table of docs/numbers.md")
+
+
+def outputs_command(args) -> int:
+    from study.docs import outputs_markdown, outputs_text
+    sys.stdout.write(outputs_markdown() if args.markdown else outputs_text())
     return 0
 
 
@@ -404,6 +438,9 @@ COMMANDS = {
                   precision_command),
     "reference": ("FE reference STE and load sharing (loaded-tooth-contact analysis)", reference_arguments,
                   reference_command),
+    "scenes": ("list the embedded scenes and studies (run them by name)", scenes_arguments, scenes_command),
+    "fields": ("list the scene fields with unit, default, range and meaning", fields_arguments, fields_command),
+    "outputs": ("list the sweep outputs (scalars and curves) with their units", outputs_arguments, outputs_command),
 }
 
 
@@ -422,12 +459,13 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     import os
 
-    from study.errors import BudgetError
+    from study.errors import BudgetError, StudyError
     from study.scene import SceneError
     try:
         return int(args._command(args) or 0)
     except SceneError as e:
-        print(f"lightgear {args.command}: invalid scene: {e}", file=sys.stderr)
+        what = "study" if isinstance(e, StudyError) else "scene"
+        print(f"lightgear {args.command}: invalid {what}: {e}", file=sys.stderr)
         return 2
     except UsageError as e:
         print(f"lightgear {args.command}: {e}", file=sys.stderr)

@@ -13,7 +13,7 @@ from study.errors import SceneError
 
 NOT_GIVEN = math.nan   # an optional field left out (written as ``nan`` when a scene is saved)
 
-# Damping defaults, as ratios of critical (see README "Damping"). Mesh: measured spur-gear mesh
+# Damping defaults, as ratios of critical (see docs/numbers.md, "Damping"). Mesh: measured spur-gear mesh
 # damping ratios are a few percent of critical: 0.03-0.17 (the range Kasuba & Evans 1981, ASME
 # J. Mech. Des. 103, report for the mesh), about 0.05-0.10 (Gerber 1984, measurements on an
 # FZG back-to-back rig), and a few percent from the EHL film of the mesh interface (Li &

@@ -11,6 +11,11 @@ class SceneError(ValueError):
         super().__init__(f"{field}: {reason}")
 
 
+class StudyError(SceneError):
+    """Invalid study input (the base scene of a study, its grid, points or outputs); ``field``
+    is the dotted scene field or the study key."""
+
+
 class BudgetError(Exception):
     """A run refused before any work because its estimate exceeds the machine's memory or the
     time bound (``lightgear ... --max-time``); ``field`` names what to change."""

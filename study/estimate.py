@@ -2,8 +2,11 @@
 statics and the time integration, checked against what the machine has and a time bound
 (`lightgear run|stiffness|reference --max-time`), and the progress bar of a long run.
 
-The costs per unit are measured on the paper pair (2 cores, warm numba cache) and are rough
-(a factor of two either way): they tell a run of seconds from one of hours, not more.
+The costs per unit are CPU seconds measured on the paper pair and the README's small pair
+(warm numba cache; a quiet machine's wall time) and are rough (a factor of two either way):
+they tell a run of seconds from one of hours, not more. A loaded machine gives each process a
+smaller share of a core: every estimate is scaled by `load_factor` (measured under a load of
+10-12 on 2 cores: wall times 2 to 4 times the CPU time). What the FE cache holds counts as free.
 """
 from __future__ import annotations
 
@@ -17,15 +20,29 @@ from study.errors import BudgetError
 
 DEFAULT_MAX_TIME_S = 3600.0       # --max-time default [s]
 PROGRESS_AFTER_S = 5.0            # runs expected to take longer than this show a progress bar [s]
-# Measured costs (paper pair, 67/67 teeth): Verlet 1.2 s CPU for 340 000 steps -> about
-# 2.6e-8 s per step and tooth of the pair; HHT-alpha about 20 x that per step (Newton).
-EXPLICIT_S_PER_STEP_TOOTH = 3e-8
+# Measured costs in CPU seconds (a quiet machine's wall time; under load the wall time grows by
+# the load per core). Verlet: a step costs a fixed part (contact search, kicks of the hubs) and a
+# part per active tooth: paper pair 0.59 s for 180 000 steps with 21 teeth active, the 20-tooth
+# example pair 0.03 s for 11 000 steps with 10, the paper run-up 5.7 s for 900 000 steps with
+# all 134 active -> 2.8e-6 s + 2.4e-8 s per active tooth. Teeth away from the mesh are frozen
+# (about ACTIVE_TEETH_PER_GEAR of each gear stay active), except in a run-up, where the rising
+# speed keeps every tooth moving on its spring; a run-up's resonances also raise the contact
+# forces beyond the step's load, so its run is repeated at about half the step (measured on
+# study/scenes/runup.toml: 900 000 then 1 700 000 steps): counted as RUNUP_RUNS runs.
+# HHT-alpha: about 20 x a Verlet step per tooth of the pair (Newton).
+DYNAMIC_S_PER_RUN = 0.05         # the step estimate and the output arrays of a run (the small pair: 0.05 s in all)
+EXPLICIT_S_PER_STEP = 2.8e-6
+EXPLICIT_S_PER_STEP_TOOTH = 2.4e-8
+ACTIVE_TEETH_PER_GEAR = 10
+RUNUP_RUNS = 3.0
 IMPLICIT_S_PER_STEP_TOOTH = 6e-7
-STATIC_S_PER_ANGLE_TOOTH = 6e-6   # Newton with continuation: 0.45 s for 1201 angles of 67/67 teeth
-# FE body: gmsh mesh, P2 assembly and the Z load cases, 17 s for the paper body's 39 700
-# elements alone (4.4e-4 s per element), twice that with the cores shared -> 8e-4 s per
-# element, growing with the size of the factorisation.
-FE_S_PER_ELEMENT = 8e-4
+STATIC_S_PER_ANGLE_TOOTH = 2e-7   # Newton with continuation: 0.02 s for 1201 angles of 67/67 teeth
+# FE body: gmsh mesh, P2 assembly and the Z load cases: the paper's lightened driven gear and
+# its solid reference, 23 400 elements each by `body_elements`, 6.7 s for both; the README's
+# 20-tooth pair, 3 500 each, 2.3 s for both -> 0.6 s a body (mesher, set-up, the cache file)
+# and 1.16e-4 s per element, growing with the size of the factorisation beyond FE_REF_ELEMENTS.
+FE_S_PER_BODY = 0.6
+FE_S_PER_ELEMENT = 1.16e-4
 FE_REF_ELEMENTS = 4e4
 OUTPUT_COPIES = 2.5               # the kernel's output array, the result's columns and the archive's
 
@@ -38,10 +55,23 @@ class Estimate:
 
     @property
     def total_s(self) -> float:
+        """Estimated wall time [s] of the whole run (its parts already scaled by `load_factor`)."""
         return float(sum(self.seconds.values()))
 
     def describe(self) -> str:
         return ", ".join(f"{k} {duration_text(v)}" for k, v in self.seconds.items() if v > 0) or "nothing"
+
+
+def load_factor() -> float:
+    """How much longer than on a quiet machine a run takes now: the square root of the load
+    average per core (1 minute; at least 1). Measured under a load of 10-12 on 2 cores: the FE
+    bodies, the reference and the dynamics took 2 to 4 times their CPU time (the load average
+    counts processes that wait on more than the CPU, hence less than the load per core)."""
+    try:
+        load = os.getloadavg()[0]
+    except (OSError, AttributeError):
+        return 1.0
+    return max(1.0, math.sqrt(load / (os.cpu_count() or 1)))
 
 
 def duration_text(s: float) -> str:
@@ -100,10 +130,16 @@ def check_dynamic_memory(scene) -> None:
                           "dynamic.output_step")
 
 
-def dynamic_seconds(model, choice, duration: float) -> float:
-    """Estimated run time [s] of the time integration with the chosen method and step."""
-    per = IMPLICIT_S_PER_STEP_TOOTH if choice.method == "implicit" else EXPLICIT_S_PER_STEP_TOOTH
-    return duration / choice.dt * per * model.n_teeth
+def dynamic_seconds(model, choice, duration: float, scene=None) -> float:
+    """Estimated run time [s] of the time integration with the chosen method and step
+    (``scene``: tells a run-up, whose teeth all stay active and whose run is repeated)."""
+    steps = duration / choice.dt
+    if choice.method == "implicit":
+        return (DYNAMIC_S_PER_RUN + steps * IMPLICIT_S_PER_STEP_TOOTH * model.n_teeth) * load_factor()
+    runup = scene is not None and scene.dynamic.speed_end > 0
+    active = model.n_teeth if runup else min(model.n_teeth, 2 * ACTIVE_TEETH_PER_GEAR)
+    per_step = EXPLICIT_S_PER_STEP + EXPLICIT_S_PER_STEP_TOOTH * active
+    return (DYNAMIC_S_PER_RUN + steps * per_step) * (RUNUP_RUNS if runup else 1.0) * load_factor()
 
 
 def static_seconds(scene, model) -> float:
@@ -111,7 +147,7 @@ def static_seconds(scene, model) -> float:
     from study.setup import static_angles
     qs = scene.quasi_static
     if qs.method == "static":
-        return static_angles(scene).size * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth
+        return static_angles(scene).size * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth * load_factor()
     return 0.0      # the transient's steps are counted like a dynamic run's by the caller when needed
 
 
@@ -136,7 +172,8 @@ def error_period_note(scene) -> str | None:
     if not qs.enabled or rot <= 1.5 * qs.rotation:
         return None
     n = static_angles(scene).size
-    sec = n * STATIC_S_PER_ANGLE_TOOTH * (scene.gear1.teeth + scene.gear2.teeth) if qs.method == "static" else float("nan")
+    sec = (n * STATIC_S_PER_ANGLE_TOOTH * (scene.gear1.teeth + scene.gear2.teeth) * load_factor()
+           if qs.method == "static" else float("nan"))
     return (f"quasi-static: the pitch errors and eccentricities repeat after {rot:.6g} deg of driver rotation: the STE "
             f"covers that instead of quasi_static.rotation = {qs.rotation:.6g} deg ({n} angles at {qs.angle_step:g} deg, "
             f"{rot / qs.rotation:.3g} x longer" + (f", about {duration_text(sec)})" if math.isfinite(sec) else ")"))
@@ -163,7 +200,7 @@ def body_elements(setup) -> float:
 def body_seconds(setup) -> float:
     """Estimated run time [s] of one FE body: mesh, assembly, factorisation and load cases."""
     n = body_elements(setup)
-    return FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25
+    return (FE_S_PER_BODY + FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25) * load_factor()
 
 
 def fe_bodies(scene) -> list:
@@ -193,16 +230,28 @@ def fe_seconds(scene) -> float:
     return sum(body_seconds(s) for _, s, _ in fe_bodies(scene)) * factor
 
 
-LTCA_S_PER_ANGLE = 1.5e-3        # contact solve of one angle, influence coefficients cached
-LTCA_BODY_FACTOR = 2.0           # a body of the LTCA is loaded at several profile points per tooth
+LTCA_S_PER_ANGLE = 1.6e-3        # contact solve of one angle, influence coefficients cached (paper: 2.0 s for 1201)
+# A body of the LTCA is loaded at several profile points per tooth: the paper's two bodies took
+# 1.0 x, the README pair's 2.0 x the time of a spring map's body
+LTCA_BODY_FACTOR = 1.4
+TEETH_SEARCH_ANGLES = 20000      # more angles than this: the cache is not searched (the bodies counted in full)
 
 
-def reference_parts(scene, angles) -> dict:
-    """Estimated seconds of the FE reference's parts: each body's influence coefficients (as
-    if not cached: the cache key needs the teeth in mesh) and the contact sweep."""
+def reference_parts(scene, angles, teeth=None) -> dict:
+    """Estimated seconds of the FE reference's parts: each body's influence coefficients (0 when
+    cached) and the contact sweep. ``teeth``: (teeth of gear 1, of gear 2, spread) in mesh over
+    ``angles`` (`study.verify.fe_reference.teeth_in_mesh`; None: found here, from the geometry)."""
+    from study.inputs.compliance import compliance_cached
     from study.inputs.gearsetup import gear_setups
-    parts = {f"gear {g} FE body": LTCA_BODY_FACTOR * body_seconds(s) for g, s in zip((1, 2), gear_setups(scene))}
-    parts["contact sweep"] = LTCA_S_PER_ANGLE * len(angles)
+    if teeth is None and len(angles) <= TEETH_SEARCH_ANGLES:
+        from study.setup import geometry_model
+        from study.verify.fe_reference import teeth_in_mesh
+        teeth = teeth_in_mesh(geometry_model(scene), angles)
+    parts = {}
+    for i, (g, s) in enumerate(zip((1, 2), gear_setups(scene))):
+        cached = teeth is not None and compliance_cached(s, teeth[i], teeth[2])
+        parts[f"gear {g} FE body"] = 0.0 if cached else LTCA_BODY_FACTOR * body_seconds(s)
+    parts["contact sweep"] = LTCA_S_PER_ANGLE * len(angles) * load_factor()
     return parts
 
 

@@ -100,3 +100,56 @@ def check_plausibility(scene) -> None:
     that summarise a run: integrator studies run windows that end with the ramps on purpose."""
     check_fe_mesh(scene)
     check_loads(scene)
+
+
+# ---------------------------------------------------------------- warnings (valid, but almost certainly a slip)
+
+# Pitch-line velocity above which a spur gear pair is almost certainly not meant (precision
+# spur gears rarely run above 40-60 m/s; rad/s given as rpm gives some ten times the speed).
+PITCH_LINE_VELOCITY_MAX = 100.0       # m/s
+# A driver speed this many times the mesh mode's 1Z critical speed (the highest critical speed
+# of the mesh orders) is far beyond the range the dynamic model is built for.
+CRITICAL_SPEED_FACTOR = 3.0
+
+
+def scene_warnings(scene) -> list[str]:
+    """Values that pass the checks but are almost certainly a unit slip, each as one line naming
+    the field: a lightening hole smaller than the FE mesh size (metres typed for millimetres), a
+    pitch-line velocity above PITCH_LINE_VELOCITY_MAX (rpm typed for rad/s)."""
+    out = []
+    for g in (1, 2):
+        b, h = scene.gear(g).body, mesh_size_mm(scene, g)
+        if b.holes and b.hole_radius < h:
+            out.append(f"gear{g}.body.hole_radius: {b.hole_radius:.4g} mm is smaller than the FE mesh size "
+                       f"({h:.4g} mm): the hole is no lightening the model can see (millimetres meant?)")
+    d = scene.dynamic
+    if d.enabled:
+        field, speed = ("dynamic.speed_end", d.speed_end) if d.speed_end > 0 else ("dynamic.speed", d.speed)
+        v = speed * gear_geometry(scene.tooth_spec(1)).pitch_radius        # m/s
+        if v > PITCH_LINE_VELOCITY_MAX:
+            out.append(f"{field}: {speed:.4g} rad/s turns the pitch line at {v:.3g} m/s, above "
+                       f"{PITCH_LINE_VELOCITY_MAX:g} m/s (rpm meant? {speed:.4g} rpm = {speed * 0.10471975511965977:.4g} rad/s)")
+    return out
+
+
+def critical_speed_warning(scene, critical_speed_1z: float) -> str | None:
+    """A line when the driver speed lies far above the mesh mode's 1Z critical speed [rad/s]
+    (the highest of the mesh orders' critical speeds), else None."""
+    d = scene.dynamic
+    if not d.enabled:
+        return None
+    field, speed = ("dynamic.speed_end", d.speed_end) if d.speed_end > 0 else ("dynamic.speed", d.speed)
+    if critical_speed_1z > 0 and speed > CRITICAL_SPEED_FACTOR * critical_speed_1z:
+        return (f"{field}: {speed:.4g} rad/s is {speed / critical_speed_1z:.3g} x the highest critical speed of the mesh "
+                f"orders (1Z on the mesh mode: {critical_speed_1z:.4g} rad/s), far beyond the resonances the model is "
+                "built to study (rpm meant?)")
+    return None
+
+
+def report_warnings(messages, show: bool = True) -> str:
+    """Print each warning on stderr (``show``) -> the text for an archive attribute ('' for none)."""
+    import sys
+    for m in messages:
+        if show:
+            print(f"lightgear: warning: {m}", file=sys.stderr)
+    return "\n".join(messages)

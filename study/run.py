@@ -20,6 +20,7 @@ from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study import estimate
 from study.inputs.gearsetup import gear_setups
+from study.plausibility import critical_speed_warning, report_warnings, scene_warnings
 from study.report import results
 from study.report.lightening import lightening_variables
 from study.report.mesh_outputs import dynamic_force_variables, mesh_variables
@@ -72,7 +73,7 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
     choice = choice or dynamic_choice(scene, model)
     speed, speed_ramp = (d.speed_end, d.duration) if d.speed_end > 0 else (d.speed, d.ramp_time)   # a run-up: one ramp
     args = (model, speed, speed_ramp, d.torque, d.ramp_time, d.duration)
-    bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration), d.duration,
+    bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration, scene), d.duration,
                                 f"dynamic run ({choice.method})", "s", show=progress)
     watch = None if bar is None else (lambda t: bar.update(t - bar.n))
     try:
@@ -106,7 +107,8 @@ def static_force_max(scene: Scene, model: Model) -> float:
 
 
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
-              max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True) -> xr.Dataset:
+              max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True,
+              warn: bool = True) -> xr.Dataset:
     """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive.
 
     Before any work: a dynamic run whose output arrays do not fit in memory is refused
@@ -115,9 +117,13 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     it concerns starts. ``progress``: bars on stderr for the parts expected to be long.
     ``mesh_outputs``: also the linearised mesh over the STE (mesh stiffness, c', loaded contact
     ratio, tooth forces of both gears; about 1 ms an angle) and the dynamic factor K_v (its static
-    reference over a revolution); a study leaves them out unless it asks for them."""
+    reference over a revolution); a study leaves them out unless it asks for them.
+    Plausibility warnings (`study.plausibility.scene_warnings`, and a speed far above the
+    critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
+    warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
+    report_warnings(warnings, warn)
     if dynamic:
         estimate.check_dynamic_memory(scene)
     est = estimate.Estimate()
@@ -138,7 +144,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     if dynamic:
         choice = dynamic_choice(scene, model)
         est.seconds[f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"] = \
-            estimate.dynamic_seconds(model, choice, scene.dynamic.duration)
+            estimate.dynamic_seconds(model, choice, scene.dynamic.duration, scene)
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
@@ -169,6 +175,13 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     coords.update(c); data.update(v); attrs.update(a)
     attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
     attrs["wall_time_modes_s"] = time.perf_counter() - t0
+    if dynamic and "critical_speed" in data:
+        cs = data["critical_speed"]
+        line = critical_speed_warning(scene, float(cs.values[list(coords["excitation"].values).index("1Z"), 0]))
+        if line:
+            report_warnings([line], warn)
+            warnings.append(line)
+    attrs["plausibility_warnings"] = "\n".join(warnings)
     if static:
         t0 = time.perf_counter()
         st = run_static(scene, model)

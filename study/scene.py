@@ -13,6 +13,7 @@ Errors: `SceneError` names the dotted field and the reason, before any work star
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 import tomllib
 import typing
@@ -254,7 +255,9 @@ class Scene:
 # ---------------------------------------------------------------- building and checking
 
 def _coerce(value, typ, path):
-    """``value`` as ``typ`` (bool, int, float or str), else SceneError; a bool is no number."""
+    """``value`` as ``typ`` (bool, int, float or str), else SceneError; a bool is no number.
+    NumPy scalars and arrays count as the Python numbers and lists they hold."""
+    value = _python_value(value)
     if typ == tuple[float, ...]:    # a list of numbers (a table's column)
         if not isinstance(value, list | tuple):
             raise SceneError(path, f"must be a list of numbers, got {value!r}")
@@ -271,6 +274,13 @@ def _coerce(value, typ, path):
     raise SceneError(path, f"must be {what}, got {value!r}")
 
 
+def _python_value(value):
+    """A NumPy scalar or array as the Python number, bool or list it holds; anything else as is."""
+    if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
+        return value.tolist()
+    return value
+
+
 def _build(cls, table, path: str):
     if not isinstance(table, dict):
         raise SceneError(path or "scene", f"must be a table, got {table!r}")
@@ -279,7 +289,9 @@ def _build(cls, table, path: str):
     for key in table:
         if key not in known:
             where = f"{path}.{key}" if path else key
-            raise SceneError(where, f"unknown key (expected one of: {', '.join(known)})")
+            close = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.6)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise SceneError(where, f"unknown key (expected one of: {', '.join(known)}){hint}")
     kwargs = {}
     for name, f in known.items():
         where = f"{path}.{name}" if path else name
@@ -364,11 +376,44 @@ def loads_scene(text: str, source: str = "scene") -> Scene:
     return scene_from_dict(_tables(text, source))
 
 
+SCENES_DIR = Path(__file__).parent / "scenes"
+
+
+def embedded_scenes() -> dict[str, tuple[Path, str, str]]:
+    """The scenes and studies that ship with lightgear: name -> (file, 'scene' or 'study', title)."""
+    out = {}
+    for p in sorted(SCENES_DIR.glob("*.toml")):
+        try:
+            raw = tomllib.loads(p.read_text())
+        except (OSError, tomllib.TOMLDecodeError):
+            continue
+        kind = "study" if ("grid" in raw or "points" in raw) else "scene"
+        out[p.stem] = (p, kind, str(raw.get("title", "")))
+    return out
+
+
+def scene_path(name: str | Path, what: str = "scene") -> Path:
+    """The file of a scene or study given by path or by the name of an embedded one
+    (``"runup"``, ``"runup.toml"``; a file that exists wins). SceneError names both ways."""
+    p = Path(name)
+    if p.is_file():
+        return p
+    stem = p.stem if p.suffix == ".toml" else p.name
+    known = embedded_scenes()
+    if len(p.parts) == 1 and stem in known:
+        return known[stem][0]
+    names = ", ".join(k for k, v in known.items() if v[1] == what) or ", ".join(known)
+    close = difflib.get_close_matches(stem, list(known), n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise SceneError(what, f"no such file or embedded {what}: {name} (embedded {'studies' if what == 'study' else 'scenes'}: {names}; "
+                     f"`lightgear scenes` lists them){hint}")
+
+
 def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] = ()) -> Scene:
-    """Read a scene file (default: the embedded paper example), apply ``key=value`` overrides."""
-    if path is not None and not Path(path).is_file():
-        raise SceneError("scene", f"no such file: {Path(path)}")
-    data = _tables(default_scene_text() if path is None else Path(path).read_text(), str(path or "scene"))
+    """Read a scene file or an embedded scene by name (default: the embedded paper example),
+    apply ``key=value`` overrides."""
+    text = default_scene_text() if path is None else scene_path(path).read_text()
+    data = _tables(text, str(path or "scene"))
     items = [parse_override(item) for item in overrides]
     keys = {k for k, _v in items}
     for key, _v in items:
@@ -428,12 +473,33 @@ def get_dotted(scene: Scene, path: str):
 def scene_field(path: str) -> dataclasses.Field:
     """The declaration (default, metadata) of a scene field or table given by its dotted path."""
     cls, f = Scene, None
-    for p in path.split("."):
+    parts = path.split(".")
+    for i, p in enumerate(parts):
         fs = {x.name: x for x in fields(cls)} if dataclasses.is_dataclass(cls) else {}
         if p not in fs:
-            raise SceneError(path, "no such scene field")
+            where = ".".join(parts[:i])
+            close = difflib.get_close_matches(path, field_paths(), n=1, cutoff=0.6)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            valid = f" (fields of {where}: {', '.join(fs)})" if fs and where else (
+                f" (sections: {', '.join(fs)})" if fs else f" ({where} is a value, not a table)")
+            raise SceneError(path, f"no such scene field{valid}{hint}{' ' if hint else '; '}"
+                             "`lightgear fields` lists them all")
         f, cls = fs[p], typing.get_type_hints(cls)[p]
     return f
+
+
+def field_paths(cls=None, prefix: str = "") -> list[str]:
+    """Dotted paths of every value field of the scene (tables left out), in declaration order."""
+    cls = Scene if cls is None else cls
+    out = []
+    hints = typing.get_type_hints(cls)
+    for f in fields(cls):
+        path = f"{prefix}.{f.name}" if prefix else f.name
+        if dataclasses.is_dataclass(hints[f.name]):
+            out += field_paths(hints[f.name], path)
+        else:
+            out.append(path)
+    return out
 
 
 def field_unit(path: str) -> str:

@@ -36,14 +36,13 @@ default grid is 3 x 2 x 2 x 2 = 24 bodies and the refinement at most 2 x 7 = 14:
 empty cache, 460 s of CPU for the grid and 120 s for the 6 refined bodies the defaults give,
 about 5 minutes on 2 quiet cores and at most some 7 with 14 refined bodies. Each body is run once for its statics (120 deg at
 0.2 deg) and once for its dynamics over a short window: the ramp twice (the steady window starts
-at twice the ramp time, `study.plausibility.check_dynamic_window`) and then one revolution of the
+at twice the ramp time, `study.check_dynamic_window`) and then one revolution of the
 driven gear, so the DTE RMS covers every tooth and hole once (0.083 s at 100 rad/s for the paper
 pair, instead of the paper's 0.2 s).
 """
 from __future__ import annotations
 
 import argparse
-import contextlib
 import itertools
 import math
 import sys
@@ -54,7 +53,7 @@ import numpy as np
 import xarray as xr
 
 import study
-from study.scene import SceneError, parse_override
+from study import SceneError
 
 DEFAULT_OUT = "results/lightest_gear"
 FIELDS = {"gear2.body.holes": "n_holes", "gear2.body.hole_radius": "hole_radius",
@@ -152,8 +151,7 @@ def base_scene(path, overrides, speed: float, duration: float | None, angle_step
         scene = scene.replace(**{"dynamic.duration": duration})
     else:
         scene = scene.replace(**{"dynamic.duration": duration})
-    from study.plausibility import check_dynamic_window
-    check_dynamic_window(scene)
+    study.check_dynamic_window(scene)
     return scene
 
 
@@ -178,17 +176,6 @@ def _row(table, i) -> dict:
     return {k: table[k].values[i].item() for k in table.data_vars}
 
 
-@contextlib.contextmanager
-def _cluster(workers: int | None):
-    """The scheduler address of a LocalCluster for both sweeps (None: in process)."""
-    if workers == 0:
-        yield None
-        return
-    from study.sweep.engine import dask_client
-    with dask_client(None, workers) as client:
-        yield client.scheduler.address
-
-
 def parse_grid(items: list[str]) -> dict:
     grid = {k: list(v) for k, v in COARSE.items()}
     for item in items:
@@ -198,7 +185,7 @@ def parse_grid(items: list[str]) -> dict:
             raise SceneError(field or "--grid", f"the grid is over {', '.join(FIELDS)}; got {item!r}")
         if not values:
             raise SceneError(field, "a grid axis must look like field=v1,v2,...")
-        grid[field] = [parse_override(f"x={v}")[1] for v in values.split(",")]
+        grid[field] = [study.parse_overrides([f"x={v}"])["x"] for v in values.split(",")]
     return grid
 
 
@@ -218,7 +205,7 @@ def run(args) -> int:
           + (f" and <= {limits.stress_max:g} MPa" if math.isfinite(limits.stress_max) else "")
           + f"; DTE over {scene.dynamic.duration:g} s; coarse grid {n} bodies -> {out}", flush=True)
     lost = 0
-    with _cluster(args.workers) as address:
+    with study.local_cluster(args.workers) as address:
         kw = {"workers": 0 if address is None else None, "scheduler": address, "progress": not args.no_progress}
         res = study.run_sweep(solid_study, out / "solid.nc", **kw)
         solid_table = candidates(res.dataset, {path: solid_study.base_value(path) for path in FIELDS})
@@ -262,17 +249,15 @@ def run(args) -> int:
 def tradeoff(table: xr.Dataset, solid_table: xr.Dataset, limits: Limits, chosen: int | None, path, title: str):
     """Mass saving against STE p2p and DTE RMS of every body run and of the solid gear
     (`study_views.tradeoff_figure`), with the TE limits and the chosen body marked."""
-    from study.report.effects import pareto_table
-    from study.report.study_views import tradeoff_figure
-    from study.sweep.outputs import SCALARS as META
+    meta = {name: (unit, doc) for name, _kind, unit, _analysis, doc in study.outputs()}
     ds = xr.concat([table, solid_table], "candidate")
     ds = ds.assign_coords(candidate=np.arange(ds.sizes["candidate"])).assign_attrs(title=title)
     for k in SCALARS:
-        ds[k].attrs.update(units=META[k].units, long_name=META[k].long_name)
+        ds[k].attrs.update(units=meta[k][0], long_name=meta[k][1])
     solid = _row(solid_table, 0)
-    pareto = pareto_table(ds, limits.stress_ratio)
+    pareto = study.pareto(ds, limits.stress_ratio)
     te_limits = {"ste_p2p": limits.ste_factor * solid["ste_p2p"], "dte_rms": limits.dte_factor * solid["dte_rms"]}
-    return tradeoff_figure(ds, pareto, path, te_limits=te_limits, chosen=chosen)
+    return study.tradeoff_figure(ds, pareto, path, te_limits=te_limits, chosen=chosen)
 
 
 def main(argv=None) -> int:

@@ -9,20 +9,17 @@ other fields, ok points only). Any grid axis can be replaced to shrink or refine
         [--workers N | --scheduler ADDRESS]
 
 Cost on a 2-core machine: dominated by the FE spring maps of the 36 distinct driven-gear
-bodies (cached on disk: a second run with other speeds reuses them); see the README.
+bodies (cached on disk: a second run with other speeds reuses them); see docs/studies.md.
 """
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import math
 from pathlib import Path
 
 import numpy as np
 
 import study
-from study.scene import SceneError, parse_override, scene_fields_from_dict, set_dotted
-from study.sweep.outputs import SCALARS, STATUS
 
 STUDY = Path(__file__).resolve().parents[1] / "study" / "scenes" / "sensitivity.toml"
 DEFAULT_OUT = "results/sensitivity/sensitivity.nc"
@@ -37,20 +34,19 @@ def sensitivity_study(path: str | Path = STUDY, grid: list[str] = (), overrides:
     for item in grid:
         field, _, values = item.partition("=")
         if not values:
-            raise SceneError(field or "grid", "a grid axis must look like field=v1,v2,...")
-        axes[field.strip()] = [parse_override(f"x={v}")[1] for v in values.split(",")]
-    scene = dataclasses.asdict(scene_fields_from_dict(base.base))   # every field, so nothing falls back to the paper's
-    for item in overrides:
-        set_dotted(scene, *parse_override(item))
+            raise study.SceneError(field or "grid", "a grid axis must look like field=v1,v2,...")
+        axes[field.strip()] = [study.parse_overrides([f"x={v}"])["x"] for v in values.split(",")]
+    scene = base.base_scene().replace(**study.parse_overrides(overrides))
     return study.make_study(scene, axes, base.extra, base.outputs, base.title)
 
 
 def sensitivity_table(ds) -> list[str]:
     """Per swept field and value: the mean of the main outputs over the other fields (ok points)."""
-    ok = ds["status"] == STATUS.index("ok")
+    ok = ds["status"] == study.STATUS.index("ok")
+    units = {name: unit for name, _kind, unit, _analysis, _doc in study.outputs()}
     shown = [k for k in SHOWN if k in ds]
     lines = ["field            value      " + "".join(f"{k:>16s}" for k in shown),
-             "                            " + "".join(f"{'[' + SCALARS[k].units + ']':>16s}" for k in shown)]
+             "                            " + "".join(f"{'[' + units[k] + ']':>16s}" for k in shown)]
     dims = [d for d in ds["status"].dims if d != "point"]
     for d in dims:
         for v in ds[d].values:
@@ -83,7 +79,7 @@ def main(argv=None) -> int:
     res = study.run_sweep(st, args.output, workers=args.workers, scheduler=args.scheduler,
                           progress=not args.no_progress)
     ds = res.dataset
-    counts = ", ".join(f"{name} {int((ds['status'] == i).sum())}" for i, name in enumerate(STATUS) if (ds["status"] == i).any())
+    counts = ", ".join(f"{name} {int((ds['status'] == i).sum())}" for i, name in enumerate(study.STATUS) if (ds["status"] == i).any())
     print(f"  {res.points} points; analyses computed {res.computed}, reused {res.reused}, invalid {res.invalid} ({counts}); "
           f"wall time {res.wall_time:.1f} s, compute {float(ds['wall_time'].sum()):.1f} s")
     for line in sensitivity_table(ds):

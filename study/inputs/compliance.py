@@ -23,6 +23,23 @@ LTCA_VERSION = "2"          # bump when the influence coefficients' definition c
 PROFILE_POINTS = 8          # roll-parameter grid points along each flank (STE within 0.01 um of 16)
 
 
+def compliance_key(setup: GearSetup, teeth: list, spread: int, u: np.ndarray) -> tuple[str, list, list]:
+    """(cache key, loaded teeth, read teeth) of the gear's compliance on the roll grid ``u``."""
+    if not setup.lightened:     # a solid body: the columns of tooth 0, read at offsets -spread..spread
+        load, read = [0], list(range(-spread, spread + 1))
+    else:
+        load = read = [int(t) for t in teeth]
+    key = FE_CACHE.key({**setup.settings, "load": load, "read": read, "u": [float(x) for x in u], "ltca": LTCA_VERSION})
+    return key, load, read
+
+
+def compliance_cached(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFILE_POINTS) -> bool:
+    """True when the compliance `gear_compliance` would compute is in the cache (memory or disk)."""
+    from solver.fe.ltca import profile_grid
+    key, _, _ = compliance_key(setup, teeth, spread, profile_grid(setup.geometry, n_u))
+    return key in FE_CACHE.compliance or (FE_CACHE.folder / f"ltca-{key}.npz").exists()
+
+
 def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFILE_POINTS,
                     u: np.ndarray | None = None) -> tuple:
     """(BodyCompliance [m/N], info) of the gear's body, cached. A solid body: columns of tooth 0,
@@ -37,11 +54,7 @@ def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFI
     settings = setup.settings
     symmetric = not setup.lightened
     u = profile_grid(geo, n_u) if u is None else np.asarray(u, float)
-    if symmetric:
-        load, read = [0], list(range(-spread, spread + 1))
-    else:
-        load = read = [int(t) for t in teeth]
-    key = FE_CACHE.key({**settings, "load": load, "read": read, "u": [float(x) for x in u], "ltca": LTCA_VERSION})
+    key, load, read = compliance_key(setup, teeth, spread, u)
     info = {"mesh_size_m": setup.mesh_size, "cached": True, "wall_time_s": 0.0, "load_cases": len(load) * u.size}
     c = FE_CACHE.read_compliance(key)
     if c is not None:

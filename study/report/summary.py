@@ -53,6 +53,14 @@ def summarize(ds: xr.Dataset) -> dict:
     return out
 
 
+def summarize_sweep(ds: xr.Dataset) -> dict:
+    """The scalars of a sweep archive: {name: DataArray over the swept dimensions}, NaN where
+    the point's status is not ok (an output not over every swept dimension is broadcast)."""
+    from study.sweep.outputs import SCALARS, STATUS
+    ok = ds["status"] == STATUS.index("ok")
+    return {k: ds[k].where(ok) for k in SCALARS if k in ds.data_vars}
+
+
 def amplitude_at_order(ds: xr.Dataset, order: float, half_width: float = 0.5) -> float:
     """Largest DTE amplitude [um] within +-half_width orders of ``order``."""
     o = ds["order"].values

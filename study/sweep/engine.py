@@ -84,7 +84,8 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
             scene = loads_scene(scene)
         if outputs.static or outputs.dynamic or outputs.modes:
             ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic,
-                           mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)))
+                           mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)),
+                           warn=False)   # the sweep warns once
         else:   # geometry (and root stress) only: no model, no solve
             from study.report.lightening import lightening_dataset
             ds = lightening_dataset(scene, stress=outputs.fe)
@@ -179,6 +180,48 @@ class SchedulerUnreachable(ConnectionError):
     """The scheduler given by address did not answer."""
 
 
+class MainGuardMissing(SystemExit):
+    """A script without ``if __name__ == "__main__":`` asked for worker processes, which would
+    run it again on import: the script stops at once with one line saying what to add."""
+
+
+def _has_main_guard(source: str) -> bool:
+    """True when module source has a top-level ``if __name__ == "__main__":``."""
+    import ast
+    try:
+        tree = ast.parse(source)
+    except SyntaxError:
+        return True          # not ours to judge
+    for node in tree.body:
+        if isinstance(node, ast.If) and isinstance(node.test, ast.Compare):
+            names = [node.test.left, *node.test.comparators]
+            if any(isinstance(n, ast.Name) and n.id == "__name__" for n in names) and \
+                    any(isinstance(n, ast.Constant) and n.value == "__main__" for n in names):
+                return True
+    return False
+
+
+def check_main_guard() -> None:
+    """Stop a script that starts worker processes without a main guard, before any is started.
+
+    dask's LocalCluster starts its workers with multiprocessing's 'spawn', which imports the
+    main script again in every worker: a script that calls `run_sweep` at module level would
+    start a cluster from each worker (dask then fails with pages of tracebacks about the
+    bootstrapping phase). An interactive session or ``python -c`` has no script to import."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if not path or not str(path).endswith(".py") or getattr(main, "__name__", "") != "__main__":
+        return
+    try:
+        source = Path(path).read_text()
+    except (OSError, UnicodeDecodeError):
+        return
+    if not _has_main_guard(source):
+        raise MainGuardMissing(
+            f"lightgear: run_sweep with worker processes imports {Path(path).name} again in each worker: put the "
+            f"script's work under `if __name__ == \"__main__\":` (or pass workers=0 to run in this process)")
+
+
 @contextlib.contextmanager
 def dask_client(scheduler: str | None = None, workers: int | None = None):
     """A dask Client: to ``scheduler`` (SchedulerUnreachable after CONNECT_TIMEOUT_S), or to a
@@ -193,6 +236,9 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
         with client:
             yield client
         return
+    if workers is not None and workers < 0:
+        raise ValueError(f"workers: must be >= 0 (0 runs in this process), got {workers}")
+    check_main_guard()
     n = workers or os.cpu_count() or 1
     # the scheduler's HTTP endpoint (health, metrics; no dashboard) moves to a free port when
     # 8787 is taken, another user's cluster say: not worth a warning
@@ -321,15 +367,27 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     if todo:
         outs = {k: tasks[k].outputs for k in todo}
         run = _in_process(todo, outs) if workers == 0 and not scheduler else _with_dask(todo, outs, scheduler, workers)
-        with contextlib.closing(run), tqdm(total=len(todo), desc=study.title[:40], unit="task", disable=not progress,
-                                           file=sys.stderr) as bar:
-            for key, res in run:
+        # the bar counts points (a point is done when all its tasks are); a task may serve many points
+        waiting = {idx: {k for k in keys if k in todo} for idx, keys in of_point.items()}
+        waiting = {idx: w for idx, w in waiting.items() if w}
+        users: dict[str, list] = {}
+        for idx, w in waiting.items():
+            for k in w:
+                users.setdefault(k, []).append(idx)
+        with contextlib.closing(run), tqdm(total=len(waiting), desc=study.title[:40], unit="point",
+                                           disable=not progress, file=sys.stderr) as bar:
+            for n_done, (key, res) in enumerate(run, 1):
                 if "lost" in res:
                     lost[key] = res["lost"]
                 else:
                     store.put(key, res)
                     results[key] = without_curves(res)
-                bar.update(1)
+                finished = 0
+                for idx in users.get(key, ()):
+                    waiting[idx].discard(key)
+                    finished += not waiting[idx]
+                bar.set_postfix_str(f"analyses {n_done}/{len(todo)}", refresh=False)
+                bar.update(finished)
     shared = Counter(k for keys in of_point.values() for k in keys)
     per_point = {p.index: invalid_result(p, out) for p in points if p.scene is None}
     lost_points = {}
@@ -340,6 +398,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
         elif causes := [lost[k] for k in keys if k in lost]:
             lost_points[idx] = "; ".join(dict.fromkeys(causes))
     ds = study_dataset(study, points, per_point, read=store.get, lost=lost_points)
+    ds.attrs["plausibility_warnings"] = sweep_warnings(points, out, progress)
     import dask
     with dask.config.set(scheduler="synchronous"):   # the curves are read from the part files here, block by block
         write_netcdf(ds, output)
@@ -347,6 +406,15 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
         store.clear()
     return SweepResult(open_archive(output), len(todo) - len(lost), reused, n_invalid, len(lost),
                        time.perf_counter() - t0, len(points))
+
+
+def sweep_warnings(points: list[Point], outputs: Outputs, show: bool) -> str:
+    """The plausibility warnings of the study's points (`study.plausibility.scene_warnings`),
+    each once with the number of points it concerns; printed on stderr when ``show``."""
+    from study.plausibility import report_warnings, scene_warnings
+    counts = Counter(w for p in points if p.scene is not None for w in scene_warnings(p.scene)
+                     if outputs.dynamic or not w.startswith("dynamic."))
+    return report_warnings([f"{w} ({n} of {len(points)} points)" for w, n in counts.items()], show)
 
 
 def without_curves(result: dict) -> dict:

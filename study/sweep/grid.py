@@ -45,6 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
+from study.errors import StudyError
 from study.plausibility import check_dynamic_window
 from study.scene import (
     Scene,
@@ -53,6 +54,7 @@ from study.scene import (
     get_dotted,
     scene_fields_from_dict,
     scene_from_dict,
+    scene_path,
     set_dotted,
 )
 from study.sweep.outputs import Outputs, outputs_from_table
@@ -243,10 +245,9 @@ def _axis_values(base: dict, path: str, spec) -> tuple:
 def _base_scene(spec, folder: Path | None) -> dict:
     def read(path) -> dict:
         p = Path(path)
-        if not p.is_absolute() and folder is not None:
+        if not p.is_absolute() and folder is not None and (folder / p).is_file():
             p = folder / p
-        if not p.is_file():
-            raise SceneError("scene", f"no such file: {p}")
+        p = scene_path(p)      # a file, or an embedded scene by name
         try:
             return tomllib.loads(p.read_text())
         except tomllib.TOMLDecodeError as e:
@@ -267,7 +268,17 @@ def _base_scene(spec, folder: Path | None) -> dict:
 
 
 def loads_study(text: str, folder: str | Path | None = None) -> Study:
-    """Parse and check a study (TOML text). ``folder`` resolves a relative scene file."""
+    """Parse and check a study (TOML text). ``folder`` resolves a relative scene file.
+    Raises `StudyError` (a SceneError) naming the study key or the dotted scene field."""
+    try:
+        return _loads_study(text, folder)
+    except StudyError:
+        raise
+    except SceneError as e:
+        raise StudyError(e.field, e.reason) from None
+
+
+def _loads_study(text: str, folder: str | Path | None = None) -> Study:
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
@@ -302,9 +313,11 @@ def loads_study(text: str, folder: str | Path | None = None) -> Study:
 
 
 def load_study(path: str | Path) -> Study:
-    p = Path(path)
-    if not p.is_file():
-        raise SceneError("study", f"no such file: {p}")
+    """A study file, or an embedded study by name (``"sensitivity"``), read and checked."""
+    try:
+        p = scene_path(path, "study")
+    except SceneError as e:
+        raise StudyError(e.field, e.reason) from None
     return loads_study(p.read_text(), p.parent)
 
 
@@ -328,7 +341,7 @@ def check_points(study: Study) -> list[Point]:
     if not any(p.scene is not None for p in points):
         first = points[0].error
         field, _, reason = first.partition(": ")
-        raise SceneError(field, f"every point of the study is invalid, e.g. {reason}")
+        raise StudyError(field, f"every point of the study is invalid, e.g. {reason}")
     return points
 
 
@@ -343,7 +356,7 @@ def _plain(value):
 
 
 def make_study(scene: Scene | Mapping | None = None, grid: Mapping | None = None, points: Iterable[Mapping] = (),
-               outputs: Outputs | Mapping | None = None, title: str = "lightgear study") -> Study:
+               outputs: Outputs | Mapping | Iterable[str] | None = None, title: str = "lightgear study") -> Study:
     """A study built in Python, checked like a study file.
 
     scene   the base scene: a Scene, or scene tables / dotted overrides on the embedded paper
@@ -351,15 +364,35 @@ def make_study(scene: Scene | Mapping | None = None, grid: Mapping | None = None
     grid    {dotted scene field: values}, values a list or a range {"start", "stop", "num"};
             the dimensions follow the dict's order
     points  explicit points, each {dotted scene field: value}
-    outputs an `Outputs`, or {"scalars": [...], "curves": [...]}; None: every scalar, no curve
+    outputs a list of output names (scalars and curves: `study.sweep.outputs`), {"scalars": [...],
+            "curves": [...]} or an `Outputs`; None: every scalar, no curve
     """
+    if not (scene is None or isinstance(scene, (Scene, Mapping))):
+        raise TypeError(f"make_study: scene takes a Scene (study.load_scene(...)), a dict of scene fields or None "
+                        f"(the paper example), got {type(scene).__name__}")
+    if not (grid is None or isinstance(grid, Mapping)):
+        raise TypeError(f"make_study: grid takes a dict {{dotted scene field: list of values or "
+                        f"{{'start', 'stop', 'num'}}}}, got {type(grid).__name__}")
+    if not isinstance(points, (str, Mapping)):
+        points = list(points)
+    if isinstance(points, (str, Mapping)) or not all(isinstance(p, Mapping) for p in points):
+        raise TypeError("make_study: points takes a list of dicts {dotted scene field: value}")
+    if not isinstance(title, str):
+        raise TypeError(f"make_study: title takes a string, got {type(title).__name__}")
     raw: dict = {"title": title}
     if scene is not None:
         raw["scene"] = dataclasses.asdict(scene) if isinstance(scene, Scene) else _plain(scene)
     raw["grid"] = _plain(grid or {})
     raw["points"] = [_plain(p) for p in points]
     if outputs is not None:
-        raw["outputs"] = _plain(dataclasses.asdict(outputs) if isinstance(outputs, Outputs) else outputs)
+        if not isinstance(outputs, (Outputs, Mapping, list, tuple, str)):
+            raise TypeError(f"make_study: outputs takes a list of output names, {{'scalars': [...], 'curves': [...]}} "
+                            f"or an Outputs, got {type(outputs).__name__}")
+        try:
+            outputs = outputs_from_table(_plain(outputs) if not isinstance(outputs, Outputs) else outputs)
+        except SceneError as e:
+            raise StudyError(e.field, e.reason) from None
+        raw["outputs"] = _plain(dataclasses.asdict(outputs))
     return loads_study(dumps_study(raw))
 
 

@@ -17,6 +17,7 @@ reads and archives its outputs over those dimensions only (an STE is not stored 
 """
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 
 from study.scene import SceneError
@@ -191,9 +192,18 @@ class Outputs:
 
 def outputs_from_table(table) -> Outputs:
     """The [outputs] table of a study ({scalars = [...], curves = [...]}) checked: unknown names
-    and an empty selection are SceneErrors. Scalars default to all of `SCALARS`, curves to none."""
+    and an empty selection are SceneErrors. Scalars default to all of `SCALARS`, curves to none.
+    A plain list of names (``["ste_p2p", "dte"]``) is split into its scalars and curves."""
     if isinstance(table, Outputs):
         table = {"scalars": list(table.scalars), "curves": list(table.curves)}
+    if isinstance(table, str):
+        table = [table]
+    if isinstance(table, (list, tuple)):
+        unknown = [x for x in table if x not in SCALARS and x not in CURVES]
+        if unknown:
+            raise SceneError("outputs", f"unknown output {unknown[0]!r} (scalars: {', '.join(SCALARS)}; curves: "
+                             f"{', '.join(CURVES)}; `lightgear outputs` lists them with their units)")
+        table = {"scalars": [x for x in table if x in SCALARS], "curves": [x for x in table if x in CURVES]}
     if not isinstance(table, dict):
         raise SceneError("outputs", f"must be a table, got {table!r}")
     for k in table:
@@ -206,7 +216,9 @@ def outputs_from_table(table) -> Outputs:
             raise SceneError(f"outputs.{name}", f"must be a list, got {items!r}")
         for it in items:
             if it not in known:
-                raise SceneError(f"outputs.{name}", f"unknown output {it!r} (expected one of: {', '.join(known)})")
+                close = difflib.get_close_matches(str(it), known, n=1)
+                hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise SceneError(f"outputs.{name}", f"unknown output {it!r} (expected one of: {', '.join(known)}){hint}")
     if not scalars and not curves:
         raise SceneError("outputs", "asks for nothing")
     return Outputs(tuple(dict.fromkeys(scalars)), tuple(dict.fromkeys(curves)))

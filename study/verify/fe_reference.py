@@ -63,16 +63,17 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
         raise SceneError("quasi_static.torque", f"the FE reference needs a positive (drive-side) torque, got {qs.torque}")
     angles = static_angles(scene) if angles is None else np.asarray(angles, float)
     model = geometry_model(scene)        # the LTCA takes its compliance from the FE, not springs
-    parts = estimate.reference_parts(scene, angles)
+    teeth = None if rigid else teeth_in_mesh(model, angles)
+    parts = estimate.reference_parts(scene, angles, teeth) if not rigid else {"contact sweep": 0.0}
     bar = estimate.progress_bar(sum(parts.values()), sum(parts.values()), "FE reference", "s (estimated)", progress)
     try:
-        return _reference(scene, angles, rigid, n_u, model, parts, bar)
+        return _reference(scene, angles, rigid, n_u, model, parts, bar, teeth)
     finally:
         if bar is not None:
             bar.close()
 
 
-def _reference(scene, angles, rigid, n_u, model, parts, bar):
+def _reference(scene, angles, rigid, n_u, model, parts, bar, teeth=None):
     def stage(name):
         if bar is not None:
             bar.set_postfix_str(name)
@@ -85,7 +86,7 @@ def _reference(scene, angles, rigid, n_u, model, parts, bar):
     if rigid:
         comp = (None, None)
     else:
-        t1, t2, spread = teeth_in_mesh(model, angles)
+        t1, t2, spread = teeth or teeth_in_mesh(model, angles)
         info.update(wall_time_teeth_s=time.perf_counter() - t0, cpu_time_teeth_s=time.process_time() - c0)
         setup1, setup2 = gear_setups(scene)
         stage("gear 1 FE body")

@@ -134,7 +134,7 @@ def test_unconverged_statics_exit_3_with_the_count(small_scene, tmp_path, capsys
     out = tmp_path / "x.nc"
     assert main(["run", str(small_scene), "-o", str(out), "--no-dynamic", "--set", "quasi_static.torque=2000"]) == 3
     err = capsys.readouterr().err
-    assert "static equilibrium not reached at 13 of 13 angles" in err and "beyond 0.2 x module" in err
+    assert "static equilibrium not reached at 37 of 37 angles" in err and "beyond 0.2 x module" in err
     assert out.exists()
 
 

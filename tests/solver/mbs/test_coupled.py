@@ -158,6 +158,7 @@ def test_implicit_integrator_refuses_and_auto_picks_explicit_for_a_coupled_model
 def test_validation_workflow_writes_archive_and_figures(tmp_path):
     import xarray as xr
 
+    from study.verify.validation import MODELS
     from workflows import validation
     s = small_scene(**{"fe.mesh_size": 1.8, **LIGHT})
     path = tmp_path / "s.toml"
@@ -165,7 +166,7 @@ def test_validation_workflow_writes_archive_and_figures(tmp_path):
     out = tmp_path / "v" / "validation.nc"
     assert validation.main([str(path), "-o", str(out), "--step", "0.5"]) == 0
     with xr.open_dataset(out) as ds:
-        assert list(ds["model"].values) == list(validation.MODELS)
+        assert list(ds["model"].values) == list(MODELS)
         assert ds["error_mean"].sel(model="fe-reference").values.tolist() == [0.0, 0.0]
         assert np.isnan(ds["hole_amplitude"].sel(pair="solid", model="fe-reference"))
         assert ds["hole_amplitude"].sel(pair="lightened", model="fe-reference") > 0

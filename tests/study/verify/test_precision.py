@@ -106,7 +106,7 @@ def test_stability_suite_subset_ends_ok_or_named():
     with a failure that names its cause, time and step; never a silent NaN."""
     import re
 
-    from workflows import stability as S
+    from study.verify import stability as S
     names = ["contact stiffness x100", "no damping", "teeth 100x lighter", "zero torque", "overload x10"]
     ds = S.run_suite(solid_scene(), duration=0.002, methods=("explicit", "implicit alpha=-0.1", "LSODA"),
                      scipy_wall=1.0, names=names, progress=lambda *a: None)
