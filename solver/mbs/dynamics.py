@@ -336,8 +336,8 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     ``progress``: a callable taking the time reached [s] while the run goes (`run_kernel`).
     ``implicit_dampers``: take the tooth-root dampers implicitly in the Verlet kicks (IMEX,
     `solver.mbs.kernels.explicit`), so that they no longer limit the step; None (default):
-    wherever they can be (`solver.mbs.stability.implicit_dampers_apply`: linear dampers, plain
-    pair); False: every force explicit (the scheme before, kept as the reference).
+    wherever they can be (`solver.mbs.stability.implicit_dampers_apply`: linear dampers);
+    False: every force explicit (the scheme before, kept as the reference).
     """
     check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step)
     table, torque, side = run_loads(load_table, torque)
@@ -351,8 +351,7 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
         # w) out of the balance unbooked
         rate = dict(RATE_QUIET=PHI_QUIET)
     if imex and not applies:
-        raise ValueError("implicit_dampers: needs linear tooth-root dampers (n_c = 1, c_phi > 0) on the plain pair "
-                         "(no body coupling)")
+        raise ValueError("implicit_dampers: needs linear tooth-root dampers (n_c = 1, c_phi > 0)")
     omega_max = float("nan")
     auto = dt is None or dt <= 0
     step_torque = torque

@@ -88,22 +88,25 @@ def body_dissipation(p, gp, w1, v):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, phi):
-    """Forces and accelerations for the contacts ws[0][:nc], the tooth rotations phi and rates
-    ws[3], the body angles hub[POS] and rates v (columns H_*): fills q, the teeth's and the
-    bodies' accelerations (row ACC of hub, and of the teeth through ``acc``);
-    drv = (theta1 [rad], theta1' [rad/s], theta1'' [rad/s²], load torque [N m], acc).
-    Returns (driver torque [N m], body-spring moment on the driver rim [N m])."""
+def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
+    """Forces and accelerations for the contacts ws[0][:nc], the tooth rotations teeth[0] and
+    the rates teeth[1] of their root dampers, the body angles hub[POS] and rates v (columns
+    H_*): fills q, the teeth's and the bodies' accelerations (row ACC of hub, and of the teeth
+    through ``acc``); drv = (theta1 [rad], theta1' [rad/s], theta1'' [rad/s²], load torque
+    [N m], acc); gpk: gear_par of the arrowhead solve (with implicit tooth-root dampers the
+    tooth inertia I_P + dt/4 c_phi, `explicit.py`). Returns (driver torque [N m], body-spring
+    moment on the driver rim [N m])."""
     gp, _pp, _lp, kphi, _ct = mdl
-    rec, _pairs, q, vel, tset, _book = ws
+    rec, _pairs, q, _vel, tset, _book = ws
     th1, w1, acc1, tl, acc = drv
+    phi = teeth[0]
     q[:] = 0.0
-    generalized_forces(rec, nc, phi, vel, tset[L.T_ACT], nact, kphi, gp, 0.0, q)
+    generalized_forces(rec, nc, phi, teeth[1], tset[L.T_ACT], nact, kphi, gp, 0.0, q)
     set_springs(cset, ns, kphi, phi, q)
     mb1, mb2 = body_moments(gp, th1, w1, hub[L.POS], v)
     q[0] += mb1
     q[1] += mb2
-    rim_accelerations(q, tset[L.T_ACT], nact, gp, acc, hub[L.ACC])
+    rim_accelerations(q, tset[L.T_ACT], nact, gpk, acc, hub[L.ACC])
     hub[L.ACC, L.H_H2] = (tl - mb2) / gp[1, L.I_HUB]
     return gp[0, L.I_HUB] * acc1 + mb1, mb1
 
@@ -163,6 +166,12 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     x, v, ha = hub[L.POS], hub[L.RATE], hub[L.ACC]
     vh = np.zeros(L.N_HUB)
     vp = np.zeros(L.N_HUB)
+    imex = par[L.IMEX] != 0.0
+    # the arrowhead of the kicks: the tooth inertia I_P + dt/4*c_phi with implicit dampers
+    gpk = gp.copy()
+    if imex:
+        for g in range(2):
+            gpk[g, L.I_P] += 0.25 * dt * gp[g, L.C_PHI]
     cset = coupled_set(ctooth)
     coupled = ctooth.shape[0] > 0
     th1, w1, acc1 = driver_motion(0.0, speed, ramp)
@@ -176,7 +185,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     nact = initial_set(tset, teeth, pairs, npair, tz2)
     vpred[:] = dphi
     drv = (th1, w1, acc1, tl, acc)
-    react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, phi)
+    react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, (phi, dphi), gpk)
     ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth)
     book[L.B_E0] = ke + pe
     book[L.B_P_IN] = react * w1 + tl * v[L.H_H2]
@@ -212,17 +221,23 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         if coupled:
             ns = update_set(cset, ns, nn, phi, dphi, vpred)
         drv = (th1, w1, acc1, tl, acc)
-        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, vp, phi)
+        # (implicit dampers: at the rates the first kick ended with, where the second starts)
+        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, vp, (phi, dphi if imex else vpred), gpk)
         # second half kick
         for k in range(L.N_HUB):
             v[k] = vh[k] + 0.5 * dt * ha[k]
         for a in range(nact):
             i = act[a]
+            v0 = dphi[i]
             dphi[i] += 0.5 * dt * acc[i]
+            if imex:    # the damper torque at the new rate, for the next first kick
+                q[2 + i] -= gp[1 if i >= tz2 else 0, L.C_PHI] * (dphi[i] - v0)
         # the driver's hub inertia sees the one-sided acceleration where the ramp ends
         p_in_left = (gp[0, L.I_HUB] * driver_acc_left(t, speed, ramp) + mb1) * w1 + tl * v[L.H_H2]
-        p_d = body_dissipation(dissipation_power(vpred, act, nact, mdl, rec, nc), gp, w1, vp)
+        p_d = body_dissipation(dissipation_power(dphi if imex else vpred, act, nact, mdl, rec, nc), gp, w1, vp)
         status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * v[L.H_H2], p_d), par, status)
+        if imex:    # the next first kick: its accelerations with the dampers at the new rates
+            rim_accelerations(q, act, nact, gpk, acc, ha)
         max_act = max(max_act, nact)
         if step % ipar[L.OUT_EVERY] == 0:
             o += 1
