@@ -84,8 +84,10 @@ def _damped_modes(sy: LinearSystem, C):
     shares (dof, mode), index of the mesh mode) of the oscillating modes of
     M x'' + C x' + K x = 0 (the state-space eigenproblem: exact for non-proportional damping,
     where a heavily damped tooth joint holds the mesh mode's shape); overdamped and rigid
-    modes are left out. The mesh mode is the one that puts the most into the TE at the hubs
-    under a force at the mesh (`te_participation`): the resonance a run-up shows."""
+    modes are left out. The mesh mode is the one whose resonance puts the most into the TE at
+    the hubs under a force at the mesh: `te_participation` over the damping ratio (the peak of
+    a lightly damped mode; at least 1e-3 counted, so that an undamped pair falls back on the
+    static share), the resonance a run-up shows."""
     M, K = sy.M, sy.K
     n = M.shape[0]
     mi = np.linalg.inv(M)
@@ -95,8 +97,9 @@ def _damped_modes(sy: LinearSystem, C):
     lam, u = lam[keep], v[:n, keep]
     share = np.real(np.conj(u) * (M @ u))
     share = share / share.sum(0)
-    mesh = int(np.argmax(te_participation(M, C, lam, u, sy.te, sy.mesh)))
-    return np.abs(lam), -lam.real / np.abs(lam), share, mesh
+    zeta = -lam.real / np.abs(lam)
+    mesh = int(np.argmax(te_participation(M, C, lam, u, sy.te, sy.mesh) / np.maximum(zeta, 1e-3)))
+    return np.abs(lam), zeta, share, mesh
 
 
 def _mesh_damping(sy: LinearSystem, C) -> float:
