@@ -104,5 +104,9 @@ def order_map_plot(ds: xr.Dataset, path):
     ax2.set_xlabel("driver speed [rad/s]")
     ax2.set_ylabel("DTE amplitude [um]")
     ax2.legend(fontsize=8)
+    status = ds["order_amplitude"].attrs.get("status", "")
+    if status:      # a completed run-up whose energy balance does not close: kept, flagged
+        fig.text(0.5, 0.005, "flagged: " + status[:160] + ("..." if len(status) > 160 else ""), ha="center",
+                 va="bottom", fontsize=7, color="C3", wrap=True)
     figure_title(fig, ds, "Run-up: computed order tracking of DTE, Campbell overlay and order cuts")
     return save_figure(fig, path)
