@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from solver.mbs.energy_guard import ENERGY_ERROR_RATIO, ENERGY_FLOW_RATIO, energy_error_limit
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.explicit import verlet
 from solver.mbs.kernels.mechanics import driver_motion
@@ -25,23 +26,6 @@ STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound"
                4: "Newton failure", 5: "wall-time limit", 6: "inaccurate"}     # 5: the scipy peer's
 ENERGY_TOL = 0.05   # relative energy growth that stops a run (see `simulate`)
 INACCURATE = 6      # a run that completed but whose energy balance does not close (`accuracy_check`)
-# Largest energy-balance error of a completed run [J]: ENERGY_ERROR_RATIO times the largest
-# potential energy of the mesh plus ENERGY_FLOW_RATIO times the energy dissipated so far. The
-# residual of a converged run has two parts. One is bounded: the energy Verlet reads at the step
-# instants oscillates about its conserved (shadow) energy, by up to a/(1 - a) (a = (w dt/2)²) of
-# the stiff modes' share, a fraction of the mesh's potential energy (paper pair at 0.9 of the
-# bound: 0.16 of it, at any run length). The other accumulates: the trapezoidal quadrature of
-# the input and damper powers errs by O(dt²) of the power that cycles through the vibration,
-# which the dampers take out, so it grows with the dissipated energy, not with the potential
-# energy: the 1 s run-up 0 -> 400 rad/s of the paper pair reads 0.23 % of its dissipated
-# energy at 0.588 us and 0.11 % at 0.4 us (O(dt²); its DTE agrees to three digits), 0.65 and
-# 0.31 x the potential energy, so a bound on the potential energy alone flagged it. The runs
-# whose step misses the contact events read 0.66 x the potential energy within 20 ms while
-# dissipating as much as the error (contact stiffness x1000, explicit), and 9 x it (150/150
-# teeth rattling, HHT at 2.5 us, 3 x the DTE of a converged run): the flow term, 20 x the
-# converged runs' rate, leaves them flagged.
-ENERGY_ERROR_RATIO = 0.5
-ENERGY_FLOW_RATIO = 0.05
 # Quiet threshold of the active set [rad] (a tooth outside the mesh freezes below it): 1e-9 by
 # default; 1e-7 where every tooth-root joint is damped to at least QUIET_ZETA of critical (the
 # mesh damping ratio puts 0.7-0.9 there), since a frozen tooth there would have stopped ringing
@@ -82,7 +66,8 @@ class DynamicResult:
     kinetic: np.ndarray         # J
     potential: np.ndarray       # J
     work: np.ndarray            # work done by driver and load torque since t = 0 [J]
-    dissipated: np.ndarray      # J
+    dissipated: np.ndarray      # J, by the dampers
+    switched: np.ndarray        # J taken out by the coupled set's switches (compliance model; 0 otherwise)
     dt: float                   # integration step [s]
     steps: int                  # steps taken
     status: int                 # 0 ok (see STATUS_TEXT)
@@ -92,9 +77,9 @@ class DynamicResult:
 
     @property
     def energy_error(self) -> np.ndarray:
-        """work - (kinetic + potential - initial) - dissipated [J]."""
+        """work - (kinetic + potential - initial) - dissipated - switched [J]."""
         e = self.kinetic + self.potential
-        return self.work - (e - e[0]) - self.dissipated
+        return self.work - (e - e[0]) - self.dissipated - self.switched
 
 
 def status_message(status: int, step: int, dt: float, delta_max: float, raise_on_failure: bool = False) -> str:
@@ -109,13 +94,6 @@ def status_message(status: int, step: int, dt: float, delta_max: float, raise_on
     if raise_on_failure:
         raise DivergenceError(msg)
     return msg
-
-
-def energy_error_limit(res: DynamicResult) -> np.ndarray:
-    """The energy-balance error [J] a converged run stays under at each output instant:
-    ENERGY_ERROR_RATIO x the largest potential energy of the mesh + ENERGY_FLOW_RATIO x the
-    energy dissipated so far (see there)."""
-    return ENERGY_ERROR_RATIO * float(np.max(res.potential)) + ENERGY_FLOW_RATIO * np.abs(res.dissipated)
 
 
 def accuracy_check(res: DynamicResult, alpha: float = 0.0) -> DynamicResult:
@@ -300,8 +278,8 @@ def watched(kernel, args: tuple, out: np.ndarray, progress):
 
 
 def result_fields(out: np.ndarray) -> tuple:
-    """The `DynamicResult` arrays time .. dissipated of a run's output records."""
-    cols = (L.O_TIME, L.O_TE, L.O_THETA2, L.O_FMAX, L.O_NC, L.O_REACT, L.O_KE, L.O_PE, L.O_WORK, L.O_DISS)
+    """The `DynamicResult` arrays time .. switched of a run's output records."""
+    cols = (L.O_TIME, L.O_TE, L.O_THETA2, L.O_FMAX, L.O_NC, L.O_REACT, L.O_KE, L.O_PE, L.O_WORK, L.O_DISS, L.O_SWITCH)
     fields = [out[:, c].copy() for c in cols]
     fields[4] = fields[4].astype(int)
     return tuple(fields)

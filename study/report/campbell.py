@@ -52,9 +52,15 @@ def campbell_plot(ds: xr.Dataset, path):
                 "sidebands kZ+-N dashed): " + ", ".join(f"{e} {v:.0f}" for e, v in crit if e.endswith("Z")) + " rad/s")
     if driver_speed > 0:
         ax.axvline(driver_speed, color="C0", lw=1.2, label=f"run speed {driver_speed:.0f} rad/s")
-    higher = [float(np.nanmean(f.sel(mode=m))) for m in ds["mode"].values if np.nanmean(f.sel(mode=m)) > y_max]
+    higher = {}
+    for m in ds["mode"].values:
+        fm = float(np.nanmean(f.sel(mode=m)))
+        if fm > y_max:
+            kind = str(ds["mode_kind"].values[m])
+            higher.setdefault("body" if kind == "body" else "tooth", []).append(fm)
     if higher:
-        ax.text(0.99, 0.01, f"{len(higher)} tooth modes above, {min(higher) / 1e3:.0f}-{max(higher) / 1e3:.0f} kHz",
+        ax.text(0.99, 0.01, "; ".join(f"{len(v)} {k} mode{'s' if len(v) > 1 else ''} above, "
+                                      f"{min(v) / 1e3:.0f}-{max(v) / 1e3:.0f} kHz" for k, v in higher.items()),
                 transform=ax.transAxes, ha="right", va="bottom", fontsize=8, color="0.3")
     ax.set_xlim(0, x_max)
     ax.set_ylim(0, y_max)

@@ -134,7 +134,7 @@ def record_output(out, o, row, book, rec, nc, finite, par, status):
     row = (time [s], TE [m], driven hub angle [rad], driver torque [N m], kinetic and
     potential energy [J]); with the largest contact force since the last record [N] (then
     reset), the loaded contacts of rec[:nc], and the work and dissipated energy [J] of
-    ``book``. Status NONFINITE when the state is not ``finite`` or the energies are not,
+    ``book``, and the energy the coupled set's switches took out [J]. Status NONFINITE when the state is not ``finite`` or the energies are not,
     ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
     [J] above par[ENERGY_TOL] times the energy scale, else ``status`` unchanged.
     """
@@ -153,11 +153,12 @@ def record_output(out, o, row, book, rec, nc, finite, par, status):
     out[o, L.O_WORK] = book[L.B_WORK]
     out[o, L.O_DISS] = book[L.B_DISS]
     out[o, L.O_THETA2] = theta2
+    out[o, L.O_SWITCH] = book[L.B_SWITCH]
     book[L.B_FMAX] = 0.0
     if not (finite and math.isfinite(ke + pe)):
         return NONFINITE
     work = book[L.B_WORK]
-    diss = book[L.B_DISS]
+    diss = book[L.B_DISS] + book[L.B_SWITCH]
     if status == OK and ke + pe - book[L.B_E0] + diss - work > par[L.ENERGY_TOL] * max(abs(work), ke + pe, diss):
         return ENERGY
     return status
