@@ -22,6 +22,7 @@ import scipy.optimize
 from solver.mbs.dynamics import simulate
 from solver.mbs.kernels import layout as L
 from solver.mbs.model import Model
+from solver.mbs.stability import implicit_dampers_apply, stable_time_step
 
 
 @dataclass
@@ -49,15 +50,18 @@ def ring_down(model: Model, torque: float, frequency: float, damping: float, cyc
     ``driver_angle`` [rad]; ``frequency`` [Hz] and ``damping`` [1] (from the modal analysis
     there) set the time scales and start the fit. ``cycles``: periods fitted (default: until
     the amplitude falls to ~5 %, 6 to 40 periods)."""
+    load = torque if abs(torque) > 1e-9 else 1.0
+    # the default step of a run, from the model's own loaded equilibria (kept: the turned
+    # pair has the same bound and needs no statics of its own)
+    dt = stable_time_step(model, load, implicit_dampers=implicit_dampers_apply(model))[0]
     if driver_angle:
         model = turned(model, driver_angle)
-    load = torque if abs(torque) > 1e-9 else 1.0
     period = 1.0 / frequency
     cycles = cycles or float(np.clip(3.0 / (2 * math.pi * max(damping, 1e-6)), 6.0, 40.0))
     t_ramp, t_step = 10 * period, 0.25 * period
     table = [[0.0, 0.0], [t_ramp, 0.9 * load], [t_ramp + t_step, load]]
     t_fit = t_ramp + t_step + period
-    res = simulate(model, 0.0, 1.0, load, t_ramp, t_fit + cycles * period, output_step=period / 40,
+    res = simulate(model, 0.0, 1.0, load, t_ramp, t_fit + cycles * period, dt=dt, output_step=period / 40,
                    load_table=table, raise_on_failure=True)
     sel = res.time >= t_fit
     t = res.time[sel] - t_fit

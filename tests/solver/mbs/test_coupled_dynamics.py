@@ -117,3 +117,24 @@ def test_coupled_step_is_the_stiffness_bound_with_implicit_tooth_dampers(models)
     dt_free, w = stability_limit(m, TORQUE, implicit_dampers=True)
     assert dt_imex == pytest.approx(0.9 * dt_free) and dt_free <= 2.0 / w * (1 + 1e-12)
     assert dt_imex > 3.0 * stable_time_step(m, TORQUE)[0]
+
+
+def test_a_run_solves_its_loaded_equilibria_once(monkeypatch):
+    """The damping conversion, the modes, the free decay, the method choice and the step bound
+    of one run share one set of loaded equilibria (solved once; a load the run's forces
+    exceed may ask for a second set under that load)."""
+    import solver.mbs.equilibria as eqm
+    from study.run import run_scene
+    loads = []
+    solve = eqm._solve
+
+    def counted(model, torque, positions):
+        loads.append(torque)
+        return solve(model, torque, positions)
+    monkeypatch.setattr(eqm, "_solve", counted)
+    sc = study.default_scene().replace(**{"coupling.model": "compliance", "dynamic.torque": 47.0,
+                                          "dynamic.duration": 0.004, "dynamic.ramp_time": 0.002,
+                                          "quasi_static.enabled": False})
+    ds = run_scene(sc)
+    assert ds.attrs["dynamic_status"] == "ok" and "mesh_mode_damping_decay" in ds.attrs
+    assert loads.count(47.0) == 1
