@@ -61,7 +61,7 @@ def stability_limit(model: Model, torque: float, positions: int = 12,
     with continuation (tooth rotations carried from angle to angle); positions where it does
     not converge are left out. ``implicit_dampers``: the tooth-root dampers are taken implicitly
     (IMEX kicks, `implicit_dampers_apply`), which are stable at any damping: only the contact
-    dampers count then.
+    and body dampers count then.
     """
     wmax = 0.0
     dt_crit = math.inf

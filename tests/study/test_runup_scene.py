@@ -48,3 +48,13 @@ def test_the_shipped_runup_is_converged_at_its_step(archive):
         sel = t >= 2 * d.ramp_time
         return float(np.sqrt(np.mean((te[sel] - te[sel].mean()) ** 2)))
     assert rms(half.time, half.te * 1e6) == pytest.approx(rms(ds["time"].values, ds["dte"].values), rel=0.01)
+
+
+def test_render_says_why_a_run_has_no_order_map():
+    from study.report.figures import order_map_missing
+    dte = {"dte": ("time", np.zeros(3))}
+    stopped = xr.Dataset(dte, attrs={"runup_speed_end_rad_s": 400.0,
+                                     "order_tracking_skipped": "the run-up stopped before its end: energy growth at t = 0.5 s"})
+    assert order_map_missing(stopped).startswith("the run-up stopped before its end: energy growth")
+    assert order_map_missing(xr.Dataset(dte)) == "not a run-up (dynamic.speed_end = 0)"
+    assert "no dynamic analysis" in order_map_missing(xr.Dataset())
