@@ -58,3 +58,21 @@ def test_render_says_why_a_run_has_no_order_map():
     assert order_map_missing(stopped).startswith("the run-up stopped before its end: energy growth")
     assert order_map_missing(xr.Dataset(dte)) == "not a run-up (dynamic.speed_end = 0)"
     assert "no dynamic analysis" in order_map_missing(xr.Dataset())
+
+
+def test_a_flagged_runup_keeps_its_order_map_with_the_flag(monkeypatch):
+    """A run-up that completes but is flagged inaccurate keeps its order tracking, the flag
+    beside it (the guard made to flag every run here)."""
+    import solver.mbs.dynamics as dyn
+    from study.run import run_scene
+    from tests.conftest import solid_scene
+
+    def flag(res, alpha=0.0):
+        res.status, res.message = dyn.INACCURATE, "inaccurate: energy balance error (made to flag)"
+        return res
+    monkeypatch.setattr(dyn, "accuracy_check", flag)
+    sc = solid_scene(**{"dynamic.speed_end": 400.0, "dynamic.duration": 0.06, "dynamic.ramp_time": 0.005,
+                        "quasi_static.enabled": False})
+    ds = run_scene(sc)
+    assert ds.attrs["dynamic_status"].startswith("inaccurate")
+    assert "order_amplitude" in ds and ds["order_amplitude"].attrs["status"].startswith("inaccurate")
