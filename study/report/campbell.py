@@ -22,7 +22,8 @@ def campbell_plot(ds: xr.Dataset, path):
     # driven speed / driver speed = z1 / z2: from the 1Z critical speed and the mesh frequency
     ratio = 2 * math.pi * float(fmesh.mean()) / (mesh_order * float(cs.sel(excitation="1Z")))
     driver_speed = speed / ratio if ratio > 0 else 0.0
-    x_max = max(1.3 * float(cs.sel(excitation="1Z")), 2.0 * driver_speed)
+    runup = float(ds.attrs.get("runup_speed_end_rad_s", 0.0))     # a run-up sweeps 0 -> runup
+    x_max = max(1.3 * float(cs.sel(excitation="1Z")), 2.0 * driver_speed if not runup else 1.05 * runup)
     x = np.linspace(0.0, x_max, 200)
     fig, ax = plt.subplots(figsize=(8.5, 6.5))
     y_max = 1.6 * float(fmesh.max())
@@ -50,7 +51,9 @@ def campbell_plot(ds: xr.Dataset, path):
     if crit:
         ax.plot([], [], "o", color="C3", label="critical speeds of the mesh mode (dots; kZ lines solid, N and "
                 "sidebands kZ+-N dashed): " + ", ".join(f"{e} {v:.0f}" for e, v in crit if e.endswith("Z")) + " rad/s")
-    if driver_speed > 0:
+    if runup > 0:
+        ax.axvspan(0.0, runup, color="C0", alpha=0.07, lw=0, label=f"run-up 0-{runup:.0f} rad/s")
+    elif driver_speed > 0:
         ax.axvline(driver_speed, color="C0", lw=1.2, label=f"run speed {driver_speed:.0f} rad/s")
     higher = {}
     for m in ds["mode"].values:
