@@ -16,6 +16,8 @@ from study.cli import main
 from study.scene import load_scene
 from study.setup import build_scene_model
 
+pytestmark = pytest.mark.slow      # two 1 s run-ups of the paper pair
+
 SCENE = Path(__file__).resolve().parents[2] / "study" / "scenes" / "runup.toml"
 
 

@@ -58,6 +58,7 @@ def test_coupled_linearisation_has_the_body_dofs(models, modes):
         assert models[cm].gear_par[0, L.K_BODY] > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cm", MODELS)
 def test_mesh_mode_critical_speed_is_the_runup_peak(cm, models, modes, runups):
     """The modal 1Z critical speed within 3 % of where the run-up's mesh-order DTE peaks
@@ -90,6 +91,7 @@ def test_free_decay_shows_the_modal_and_the_requested_ratio(cm, models, modes):
     assert rd.frequency == pytest.approx(md.frequency[0, j], rel=0.01)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cm", ("body-torsion", "compliance"))
 def test_coupled_energy_balance_closes_within_the_plain_margin(cm, runups):
     """Through the resonance at the default step: the coupled model's energy-balance error,
