@@ -12,7 +12,7 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import run_loads, simulate
+from solver.mbs.dynamics import INACCURATE, run_loads, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.kernels.layout import R_PV
 from solver.mbs.mesh_stiffness import mesh_states
@@ -219,10 +219,14 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
             data.update(results.efficiency_variable(dy, d.torque, d.speed, start))
         if runup:
             attrs["runup_speed_end_rad_s"] = d.speed_end
-        if runup and dy.status == 0:
-            from study.report.order_tracking import order_tracking_variables
-            c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
-            coords.update(c); data.update(v)
+            if dy.status in (0, INACCURATE):    # completed: the map is kept, an inaccurate one with its flag
+                from study.report.order_tracking import order_tracking_variables
+                c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
+                if dy.status:
+                    v["order_amplitude"].attrs["status"] = dy.message
+                coords.update(c); data.update(v)
+            else:
+                attrs["order_tracking_skipped"] = f"the run-up stopped before its end: {dy.message}"
         attrs["dynamic_method"] = dy.choice.method
         attrs["dynamic_method_reason"] = dy.choice.reason
         attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")

@@ -1,12 +1,24 @@
 """Loaded static equilibria of the pair across one mesh period: where the pair is linearised
-(`solver.mbs.stability` for the step bound, `solver.mbs.modes` for its modes)."""
+(`solver.mbs.linearization`; the step bound, the modes and the damping conversion).
+
+A run asks for them several times (the damping conversion, the modes, the step bound, the
+method choice, the free decay's step): they are solved once per model and load and kept
+(`loaded_equilibria`), keyed by what they depend on, so that a model that only differs in its
+dampers (`solver.mbs.modes.with_damping`) shares them.
+"""
 from __future__ import annotations
 
+import hashlib
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 
+from solver.mbs.kernels import layout as L
 from solver.mbs.model import Model
+
+_KEPT: OrderedDict = OrderedDict()
+KEEP = 32           # equilibrium sets kept (a study point asks for one or two)
 
 
 @dataclass
@@ -18,10 +30,36 @@ class Equilibrium:
     phi: np.ndarray        # tooth rotations [rad]
 
 
+def statics_key(model: Model, torque: float, positions: int) -> str:
+    """Digest of everything a static equilibrium depends on: the model's arrays less its
+    dampers (gear_par C_PHI, N_C, C_BODY; law_par C_CON, M2, M3), the load and the positions."""
+    gp = model.gear_par.copy()
+    gp[:, [L.C_PHI, L.N_C, L.C_BODY]] = 0.0
+    lp = model.law_par.copy()
+    lp[[L.C_CON, L.M2, L.M3]] = 0.0
+    h = hashlib.blake2b(digest_size=16)
+    for a in (gp, model.pair_par, lp, model.k_phi, model.tooth_compliance, np.array([torque, positions], float)):
+        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+        h.update(str(np.shape(a)).encode())
+    return h.hexdigest()
+
+
 def loaded_equilibria(model: Model, torque: float, positions: int = 12) -> list[Equilibrium]:
     """Static equilibria under ``torque`` [N·m] (1 N·m if zero) at ``positions`` driver angles
     across one angular pitch, by one sweep with continuation; positions that do not converge
-    are left out."""
+    are left out. Solved once per `statics_key` (the last KEEP sets are kept); the caller
+    gets copies of the tooth rotations."""
+    key = statics_key(model, torque, positions)
+    if key in _KEPT:
+        _KEPT.move_to_end(key)
+    else:
+        _KEPT[key] = _solve(model, torque, positions)
+        while len(_KEPT) > KEEP:
+            _KEPT.popitem(last=False)
+    return [Equilibrium(e.theta1, e.rim1, e.rim2, e.phi.copy()) for e in _KEPT[key]]
+
+
+def _solve(model: Model, torque: float, positions: int) -> list[Equilibrium]:
     from solver.mbs.statics import solve_static
     angles = np.linspace(0.0, model.geometry[0].pitch_angle, positions, endpoint=False)
     load = torque if abs(torque) > 1e-9 else 1.0

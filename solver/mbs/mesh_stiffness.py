@@ -1,26 +1,25 @@
 """Tangent mesh stiffness of the loaded pair over driver angle, from the linearisation the
-modes use (`solver.mbs.stability.linearized_system`), and the tooth loads at the same
-equilibria.
+modes use (`solver.mbs.linearization.linearize`), and the tooth loads at the same equilibria.
 
 At each driver angle the pair is solved to static equilibrium under the torque (continuation
 from the previous angle, as the STE), linearised there, and the tangent stiffness matrix K
-over the free DOFs (DOF 0 the driven gear's angle at the mesh, then the teeth near the mesh,
-then whatever other DOFs the linearisation carries) is condensed onto DOF 0 with the driver
-hub prescribed: every other DOF takes its static response x_r = -K_rr^-1 K_r0 to a unit
-rotation of DOF 0, and K00* = K00 + K0r x_r [N·m/rad] is dT2/dtheta2. The transmission error
-moves by rb2 per radian of the driven gear, and the load along the line of action is
-T2/rb2, so the mesh stiffness is
+over the free DOFs (the driven hub, the teeth near the mesh and, for a body-coupled model, the
+rims on their body springs) is condensed onto the driven hub with the driver hub prescribed:
+every other DOF takes its static response x_r = -K_rr^-1 K_rh to a unit rotation of the hub,
+and K_hh* = K_hh + K_hr x_r [N·m/rad] is dT2/dtheta2. The transmission error moves by rb2 per
+radian of the driven hub, and the load along the line of action is T2/rb2, so the mesh
+stiffness is
 
-    k_m = dF/dTE = K00* / rb2**2  [N/m].
+    k_m = dF/dTE = K_hh* / rb2**2  [N/m],
 
-A body-torsion coupled model whose linearisation has no body DOFs (the rims taken as
-fixed to their hubs) gets its body springs in series, 1/k = 1/k_m + rb1**2/k_b1 + rb2**2/k_b2,
-so that k_m is the slope of the hubs' static TE.
+the body springs of a coupled model included in series, so that k_m is the slope of the hubs'
+static TE.
 
 The same response split by contacts gives each loaded tooth pair's share,
 k_p = sum over its contacts of g2 * kt * (g . x) / rb2**2 (the pairs act in parallel between
-the prescribed driver and the driven gear, so the shares sum to k_m): the stiffness of that
-pair as if it were alone in mesh (ISO 6336-1's single stiffness c' is its largest value).
+the driver and the driven rim, and the whole rim moment reaches the hub, so the shares sum to
+k_m): where the pair is alone in mesh, its stiffness with the bodies in series (ISO 6336-1's
+single stiffness c' is its largest value).
 DOFs with no stiffness (an unloaded tooth on a spring with n_k > 1, which has no tangent at
 rest) carry no load and are left out of the condensation.
 """
@@ -71,7 +70,7 @@ def mesh_states(model: Model, angles, torque: float) -> MeshStates:
     ``torque`` [N·m] on the driven gear (1 N·m if zero) at driver angles ``angles`` [rad]
     (see the module docstring). Angles where the statics do not converge hold NaN."""
     from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
-    from solver.mbs.stability import linearized_system
+    from solver.mbs.linearization import linearize
     from solver.mbs.statics import solve_static
     angles = np.asarray(angles, dtype=float)
     load = torque if abs(torque) > 1e-9 else 1.0
@@ -85,7 +84,6 @@ def mesh_states(model: Model, angles, torque: float) -> MeshStates:
     ok = np.zeros(n, bool)
     kb1, kb2 = model.body_stiffness
     rb1, rb2 = model.base_radii
-    series = (rb1**2 / kb1 if math.isfinite(kb1) else 0.0) + (rb2**2 / kb2 if math.isfinite(kb2) else 0.0)
     gp = model.gear_par
     tz2 = int(gp[1, L.TOOTH0])
     rec, pairs = new_contact_buffer()
@@ -101,10 +99,16 @@ def mesh_states(model: Model, angles, torque: float) -> MeshStates:
         # a coupled model's mesh sits at the rim angles: the hubs less the body wind-up
         rim1 = theta1 - (load * rb1 / rb2 / kb1 if math.isfinite(kb1) else 0.0)
         rim2 = float(st.theta2[0]) - (load / kb2 if math.isfinite(kb2) else 0.0)
-        _M, K, teeth = linearized_system(model, rim1, rim2, phi)
-        k00, x = condense(K)
-        no_body_dofs = K.shape[0] == 1 + len(teeth)      # the body springs then in series
-        pos = {t: j + 1 for j, t in enumerate(teeth)}
+        lin = linearize(model, rim1, rim2, phi)
+        hub = int(np.flatnonzero(lin.te)[0])            # the driven hub: theta2, or h2 when coupled
+        order = [hub] + [j for j in range(lin.K.shape[0]) if j != hub]
+        k00, xo = condense(lin.K[np.ix_(order, order)])
+        x = np.empty_like(xo)
+        x[order] = xo
+        nb = lin.n_body
+        th2 = lin.dofs.index("theta2")
+        r1 = lin.dofs.index("r1") if "r1" in lin.dofs else None
+        pos = {t: nb + j for j, t in enumerate(lin.teeth)}
         nc, _np = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, (gp, model.pair_par, model.law_par), (rec, pairs))
         for c in range(nc):
             a, b = int(rec[c, L.C_TOOTH1]), int(rec[c, L.C_TOOTH2])
@@ -113,14 +117,15 @@ def mesh_states(model: Model, angles, torque: float) -> MeshStates:
             force[i, tz2 + b] += f
             if f > 0 and (mate[i, a] < 0 or f > force[i, tz2 + mate[i, a]]):
                 mate[i, a] = b
-            g = np.array([rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB]])
-            dx = np.array([x[0], x[pos[a]] if a in pos else 0.0, x[pos[tz2 + b]] if tz2 + b in pos else 0.0])
-            kp[i, a] += rec[c, L.C_G2] * rec[c, L.C_KT] * float(g @ dx) / rb2**2
+            g = [rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB]]
+            dx = [x[th2], x[pos[a]] if a in pos else 0.0, x[pos[tz2 + b]] if tz2 + b in pos else 0.0]
+            if r1 is not None:
+                g.append(rec[c, L.C_G1])
+                dx.append(x[r1])
+            # its part of the driven rim's moment (all of it reaches the hub): lever g2 times the
+            # contact's force change
+            kp[i, a] += rec[c, L.C_G2] * rec[c, L.C_KT] * float(np.dot(g, dx)) / rb2**2
         km = k00 / rb2**2
-        if no_body_dofs and series > 0:
-            km = 1.0 / (1.0 / km + series)
-            loaded = kp[i] > 0
-            kp[i, loaded] = 1.0 / (1.0 / kp[i, loaded] + series)
         k[i] = km
     return MeshStates(angles, k, kp, force, mate, te, ok)
 

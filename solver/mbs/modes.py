@@ -1,18 +1,20 @@
 """Modes of the loaded pair and damping given as a ratio of critical (numpy, no kernels).
 
-The pair is linearised (`solver.mbs.stability.linearized_system`) at static equilibrium under
-the mean load at ``positions`` driver angles across one angular pitch (one mesh period). At
-each position the eigenvalues lambda of M x'' + C x' + K x = 0 over the free DOFs (driven
-hub, then the teeth near the mesh; C: tooth-spring and contact dampers linearised at rest),
-from its state-space form, give the natural frequency |lambda| and the damping ratio
--Re(lambda)/|lambda| of each mode. They are exact for the linearised pair where the modal
-estimate x^T C x / (2 w) on undamped modes is not: a heavily damped tooth joint holds the
-mesh mode's shape (at 5 % that estimate reads twice the ratio the free decay shows). Each
-mode is named by where its kinetic energy lies: the mode with the largest share on the
-driven hub is the mesh mode (the driven gear rotating on the mesh spring against the
-prescribed driver); the others are tooth modes, named by the gear whose teeth carry most of
-their energy. Modes of teeth near the mesh that carry no load (a spring with n_k > 1 has no
-stiffness at zero deflection) and overdamped modes are left out.
+The pair is linearised (`solver.mbs.linearization`: the DOFs the kernels integrate, the rims,
+hubs and body springs of a coupled model included) at static equilibrium under the mean load
+at ``positions`` driver angles across one angular pitch (one mesh period). At each position
+the eigenvalues lambda of M x'' + C x' + K x = 0 (C: body, tooth-spring and contact dampers
+linearised at rest), from its state-space form, give the natural frequency |lambda| and the
+damping ratio -Re(lambda)/|lambda| of each mode. They are exact for the linearised pair where
+the modal estimate x^T C x / (2 w) on undamped modes is not: a heavily damped tooth joint
+holds the mesh mode's shape (at 5 % that estimate reads twice the ratio the free decay
+shows). The mesh mode is the mode that puts the most into the TE at the hubs under a force at
+the mesh (`te_participation`): in the plain model the driven gear rotating on the mesh
+spring against the prescribed driver; in a coupled model the rims and the driven hub
+against the mesh and the body springs together. The others are named by where their kinetic
+energy lies: body modes (coupled models: mostly on the rims and hubs), or tooth modes of the
+gear whose teeth carry most of it. Modes of teeth near the mesh that carry no load (a spring
+with n_k > 1 has no stiffness at zero deflection) and overdamped modes are left out.
 
 Damping as a ratio (`joint_damping_for_ratio`, `tooth_damping_for_ratio`):
 * tooth dampers: zeta_t of the tooth's own mode, the tooth on its spring about its pivot:
@@ -40,6 +42,7 @@ import scipy.optimize
 
 from solver.mbs.equilibria import Equilibrium, loaded_equilibria
 from solver.mbs.kernels import layout as L
+from solver.mbs.linearization import LinearSystem, at_equilibrium
 from solver.mbs.model import Model
 
 
@@ -56,28 +59,36 @@ def with_damping(model: Model, c_con: float | None = None, c_phi: tuple | None =
     return dataclasses.replace(model, gear_par=gp, law_par=lp)
 
 
-def _system(model: Model, eq: Equilibrium):
-    from solver.mbs.stability import linearized_system
-    return linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True)
+def _system(model: Model, eq: Equilibrium) -> LinearSystem:
+    return at_equilibrium(model, eq)
 
 
 def _modes(M, K):
-    """(w [rad/s], mass-normalised modes, kinetic-energy shares) of the modes with stiffness."""
+    """(w [rad/s], mass-normalised modes) of the modes with stiffness."""
     lam, x = scipy.linalg.eigh(K, M)
     keep = lam > 1e-8 * max(lam.max(), 0.0)
-    x = x[:, keep]
-    return np.sqrt(lam[keep]), x, x * (M @ x)
+    return np.sqrt(lam[keep]), x[:, keep]
 
 
-def _mesh_index(share) -> int:
-    return int(np.argmax(share[0]))
+def te_participation(M, C, lam, u, te, mesh) -> np.ndarray:
+    """How much each mode (eigenvalue lam, shape u of M x'' + C x' + K x = 0) puts into the TE
+    at the hubs under a force at the mesh: |(te.u)(mesh.u)| / |a lam|, a = u^T (2 lam M + C) u
+    (the residue of the receptance; for an undamped mode of unit modal mass (te.x)(mesh.x) /
+    (2 w^2), its static share). Independent of the shapes' scaling."""
+    a = np.array([u[:, k] @ ((2 * lam[k]) * M + C) @ u[:, k] for k in range(u.shape[1])])
+    return np.abs((te @ u) * (mesh @ u)) / np.maximum(np.abs(a * lam), 1e-300)
 
 
-def _damped_modes(M, K, C):
+def _damped_modes(sy: LinearSystem, C):
     """(natural frequency |lambda| [rad/s], damping ratio -Re(lambda)/|lambda| [1], kinetic-energy
-    shares (dof, mode)) of the oscillating modes of M x'' + C x' + K x = 0 (the state-space
-    eigenproblem: exact for non-proportional damping, where a heavily damped tooth joint
-    holds the mesh mode's shape); overdamped and rigid modes are left out."""
+    shares (dof, mode), index of the mesh mode) of the oscillating modes of
+    M x'' + C x' + K x = 0 (the state-space eigenproblem: exact for non-proportional damping,
+    where a heavily damped tooth joint holds the mesh mode's shape); overdamped and rigid
+    modes are left out. The mesh mode is the one whose resonance puts the most into the TE at
+    the hubs under a force at the mesh: `te_participation` over the damping ratio (the peak of
+    a lightly damped mode; at least 1e-3 counted, so that an undamped pair falls back on the
+    static share), the resonance a run-up shows."""
+    M, K = sy.M, sy.K
     n = M.shape[0]
     mi = np.linalg.inv(M)
     lam, v = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [-mi @ K, -mi @ C]]))
@@ -86,23 +97,25 @@ def _damped_modes(M, K, C):
     lam, u = lam[keep], v[:n, keep]
     share = np.real(np.conj(u) * (M @ u))
     share = share / share.sum(0)
-    return np.abs(lam), -lam.real / np.abs(lam), share
+    zeta = -lam.real / np.abs(lam)
+    mesh = int(np.argmax(te_participation(M, C, lam, u, sy.te, sy.mesh) / np.maximum(zeta, 1e-3)))
+    return np.abs(lam), zeta, share, mesh
 
 
-def _mesh_damping(M, K, C) -> float:
-    w, z, share = _damped_modes(M, K, C)
-    return float(z[_mesh_index(share)])
+def _mesh_damping(sy: LinearSystem, C) -> float:
+    w, z, share, i = _damped_modes(sy, C)
+    return float(z[i])
 
 
 @dataclass
 class Modes:
     """Natural frequencies and damping ratios over mesh positions (mode 0 is the mesh mode;
-    then the tooth modes by rising frequency, NaN where a position has fewer)."""
+    then the other modes by rising frequency, NaN where a position has fewer)."""
     position: np.ndarray       # driver angle [rad] of each mesh position
     frequency: np.ndarray      # (mode, position) [Hz]
     damping: np.ndarray        # (mode, position) ratio of critical [1]
-    gear: np.ndarray           # (mode, position) gear whose teeth carry most of the mode's energy (0: the hub)
-    kind: tuple                # per mode: 'mesh', 'tooth gear1', 'tooth gear2' (most frequent over positions)
+    gear: np.ndarray           # (mode, position) gear whose teeth carry most of the mode's energy (0: the mesh mode, 3: a body mode)
+    kind: tuple                # per mode: 'mesh', 'body', 'tooth gear1', 'tooth gear2' (most frequent over positions)
 
 
 def modal_analysis(model: Model, torque: float, positions: int = 12, equilibria=None) -> Modes:
@@ -112,11 +125,14 @@ def modal_analysis(model: Model, torque: float, positions: int = 12, equilibria=
     rows = []
     tz2 = int(model.gear_par[1, L.TOOTH0])
     for eq in eqs:
-        M, K, C, teeth = _system(model, eq)
-        w, zeta, share = _damped_modes(M, K, C)
-        g2 = np.array([t >= tz2 for t in teeth])
-        gear = np.where(share[1:][g2].sum(0) > share[1:][~g2].sum(0), 2, 1)
-        im = _mesh_index(share)
+        sy = _system(model, eq)
+        w, zeta, share, im = _damped_modes(sy, sy.damping())
+        nb = sy.n_body
+        g2 = np.array([t >= tz2 for t in sy.teeth], dtype=bool)
+        tooth = share[nb:]
+        gear = np.where(tooth[g2].sum(0) > tooth[~g2].sum(0), 2, 1)
+        if nb > 1:      # body-coupled: a mode whose energy lies mostly on the rims and hubs
+            gear[share[:nb].sum(0) > 0.5] = 3
         gear[im] = 0
         order = [im] + [j for j in np.argsort(w) if j != im]
         rows.append((w[order] / (2 * math.pi), zeta[order], gear[order]))
@@ -129,7 +145,8 @@ def modal_analysis(model: Model, torque: float, positions: int = 12, equilibria=
     kind = ["mesh"]
     for row in gear[1:]:
         vals = row[row > 0]
-        kind.append(f"tooth gear{np.bincount(vals).argmax()}" if vals.size else "tooth")
+        top = np.bincount(vals).argmax() if vals.size else 0
+        kind.append("body" if top == 3 else f"tooth gear{top}" if top else "tooth")
     return Modes(np.array([e.theta1 for e in eqs]), pad(0, np.nan), pad(1, np.nan), gear, tuple(kind))
 
 
@@ -153,22 +170,24 @@ def tooth_damping_for_ratio(model: Model, equilibria, zeta: float, gear: int) ->
 
 def _solve_scale(parts, zeta: float, what: str) -> float:
     """The scale s >= 0 of the damper C1 in C = C0 + s C1 for which the mesh mode's ratio,
-    mean over the positions ``parts`` [(M, K, C0, C1)], is ``zeta``. The ratio grows with s
-    from that of C0 up to a largest value (a very stiff damper locks its joint) and falls
-    after it: the root below that largest value is taken."""
+    mean over the positions ``parts`` [(LinearSystem, C0, C1)], is ``zeta``. The ratio grows
+    with s from that of C0 up to a largest value (a very stiff damper locks its joint) and
+    falls after it: the root below that largest value is taken."""
     def mean(s):
-        return float(np.mean([_mesh_damping(M, K, C0 + s * C1) for M, K, C0, C1 in parts]))
+        return float(np.mean([_mesh_damping(sy, C0 + s * C1) for sy, C0, C1 in parts]))
     z0 = mean(0.0)
     if z0 > zeta:
         raise ValueError(f"the other dampers alone give the mesh mode {z0:.4g} of critical, more than {zeta:.4g}")
     if zeta == z0:
         return 0.0
-    # first guess: the proportional-damping estimate x^T C1 x / (2 w), linear in s
+    # first guess: the proportional-damping estimate x^T C1 x / (2 w), linear in s, on the
+    # undamped mode nearest the damped mesh mode
     est = []
-    for M, K, _c0, C1 in parts:
-        w, x, share = _modes(M, K)
-        i = _mesh_index(share)
-        est.append(0.5 * x[:, i] @ C1 @ x[:, i] / w[i])
+    for sy, C0, C1 in parts:
+        w, x = _modes(sy.M, sy.K)
+        wd, _z, _share, i = _damped_modes(sy, C0)
+        j = int(np.argmin(np.abs(w - wd[i])))
+        est.append(0.5 * x[:, j] @ C1 @ x[:, j] / w[j])
     unit = float(np.mean(est))
     if not unit > 0:
         raise ValueError(f"the {what} do not damp the mesh mode (check the exponents and the load)")
@@ -185,22 +204,19 @@ def _solve_scale(parts, zeta: float, what: str) -> float:
     raise ValueError(f"the {what} cannot damp the mesh mode to {zeta:.4g} of critical (at most about {best:.3g})")
 
 
-def _parts(model: Model, equilibria, m0: Model, m1: Model):
-    out = []
-    for eq in equilibria:
-        M, K, C0, _t = _system(m0, eq)
-        out.append((M, K, C0, _system(m1, eq)[2] - C0))
-    return out
-
-
 def joint_damping_for_ratio(model: Model, equilibria, zeta: float) -> tuple[float, float]:
     """Tooth-root joint dampers (c_phi gear 1, gear 2) [N·m·s/rad] that alone (no contact
-    damper) give the mesh mode the ratio ``zeta`` on average over the equilibria; both gears'
-    teeth at the same ratio of their own mode. The mesh mode deflects mostly the tooth
-    springs (the contact is stiff in series with them), so this damps it at a small price on
-    the local modes; a contact damper that did it alone would overdamp the tooth-on-contact
-    modes far above and cut the explicit step by some fifty times."""
+    damper; the body dampers of a coupled model stay) give the mesh mode the ratio ``zeta`` on
+    average over the equilibria; both gears' teeth at the same ratio of their own mode. The
+    mesh mode deflects mostly the tooth springs (the contact is stiff in series with them),
+    so this damps it at a small price on the local modes; a contact damper that did it alone
+    would overdamp the tooth-on-contact modes far above and cut the explicit step by some
+    fifty times. The linearisation is that of the model integrated (`solver.mbs.linearization`),
+    made once per equilibrium."""
     unit = (tooth_damping_for_ratio(model, equilibria, 1.0, 1), tooth_damping_for_ratio(model, equilibria, 1.0, 2))
-    m0 = with_damping(model, c_con=0.0, c_phi=(0.0, 0.0))
-    s = _solve_scale(_parts(model, equilibria, m0, with_damping(m0, c_phi=unit)), zeta, "tooth-root joint dampers")
+    parts = []
+    for eq in equilibria:
+        sy = _system(model, eq)
+        parts.append((sy, sy.c_body, unit[0] * sy.joint_unit[0] + unit[1] * sy.joint_unit[1]))
+    s = _solve_scale(parts, zeta, "tooth-root joint dampers")
     return unit[0] * s, unit[1] * s

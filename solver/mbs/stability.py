@@ -1,5 +1,6 @@
-"""Step bound of the explicit integrator: the pair linearised at static equilibrium, its
-natural frequencies and modal damping, and the body-spring modes.
+"""Step bound of the explicit integrator: the pair linearised at static equilibrium
+(`solver.mbs.linearization`: the DOFs the kernel integrates, the body modes of a coupled
+model included), its natural frequencies and modal damping.
 
 `stable_time_step` gives ``dt = safety * 2 / omega_max`` (velocity Verlet is stable for
 omega*dt < 2), reduced where the modal damping of the loaded contacts asks for it
@@ -13,78 +14,35 @@ import math
 import numpy as np
 import scipy.linalg
 
-from solver.mbs.equilibria import loaded_equilibria
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
-from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
+from solver.mbs.linearization import linearizations, linearize
 from solver.mbs.model import Model
 
 
 def implicit_dampers_apply(model: Model) -> bool:
-    """Whether the explicit kernel can take the tooth-root dampers implicitly (IMEX, see
-    `solver.mbs.kernels.explicit`): the plain pair (no body coupling) with linear dampers
+    """Whether the explicit kernels can take the tooth-root dampers implicitly (IMEX, see
+    `solver.mbs.kernels.explicit`; the body-coupled kernel the same way): linear dampers
     (n_c = 1) on both gears, at least one of them nonzero."""
     gp = model.gear_par
-    return (not model.coupled and not model.teeth_coupled and bool(np.all(gp[:, L.N_C] == 1.0))
-            and bool(np.any(gp[:, L.C_PHI] != 0.0)))
+    return bool(np.all(gp[:, L.N_C] == 1.0)) and bool(np.any(gp[:, L.C_PHI] != 0.0))
 
 
 def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarray, damping: bool = False,
                       friction: bool = False, spring_dampers: bool = True):
-    """Mass and tangent stiffness over the free DOFs (theta2, then the teeth near the mesh).
+    """Mass and tangent stiffness over the free DOFs of `solver.mbs.linearization.linearize`
+    (the body DOFs first: theta2, or r1, theta2, h2 for a body-coupled model; then the teeth
+    near the mesh), about the rim angles theta1, theta2 [rad] and the tooth rotations phi.
 
-    Returns (M, K, dof_teeth) in SI; the driver hub is prescribed and not a DOF. With
-    ``damping`` also the damping tangent at rest, (M, K, C, dof_teeth): spring dampers and
-    contact dampers dF/d(ddelta) = c*delta^m3 (for m2 = 1; 0 at rest for m2 > 1); with
-    ``friction``, also the flank friction's slope at zero sliding, mu*F/v_reg along the lever
-    arms H (the step bound wants it; a modal damping would not: the flanks slide but at the
-    pitch point); without ``spring_dampers`` the contact dampers (and the friction) only (those
-    the explicit kicks take explicitly when the tooth-root dampers are implicit).
-    The damping laws run as plain Python here (``.py_func``, a few dozen calls): compiling
-    them would add to the first run's compile time for nothing.
+    Returns (M, K, dof_teeth) in SI. With ``damping`` also the damping tangent at rest,
+    (M, K, C, dof_teeth): body, spring and contact dampers; with ``friction``, also the flank
+    friction's slope at zero sliding (the step bound wants it; a modal damping would not:
+    the flanks slide but at the pitch point); without ``spring_dampers`` the tooth-root
+    dampers are left out (those the explicit kicks take implicitly).
     """
-    rec, pairs = new_contact_buffer()
-    zeros = np.zeros(model.n_teeth)
-    gp = model.gear_par
-    nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), phi, zeros, (gp, model.pair_par, model.law_par), (rec, pairs))
-    tz2 = int(gp[1, L.TOOTH0])
-    teeth = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
-    pos = {t: i + 1 for i, t in enumerate(teeth)}
-    n = len(teeth) + 1
-    M = np.zeros((n, n))
-    K = np.zeros((n, n))
-    C = np.zeros((n, n))
-    M[0, 0] = gp[1, L.I_TOT]
-    lp = model.law_par
-    for t, i in pos.items():
-        g = 1 if t >= tz2 else 0
-        M[i, i] = gp[g, L.I_P]
-        if g == 1:
-            M[0, i] = M[i, 0] = gp[1, L.I_CPL]
-        if not model.teeth_coupled:
-            K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
-        if spring_dampers:
-            C[i, i] += spring_damping_tangent.py_func(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
-    if model.teeth_coupled:     # the springs of the teeth near the mesh: (C[S, S])^-1
-        K[1:, 1:] += np.linalg.inv(model.tooth_compliance[np.ix_(teeth, teeth)])
-    for c in range(nc):
-        kt = rec[c, L.C_KT]
-        ia = int(rec[c, L.C_TOOTH1])
-        ib = tz2 + int(rec[c, L.C_TOOTH2])
-        idx = [0, pos[ia], pos[ib]]
-        g = np.array([rec[c, L.C_G2], rec[c, L.C_GA], rec[c, L.C_GB]])
-        K[np.ix_(idx, idx)] += kt * np.outer(g, g)
-        _kd, cd = contact_damping_tangents.py_func(rec[c, L.C_DELTA], 0.0, max(rec[c, L.C_FORCE], 1e-300),
-                                           lp[L.C_CON], lp[L.M2], lp[L.M3])
-        C[np.ix_(idx, idx)] += cd * np.outer(g, g)
-        if friction and lp[L.MU] > 0:
-            # flank friction at rest: its slope mu*F/v_reg in the sliding speed, a stiff damper
-            # along the lever arms H (the symmetric part; it sets the explicit step)
-            hv = np.array([rec[c, L.C_H2], rec[c, L.C_HA], rec[c, L.C_HB]])
-            C[np.ix_(idx, idx)] += rec[c, L.C_DFT] * np.outer(hv, hv)
+    s = linearize(model, theta1, theta2, phi)
     if damping:
-        return M, K, C, teeth
-    return M, K, teeth
+        return s.M, s.K, s.damping(joint=spring_dampers, friction=friction), s.teeth
+    return s.M, s.K, s.teeth
 
 
 def stability_limit(model: Model, torque: float, positions: int = 12,
@@ -103,13 +61,12 @@ def stability_limit(model: Model, torque: float, positions: int = 12,
     with continuation (tooth rotations carried from angle to angle); positions where it does
     not converge are left out. ``implicit_dampers``: the tooth-root dampers are taken implicitly
     (IMEX kicks, `implicit_dampers_apply`), which are stable at any damping: only the contact
-    dampers count then.
+    and body dampers count then.
     """
     wmax = 0.0
     dt_crit = math.inf
-    for eq in loaded_equilibria(model, torque, positions):
-        M, K, C, _t = linearized_system(model, eq.rim1, eq.rim2, eq.phi, damping=True, friction=True,
-                                        spring_dampers=not implicit_dampers)
+    for sy in linearizations(model, torque, positions):
+        M, K, C = sy.M, sy.K, sy.damping(joint=not implicit_dampers, friction=True)
         lam, x = scipy.linalg.eigh(K, M)
         w = np.sqrt(np.maximum(lam, 0.0))
         h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
@@ -125,19 +82,6 @@ def highest_frequency(model: Model, torque: float, positions: int = 12) -> float
     return stability_limit(model, torque, positions)[1]
 
 
-def body_frequency(model: Model) -> float:
-    """Highest natural frequency [rad/s] of the body springs alone (hub against rim and teeth);
-    the tooth modes of `highest_frequency` are usually far above it."""
-    gp = model.gear_par
-    w = 0.0
-    for g in range(2):
-        if gp[g, L.K_BODY] > 0:
-            i_rim = gp[g, L.I_TOT] - gp[g, L.I_HUB]
-            inv = 1.0 / i_rim + (1.0 / gp[g, L.I_HUB] if g == 1 else 0.0)   # the driver's hub is prescribed
-            w = max(w, math.sqrt(gp[g, L.K_BODY] * inv))
-    return w
-
-
 def stable_time_step(model: Model, torque: float, safety: float | None = None,
                      implicit_dampers: bool = False) -> tuple[float, float]:
     """(dt [s], omega_max [rad/s]) for the explicit integrator: safety times the critical step
@@ -146,10 +90,6 @@ def stable_time_step(model: Model, torque: float, safety: float | None = None,
     if safety is None:
         safety = IMEX_SAFETY if implicit_dampers else SAFETY
     dt_crit, w = stability_limit(model, torque, implicit_dampers=implicit_dampers)
-    if model.coupled:   # the body modes are not in the mesh linearisation
-        wb = body_frequency(model)
-        w = max(w, wb)
-        dt_crit = min(dt_crit, 2.0 / wb)
     if not w > 0:
         raise ValueError("no loaded contact found to estimate the highest natural frequency")
     return safety * dt_crit, w

@@ -157,7 +157,7 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
         raise DivergenceError(msg)
     mean_dt = t_reached / steps if steps else float("nan")
     return ScipyResult(t_out, te, ys[:, 0], fmax, ncon, react, ke, pe, ys[:, 2 * n], ys[:, 2 * n + 1],
-                       mean_dt, steps, status, msg, float("nan"), eq.nt,
+                       np.zeros_like(t_out), mean_dt, steps, status, msg, float("nan"), eq.nt,
                        method=method, rtol=rtol, atol=float(atol), nfev=nfev, njev=njev, nlu=nlu, wall_time=wall)
 
 

@@ -22,8 +22,8 @@ def campbell_plot(ds: xr.Dataset, path):
     # driven speed / driver speed = z1 / z2: from the 1Z critical speed and the mesh frequency
     ratio = 2 * math.pi * float(fmesh.mean()) / (mesh_order * float(cs.sel(excitation="1Z")))
     driver_speed = speed / ratio if ratio > 0 else 0.0
-    speed_end = float(ds.attrs.get("runup_speed_end_rad_s", 0.0))      # a run-up sweeps 0 .. speed_end
-    x_max = max(1.3 * float(cs.sel(excitation="1Z")), 2.0 * driver_speed if not speed_end else 1.05 * speed_end)
+    runup = float(ds.attrs.get("runup_speed_end_rad_s", 0.0))     # a run-up sweeps 0 -> runup
+    x_max = max(1.3 * float(cs.sel(excitation="1Z")), 2.0 * driver_speed if not runup else 1.05 * runup)
     x = np.linspace(0.0, x_max, 200)
     fig, ax = plt.subplots(figsize=(8.5, 6.5))
     y_max = 1.6 * float(fmesh.max())
@@ -51,13 +51,19 @@ def campbell_plot(ds: xr.Dataset, path):
     if crit:
         ax.plot([], [], "o", color="C3", label="critical speeds of the mesh mode (dots; kZ lines solid, N and "
                 "sidebands kZ+-N dashed): " + ", ".join(f"{e} {v:.0f}" for e, v in crit if e.endswith("Z")) + " rad/s")
-    if speed_end > 0:
-        ax.axvspan(0.0, speed_end, color="C0", alpha=0.08, lw=0, label=f"run-up 0-{speed_end:.0f} rad/s")
+    if runup > 0:
+        ax.axvspan(0.0, runup, color="C0", alpha=0.07, lw=0, label=f"run-up 0-{runup:.0f} rad/s")
     elif driver_speed > 0:
         ax.axvline(driver_speed, color="C0", lw=1.2, label=f"run speed {driver_speed:.0f} rad/s")
-    higher = [float(np.nanmean(f.sel(mode=m))) for m in ds["mode"].values if np.nanmean(f.sel(mode=m)) > y_max]
+    higher = {}
+    for m in ds["mode"].values:
+        fm = float(np.nanmean(f.sel(mode=m)))
+        if fm > y_max:
+            kind = str(ds["mode_kind"].values[m])
+            higher.setdefault("body" if kind == "body" else "tooth", []).append(fm)
     if higher:
-        ax.text(0.99, 0.01, f"{len(higher)} tooth modes above, {min(higher) / 1e3:.0f}-{max(higher) / 1e3:.0f} kHz",
+        ax.text(0.99, 0.01, "; ".join(f"{len(v)} {k} mode{'s' if len(v) > 1 else ''} above, "
+                                      f"{min(v) / 1e3:.0f}-{max(v) / 1e3:.0f} kHz" for k, v in higher.items()),
                 transform=ax.transAxes, ha="right", va="bottom", fontsize=8, color="0.3")
     ax.set_xlim(0, x_max)
     ax.set_ylim(0, y_max)
@@ -107,5 +113,9 @@ def order_map_plot(ds: xr.Dataset, path):
     ax2.set_xlabel("driver speed [rad/s]")
     ax2.set_ylabel("DTE amplitude [um]")
     ax2.legend(fontsize=8)
+    status = ds["order_amplitude"].attrs.get("status", "")
+    if status:      # a completed run-up whose energy balance does not close: kept, flagged
+        fig.text(0.5, 0.005, "flagged: " + status[:160] + ("..." if len(status) > 160 else ""), ha="center",
+                 va="bottom", fontsize=7, color="C3", wrap=True)
     figure_title(fig, ds, "Run-up: computed order tracking of DTE, Campbell overlay and order cuts", width=100)
     return save_figure(fig, path)

@@ -46,8 +46,20 @@ def run_plots() -> tuple:
          "no spectrum in the archive (DTE record too short or not computed)"),
         (("tooth_stiffness",), "tooth_stiffness", stiffness_plot, "stiffness plot", "no tooth_stiffness in the archive"),
         (("mode_frequency",), "campbell", campbell_plot, "Campbell diagram", "no modes in the archive"),
-        (("order_amplitude",), "order_map", order_map_plot, "order map", "not a run-up (dynamic.speed_end = 0)"),
+        (("order_amplitude",), "order_map", order_map_plot, "order map", order_map_missing),
     )
+
+
+def order_map_missing(ds: xr.Dataset) -> str:
+    """Why a run archive has no order map: no dynamic run, not a run-up, or a run-up that
+    stopped before its end (the reason `study.run` recorded)."""
+    if "order_tracking_skipped" in ds.attrs:
+        return str(ds.attrs["order_tracking_skipped"])
+    if "dte" not in ds:
+        return "the archive has no dynamic analysis (dte)"
+    if "runup_speed_end_rad_s" in ds.attrs:
+        return "the run-up's archive has no order tracking"
+    return "not a run-up (dynamic.speed_end = 0)"
 
 
 def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True) -> list[Path]:
@@ -69,7 +81,7 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True)
         if any(v in ds for v in variables):
             out.append(plot(ds, name(stem)))
         else:
-            skip(what, why)
+            skip(what, why(ds) if callable(why) else why)
     if not renders:
         skip("renders", "not asked for")
         return out

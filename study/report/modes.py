@@ -7,8 +7,8 @@ archive variables (`solver.mbs.modes`, `solver.mbs.ringdown`).
   critical_speed(excitation, mode)      driver speed [rad/s] at which an excitation order meets the
                                         mode's mean frequency; excitation: 1Z..5Z, N, 2N, kZ-N, kZ+N
 Attributes: the damping coefficients the run has (scene units), the mesh mode's frequency and
-damping ratio from the modal analysis (mean over the mesh period and at the driver angle 0)
-and from the simulated free decay there.
+damping ratio from the modal analysis (mean over the mesh period, and at the mesh position
+whose ratio is nearest that mean) and from the simulated free decay there.
 """
 from __future__ import annotations
 
@@ -75,9 +75,14 @@ def modal_variables(model: Model, torque: float, holes: int, decay: bool = True)
     }
     if decay:
         from solver.mbs.ringdown import ring_down
-        rd = ring_down(model, torque, float(md.frequency[0, 0]), float(md.damping[0, 0]))
+        # where the mesh mode's ratio is nearest its mean over the mesh period (the ratio a
+        # run-up's resonance sees: at 1Z one mesh period passes per vibration period)
+        j = int(np.nanargmin(np.abs(md.damping[0] - np.nanmean(md.damping[0]))))
+        rd = ring_down(model, torque, float(md.frequency[0, j]), float(md.damping[0, j]), driver_angle=float(md.position[j]))
         attrs.update(mesh_mode_frequency_decay_hz=rd.frequency, mesh_mode_damping_decay=rd.damping,
-                     mesh_mode_damping_at_0=float(md.damping[0, 0]),
-                     mesh_mode_decay_method="free decay after a 10 % load step at driver angle 0 "
-                                            "(solver.mbs.ringdown): damped cosine fitted to TE")
+                     mesh_mode_damping_at_decay=float(md.damping[0, j]),
+                     mesh_mode_decay_angle_deg=float(np.degrees(md.position[j])),
+                     mesh_mode_decay_method="free decay after a 10 % load step with the driver held at "
+                                            "mesh_mode_decay_angle_deg, the mesh position whose modal ratio is "
+                                            "nearest the mean (solver.mbs.ringdown): damped cosine fitted to TE")
     return coords, data, attrs

@@ -29,6 +29,7 @@ import numpy as np
 import xarray as xr
 
 from solver import units
+from solver.mbs.energy_guard import energy_error_limit
 from study.report.spectra import WINDOW, amplitude_spectrum, named_peaks, ste_order_spectrum
 
 INACCURATE = 6      # `solver.mbs.dynamics.INACCURATE` (not imported: the reports load no numba)
@@ -167,7 +168,8 @@ def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_orde
         "contact_force_max": _var("time", res.force_max, "N", "largest tooth contact force over the output interval"),
         "dte_contacts": _var("time", res.n_contacts.astype("int16"), "1", "loaded tooth contacts"),
         "driver_torque": _var("time", res.driver_torque, "N m", "torque applied by the driver"),
-        "energy_balance_error": _var("time", res.energy_error, "J", "work in - change of kinetic and potential energy - dissipated energy"),
+        "energy_balance_error": _var("time", res.energy_error, "J", "work in - change of kinetic and potential energy "
+                                     "- dissipated energy - energy taken out by the coupled set's switches"),
     }
     attrs = {}
     sel = res.time >= spectrum_start
@@ -187,6 +189,11 @@ def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_orde
             coords.update(c); data.update(v)
     attrs.update(dt_s=res.dt, steps=res.steps, omega_max_rad_s=res.omega_max, dynamic_status=res.message,
                  max_active_teeth=res.max_active_teeth)
+    if res.time.size > 1:
+        # the energy guard's margin: largest |error| / limit over the run (flagged above 1)
+        err = np.abs(res.energy_error)
+        attrs.update(energy_error_max_J=float(err.max()), potential_energy_max_J=float(np.max(res.potential)),
+                     energy_error_margin=float(np.max(err / np.maximum(energy_error_limit(res), 1e-300))))
     return coords, data, attrs
 
 

@@ -112,7 +112,7 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         line = (f"  mesh mode: {a['mesh_mode_frequency_hz']:.0f} Hz, damping {a['mesh_mode_damping']:.4f} of critical "
                 f"(modal, mean over the mesh period)")
         if "mesh_mode_damping_decay" in a:
-            line += f", {a['mesh_mode_damping_decay']:.4f} from the free decay ({a['mesh_mode_damping_at_0']:.4f} modal there)"
+            line += f", {a['mesh_mode_damping_decay']:.4f} from the free decay ({a['mesh_mode_damping_at_decay']:.4f} modal there)"
         w(line + "\n")
         cs = ds["critical_speed"].sel(mode=0)
         w("    critical driver speeds [rad/s]: " + ", ".join(f"{e} {v:.0f}" for e, v in zip(ds["excitation"].values, cs.values)

@@ -97,7 +97,7 @@ def plausibility(res, model, torque: float, method: str) -> str:
     if np.max(res.force_max) > f_bound:
         return f"contact force {np.max(res.force_max):.4g} N beyond {f_bound:.4g} N"
     e = res.kinetic + res.potential
-    growth = (e - e[0]) + res.dissipated - res.work
+    growth = -res.energy_error
     scale = max(np.max(np.abs(res.work)), np.max(e), 1e-12)
     if np.max(growth) > 0.02 * scale:
         return f"energy grows by {np.max(growth):.3g} J ({np.max(growth) / scale:.1%} of the work)"

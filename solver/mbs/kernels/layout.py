@@ -134,7 +134,8 @@ O_WORK = 7          # work of the driver and the load since t = 0 [J]
 O_DISS = 8          # dissipated energy [J]
 O_THETA2 = 9        # driven hub angle [rad]
 O_NEWTON = 10       # most Newton iterations in a step of the interval (implicit) [-]
-N_OUT = 11
+O_SWITCH = 11       # energy the coupled set's switches took out since t = 0 (compliance model) [J]
+N_OUT = 12
 # after the N_OUT columns, when ``out`` is wider: the loaded contacts at the output instant,
 # O_CONTACT_COLS columns each (as many as fit; unused slots hold tooth -1 and force 0)
 OC_TOOTH1 = 0       # gear-1 tooth index
@@ -151,7 +152,8 @@ B_P_IN = 2          # input power at the last step [W]
 B_P_D = 3           # dissipation power at the last step [W]
 B_FMAX = 4          # largest contact force since the last output [N]
 B_E0 = 5            # kinetic + potential energy at t = 0 [J]
-N_BOOK = 6
+B_SWITCH = 6        # energy the coupled set's switches took out [J] (`explicit_coupled`)
+N_BOOK = 7
 
 # active-tooth set: int array ``tset[row, :]``
 T_ACT = 0           # active tooth indices (the first nact valid)

@@ -157,8 +157,8 @@ def record_output(out, o, row, book, rec, nc, finite, par, status):
     row = (time [s], TE [m], driven hub angle [rad], driver torque [N m], kinetic and
     potential energy [J]); with the largest contact force since the last record [N] (then
     reset), the loaded contacts of rec[:nc] (their count, and each in a slot when ``out`` has
-    them: `record_contacts`), and the work and dissipated energy [J] of
-    ``book``. Status NONFINITE when the state is not ``finite`` or the energies are not,
+    them: `record_contacts`), the work and dissipated energy [J] of ``book``, and the energy the
+    coupled set's switches took out [J]. Status NONFINITE when the state is not ``finite`` or the energies are not,
     ENERGY when the balance shows a growth kinetic + potential - initial + dissipated - work
     [J] above par[ENERGY_TOL] times the energy scale, else ``status`` unchanged.
     """
@@ -177,12 +177,13 @@ def record_output(out, o, row, book, rec, nc, finite, par, status):
     out[o, L.O_WORK] = book[L.B_WORK]
     out[o, L.O_DISS] = book[L.B_DISS]
     out[o, L.O_THETA2] = theta2
+    out[o, L.O_SWITCH] = book[L.B_SWITCH]
     record_contacts(out, o, rec, nc)
     book[L.B_FMAX] = 0.0
     if not (finite and math.isfinite(ke + pe)):
         return NONFINITE
     work = book[L.B_WORK]
-    diss = book[L.B_DISS]
+    diss = book[L.B_DISS] + book[L.B_SWITCH]
     if status == OK and ke + pe - book[L.B_E0] + diss - work > par[L.ENERGY_TOL] * max(abs(work), ke + pe, diss):
         return ENERGY
     return status

@@ -76,6 +76,18 @@ def coupled_set(ctooth):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
+def set_differs(cset, ns, nn):
+    """Whether newl[:nn] differs from the current set (ns teeth)."""
+    _ct, _ks, slst, newl, inset, _innew, _mo, _dmo = cset
+    if nn != ns:
+        return True
+    for a in range(nn):
+        if not inset[newl[a]]:
+            return True
+    return False
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
 def update_set(cset, ns, nn, phi, dphi, vpred):
     """Make newl[:nn] the coupled set (``inset`` flags the old members, ns of them): teeth that
     join take their neighbours' share of rotation phi [rad] and of the rates dphi, vpred

@@ -188,9 +188,11 @@ def test_diagonal_compliance_dynamics_is_the_body_torsion_model():
     assert b.te == pytest.approx(a.te, abs=1e-15)
 
 
-def test_coupled_kernel_matches_its_plain_python_run():
+@pytest.mark.parametrize("imex", [0.0, 1.0])
+def test_coupled_kernel_matches_its_plain_python_run(imex):
     """The compiled coupled loop against the same loop run as plain Python, set changes
-    included (300 steps through a change of the candidate teeth)."""
+    included (300 steps through a change of the candidate teeth), with the tooth-root dampers
+    explicit and implicit."""
     from solver.mbs.kernels.explicit_coupled import verlet_coupled
     from solver.mbs.kernels.stepping import work_arrays
     from solver.mbs.stability import stable_time_step
@@ -200,7 +202,8 @@ def test_coupled_kernel_matches_its_plain_python_run():
     runs = []
     for f in (verlet_coupled, verlet_coupled.py_func):
         par = np.zeros(L.N_PAR)
-        par[[L.SPEED, L.SPEED_RAMP, L.TORQUE, L.TORQUE_RAMP, L.DT, L.DELTA_MAX, L.ENERGY_TOL]] = 300.0, 1e-9, 50.0, 1e-9, dt, 1e-4, 0.5
+        par[[L.SPEED, L.SPEED_RAMP, L.TORQUE, L.TORQUE_RAMP, L.DT, L.DELTA_MAX, L.ENERGY_TOL, L.IMEX]] = \
+            300.0, 1e-9, 50.0, 1e-9, dt, 1e-4, 0.5, imex
         ipar = np.array([300, 1, 0])
         out = np.zeros((301, L.N_OUT))
         hub = np.zeros((3, L.N_HUB))
