@@ -129,10 +129,11 @@ def run_sweep(study, output, workers: int | None = None, scheduler: str | None =
     return run_sweep(study, output, workers=workers, scheduler=scheduler, progress=progress, keep_parts=keep_parts)
 
 
-def render(archive, out_dir=None, renders: bool = True) -> list:
+def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None) -> list:
     """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
     files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a
-    path or an xarray.Dataset."""
+    path or an xarray.Dataset; ``limits`` ({output: value}, sampled studies): the probability
+    of exceeding each."""
     from pathlib import Path
 
     from study.report.figures import make_figures
@@ -144,7 +145,7 @@ def render(archive, out_dir=None, renders: bool = True) -> list:
         archive = read(path)
     elif out_dir is None:
         raise ValueError("render: out_dir is needed for a dataset")
-    return make_figures(archive, Path(out_dir), renders=renders)
+    return make_figures(archive, Path(out_dir), renders=renders, limits=limits)
 
 
 __all__ = ["Scene", "SceneError", "Study", "Outputs", "SweepResult", "load_scene", "default_scene", "run_scene", "write",
