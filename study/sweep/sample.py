@@ -172,12 +172,22 @@ def unit_points(method: str, n: int, d: int, seed: int) -> np.ndarray:
 
 # ---------------------------------------------------------------- reading and checking
 
+def _scene_table(path: str) -> bool:
+    """True when ``path`` names a table of the scene (``gear1.errors``), not a value field."""
+    try:
+        f = scene_field(path)
+    except SceneError:
+        return False
+    return dataclasses.is_dataclass(f.default_factory) if f.default_factory is not dataclasses.MISSING else False
+
+
 def flatten_sample(table: dict, prefix: str = "") -> dict:
-    """{dotted key: value} of a [sample] table; a distribution table ({uniform = ...}) is a leaf."""
+    """{dotted key: value} of a [sample] table: nested scene tables (unquoted dotted keys) are
+    followed down to their fields, whose value is the distribution table."""
     out = {}
     for k, v in table.items():
         path = f"{prefix}.{k}" if prefix else k
-        if isinstance(v, dict) and not (set(v) & set(KINDS)) and v:
+        if isinstance(v, dict) and _scene_table(path):
             out.update(flatten_sample(v, path))
         else:
             out[path] = v
