@@ -48,6 +48,20 @@ WORDS = {
 }
 
 
+GRID_WORDS = {"gear1.errors.grade": "driver class {}", "gear2.errors.grade": "driven gear class {}"}
+
+
+def grid_label(ds: xr.Dataset, at: dict) -> str:
+    """'driver class 5' for a grid point of the grade, else 'field = value'."""
+    from study.report.distributions import point_label
+    words = []
+    for d, i in at.items():
+        field = ds[d].attrs.get("scene_field", d) if d in ds.coords else d
+        value = ds[d].values[i] if d in ds.coords else i
+        words.append(GRID_WORDS[field].format(value) if field in GRID_WORDS else point_label(ds, {d: i}))
+    return ", ".join(words) or "all builds"
+
+
 def reduced_study(path: Path, size: int | None, overrides: list[str]) -> study.Study:
     """The study at ``path`` with ``size`` draws (when given) and scene overrides."""
     from study.sweep.grid import dumps_study, loads_study
@@ -81,10 +95,10 @@ def _pct(tab: xr.Dataset, out: str, at: dict, q: float = 0.95) -> tuple[float, f
 
 def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
     """The one-paragraph answer from a sampled study's archive and tables."""
-    from study.report.distributions import grid_points, point_label
+    from study.report.distributions import grid_points
     unit = ds[out].attrs.get("units", "")
     points = grid_points(ds)
-    labels = [point_label(ds, at) for at in points]
+    labels = [grid_label(ds, at) for at in points]
     p95 = [_pct(tab, out, at) for at in points]
     p50 = [_pct(tab, out, at, 0.5) for at in points]
     parts = []

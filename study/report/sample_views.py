@@ -159,8 +159,10 @@ def sobol_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path):
         n_ok = int(ds["sample_row"].max()) + 1
         ax.set_title(f"{point_label(ds, at)} ({n_ok} rows of the design)", fontsize=9)
         ax.set_xlabel("share of the variance [–]", fontsize=8)
-        if k == 0:
+        if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=8, loc="lower right")
+        else:
+            ax.text(0.5, 0.5, "fewer than 4 complete rows: no indices", transform=ax.transAxes, ha="center", fontsize=9)
     for k in range(len(points), nrow * ncol):
         axes[k // ncol, k % ncol].set_visible(False)
     figure_title(fig, ds, f"Which drawn field drives {var}: Sobol indices with 95 % intervals (bootstrap), "
