@@ -179,7 +179,7 @@ def stiffness_command(args) -> int:
 # ---------------------------------------------------------------- sweep
 
 def sweep_arguments(p) -> None:
-    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]] + [outputs])")
+    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]], or a [sample], + [outputs])")
     p.add_argument("-o", "--output", help="archive to write (NetCDF; default results/<study name>.nc)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="address of an existing dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--workers", type=int, default=None,

@@ -1,6 +1,6 @@
 """What a driver's tolerance class does to the transmission error, in one paragraph.
 
-    python -m workflows.tolerance [STUDY.toml] [--size N] [--set key=value ...] [--answer dte_rms]
+    python -m workflows.tolerance [STUDY.toml] [--size N] [--set key=value ...] [--answer dte_rms ...]
         [--limit dte_rms=0.5] [-o results/tolerance] [--workers N]
 
 Runs a sampled study (default `study/scenes/tolerance.toml`: the lightened paper pair with tip
@@ -35,6 +35,7 @@ from study.scene import SceneError, parse_override
 DEFAULT_STUDY = Path(__file__).resolve().parents[1] / "study" / "scenes" / "tolerance.toml"
 DEFAULT_OUT = "results/tolerance"
 DEFAULT_LIMIT = "dte_rms=0.5"           # um
+DEFAULT_ANSWER = ("dte_rms", "amp_mesh_order")
 # the drawn fields in a gear engineer's words
 WORDS = {
     "gear1.errors.seed": "the driver's pitch deviations",
@@ -113,8 +114,11 @@ def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
         parts.append(f"The P95 of {out} is {p95[0][0]:.3g} [{p95[0][1]:.3g}, {p95[0][2]:.3g}] {unit} "
                      f"(median {p50[0][0]:.3g} {unit})")
     if out in limits and "exceedance_probability" in tab:
-        probs = [tab["exceedance_probability"].isel(at).sel(limit=out, bound="estimate").item() for at in points]
-        parts.append(f"{' / '.join(f'{100 * p:.1f} %' for p in probs)} of the builds exceed {limits[out]:g} {unit}")
+        probs = [[tab["exceedance_probability"].isel(at).sel(limit=out, bound=b).item() for b in ("estimate", "low", "high")]
+                 for at in points]
+        parts.append(f"{out} exceeds {limits[out]:g} {unit} in " + ", ".join(
+            f"{100 * p:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}] of the builds at {lab}"
+            for (p, lo, hi), lab in zip(probs, labels)))
     if "sobol_total" in tab:
         for at, lab in zip(points, labels):
             s1 = tab["sobol_first"].isel(at).sel(output=out)
@@ -123,16 +127,23 @@ def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
             words = []
             for i in order[:3]:
                 f = str(tab["field"].values[i])
-                e1, e1l, e1h = (float(s1.isel(field=i).sel(bound=b)) for b in ("estimate", "low", "high"))
-                et = float(st.isel(field=i).sel(bound="estimate"))
-                words.append(f"{WORDS.get(f, f)} {100 * e1:.0f} % alone [{100 * e1l:.0f}, {100 * e1h:.0f}] "
-                             f"({100 * et:.0f} % with its interactions)")
-            parts.append(f"at {lab}, of the variance of {out}: " + "; ".join(words))
+                # shares in words: the estimators can stray below 0 or above 1 by their sampling
+                # error; the tables keep the raw values
+                e1, e1l, e1h = (min(max(float(s1.isel(field=i).sel(bound=b)), 0.0), 1.0)
+                                for b in ("estimate", "low", "high"))
+                et = min(max(float(st.isel(field=i).sel(bound="estimate")), 0.0), 1.0)
+                words.append(f"{WORDS.get(f, f)} {100 * e1:.0f} % alone ({100 * e1l:.0f} to {100 * e1h:.0f} %), "
+                             f"{100 * et:.0f} % with its interactions")
+            parts.append(f"of the variance of {out} at {lab}: " + "; ".join(words))
+    return ". ".join(p[0].upper() + p[1:] for p in parts) + "."
+
+
+def cost(ds: xr.Dataset) -> str:
+    """'N of M builds ok, T s of compute (t s a build)'."""
     n = int(ds["status"].size)
     ok = int((ds["status"] == 1).sum())
     compute = float(ds["wall_time"].sum())
-    parts.append(f"{ok} of {n} builds ok, {compute:.0f} s of compute ({compute / n:.2f} s a build)")
-    return ". ".join(p[0].upper() + p[1:] for p in parts) + "."
+    return f"{ok} of {n} builds ok, {compute:.0f} s of compute ({compute / n:.2f} s a build)."
 
 
 def run(args) -> int:
@@ -149,11 +160,12 @@ def run(args) -> int:
     archive = outdir / "tolerance.nc"
     print(f"{st.title}: {int(np.prod(st.shape))} builds ({st.sample.describe()}) -> {archive}", flush=True)
     res = study.run_sweep(st, archive, workers=args.workers, progress=not args.no_progress)
-    print(f"  {res.computed} builds computed, {res.reused} reused, {res.wall_time:.0f} s wall", flush=True)
+    print(f"  {res.computed} analyses computed, {res.reused} reused (a build's statics and its dynamics are two), "
+          f"{res.wall_time:.0f} s wall", flush=True)
     ds = res.dataset
     from study.report.distributions import sample_outputs, sample_tables
     outputs = sample_outputs(ds)
-    out = args.answer_output if args.answer_output in outputs else outputs[0]
+    answers = [o for o in (args.answer or DEFAULT_ANSWER) if o in outputs] or outputs[:1]
     if not args.limit and DEFAULT_LIMIT.split("=")[0] not in outputs:
         limits = {}             # the default limit, on an output this study does not have
     for k in limits:
@@ -161,7 +173,7 @@ def run(args) -> int:
             raise SceneError("--limit", f"{k!r} is not an output of the study ({', '.join(outputs)})")
     study.render(ds, outdir, limits=limits)
     tab = sample_tables(ds, outputs, limits)
-    text = answer(ds, tab, out, limits)
+    text = "\n\n".join([*(answer(ds, tab, out, limits) for out in answers), cost(ds)])
     (outdir / "tolerance.txt").write_text(text + "\n")
     print("\n" + text)
     return 1 if res.pending else 0
@@ -172,8 +184,9 @@ def main(argv=None) -> int:
     p.add_argument("study", nargs="?", default=str(DEFAULT_STUDY), help="sampled study TOML (default: tolerance.toml)")
     p.add_argument("--size", type=int, default=None, help="draws a grid point (replaces [sample] size)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a base-scene field")
-    p.add_argument("--answer", dest="answer_output", default="dte_rms",
-                   help="the output the answer is about (default dte_rms; else the study's first)")
+    p.add_argument("--answer", action="append", default=[], metavar="OUTPUT",
+                   help=f"an output the answer is about, repeatable (default {', '.join(DEFAULT_ANSWER)}; "
+                        "else the study's first)")
     p.add_argument("--limit", action="append", default=[], metavar="OUTPUT=VALUE",
                    help=f"probability of exceeding a limit, repeatable (default {DEFAULT_LIMIT} um)")
     p.add_argument("-o", "--output-dir", default=DEFAULT_OUT, help="output folder (archive, figures, answer)")
