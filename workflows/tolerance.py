@@ -124,6 +124,9 @@ def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
             s1 = tab["sobol_first"].isel(at).sel(output=out)
             st = tab["sobol_total"].isel(at).sel(output=out)
             order = np.argsort(-np.nan_to_num(st.sel(bound="estimate").values, nan=-1))
+            if not np.isfinite(st.sel(bound="estimate").values).any():
+                parts.append(f"no Sobol indices of {out} at {lab}: fewer than 4 rows of the design have every build ok")
+                continue
             words = []
             for i in order[:3]:
                 f = str(tab["field"].values[i])

@@ -30,20 +30,28 @@ def test_the_answer_quotes_the_tables_of_a_tiny_tolerance_study(tmp_path, capsys
     path = tmp_path / "tiny.toml"
     path.write_text(TINY)
     out = tmp_path / "out"
-    assert main([str(path), "-o", str(out), "--workers", "0", "--no-progress", "--size", "2",
+    assert main([str(path), "-o", str(out), "--workers", "0", "--no-progress", "--size", "4",
                  "--limit", "ste_p2p=20"]) == 0
     text = (out / "tolerance.txt").read_text()
     assert text.strip() in capsys.readouterr().out
     with xr.open_dataset(out / "study_tables.nc", engine="netcdf4") as f:
         tab = f.load()
-    # --size 2: 2 rows x (2 + 2) matrices at each of the two classes
-    assert tab["sample_count"].values.tolist() == [[8], [8]]
+    # --size 4: 4 rows x (2 + 2) matrices at each of the two classes
+    assert tab["sample_count"].values.tolist() == [[16], [16]]
     p95 = tab["sample_percentile"].sel(output="ste_p2p", quantile=0.95, bound="estimate").values
-    m = re.search(r"driver class 5 to driver class 7 raises the P95 of ste_p2p from ([\d.]+) .* to ([\d.]+) ", text)
+    m = re.search(r"driver class 5 to driver class 7 raises the P95 of ste_p2p from ([\d.]+) \[[^]]*\] to ([\d.]+) ", text)
     assert m and float(m[1]) == float(f"{p95[0]:.3g}") and float(m[2]) == float(f"{p95[1]:.3g}"), text
-    assert "the driver's runout" in text and "the driver's pitch deviations" in text and "exceed 20 um" in text
+    assert "the driver's runout" in text and "the driver's pitch deviations" in text and "exceeds 20 um in" in text and "nan" not in text
     for stem in ("distribution_ste_p2p", "convergence_ste_p2p", "sobol_ste_p2p"):
         assert (out / f"{stem}.png").is_file()
+
+
+def test_too_few_rows_for_sobol_indices_are_said_not_printed_as_nan(tmp_path, capsys):
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY)
+    assert main([str(path), "-o", str(tmp_path / "out"), "--workers", "0", "--no-progress", "--size", "2"]) == 0
+    text = (tmp_path / "out" / "tolerance.txt").read_text()
+    assert "fewer than 4 rows" in text and "nan" not in text
 
 
 def test_a_reduced_variant_of_the_tolerance_study():
