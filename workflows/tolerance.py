@@ -116,8 +116,8 @@ def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
     if out in limits and "exceedance_probability" in tab:
         probs = [[tab["exceedance_probability"].isel(at).sel(limit=out, bound=b).item() for b in ("estimate", "low", "high")]
                  for at in points]
-        parts.append(f"{out} exceeds {limits[out]:g} {unit} in " + ", ".join(
-            f"{100 * p:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}] of the builds at {lab}"
+        parts.append(f"the share of builds whose {out} exceeds {limits[out]:g} {unit} is " + ", ".join(
+            f"{100 * p:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}] at {lab}"
             for (p, lo, hi), lab in zip(probs, labels)))
     if "sobol_total" in tab:
         for at, lab in zip(points, labels):

@@ -41,7 +41,7 @@ def test_the_answer_quotes_the_tables_of_a_tiny_tolerance_study(tmp_path, capsys
     p95 = tab["sample_percentile"].sel(output="ste_p2p", quantile=0.95, bound="estimate").values
     m = re.search(r"driver class 5 to driver class 7 raises the P95 of ste_p2p from ([\d.]+) \[[^]]*\] to ([\d.]+) ", text)
     assert m and float(m[1]) == float(f"{p95[0]:.3g}") and float(m[2]) == float(f"{p95[1]:.3g}"), text
-    assert "the driver's runout" in text and "the driver's pitch deviations" in text and "exceeds 20 um in" in text and "nan" not in text
+    assert "the driver's runout" in text and "the driver's pitch deviations" in text and "ste_p2p exceeds 20 um is" in text and "nan" not in text
     for stem in ("distribution_ste_p2p", "convergence_ste_p2p", "sobol_ste_p2p"):
         assert (out / f"{stem}.png").is_file()
 
