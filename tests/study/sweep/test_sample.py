@@ -267,3 +267,27 @@ def test_sampled_ste_statistics_against_the_closed_form(tmp_path):
         assert lo - below - arm <= 4 + 20 * q + r <= hi + arm, (q, lo, hi, r)
     _, lo, hi = tab["sample_mean"].sel(output="ste_p2p").values
     assert lo - below - arm <= 14 + r <= hi + arm
+
+
+def test_a_sampled_study_on_dask_interrupted_and_resumed_in_process_gives_the_same_archive(sampled_run, tmp_path,
+                                                                                          monkeypatch):
+    """Builds are ordinary tasks: two stored by a 2-worker LocalCluster, Ctrl-C, the rest here."""
+    res, _ = sampled_run
+    out = tmp_path / "dask.nc"
+    real_put = engine.PartStore.put
+    stored = []
+
+    def put(self, key, result):
+        if len(stored) == 2:
+            raise KeyboardInterrupt
+        stored.append(key)
+        real_put(self, key, result)
+
+    monkeypatch.setattr(engine.PartStore, "put", put)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(sampled(RESUME, RESUME_GRID), out, workers=2, progress=False)
+    monkeypatch.setattr(engine.PartStore, "put", real_put)
+    again = run_sweep(sampled(RESUME, RESUME_GRID), out, workers=0, progress=False)
+    assert again.reused == 2 and again.computed == 10
+    xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created="", history=""),
+                                res.dataset.drop_vars("wall_time").assign_attrs(created="", history=""))
