@@ -309,10 +309,11 @@ def tradeoff_figure(ds, pareto_flags, path, te_limits=None, chosen=None):
     return figure(ds, pareto_flags, path, te_limits=te_limits, chosen=chosen)
 
 
-def render(archive, out_dir=None, renders: bool = True) -> list:
+def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None) -> list:
     """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
     files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a
-    path or an xarray.Dataset."""
+    path or an xarray.Dataset; ``limits`` ({output: value}, sampled studies): the probability
+    of exceeding each."""
     from pathlib import Path
 
     from study.report.figures import make_figures
@@ -325,7 +326,7 @@ def render(archive, out_dir=None, renders: bool = True) -> list:
         archive = read(path)
     elif out_dir is None:
         raise ValueError("render: out_dir is needed for a dataset")
-    return make_figures(archive, Path(out_dir), renders=renders)
+    return make_figures(archive, Path(out_dir), renders=renders, limits=limits)
 
 
 # ---------------------------------------------------------------- the other commands

@@ -186,8 +186,8 @@ def stiffness_command(args) -> int:
 # ---------------------------------------------------------------- sweep
 
 def sweep_arguments(p) -> None:
-    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]] + [outputs]), or the name of an "
-                                 "embedded study (`lightgear scenes`)")
+    p.add_argument("study", help="study TOML (base scene + [grid] and/or [[points]], or a [sample], + [outputs]), "
+                                 "or the name of an embedded study (`lightgear scenes`)")
     p.add_argument("-o", "--output", help="archive to write (NetCDF; default results/<study name>.nc)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="address of an existing dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--workers", type=int, default=None,
@@ -267,14 +267,19 @@ def render_arguments(p) -> None:
     p.add_argument("archive", help="run or sweep archive (NetCDF)")
     p.add_argument("-o", "--output", default=None, help="directory for the PNGs (default: beside the archive)")
     p.add_argument("--no-renders", action="store_true", help="plots only (no pyvista renders, no FE)")
+    p.add_argument("--limit", dest="limits", action="append", default=[], metavar="OUTPUT=VALUE",
+                   help="sampled study: the probability of exceeding a limit, e.g. --limit dte_rms=0.5 "
+                        "(in the output's units; repeatable)")
 
 
 def render_command(args) -> int:
     import study
+    from study.report.render_limits import checked_limits
     path = checked_archive(args.archive)
+    limits = checked_limits(path, args.limits)
     writable_folder(Path(args.output) if args.output else path.parent)
     t0 = time.perf_counter()
-    for p in study.render(path, args.output, renders=not args.no_renders):
+    for p in study.render(path, args.output, renders=not args.no_renders, limits=limits):
         print(f"  figure: {p}")
     print(f"  {time.perf_counter() - t0:.1f} s")
     return 0

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 import math
 import tomllib
 import typing
@@ -281,10 +282,15 @@ def _python_value(value):
     return value
 
 
+# the section classes never change: resolve their annotations once (a sampled study builds
+# thousands of scenes, and resolving them took two thirds of each build)
+_type_hints = functools.cache(typing.get_type_hints)
+
+
 def _build(cls, table, path: str):
     if not isinstance(table, dict):
         raise SceneError(path or "scene", f"must be a table, got {table!r}")
-    hints = typing.get_type_hints(cls)
+    hints = _type_hints(cls)
     known = {f.name: f for f in fields(cls)}
     for key in table:
         if key not in known:
@@ -484,7 +490,7 @@ def scene_field(path: str) -> dataclasses.Field:
                 f" (sections: {', '.join(fs)})" if fs else f" ({where} is a value, not a table)")
             raise SceneError(path, f"no such scene field{valid}{hint}{' ' if hint else '; '}"
                              "`lightgear fields` lists them all")
-        f, cls = fs[p], typing.get_type_hints(cls)[p]
+        f, cls = fs[p], _type_hints(cls)[p]
     return f
 
 

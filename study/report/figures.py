@@ -11,6 +11,7 @@ the study views (`study.report.study_views`): main effects of each output, the s
 ranking (grid layout) and the mass / TE trade-off with its Pareto set, with their tables
 (``sensitivity_share``, ``pareto_*``) written to ``study_tables.nc`` beside the figures; and,
 with up to four swept dimensions, one sweep view per output that varies only over them.
+A sampled study (a ``sample`` dimension) gets the views of `study.report.sample_views` instead.
 
 CLI: ``lightgear render ARCHIVE.nc [-o DIR]`` (default: beside the archive).
 """
@@ -62,8 +63,9 @@ def order_map_missing(ds: xr.Dataset) -> str:
     return "not a run-up (dynamic.speed_end = 0)"
 
 
-def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True) -> list[Path]:
-    """Write every plot and render ``ds`` supports into ``outdir``; return the PNG paths."""
+def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True, limits: dict | None = None) -> list[Path]:
+    """Write every plot and render ``ds`` supports into ``outdir``; return the PNG paths.
+    ``limits`` ({output: value}): the probability of exceeding each, for a sampled study."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     out: list[Path] = []
@@ -75,6 +77,11 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True)
         print(f"  skip {what}: {why}")
 
     swept = swept_dims(ds)
+    if "sample" in swept:       # a sampled study: distributions, convergence, Sobol indices
+        from study.report.sample_views import sample_figures
+        return sample_figures(ds, name, skip, limits)
+    if limits:
+        raise ValueError(f"limits ({', '.join(limits)}) apply to a sampled study; this archive has no sample dimension")
     if swept:
         return _sweep_figures(ds, swept, name, skip)
     for variables, stem, plot, what, why in run_plots():

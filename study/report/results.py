@@ -35,7 +35,10 @@ from study.report.spectra import WINDOW, amplitude_spectrum, named_peaks, ste_or
 INACCURATE = 6      # `solver.mbs.dynamics.INACCURATE` (not imported: the reports load no numba)
 
 
+@functools.lru_cache(maxsize=1)
 def versions() -> str:
+    """The installed versions of the packages a result depends on; read once per process (the
+    package metadata lookups took 0.09 s a call, a third of a sampled build's statics)."""
     out = []
     for pkg in ("lightgear", "numpy", "numba", "scipy", "xarray", "netCDF4", "dask", "scikit-fem", "gmsh"):
         try:

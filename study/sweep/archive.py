@@ -15,7 +15,11 @@ In the grid layout an output lies only over the swept dimensions its analysis re
 (`outputs.ANALYSIS_FIELDS`): ``ste_p2p`` over the body fields but not over ``speed``,
 ``mass_gear2`` over the body fields only; ``status`` says which points are ok (an output is
 read with ``.where(ds.status == 1)``, which broadcasts it over every dimension). In the point
-layout every variable lies over ``point``. Archives of a split study open together with
+layout every variable lies over ``point``.
+A sampled study (`study.sweep.sample`) has a last dimension ``sample`` (one build each), the
+drawn values of each field as variables over it (named like a grid dimension, with its
+``distribution``), ``sample_block`` and ``sample_row`` for the Saltelli design, and every output
+over (the swept dimensions its analysis reads..., ``sample``). Archives of a split study open together with
 ``xr.open_mfdataset(paths, combine="by_coords", data_vars="minimal", compat="no_conflicts")`` (outputs that do not lie
 over the split dimension are then taken once, checked equal).
 Global attributes: title, the study TOML, the base scene TOML, the study key (a hash of all
@@ -33,6 +37,7 @@ from study.report.results import provenance
 from study.scene import field_doc, field_unit
 from study.sweep.grid import Point, Study, dim_name
 from study.sweep.outputs import CURVES, SCALARS, STATUS, analysis_of, reads
+from study.sweep.sample import sample_attrs, sample_variables
 from study.sweep.tasks import point_task_keys
 
 CF_UNITS = {"": "1", "deg": "degree", "N*m": "N m", "rad/s": "rad s-1", "kg/m^3": "kg m-3",
@@ -64,7 +69,12 @@ def study_layout(study: Study, points: list[Point]) -> tuple[tuple[str, ...], di
         for a in study.axes:
             arr, attrs = _coord_values(a.values, a.path)
             coords[a.name] = xr.Variable(a.name, arr, attrs)
-        return tuple(a.name for a in study.axes), coords
+        dims = tuple(a.name for a in study.axes)
+        if study.sample:
+            coords["sample"] = xr.Variable("sample", np.arange(study.sample.builds),
+                                           {"units": "1", "long_name": "build of the sample"})
+            dims += ("sample",)
+        return dims, coords
     coords = {"point": xr.Variable("point", np.arange(len(points)), {"units": "1", "long_name": "study point"})}
     for path in study.fields:
         arr, attrs = _coord_values([p.values.get(path, study.base_value(path)) for p in points], path)
@@ -84,10 +94,11 @@ MERGE_BLOCK_BYTES = 8 * 2**20    # bytes: curve values the merge reads from the 
 
 def output_axes(study: Study, output: str) -> tuple[int, ...]:
     """Positions (in ``study.axes``) of the swept dimensions an output lies over: all of them in
-    the point layout, else the fields its analysis reads."""
+    the point layout, else the fields its analysis reads, and the sample (last) when drawn."""
     if study.layout == "point":
         return ()
-    return tuple(i for i, a in enumerate(study.axes) if reads(analysis_of(output), a.path))
+    sample = (len(study.axes),) if study.sample else ()
+    return tuple(i for i, a in enumerate(study.axes) if reads(analysis_of(output), a.path)) + sample
 
 
 def study_dataset(study: Study, points: list[Point], results: dict, read=None, lost: dict | None = None,
@@ -200,9 +211,12 @@ def study_dataset(study: Study, points: list[Point], results: dict, read=None, l
             attrs["comment"] = CURVES[name].comment
         attrs["analysis"] = CURVES[name].analysis
         data[name] = xr.Variable(dims_of(name) + (axis,), curves[name], attrs)
+    if study.sample:
+        data.update(sample_variables(study.sample))
     attrs = {"title": study.title, "study": study.text, "base_scene": study.base_scene_toml(),
              "study_layout": study.layout, "study_key": study_key(study, points),
-             "outputs": ", ".join(out.scalars + out.curves), **provenance()}
+             "outputs": ", ".join(out.scalars + out.curves), **provenance(),
+             **(sample_attrs(study.sample) if study.sample else {})}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

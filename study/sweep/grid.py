@@ -20,6 +20,10 @@ A study TOML file::
     gear2.body.holes = 9             # dimension: the factorial points first, then these)
     dynamic.speed = 300.0
 
+    [sample]                         # optional: draws of scene fields (`study.sweep.sample`);
+    size = 256                       # with a [grid], every grid point gets the whole sample
+    "gear1.errors.eccentricity" = {uniform = [0.0, 6.0]}
+
     [outputs]
     scalars = ["ste_p2p", "dte_rms"]            # default: all of `outputs.SCALARS`
     curves = ["ste", "dte", "dte_amplitude"]    # default: none (only scalars are archived)
@@ -58,6 +62,7 @@ from study.scene import (
     set_dotted,
 )
 from study.sweep.outputs import Outputs, outputs_from_table
+from study.sweep.sample import Sample, flatten_sample, parse_sample
 from study.toml_writer import toml_value
 
 # dimension names for the fields an engineer sweeps most; others get the dotted path with '_'
@@ -73,7 +78,7 @@ DIM_NAMES = {
     "quasi_static.torque": "static_torque",
 }
 
-STUDY_KEYS = ("title", "scene", "grid", "points", "outputs")
+STUDY_KEYS = ("title", "scene", "grid", "points", "outputs", "sample")
 RANGE_KEYS = ("start", "stop", "num")
 
 
@@ -110,6 +115,7 @@ class Study:
     axes: tuple[Axis, ...]    # factorial grid
     extra: tuple[dict, ...]   # explicit points: dotted path -> value
     outputs: Outputs
+    sample: Sample | None = None     # drawn fields: a last dimension `sample` (grid layout only)
 
     @property
     def layout(self) -> str:
@@ -127,7 +133,7 @@ class Study:
     @property
     def shape(self) -> tuple[int, ...]:
         if self.layout == "grid":
-            return tuple(len(a.values) for a in self.axes)
+            return tuple(len(a.values) for a in self.axes) + ((self.sample.builds,) if self.sample else ())
         n_grid = int(np.prod([len(a.values) for a in self.axes])) if self.axes else 0
         return (n_grid + len(self.extra),)
 
@@ -149,6 +155,9 @@ class Study:
         grid = list(itertools.product(*[range(len(a.values)) for a in self.axes])) if self.axes else []
         for idx in grid:
             combos.append((idx, {a.path: a.values[i] for a, i in zip(self.axes, idx)}))
+        if self.sample:     # every grid point (or the base scene alone) gets the whole sample
+            combos = [(idx + (i,), {**vals, **self.sample.point_values(i)})
+                      for idx, vals in (combos or [((), {})]) for i in range(self.sample.builds)]
         if self.layout == "point":
             combos = [((i,), vals) for i, (_, vals) in enumerate(combos)]
             combos += [((len(combos) + i,), dict(p)) for i, p in enumerate(self.extra)]
@@ -301,15 +310,19 @@ def _loads_study(text: str, folder: str | Path | None = None) -> Study:
         for path in flat:
             _field_kind(base, path)
         points.append({path: _check_value(base, path, v, f"points[{i}]") for path, v in flat.items()})
-    if not axes and not points:
-        raise SceneError("grid", "the study sweeps nothing: give a [grid] table or [[points]]")
+    sample = parse_sample(raw["sample"], base, tuple(a.path for a in axes)) if "sample" in raw else None
+    if sample and points:
+        raise SceneError("points", "a sampled study takes a [grid] (every grid point gets the whole sample), "
+                                   "not [[points]]")
+    if not axes and not points and not sample:
+        raise SceneError("grid", "the study sweeps nothing: give a [grid] table, [[points]] or a [sample]")
     seen = {}
     for path in dict.fromkeys([a.path for a in axes] + [q for pt in points for q in pt]):
         if dim_name(path) in seen:
             raise SceneError(path, f"its dimension name {dim_name(path)!r} clashes with {seen[dim_name(path)]}")
         seen[dim_name(path)] = path
     return Study(str(raw.get("title", "lightgear study")), text, base, axes, tuple(points),
-                 outputs_from_table(raw.get("outputs", {})))
+                 outputs_from_table(raw.get("outputs", {})), sample)
 
 
 def load_study(path: str | Path) -> Study:
@@ -329,6 +342,9 @@ def dumps_study(raw: dict) -> str:
             out.append(f"\n[{table}]")
             flat = _flatten(raw[table], table, repeat=table == "scene") if table != "outputs" else raw[table]
             out += [f'"{k}" = {toml_value(v)}' for k, v in flat.items()]
+    if isinstance(raw.get("sample"), dict):
+        out.append("\n[sample]")
+        out += [f'"{k}" = {toml_value(v)}' for k, v in flatten_sample(raw["sample"]).items()]
     for p in raw.get("points", []):
         out.append("\n[[points]]")
         out += [f'"{k}" = {toml_value(v)}' for k, v in _flatten(p, "points").items()]
@@ -356,7 +372,8 @@ def _plain(value):
 
 
 def make_study(scene: Scene | Mapping | None = None, grid: Mapping | None = None, points: Iterable[Mapping] = (),
-               outputs: Outputs | Mapping | Iterable[str] | None = None, title: str = "lightgear study") -> Study:
+               outputs: Outputs | Mapping | Iterable[str] | None = None, title: str = "lightgear study",
+               sample: Mapping | None = None) -> Study:
     """A study built in Python, checked like a study file.
 
     scene   the base scene: a Scene, or scene tables / dotted overrides on the embedded paper
@@ -366,6 +383,8 @@ def make_study(scene: Scene | Mapping | None = None, grid: Mapping | None = None
     points  explicit points, each {dotted scene field: value}
     outputs a list of output names (scalars and curves: `study.sweep.outputs`), {"scalars": [...],
             "curves": [...]} or an `Outputs`; None: every scalar, no curve
+    sample  drawn fields, what the [sample] table of a study file holds (`study.sweep.sample`):
+            {"size": 256, "method": "sobol", "seed": 1, "gear1.errors.eccentricity": {"uniform": [0, 6]}}
     """
     if not (scene is None or isinstance(scene, (Scene, Mapping))):
         raise TypeError(f"make_study: scene takes a Scene (study.load_scene(...)), a dict of scene fields or None "
@@ -393,6 +412,8 @@ def make_study(scene: Scene | Mapping | None = None, grid: Mapping | None = None
         except SceneError as e:
             raise StudyError(e.field, e.reason) from None
         raw["outputs"] = _plain(dataclasses.asdict(outputs))
+    if sample is not None:
+        raw["sample"] = _plain(sample)
     return loads_study(dumps_study(raw))
 
 
