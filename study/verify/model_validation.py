@@ -138,19 +138,26 @@ def relief_scene(scene: Scene, relief: float, torque: float) -> Scene:
 
 
 def optimum_relief(scene: Scene, model: str, torque: float, angles, reliefs, p2p) -> float:
-    """The relief [um] that minimises the STE peak-to-peak of ``model``: the best of the grid
-    ``reliefs`` (with its ``p2p`` [um]), refined by a bounded scalar search between its
-    neighbours (to 0.05 um)."""
+    """The relief [um] that minimises the STE peak-to-peak of ``model``: each local minimum of
+    the grid ``reliefs`` (with its ``p2p`` [um]; the curve can have two, e.g. where the tip
+    corners stop carrying load) refined by a bounded scalar search between its neighbours (to
+    0.05 um), the best of them."""
     from scipy.optimize import minimize_scalar
-    reliefs = np.asarray(reliefs, float)
-    i = int(np.nanargmin(p2p))
-    lo, hi = reliefs[max(i - 1, 0)], reliefs[min(i + 1, reliefs.size - 1)]
+    reliefs, p2p = np.asarray(reliefs, float), np.asarray(p2p, float)
+    n = reliefs.size
 
     def f(r):
         te, _ = model_ste(relief_scene(scene, r, torque), model, angles)
         return float(np.ptp(te)) * units.UM_PER_M
-    res = minimize_scalar(f, bounds=(lo, hi), method="bounded", options=dict(xatol=0.05))
-    return float(res.x) if res.fun <= p2p[i] else float(reliefs[i])
+    best = (float(np.nanmin(p2p)), float(reliefs[int(np.nanargmin(p2p))]))
+    for i in range(n):
+        if (i > 0 and p2p[i] > p2p[i - 1]) or (i < n - 1 and p2p[i] > p2p[i + 1]):
+            continue                       # not a local minimum of the grid
+        res = minimize_scalar(f, bounds=(reliefs[max(i - 1, 0)], reliefs[min(i + 1, n - 1)]), method="bounded",
+                              options=dict(xatol=0.05))
+        if res.fun < best[0]:
+            best = (float(res.fun), float(res.x))
+    return best[1]
 
 
 def relief_dataset(pairs: dict, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=(25.0, 50.0, 100.0),
