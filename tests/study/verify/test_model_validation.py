@@ -74,3 +74,7 @@ def test_the_run_archive_names_the_model_it_ran():
     scene = solid_scene(default_scene().replace(**{**SMALL_PAIR, "quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5}))
     ds = run_scene(scene, static=True, dynamic=False)
     assert ds.attrs["coupling_model"] == "paper" and ds.attrs["coupling_model_setting"] == "auto"
+    lite = small_light(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})
+    ds = run_scene(lite, static=True, dynamic=False)
+    assert ds.attrs["coupling_model"] == "compliance" and ds.attrs["coupling_model_setting"] == "auto"
+    assert ds.attrs["teeth_coupled"] == 1
