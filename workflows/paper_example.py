@@ -72,8 +72,8 @@ def main(argv=None) -> int:
               f"mean {float(settle.mean()):+.4f} um, RMS {float(np.sqrt((settle**2).mean())):.4f} um, "
               f"max |diff| {float(abs(settle).max()):.4f} um")
     if "ste_default" in ds:
-        print(f"  STE peak-to-peak: {float(np.ptp(ds['ste'])):.3f} um by the paper's model, "
-              f"{float(np.ptp(ds['ste_default'])):.3f} um by the default ({ds.attrs['default_coupling_model']}, "
+        print(f"  STE peak-to-peak: {float(np.ptp(ds['ste'].values)):.3f} um by the paper's model, "
+              f"{float(np.ptp(ds['ste_default'].values)):.3f} um by the default ({ds.attrs['default_coupling_model']}, "
               f"the model that agrees with the FE reference: docs/models.md)")
     if "ste_solid" in ds:
         print(f"  solid driven gear: STE mean {float(ds['ste_solid'].mean()):.3f} um, "
