@@ -170,8 +170,8 @@ class FESection:
 @dataclass(frozen=True)
 class CouplingSection:
     model: str = _f("auto", "", "foundation coupling between the teeth: 'auto' (the default: 'compliance' when either "
-                    "gear's body is lightened, which needs its FE anyway, 'paper' for a pair of solid bodies, which needs "
-                    "none), 'paper' (the paper's MUBOCO-PR: per-tooth springs that each hold the body's wind-up; 'none' is "
+                    "gear has FE springs, a lightened body that needs its FE anyway, else 'paper': solid bodies, or "
+                    "spring.stiffness 'uniform', need none), 'paper' (the paper's MUBOCO-PR: per-tooth springs that each hold the body's wind-up; 'none' is "
                     "the same), 'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and "
                     "identified from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not "
                     "used) or 'compliance' (the same, with the tooth springs coupled through the FE compliance between the "
@@ -223,10 +223,12 @@ class Scene:
     def coupling_model(self) -> str:
         """The coupling model the scene runs: 'none' (the paper's plain model, also named
         'paper'), 'body-torsion' or 'compliance'; 'auto' resolves to 'compliance' when either
-        body is lightened and to 'none' for two solid bodies."""
+        gear has FE springs (a lightened body whose spring.stiffness is not 'uniform') and to
+        'none' otherwise (solid bodies, or springs that ignore the lightening: no FE wanted)."""
         m = self.coupling.model
         if m == "auto":
-            return "compliance" if self.is_lightened(1) or self.is_lightened(2) else "none"
+            fe = any(self.is_lightened(g) and self.gear(g).spring.stiffness != "uniform" for g in (1, 2))
+            return "compliance" if fe else "none"
         return "none" if m == "paper" else m
 
     @property

@@ -167,8 +167,9 @@ class Study:
 
 def _one_coupling_model(points: list[Point]) -> list[Point]:
     """The points with one coupling model for the whole study: where the scenes leave it to
-    'auto' and the grid mixes solid and lightened bodies, every point takes 'compliance' (a
-    study's trade-off is only fair when each point is answered by the same model)."""
+    'auto' and the grid mixes bodies with and without FE springs (solid and lightened), every
+    point takes 'compliance' (a study's trade-off is only fair when each point is answered by
+    the same model)."""
     auto = {id(p) for p in points if p.scene is not None and p.scene.coupling.model == "auto"}
     if len({p.scene.coupling_model for p in points if id(p) in auto}) <= 1:
         return points

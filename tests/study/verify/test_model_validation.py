@@ -54,6 +54,8 @@ def test_the_paper_model_is_one_key_away_and_none_still_reads():
     # two solid bodies need no FE: 'auto' is the paper's model there
     solid = solid_scene(default_scene())
     assert solid.coupling.model == "auto" and solid.coupling_model == "none"
+    # nor do springs that ignore the lightening
+    assert scene.replace(**{"gear2.spring.stiffness": "uniform"}).coupling_model == "none"
     with pytest.raises(SceneError, match="coupling.model"):
         scene.replace(**{"coupling.model": "plain-ish"})
 
