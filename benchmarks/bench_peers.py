@@ -136,8 +136,8 @@ def main(argv=None) -> int:
     args, rep = common.quick_options(__doc__.splitlines()[0], "solid scene only, shorter tolerance ladders", argv)
     rows = []
     for kind in (["solid"] if args.quick else ["solid", "lightened"]):
-        m = common.model(kind)
-        rows += static_rows(kind, m, common.scene(kind), rep)
+        m = common.model(kind, "paper")      # the peers integrate the paper's per-tooth springs
+        rows += static_rows(kind, m, common.scene(kind, "paper"), rep)
         rows += dynamic_rows(kind, m, rep, args.quick)
     common.add_ratios(rows)
     common.write_table("peers", "lightgear vs peers, Table 1 pairs (s; best of N; error = max |TE - TE_ref| um; "

@@ -36,12 +36,14 @@ SHORT_DYNAMIC = (100.0, 0.0005, 50.0, 0.0005, 0.0015)
 COLUMNS = ("case", "method", "wall_min_s", "wall_median_s", "cpu_min_s", "repeats", "error_um", "ratio", "note")
 
 
-def scene(kind: str):
+def scene(kind: str, coupling: str | None = None):
     """The paper pair (Table 1) with a solid driven gear ('solid') or as published ('lightened':
-    the default scene)."""
+    the default scene), with the default model or ``coupling`` (a `coupling.model`)."""
     from study.scene import default_scene
     from study.setup import solid_scene
     s = default_scene()
+    if coupling is not None:
+        s = s.replace(**{"coupling.model": coupling})
     if kind == "solid":
         return solid_scene(s, gears=(2,))
     if kind == "lightened":
@@ -49,12 +51,12 @@ def scene(kind: str):
     raise ValueError(f"scene kind: 'solid' or 'lightened', got {kind!r}")
 
 
-def model(kind: str):
-    """Solver model of the scene; the lightened gear's FE springs come from study.inputs.springs
-    (computed once, then read from its disk cache)."""
+def model(kind: str, coupling: str | None = None):
+    """Solver model of the scene (`scene`); the lightened gear's FE springs come from
+    study.inputs.springs (computed once, then read from its disk cache)."""
     os.environ.setdefault("LIGHTGEAR_CACHE", str(ROOT / ".lightgear-cache"))
     from study.setup import build_scene_model
-    return build_scene_model(scene(kind))
+    return build_scene_model(scene(kind, coupling))
 
 
 def quick_options(description: str, quick_help: str, argv=None) -> tuple[argparse.Namespace, int]:

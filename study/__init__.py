@@ -414,9 +414,46 @@ def validation(scene, step: float | None = None):
     return ds
 
 
+def validate_design_space(scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), rims=(5.0, 7.0), rotation: float = 120.0,
+                          step: float = 0.1, log=None):
+    """STE of every model (paper, body-torsion, compliance) and the FE reference over gear 2's
+    body: hole counts x web thickness [mm] x rim height [mm], at the scene's quasi-static torque,
+    over ``rotation`` [deg] at ``step`` [deg] -> Dataset (mean, elastic mean and p2p [um],
+    hole-order amplitude [um]; `study.verify.model_validation`)."""
+    from study.verify.model_validation import design_space_dataset
+    _check_scene("validate_design_space", scene)
+    return design_space_dataset(scene, holes=holes, webs=webs, rims=rims, rotation=rotation, step=step, log=log)
+
+
+def validate_relief(scene, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=(25.0, 50.0, 100.0), step: float = 0.1,
+                    log=None):
+    """STE peak-to-peak of every model and the FE reference for the scene's pair with its driven
+    gear solid and as given, with a linear tip relief [um] of each amount on both gears at each
+    torque [N·m], and the relief that minimises it -> Dataset (`study.verify.model_validation`)."""
+    from study.setup import solid_scene as solid
+    from study.verify.model_validation import relief_dataset
+    _check_scene("validate_relief", scene)
+    return relief_dataset({"solid": solid(scene), "paper": scene}, reliefs=reliefs, torques=torques,
+                          rotations={"solid": 30.0, "paper": 60.0}, step=step, log=log)
+
+
+def validation_errors(ds):
+    """Relative errors [1] of every model of a `validate_design_space` or `validate_relief`
+    dataset against the FE reference: elastic mean, p2p, hole order."""
+    from study.verify.model_validation import relative_errors
+    return relative_errors(ds)
+
+
+def validation_misses(ds, model: str = "compliance") -> list:
+    """The points of a validation dataset where ``model`` misses its target (text; empty: none)."""
+    from study.verify.model_validation import check_targets
+    return check_targets(ds, model)
+
+
 __all__ = ["Scene", "SceneError", "StudyError", "BudgetError", "Study", "Outputs", "SweepResult", "STATUS",
            "scenes", "fields", "outputs", "parse_overrides", "load_scene", "default_scene", "solid_scene",
            "check_dynamic_window", "plausibility_warnings", "run_scene", "write", "read", "summarize",
            "print_summary", "load_study", "make_study", "run_sweep", "local_cluster", "pareto", "tradeoff_figure",
            "render", "stiffness", "identify_spring", "fit_contact", "reference", "precision", "precision_table",
-           "stability_suite", "validation"]
+           "stability_suite", "validation", "validate_design_space", "validate_relief", "validation_errors",
+           "validation_misses"]

@@ -214,7 +214,7 @@ def fe_bodies(scene) -> list:
         need = []
         if uses_fe_springs(setup):
             need += [(f"gear {g}", setup, None), (f"gear {g} solid reference", setup.solid(), [0])]
-        elif scene.coupling.model != "none":
+        elif scene.coupling_model != "none":
             need.append((f"gear {g}", setup, None))
         for label, s, teeth in need:
             key = FE_CACHE.key({**s.settings, "teeth": list(range(s.teeth)) if teeth is None else teeth})
@@ -226,7 +226,7 @@ def fe_bodies(scene) -> list:
 def fe_seconds(scene) -> float:
     """Estimated run time [s] of the FE bodies the scene needs and the cache lacks (the
     coupling fits load each body at several profile points: counted as three bodies)."""
-    factor = 3.0 if scene.coupling.model == "compliance" else 1.0
+    factor = 3.0 if scene.coupling_model == "compliance" else 1.0
     return sum(body_seconds(s) for _, s, _ in fe_bodies(scene)) * factor
 
 
@@ -263,7 +263,7 @@ def run_fe_bodies(scene, show: bool = True) -> None:
     """Compute (into the FE cache) the bodies the scene's springs need, with a bar whose unit
     is the estimated second, when they are expected to take more than PROGRESS_AFTER_S; else
     nothing (the springs compute them as they go). The coupling fits compute their own bodies."""
-    if scene.coupling.model != "none":
+    if scene.coupling_model != "none":
         return
     bodies = fe_bodies(scene)
     secs = [body_seconds(s) for _, s, _ in bodies]

@@ -70,7 +70,7 @@ def approach_estimate_mm(scene, torque_nm: float) -> float:
     delta = (force / k_con) ** (1.0 / c.m1)                      # m
     for g, geo in ((1, g1), (2, g2)):
         spring = scene.gear(g).spring
-        if scene.coupling.model != "none":    # the coupled models' springs: the paper's solid tooth stands in
+        if scene.coupling_model != "none":    # the coupled models' springs: the paper's solid tooth stands in
             spring = type(spring)()
         lever = max(geo.pitch_radius - scene.pivot_radius(g), 0.25 * scene.gear(g).module * units.MM)   # m
         k_phi = spring.k_phi * units.NMM                         # N·m/rad^n_k

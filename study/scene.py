@@ -171,11 +171,14 @@ class FESection:
 
 @dataclass(frozen=True)
 class CouplingSection:
-    model: str = _f("none", "", "foundation coupling between the teeth: 'none' (the paper's per-tooth springs) or "
-                    "'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and identified "
-                    "from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not used) or "
-                    "'compliance' (the same, with the tooth springs coupled through the FE compliance between the teeth: "
-                    "neighbours and hole positions)", choices=("none", "body-torsion", "compliance"))
+    model: str = _f("auto", "", "foundation coupling between the teeth: 'auto' (the default: 'compliance' when either "
+                    "gear has FE springs, a lightened body that needs its FE anyway, else 'paper': solid bodies, or "
+                    "spring.stiffness 'uniform', need none), 'paper' (the paper's MUBOCO-PR: per-tooth springs that each hold the body's wind-up; 'none' is "
+                    "the same), 'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and "
+                    "identified from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not "
+                    "used) or 'compliance' (the same, with the tooth springs coupled through the FE compliance between the "
+                    "teeth: neighbours and hole positions; the model that agrees with the FE reference, see docs/models.md)",
+                    choices=("auto", "paper", "none", "body-torsion", "compliance"))
 
 
 @dataclass(frozen=True)
@@ -217,6 +220,24 @@ class Scene:
         if g not in (1, 2):
             raise ValueError("gear index is 1 or 2")
         return self.gear1 if g == 1 else self.gear2
+
+    @property
+    def coupling_model(self) -> str:
+        """The coupling model the scene runs: 'none' (the paper's plain model, also named
+        'paper'), 'body-torsion' or 'compliance'; 'auto' resolves to 'compliance' when either
+        gear has FE springs (a lightened body whose spring.stiffness is not 'uniform') and to
+        'none' otherwise (solid bodies, or springs that ignore the lightening: no FE wanted)."""
+        m = self.coupling.model
+        if m == "auto":
+            fe = any(self.is_lightened(g) and self.gear(g).spring.stiffness != "uniform" for g in (1, 2))
+            return "compliance" if fe else "none"
+        return "none" if m == "paper" else m
+
+    @property
+    def coupling_model_name(self) -> str:
+        """`coupling_model` as a user reads it: 'paper' for the plain MUBOCO-PR model."""
+        m = self.coupling_model
+        return "paper" if m == "none" else m
 
     def is_lightened(self, g: int) -> bool:
         """True when gear g's body differs from a solid disc (holes or a thinner web)."""

@@ -37,7 +37,7 @@ def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple |
     ``model``: the coupling model (default: the scene's); ``setups``: the scene's gear setups
     when already made. Kept in `FE_CACHE` by both gears' FE settings: a run asks for it for
     the springs and again for the model."""
-    model = scene.coupling.model if model is None else model
+    model = scene.coupling_model if model is None else model
     if model not in ("body-torsion", "compliance"):
         return None
     setups = setups or gear_setups(scene)
@@ -56,14 +56,14 @@ def coupled_springs(scene: Scene, setup: GearSetup, setups: tuple) -> tuple[np.n
     compliance model each tooth's own spring, loaded alone) and the FE stiffness ratio [1] of
     the plain model's springs."""
     fit = coupling_fit(scene, setup.gear, setups=setups)
-    k = fit.k_tooth if scene.coupling.model == "body-torsion" else fit.k_own
+    k = fit.k_tooth if scene.coupling_model == "body-torsion" else fit.k_own
     return k / units.spring_stiffness_to_si(1.0), tooth_springs(setup)[1]
 
 
 def scene_springs(scene: Scene, setups: tuple | None = None):
     """((k1, r1), (k2, r2)): per-tooth springs [N·mm/rad^n_k] and stiffness ratios of both gears."""
     setups = setups or gear_setups(scene)
-    if scene.coupling.model != "none":
+    if scene.coupling_model != "none":
         return tuple(coupled_springs(scene, s, setups) for s in setups)
     return tuple(tooth_springs(s) for s in setups)
 
@@ -81,7 +81,7 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
         cmat = None
         if fit is not None:
             k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
-            if scene.coupling.model == "compliance":
+            if scene.coupling_model == "compliance":
                 cmat = fit.compliance
         else:
             k_body, n_k, pivot = math.inf, sp.n_k, setup.pivot_radius

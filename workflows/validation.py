@@ -18,10 +18,21 @@ hole sidebands), mean and RMS error where the rigid geometry has one and two pai
 path of contact, and the worst load-sharing error of one driver tooth through the mesh.
 
     python -m workflows.validation [SCENE] [-o results/validation/validation.nc] [--step DEG]
+
+Over the design space (`study.verify.model_validation`; the tables of docs/models.md):
+
+    python -m workflows.validation --design-space [-o results/validation/design_space.nc]
+    python -m workflows.validation --relief [-o results/validation/relief.nc]
+
+``--design-space``: gear 2's body over holes {0, 3, 6, 9, 12} x web {6, 10} mm x rim {5, 7} mm
+at 50 N m; ``--relief``: the solid and the paper pair with a linear tip relief {0, 1, 2, 3, 4, 6}
+um on both gears at 25, 50 and 100 N m. Both print the table and the points where the default
+model misses its targets; ``--quick`` runs a reduced grid.
 """
 from __future__ import annotations
 
 import argparse
+import time
 from pathlib import Path
 
 import numpy as np
@@ -123,6 +134,69 @@ def make_figures(ds: xr.Dataset, outdir: Path) -> list[Path]:
     return paths
 
 
+def print_design_space(ds: xr.Dataset, default: str = "compliance") -> None:
+    err = study.validation_errors(ds)
+    models = [str(m) for m in ds["model"].values if m != "fe-reference"]
+    print(f"STE against the FE reference over gear 2's body, {ds.attrs['static_torque_N_m']:g} N m "
+          "(FE: elastic mean and p2p in um, hole-order amplitude in nm; models: error in %, mean / p2p / hole order)")
+    print(f"{'holes':>5s} {'web':>5s} {'rim':>5s} {'FE mean':>8s} {'p2p':>6s} {'hole':>6s}  " + "  ".join(f"{m:>20s}" for m in models))
+    for n in ds["holes"].values:
+        for w in ds["web_thickness"].values:
+            for r in ds["rim_height"].values:
+                ref = ds.sel(holes=n, web_thickness=w, rim_height=r, model="fe-reference")
+                e = err.sel(holes=n, web_thickness=w, rim_height=r)
+                cells = []
+                for m in models:
+                    em = e.sel(model=m)
+                    h = f"{100 * float(em['hole']):+5.1f}" if np.isfinite(float(em["hole"])) else "    -"
+                    cells.append(f"{100 * float(em['elastic_mean']):+5.1f} {100 * float(em['p2p']):+5.1f} {h}")
+                hole = float(ref["hole_amplitude"]) * 1e3
+                print(f"{int(n):5d} {w:5.1f} {r:5.1f} {float(ref['ste_elastic_mean']):8.3f} {float(ref['ste_p2p']):6.3f} "
+                      f"{hole if np.isfinite(hole) else float('nan'):6.1f}  " + "  ".join(f"{c:>20s}" for c in cells))
+    for m in models:
+        em = err.sel(model=m)
+        print(f"  {m:12s} largest |error|: elastic mean {100 * float(np.abs(em['elastic_mean']).max()):.1f} %, "
+              f"p2p {100 * float(np.abs(em['p2p']).max()):.1f} %, hole order {100 * float(np.abs(em['hole']).max()):.1f} %")
+    miss = study.validation_misses(ds, default)
+    print(f"  default model ({default}): " + ("every point within the targets" if not miss else
+                                              f"{len(miss)} misses: " + "; ".join(miss)))
+
+
+def print_relief(ds: xr.Dataset, default: str = "compliance") -> None:
+    models = [str(m) for m in ds["model"].values]
+    print("STE peak-to-peak [um] against a linear tip relief on both gears")
+    for p in ds["pair"].values:
+        for t in ds["torque"].values:
+            print(f"  {p} pair, {t:g} N m: relief [um] " + " ".join(f"{r:6.2f}" for r in ds["relief"].values) + "   optimum")
+            for m in models:
+                r = ds.sel(pair=p, torque=t, model=m)
+                print(f"    {m:14s}" + " " * 13 + " ".join(f"{x:6.3f}" for x in r["ste_p2p"].values)
+                      + f"   {float(r['optimum_relief']):5.2f}")
+    miss = study.validation_misses(ds, default)
+    print(f"  default model ({default}): " + ("every point within the targets" if not miss else
+                                              f"{len(miss)} misses: " + "; ".join(miss)))
+
+
+def campaign(args) -> int:
+    """The design-space or relief campaign (`study.validate_design_space`, `study.validate_relief`)."""
+    base = study.load_scene(args.scene, args.overrides)
+    step = args.step or 0.1
+    t0 = time.perf_counter()
+    if args.design_space:
+        grid = dict(holes=(0, 6, 12), webs=(6.0,), rims=(5.0,)) if args.quick else {}
+        ds = study.validate_design_space(base.replace(**{"quasi_static.torque": 50.0}), step=step, log=print, **grid)
+        out = args.output if args.output != DEFAULT_OUT else "results/validation/design_space.nc"
+    else:
+        kw = dict(reliefs=(0.0, 2.0, 4.0), torques=(50.0,)) if args.quick else {}
+        ds = study.validate_relief(base, step=step, log=print, **kw)
+        out = args.output if args.output != DEFAULT_OUT else "results/validation/relief.nc"
+    ds.attrs["wall_time_s"] = time.perf_counter() - t0
+    study.write(ds, out)
+    print(f"archive -> {out} ({ds.attrs['wall_time_s']:.0f} s)")
+    (print_design_space if args.design_space else print_relief)(ds)
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("scene", nargs="?", help="scene TOML (default: the paper example; its driven gear is the lightened one)")
@@ -130,7 +204,12 @@ def main(argv=None) -> int:
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     p.add_argument("--step", type=float, default=None, metavar="DEG", help="driver angle step (default: quasi_static.angle_step)")
     p.add_argument("--no-figures", action="store_true", help="write only the archive")
+    p.add_argument("--design-space", action="store_true", help="all models against the FE reference over gear 2's body")
+    p.add_argument("--relief", action="store_true", help="all models against the FE reference over tip relief and torque")
+    p.add_argument("--quick", action="store_true", help="a reduced grid (with --design-space or --relief)")
     args = p.parse_args(argv)
+    if args.design_space or args.relief:
+        return campaign(args)
     scene = study.load_scene(args.scene, args.overrides)
     ds = study.validation(scene, args.step)
     study.write(ds, args.output)

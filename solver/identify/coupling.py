@@ -97,14 +97,14 @@ class ToothComplianceFit:
         return 1.0 / np.diag(self.compliance)
 
 
-def _linear_fit(sample_pair, n_pairs, LL, value):
-    """For levers fixed (LL = lever_read*lever_load [m^2]): the least-squares c_body [m/N] and
-    C of every pair [rad/(N·m)] (the model is linear in them), and the sum of squared relative
-    residuals. C_p = A_p - c_body*B_p eliminates the pairs; c_body is then one linear fit,
+def _linear_fit(sample_pair, n_pairs, LL, value, weight):
+    """For levers fixed (LL = lever_read*lever_load [m^2]): the weighted least-squares c_body
+    [m/N] and C of every pair [rad/(N·m)] (the model is linear in them), and the weighted sum
+    of squared relative residuals. C_p = A_p - c_body*B_p eliminates the pairs; c_body is then one linear fit,
     held at or below the smallest coefficient (the objective is convex in it, so the bound is
     the constrained optimum): the body part is what every loaded pair shares, and the local
     part never pulls a neighbour back."""
-    w = 1.0 / value**2
+    w = weight / value**2
     den = np.bincount(sample_pair, w * LL * LL, n_pairs)
     A = np.bincount(sample_pair, w * value * LL, n_pairs) / den
     B = np.bincount(sample_pair, w * LL, n_pairs) / den
@@ -116,7 +116,7 @@ def _linear_fit(sample_pair, n_pairs, LL, value):
 
 
 def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, base_radius: float,
-                         psi_base: float, pivot_bounds: tuple) -> ToothComplianceFit:
+                         psi_base: float, pivot_bounds: tuple, weight=None) -> ToothComplianceFit:
     """The full foundation coupling, identified from FE influence coefficients.
 
     Samples k = 0..N-1: ``value[k]`` [m/N], the displacement along the line of action at roll
@@ -130,8 +130,10 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
     the body wind-up (a rotation about the gear centre, lever rb: the same along the line of
     action wherever the contact) plus the teeth's rotations about the pivot (levers about the
     pivot at radius r_Q). For a given r_Q the model is linear in c_body and the C of every
-    pair (one least-squares solve on the relative residuals); r_Q minimises that residual
-    within ``pivot_bounds`` [m] (the rim under the tooth; a bounded scalar search). Pairs not
+    pair (one least-squares solve on the relative residuals, each sample's squared residual
+    times its ``weight`` [1], default 1: how much load the mesh puts there); r_Q minimises
+    that residual within ``pivot_bounds`` [m] (the rim under the tooth; a bounded scalar
+    search). ``rms_rel_error`` is the weighted RMS relative residual. Pairs not
     listed are not coupled (C = 0): the mesh never loads them together. Raises ValueError
     when the fit is not a valid stiffness (a window of reach + 2 neighbouring teeth not
     positive definite).
@@ -150,6 +152,9 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
         raise ValueError("sample_pair: every pair needs at least one sample, and only listed pairs")
     if not np.all(value > 0):
         raise ValueError("value: influence coefficients along the load must be positive")
+    weight = np.ones(n) if weight is None else np.asarray(weight, float)
+    if weight.shape != (n,) or not np.all(weight >= 0) or np.bincount(sample_pair, weight, len(pairs)).min() <= 0:
+        raise ValueError("weight: need one non-negative weight per sample, and a positive one in every pair")
     lo, hi = pivot_bounds
     if not 0 < lo < hi:
         raise ValueError(f"pivot_bounds: need 0 < lower < upper, got {pivot_bounds}")
@@ -158,7 +163,7 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
 
     def fit(r_q):       # levers about the pivot (identify.lever), r_q [m]
         LL = np.abs(base_radius - r_q * cos_r) * np.abs(base_radius - r_q * cos_l)
-        return _linear_fit(sample_pair, P, LL, value)
+        return _linear_fit(sample_pair, P, LL, value, weight)
 
     res = minimize_scalar(lambda x: fit(x * 1e-3)[2], bounds=(lo * 1e3, hi * 1e3), method="bounded",
                           options=dict(xatol=1e-6))
@@ -181,4 +186,4 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
         except np.linalg.LinAlgError:
             raise ValueError(f"value: the fitted compliance of teeth {a}..{a + w - 1} is not positive "
                              "definite (not a valid stiffness)") from None
-    return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / n)))
+    return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / weight.sum())))

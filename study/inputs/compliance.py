@@ -46,12 +46,9 @@ def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFI
     read at offsets -spread..spread; a lightened body: every tooth in ``teeth`` loaded and read.
     ``u``: the roll grid (default: ``n_u`` points from the form circle to the tip). ``info``:
     mesh size [m], whether it came from the cache, wall and CPU times [s] of each stage."""
-    from solver.fe import body as fe
     from solver.fe.ltca import body_compliance, profile_grid
-    from solver.fe.mesh import mesh_body
 
-    geo, body = setup.geometry, setup.body
-    settings = setup.settings
+    geo = setup.geometry
     symmetric = not setup.lightened
     u = profile_grid(geo, n_u) if u is None else np.asarray(u, float)
     key, load, read = compliance_key(setup, teeth, spread, u)
@@ -61,20 +58,33 @@ def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFI
         return c, info
     t0, c0 = time.perf_counter(), time.process_time()
     stages = {}              # wall and CPU seconds of each stage (CPU: all threads of the process)
-
-    def build():
-        mesh = mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body",
-                     grading=setup.mesh_grading)
-        stages.update(mesh_wall_s=time.perf_counter() - t0, mesh_cpu_s=time.process_time() - c0)
-        model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, setup.material)
-        stages.update(assembly_wall_s=model.assembly_time, assembly_cpu_s=model.assembly_cpu,
-                      factor_wall_s=model.factor_time, factor_cpu_s=model.factor_cpu)
-        return model
-    # the body model depends on geometry, material and mesh size only (not on the load or pivot)
-    model = FE_CACHE.body(json.dumps({k: v for k, v in settings.items() if k not in ("force", "pivot")},
-                                     sort_keys=True, default=float), build)
+    model = factorised_body(setup, stages)
     c = body_compliance(model, geo, u, load, read, setup.patch, symmetric_body=symmetric, timings=stages)
     info.update(cached=False, wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0,
                 dofs=int(model.n_dofs), stages=stages)
     FE_CACHE.write_compliance(key, c)
     return c, info
+
+
+def factorised_body(setup: GearSetup, stages: dict | None = None):
+    """The gear's meshed, assembled and factorised FE body (`solver.fe.body.BodyModel`), kept
+    in memory by `FE_CACHE` for every FE result of the same body: the spring map, its fillet
+    stress and the influence coefficients share one factorisation (the body depends on the
+    geometry, material and mesh only, not on the load or the pivot). ``stages``: if given and
+    the body is built, the wall and CPU seconds of meshing, assembly and factorisation."""
+    from solver.fe import body as fe
+    from solver.fe.mesh import mesh_body
+
+    def build():
+        t0, c0 = time.perf_counter(), time.process_time()
+        mesh = mesh_body(setup.geometry, setup.body, setup.mesh_size, prefix=f"{setup.prefix}.body",
+                         grading=setup.mesh_grading)
+        model = fe.assemble(mesh, setup.geometry.spec.face_width, setup.body.web_thickness, setup.material)
+        if stages is not None:
+            stages.update(mesh_wall_s=time.perf_counter() - t0 - model.assembly_time - model.factor_time,
+                          mesh_cpu_s=time.process_time() - c0 - model.assembly_cpu - model.factor_cpu,
+                          assembly_wall_s=model.assembly_time, assembly_cpu_s=model.assembly_cpu,
+                          factor_wall_s=model.factor_time, factor_cpu_s=model.factor_cpu)
+        return model
+    key = json.dumps({k: v for k, v in setup.settings.items() if k not in ("force", "pivot")}, sort_keys=True, default=float)
+    return FE_CACHE.body(key, build)

@@ -37,7 +37,7 @@ def fe_stiffness(setup: GearSetup, teeth=None, keep_fields: bool = False):
     Returns k (n,) and, when ``keep_fields``, the (model, U) pair for renders (not cached).
     """
     from solver.fe import body as fe
-    from solver.fe.mesh import mesh_body
+    from study.inputs.compliance import factorised_body
 
     settings = setup.settings
     tooth_list = _teeth(setup, teeth)
@@ -46,10 +46,8 @@ def fe_stiffness(setup: GearSetup, teeth=None, keep_fields: bool = False):
         k = FE_CACHE.read_stiffness(key)
         if k is not None:
             return k
-    geo, body = setup.geometry, setup.body
-    mesh = mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body",
-                     grading=setup.mesh_grading)
-    model = fe.assemble(mesh, geo.spec.face_width, body.web_thickness, setup.material)
+    geo = setup.geometry
+    model = factorised_body(setup)      # shared with the influence coefficients of the same body
     k, U = fe.tooth_stiffness(model, geo, setup.pivot_radius, tooth_list, setup.force, setup.patch)
     stress = fe.fillet_stress(model, geo, U, tooth_list)
     FE_CACHE.write_stiffness(key, k, settings, stress)

@@ -79,6 +79,8 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
     if "loaded_contact_ratio" in s:
         line += f", {s['loaded_contact_ratio']:.3f} loaded (mean loaded pairs, tip corners included)"
     w(line + f", backlash offset {ds.attrs['backlash_offset_um']:.3f} um\n")
+    if "coupling_model" in ds.attrs:
+        w(f"  model: {ds.attrs['coupling_model']} (coupling.model = {ds.attrs.get('coupling_model_setting', '?')})\n")
     if "ste" in s or "ste_mean" in s:
         w(f"  STE: mean {s['ste_mean']:.3f} um (elastic part {s['ste_elastic_mean']:.3f} um), "
           f"peak-to-peak {s['ste_p2p']:.3f} um over {float(ds['angle'][-1]):.4g} deg\n")

@@ -35,7 +35,7 @@ import xarray as xr
 
 from study.report.results import provenance
 from study.scene import field_doc, field_unit
-from study.sweep.grid import Point, Study, dim_name
+from study.sweep.grid import Point, Study, coupling_models, dim_name
 from study.sweep.outputs import CURVES, SCALARS, STATUS, analysis_of, reads
 from study.sweep.sample import sample_attrs, sample_variables
 from study.sweep.tasks import point_task_keys
@@ -215,7 +215,7 @@ def study_dataset(study: Study, points: list[Point], results: dict, read=None, l
         data.update(sample_variables(study.sample))
     attrs = {"title": study.title, "study": study.text, "base_scene": study.base_scene_toml(),
              "study_layout": study.layout, "study_key": study_key(study, points),
-             "outputs": ", ".join(out.scalars + out.curves), **provenance(),
+             "outputs": ", ".join(out.scalars + out.curves), "coupling_model": coupling_models(points), **provenance(),
              **(sample_attrs(study.sample) if study.sample else {})}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 

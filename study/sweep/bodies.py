@@ -24,7 +24,7 @@ def spring_maps(scene: Scene) -> list[tuple[str, object, list | None]]:
     from study.inputs.gearsetup import gear_setups
     from study.inputs.springs import uses_fe_springs
 
-    if scene.coupling.model != "none":
+    if scene.coupling_model != "none":
         return []
     try:
         setups = gear_setups(scene)

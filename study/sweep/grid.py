@@ -173,7 +173,24 @@ class Study:
                 out.append(Point(idx, vals, scene))
             except SceneError as e:
                 out.append(Point(idx, vals, None, str(e)))
-        return out
+        return _one_coupling_model(out)
+
+
+def _one_coupling_model(points: list[Point]) -> list[Point]:
+    """The points with one coupling model for the whole study: where the scenes leave it to
+    'auto' and the grid mixes bodies with and without FE springs (solid and lightened), every
+    point takes 'compliance' (a study's trade-off is only fair when each point is answered by
+    the same model)."""
+    auto = {id(p) for p in points if p.scene is not None and p.scene.coupling.model == "auto"}
+    if len({p.scene.coupling_model for p in points if id(p) in auto}) <= 1:
+        return points
+    return [dataclasses.replace(p, scene=p.scene.replace(**{"coupling.model": "compliance"})) if id(p) in auto else p
+            for p in points]
+
+
+def coupling_models(points: list[Point]) -> str:
+    """The coupling model(s) the study's valid points run, as a user names them."""
+    return ", ".join(sorted({p.scene.coupling_model_name for p in points if p.scene is not None}))
 
 
 # ---------------------------------------------------------------- reading and checking

@@ -21,7 +21,6 @@ path of contact, and the worst load-sharing error of one driver tooth through th
 """
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -33,6 +32,7 @@ from solver.mbs.statics import solve_static
 from study.report import results
 from study.setup import build_scene_model, coupling_fit, gear_setup, solid_scene
 from study.verify.fe_reference import reference
+from study.verify.model_validation import order_amplitude
 
 MODELS = ("fe-reference", "plain", "plain-fe", "coupled", "compliance")
 PAIRS = ("solid", "lightened")
@@ -55,18 +55,6 @@ def model_scene(scene, name: str):
             springs.append((k, k / k.max()))
         return lin, tuple(springs)
     raise ValueError(f"model: unknown {name!r}")
-
-
-def order_amplitude(angle_rad: np.ndarray, te: np.ndarray, order: float, mesh_order: float) -> float:
-    """Amplitude [units of te] at ``order`` of the driven gear's rotation (equal to the driver's
-    for a 1:1 pair scaled by z1/z2), fitted jointly with the mesh harmonics and their sidebands."""
-    x = np.asarray(angle_rad)
-    cols = [np.ones_like(x)]
-    freqs = [order] + [h * mesh_order + s * order for h in (1, 2, 3) for s in (-1, 0, 1)]
-    for f in freqs:
-        cols += [np.cos(f * x), np.sin(f * x)]
-    c, *_ = np.linalg.lstsq(np.column_stack(cols), te, rcond=None)
-    return float(math.hypot(c[1], c[2]))
 
 
 def nominal_contacts(model, angles) -> np.ndarray:

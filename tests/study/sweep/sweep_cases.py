@@ -13,6 +13,7 @@ gear2.teeth = 20
 gear1.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0}
 gear2.body = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0, holes = 0, hole_radius = 1.5, hole_circle_radius = 8.1, web_thickness = 17.0}
 gear2.spring.stiffness = "uniform"
+coupling.model = "paper"                # the engine's tests: no FE, the paper's springs
 quasi_static = {rotation = 6.0, angle_step = 0.5}
 dynamic = {duration = 0.01, ramp_time = 0.002}
 """

@@ -18,7 +18,8 @@ pytestmark = pytest.mark.usefixtures("private_fe_cache")
 SCENE = "\n".join(f'"{k}" = {v!r}' if not isinstance(v, str) else f'"{k}" = "{v}"' for k, v in {
     **SMALL_PAIR, "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
     "quasi_static.rotation": 6.0, "quasi_static.angle_step": 1.0, "dynamic.duration": 0.004,
-    "dynamic.ramp_time": 0.001, "fe.mesh_size": 1.5}.items())
+    "dynamic.ramp_time": 0.001, "fe.mesh_size": 1.5,
+    "coupling.model": "paper"}.items())     # the maps computed ahead are the paper model's springs
 # 3 lightened bodies (holes and/or a 12 mm web) and the solid one (no holes, 20 mm web): the
 # lightened ones share one solid reference (same rim), so 4 maps for the 9 tasks that read them
 STUDY = f"""title = "maps"

@@ -1,0 +1,82 @@
+"""The default model against the FE reference: STE figures on a small lightened pair, the
+tip relief that minimises the STE, and the default's name in scenes, studies and archives."""
+import numpy as np
+import pytest
+from conftest import SMALL_PAIR
+
+from study.scene import SceneError, default_scene
+from study.setup import build_scene_model, solid_scene
+from study.verify import model_validation as mv
+
+LIGHT = {**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
+         "gear2.body.hole_circle_radius": 19.5, "quasi_static.torque": 100.0}
+
+
+def small_light(**kw):
+    """The small 24-tooth pair of conftest, the driven gear with a web of 8 mm and 4 holes."""
+    return default_scene().replace(**{**LIGHT, **kw})
+
+
+def test_the_default_model_of_a_lightened_pair_agrees_with_the_fe_reference():
+    scene = small_light()
+    assert scene.coupling.model == "auto" and scene.coupling_model == "compliance"
+    angles = np.radians(np.arange(0.0, 90.0001, 0.25))          # one revolution of the 4 holes' period
+    f = mv.ste_figures(scene, angles, ("fe-reference", "paper", "compliance"))
+    ref = f["fe-reference"]
+    assert ref["hole"] > 0.02 * ref["p2p"]                        # the holes are visible in the STE
+    err = {m: {k: f[m][k] / ref[k] - 1 for k in ("elastic_mean", "p2p", "hole")} for m in ("paper", "compliance")}
+    c = err["compliance"]
+    assert abs(c["elastic_mean"]) < mv.TARGETS["elastic_mean"]
+    assert abs(c["p2p"]) < mv.TARGETS["p2p"]
+    assert abs(c["hole"]) < mv.TARGETS["hole"]
+    # and the paper's plain model does not: it misses the ripple, which is why it is not the default
+    assert abs(err["paper"]["p2p"]) > mv.TARGETS["p2p"]
+
+
+def test_the_relief_that_minimises_the_ste_agrees_with_the_fe_reference():
+    scene = solid_scene(default_scene().replace(**SMALL_PAIR))
+    ds = mv.relief_dataset({"small": scene}, reliefs=(0.0, 2.0, 4.0, 6.0), torques=(25.0,),
+                           rotations={"small": 15.0}, step=0.25, models=("fe-reference", "compliance"))
+    opt = ds["optimum_relief"].sel(pair="small", torque=25.0)
+    p2p = ds["ste_p2p"].sel(pair="small", torque=25.0, model="fe-reference").values
+    assert p2p.min() < 0.5 * p2p[0]                               # the relief matters at this load
+    assert 2.0 < float(opt.sel(model="fe-reference")) < 6.0       # an optimum inside the grid, refined
+    assert abs(float(opt.sel(model="compliance") - opt.sel(model="fe-reference"))) < mv.TARGETS["relief_um"]
+    assert mv.check_targets(ds.isel(relief=[0]), "compliance") == []
+
+
+def test_the_paper_model_is_one_key_away_and_none_still_reads():
+    scene = small_light()
+    paper = scene.replace(**{"coupling.model": "paper"})
+    assert paper.coupling_model == "none" and paper.coupling_model_name == "paper"
+    assert scene.replace(**{"coupling.model": "none"}).coupling_model_name == "paper"
+    assert not build_scene_model(paper).teeth_coupled
+    # two solid bodies need no FE: 'auto' is the paper's model there
+    solid = solid_scene(default_scene())
+    assert solid.coupling.model == "auto" and solid.coupling_model == "none"
+    # nor do springs that ignore the lightening
+    assert scene.replace(**{"gear2.spring.stiffness": "uniform"}).coupling_model == "none"
+    with pytest.raises(SceneError, match="coupling.model"):
+        scene.replace(**{"coupling.model": "plain-ish"})
+
+
+def test_a_study_over_solid_and_lightened_bodies_runs_one_model():
+    from study.sweep.grid import coupling_models, make_study
+    base = default_scene().replace(**{"gear2.body.web_thickness": 17.0})
+    pts = make_study(base, {"gear2.body.holes": [0, 6]}, outputs={"scalars": ["ste_p2p"]}).points()
+    assert [p.scene.coupling_model for p in pts] == ["compliance", "compliance"]
+    assert coupling_models(pts) == "compliance"
+    pts = make_study(base.replace(**{"coupling.model": "paper"}), {"gear2.body.holes": [0, 6]},
+                     outputs={"scalars": ["ste_p2p"]}).points()
+    assert coupling_models(pts) == "paper"
+
+
+def test_the_run_archive_names_the_model_it_ran():
+    from study.run import run_scene
+    scene = solid_scene(default_scene().replace(**{**SMALL_PAIR, "quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5}))
+    ds = run_scene(scene, static=True, dynamic=False)
+    assert ds.attrs["coupling_model"] == "paper" and ds.attrs["coupling_model_setting"] == "auto"
+    lite = small_light(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})
+    ds = run_scene(lite, static=True, dynamic=False)
+    assert ds.attrs["coupling_model"] == "compliance" and ds.attrs["coupling_model_setting"] == "auto"
+    assert ds.attrs["teeth_coupled"] == 1
