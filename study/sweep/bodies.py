@@ -9,8 +9,12 @@ the tasks behind it. `spring_maps` lists the maps of a scene, `compute_map` comp
 the cache; the sweep engine (`study.sweep.engine`) runs one `compute_map` per distinct map,
 ahead of the tasks, and makes each task wait for the maps it reads.
 
-Scenes with a foundation coupling (``coupling.model`` not 'none') build other FE bodies (the
-coupling fits): none is listed for them, their tasks compute what they need.
+With the compliance model (``coupling.model = "compliance"``, what 'auto' gives a lightened
+gear) a gear's coupling fit reads its bulk compliance (`study.inputs.compliance`, every tooth
+loaded along its profile: the dearest FE of a study). `fe_jobs` lists, per gear, one
+`compute_body` job that computes the gear's spring map and its compliance in one process, so
+that both come from one factorisation of the body, and the solid reference's map as above.
+Scenes with the body-torsion model list no job: their tasks compute what they need.
 """
 from __future__ import annotations
 
@@ -39,6 +43,79 @@ def spring_maps(scene: Scene) -> list[tuple[str, object, list | None]]:
             if key not in FE_CACHE.stiffness and not (FE_CACHE.folder / f"{key}.nc").exists():
                 out.append((key, s, teeth))
     return out
+
+
+def _map_missing(setup, teeth) -> tuple[str, bool]:
+    """(cache key, True when neither memory nor disk holds it) of the FE spring map of ``teeth``."""
+    from study.inputs.cache import FE_CACHE
+    key = FE_CACHE.key({**setup.settings, "teeth": list(range(setup.teeth)) if teeth is None else teeth})
+    return key, key not in FE_CACHE.stiffness and not (FE_CACHE.folder / f"{key}.nc").exists()
+
+
+_REACH: dict = {}       # (gear 1 key, gear 2 key, gear) -> coupling reach [teeth]: one geometry per pair
+
+
+def _reach(scene: Scene, setups: tuple, g: int) -> int:
+    """How many pitches apart the mesh loads gear g's teeth together (`mesh_samples`): the spread
+    of a solid body's compliance."""
+    from study.inputs.coupling import mesh_samples
+    from study.setup import geometry_model
+    key = (setups[0].key, setups[1].key, g)
+    if key not in _REACH:
+        _REACH[key] = max(abs(d) for d in mesh_samples(geometry_model(scene), g))
+    return _REACH[key]
+
+
+def fe_jobs(scene: Scene) -> list[tuple[str, object, tuple]]:
+    """(job key, function, arguments) of each FE computation the scene's task reads that the
+    disk cache lacks: `compute_map` for the plain model's maps (`spring_maps`); with the
+    compliance model a `compute_body` per gear whose spring map or compliance is missing (key
+    ``body-`` + the compliance's cache key) and a `compute_map` per missing solid reference.
+    [] when the scene cannot be prepared (its task reports why) or for the body-torsion model."""
+    from solver.fe.ltca import profile_grid
+    from study.inputs.compliance import PROFILE_POINTS, compliance_cached, compliance_key
+    from study.inputs.gearsetup import gear_setups
+    from study.inputs.springs import uses_fe_springs
+
+    model = scene.coupling_model
+    if model == "none":
+        return [(key, compute_map, (setup, teeth)) for key, setup, teeth in spring_maps(scene)]
+    if model != "compliance":
+        return []
+    try:
+        setups = gear_setups(scene)
+        out = []
+        for setup in setups:
+            fe = uses_fe_springs(setup)
+            teeth = list(range(setup.teeth))
+            spread = 0 if setup.lightened else _reach(scene, setups, setup.gear)
+            ckey, _, _ = compliance_key(setup, teeth, spread, profile_grid(setup.geometry, PROFILE_POINTS))
+            if (fe and _map_missing(setup, None)[1]) or not compliance_cached(setup, teeth, spread):
+                out.append((f"body-{ckey}", compute_body, (scene, setup.gear)))
+            if fe:
+                key, missing = _map_missing(setup.solid(), [0])
+                if missing:
+                    out.append((key, compute_map, (setup.solid(), [0])))
+        return out
+    except Exception:  # noqa: BLE001 - an invalid scene: its task records the error
+        return []
+
+
+def compute_body(scene: Scene, g: int) -> None:
+    """Compute gear g's FE spring map (when its springs read one) and the compliance its
+    coupling fit reads into the cache, one factorisation for both; never raises (see
+    `compute_map`)."""
+    from study.inputs.gearsetup import gear_setups
+    from study.inputs.springs import fe_stiffness, uses_fe_springs
+    from study.setup import coupling_fit
+    try:
+        setups = gear_setups(scene)
+        setup = setups[g - 1]
+        if uses_fe_springs(setup):
+            fe_stiffness(setup)
+        coupling_fit(scene, g, setups=setups)
+    except Exception:  # noqa: BLE001 - see above
+        pass
 
 
 def compute_map(setup, teeth) -> None:

@@ -284,15 +284,16 @@ def run_after(scene: Scene, outputs: Outputs, *maps) -> dict:
 def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None):
     from distributed import as_completed
 
-    from study.sweep.bodies import compute_map, spring_maps
+    from study.sweep.bodies import compute_body, fe_jobs
     with dask_client(scheduler, workers) as client:
-        # each FE map once, ahead of the tasks (higher priority), and each task after its maps
+        # each FE map or body once, ahead of the tasks (higher priority; the bodies, dearest,
+        # first), and each task after the FE it reads
         maps, after = {}, {}
         for key, scene in todo.items():
-            for fe_key, setup, teeth in spring_maps(scene):
+            for fe_key, func, args in fe_jobs(scene):
                 if fe_key not in maps:
-                    maps[fe_key] = client.submit(compute_map, setup, teeth, key=f"lightgear-fe-{fe_key}", pure=False,
-                                                 priority=1)
+                    maps[fe_key] = client.submit(func, *args, key=f"lightgear-fe-{fe_key}", pure=False,
+                                                 priority=2 if func is compute_body else 1)
                 after.setdefault(key, []).append(maps[fe_key])
         futures = {client.submit(run_after, scene, outputs[key], *after.get(key, ()), key=f"lightgear-task-{key}",
                                  pure=False): key
