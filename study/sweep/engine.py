@@ -25,7 +25,10 @@ Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a da
 that is always closed, or an existing scheduler (``scheduler="tcp://host:8786"``) whose workers
 can import this package. On dask the FE spring maps the tasks read go first, each once
 (`study.sweep.bodies`), and each task waits for its maps: no two workers compute the same map,
-and no task holds a worker up with a map in the middle of the study.
+and no task holds a worker up with a map in the middle of the study. On a local cluster whose
+numba cache lacks the kernels, one task (the pilot) runs first and compiles them into the disk
+cache; the other tasks wait for it and load them, so the machine compiles once, not once per
+worker (the other workers compute the FE meanwhile).
 """
 from __future__ import annotations
 
@@ -281,6 +284,17 @@ def run_after(scene: Scene, outputs: Outputs, *maps) -> dict:
     return run_point(scene, outputs)
 
 
+def kernels_cached() -> bool:
+    """True when this machine's numba disk cache holds compiled kernels of the current sources
+    (`solver.mbs.kernels`: a folder per kernel-source hash)."""
+    import numba
+
+    from solver.mbs import kernels
+    own = Path(kernels.__file__).resolve().parent / "__pycache__"
+    folder = Path(numba.config.CACHE_DIR or own) / f"kernels-{kernels.KERNELS_FINGERPRINT}"
+    return folder.is_dir() and any(folder.rglob("*.nbi"))
+
+
 def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None):
     from distributed import as_completed
 
@@ -288,16 +302,24 @@ def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | 
     with dask_client(scheduler, workers) as client:
         # each FE map or body once, ahead of the tasks (higher priority; the bodies, dearest,
         # first), and each task after the FE it reads
+        pilot = next(iter(todo), None) if scheduler is None and not kernels_cached() else None
         maps, after = {}, {}
         for key, scene in todo.items():
             for fe_key, func, args in fe_jobs(scene):
                 if fe_key not in maps:
                     maps[fe_key] = client.submit(func, *args, key=f"lightgear-fe-{fe_key}", pure=False,
-                                                 priority=2 if func is compute_body else 1)
+                                                 priority=3 if key == pilot else 2 if func is compute_body else 1)
                 after.setdefault(key, []).append(maps[fe_key])
-        futures = {client.submit(run_after, scene, outputs[key], *after.get(key, ()), key=f"lightgear-task-{key}",
-                                 pure=False): key
-                   for key, scene in todo.items()}
+        futures = {}
+        if pilot is not None:       # compiles the kernels into the disk cache; the other tasks load them
+            first = client.submit(run_after, todo[pilot], outputs[pilot], *after.get(pilot, ()),
+                                  key=f"lightgear-task-{pilot}", pure=False, priority=3)
+            futures[first] = pilot
+            for key in todo:
+                after.setdefault(key, []).append(first)
+        futures.update({client.submit(run_after, scene, outputs[key], *after.get(key, ()), key=f"lightgear-task-{key}",
+                                      pure=False): key
+                        for key, scene in todo.items() if key != pilot})
         del maps, after     # the tasks hold the maps' futures now; dask forgets each map once its tasks ran
         try:
             for fut in as_completed(futures):

@@ -1,0 +1,65 @@
+"""A local dask sweep on a machine whose numba cache lacks the kernels compiles them once: one
+task (the pilot) first, the others after it."""
+import numba
+import numpy as np
+import pytest
+from conftest import SMALL_PAIR
+
+from solver.mbs import kernels
+from study.sweep import engine
+from study.sweep.engine import kernels_cached, run_sweep
+from study.sweep.grid import loads_study
+from study.sweep.outputs import STATUS
+
+pytestmark = pytest.mark.usefixtures("private_fe_cache")
+
+SCENE = "\n".join(f'"{k}" = {v!r}' for k, v in {**SMALL_PAIR, "quasi_static.rotation": 6.0,
+                                                 "quasi_static.angle_step": 1.0, "dynamic.duration": 0.004,
+                                                 "dynamic.ramp_time": 0.001}.items())
+STUDY = f"""title = "pilot"
+[scene]
+{SCENE}
+[grid]
+"dynamic.speed" = [50.0, 60.0, 70.0]
+[outputs]
+scalars = ["ste_p2p", "dte_rms"]
+"""
+
+
+def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_the_current_sources(tmp_path, monkeypatch):
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
+    assert not kernels_cached()
+    stale = tmp_path / "kernels-0000000000000000" / "solver" / "statics.nbi"   # another version's kernels
+    stale.parent.mkdir(parents=True)
+    stale.write_bytes(b"")
+    assert not kernels_cached()
+    own = tmp_path / f"kernels-{kernels.KERNELS_FINGERPRINT}" / "solver" / "statics.nbi"
+    own.parent.mkdir(parents=True)
+    own.write_bytes(b"")
+    assert kernels_cached()
+
+
+def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, monkeypatch):
+    import distributed
+    st = loads_study(STUDY)
+    submitted = []
+    real = distributed.Client.submit
+
+    def submit(self, func, *args, **kw):
+        future = real(self, func, *args, **kw)
+        submitted.append((future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
+        return future
+    monkeypatch.setattr(distributed.Client, "submit", submit)
+    monkeypatch.setattr(engine, "kernels_cached", lambda: False)
+    res = run_sweep(st, tmp_path / "cold.nc", workers=2, progress=False)
+    (pilot, before), *rest = submitted
+    assert before == [] and len(rest) == len(submitted) - 1 >= 3
+    assert all(after == [pilot] for _, after in rest)
+    assert (res.dataset["status"] == STATUS.index("ok")).all()
+    # a warm cache: no pilot, no waiting, the same numbers
+    submitted.clear()
+    monkeypatch.setattr(engine, "kernels_cached", lambda: True)
+    warm = run_sweep(st, tmp_path / "warm.nc", workers=2, progress=False)
+    assert all(after == [] for _, after in submitted)
+    for name in ("ste_p2p", "dte_rms"):
+        np.testing.assert_array_equal(res.dataset[name].values, warm.dataset[name].values)
