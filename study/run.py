@@ -30,6 +30,7 @@ from study.setup import (
     build_scene_model,
     damping_ratios,
     error_period,
+    kept_scene_model,
     load_table,
     mean_load,
     scene_springs,
@@ -108,7 +109,7 @@ def static_force_max(scene: Scene, model: Model) -> float:
 
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
               max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True,
-              warn: bool = True) -> xr.Dataset:
+              warn: bool = True, keep_model: bool = False) -> xr.Dataset:
     """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive.
 
     Before any work: a dynamic run whose output arrays do not fit in memory is refused
@@ -119,7 +120,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     ratio, tooth forces of both gears; about 1 ms an angle) and the dynamic factor K_v (its static
     reference over a revolution); a study leaves them out unless it asks for them.
     Plausibility warnings (`study.plausibility.scene_warnings`, and a speed far above the
-    critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr."""
+    critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr.
+    ``keep_model``: take the model from `study.setup.kept_scene_model` (a study's worker: the
+    points of one body share it)."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
     warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
@@ -135,7 +138,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         estimate.run_fe_bodies(scene, progress)
     springs = springs or scene_springs(scene)
     t_springs = time.perf_counter() - t0
-    model = build_scene_model(scene, springs)
+    model = (kept_scene_model if keep_model else build_scene_model)(scene, springs)
     choice = None
     if static:
         est.seconds["statics"] = estimate.static_seconds(scene, model)

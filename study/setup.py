@@ -7,7 +7,11 @@ inputs (`study.inputs`) take those setups and the model is assembled from them.
 """
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import json
 import math
+from collections import OrderedDict
 
 import numpy as np
 
@@ -21,7 +25,7 @@ from study.inputs.springs import tooth_springs
 from study.scene import MESH_DAMPING_RATIO, TOOTH_DAMPING_RATIO, Scene, SceneError
 
 __all__ = ["GearSetup", "gear_setup", "gear_setups", "solid_scene", "coupling_fit", "scene_springs",
-           "build_scene_model", "geometry_model", "static_angles", "load_table", "damping_ratios", "mean_load"]
+           "build_scene_model", "kept_scene_model", "geometry_model", "static_angles", "load_table", "damping_ratios", "mean_load"]
 
 
 def solid_scene(scene: Scene, gears=(1, 2)) -> Scene:
@@ -66,6 +70,46 @@ def scene_springs(scene: Scene, setups: tuple | None = None):
     if scene.coupling_model != "none":
         return tuple(coupled_springs(scene, s, setups) for s in setups)
     return tuple(tooth_springs(s) for s in setups)
+
+
+MODEL_SLOTS = 4     # built models kept in a process: a study's worker runs many points of one body
+_MODELS: OrderedDict = OrderedDict()
+
+
+def model_key(scene: Scene, springs, convert_damping: bool) -> str:
+    """What a scene's model depends on: every field but ``dynamic.*`` (the run, not the model)
+    except the mean load the damping ratios are converted at, the springs given and whether the
+    ratios are converted. Points of a study that differ only in speed share it."""
+    data = dataclasses.asdict(scene)
+    data.pop("dynamic", None)
+    data["mean_load"] = mean_load(scene)
+    data["convert_damping"] = convert_damping
+    if springs is not None:
+        data["springs"] = [[np.asarray(a, float).tolist() for a in pair] for pair in springs]
+    return hashlib.sha256(json.dumps(data, sort_keys=True, default=_plain).encode()).hexdigest()
+
+
+def _plain(value):
+    """A scene value JSON does not take, in full (arrays as lists, not numpy's shortened repr)."""
+    if isinstance(value, np.ndarray | np.generic):
+        return value.tolist()
+    return repr(value)
+
+
+def kept_scene_model(scene: Scene, springs=None) -> Model:
+    """`build_scene_model`, kept: the last `MODEL_SLOTS` models by `model_key`, so that a study
+    point that differs from an earlier one of the process only in ``dynamic.*`` builds nothing,
+    its damping conversion (dozens of modal analyses) included. For callers that never change
+    a model in place (the solver does not; the sweep's tasks do not): the object is shared."""
+    key = model_key(scene, springs, True)
+    if key in _MODELS:
+        _MODELS.move_to_end(key)
+        return _MODELS[key]
+    model = build_scene_model(scene, springs)
+    _MODELS[key] = model
+    while len(_MODELS) > MODEL_SLOTS:
+        _MODELS.popitem(last=False)
+    return model
 
 
 def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) -> Model:

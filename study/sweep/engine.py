@@ -88,7 +88,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
         if outputs.static or outputs.dynamic or outputs.modes:
             ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic,
                            mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)),
-                           warn=False)   # the sweep warns once
+                           warn=False, keep_model=True)   # the sweep warns once; a body's points share its model
         else:   # geometry (and root stress) only: no model, no solve
             from study.report.lightening import lightening_dataset
             ds = lightening_dataset(scene, stress=outputs.fe)
