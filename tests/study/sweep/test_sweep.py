@@ -164,12 +164,13 @@ def test_only_the_asked_analyses_run(monkeypatch):
     monkeypatch.setattr(study.run, "run_scene", lambda s, **kw: seen.append(kw) or real(s, **kw))
     st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['ste_p2p']")
     r = sweep.run_point(st.points()[0].scene, st.outputs)
-    assert r["status"] == "ok" and seen == [{"static": True, "dynamic": False, "mesh_outputs": False, "warn": False}]   # the sweep warns once
+    assert r["status"] == "ok" and seen == [{"static": True, "dynamic": False, "mesh_outputs": False, "warn": False,
+                                                  "keep_model": True}]   # the sweep warns once; keeps the model
     assert set(r["scalars"]) == {"ste_p2p"} and r["curves"] == {}
     # a mesh scalar asks for the linearised mesh over the STE
     st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['mesh_stiffness_mean']")
     r = sweep.run_point(st.points()[0].scene, st.outputs)
-    assert seen[-1] == {"static": True, "dynamic": False, "mesh_outputs": True, "warn": False} and r["scalars"]["mesh_stiffness_mean"] > 0
+    assert seen[-1] == {"static": True, "dynamic": False, "mesh_outputs": True, "warn": False, "keep_model": True} and r["scalars"]["mesh_stiffness_mean"] > 0
     st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['ste_p2p']\ncurves = ['mesh_stiffness']")
     r = sweep.run_point(st.points()[0].scene, st.outputs)
     assert seen[-1]["mesh_outputs"] and r["curves"]["mesh_stiffness"][0] == "angle"
