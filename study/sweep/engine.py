@@ -284,15 +284,24 @@ def run_after(scene: Scene, outputs: Outputs, *maps) -> dict:
     return run_point(scene, outputs)
 
 
-def kernels_cached() -> bool:
-    """True when this machine's numba disk cache holds compiled kernels of the current sources
-    (`solver.mbs.kernels`: a folder per kernel-source hash)."""
+def kernel_cache_folder() -> Path:
+    """Where numba keeps the compiled kernels of this checkout (`solver.mbs.kernels`: a folder
+    per kernel-source hash; in it numba files a source folder's kernels under '<folder
+    name>_<SHA-1 of its absolute path>', so another checkout's kernels are elsewhere)."""
+    import hashlib
+
     import numba
 
     from solver.mbs import kernels
-    own = Path(kernels.__file__).resolve().parent / "__pycache__"
-    folder = Path(numba.config.CACHE_DIR or own) / f"kernels-{kernels.KERNELS_FINGERPRINT}"
-    return folder.is_dir() and any(folder.rglob("*.nbi"))
+    source = Path(kernels.__file__).resolve().parent
+    top = Path(numba.config.CACHE_DIR or source / "__pycache__") / f"kernels-{kernels.KERNELS_FINGERPRINT}"
+    return top / f"{source.name}_{hashlib.sha1(str(source).encode()).hexdigest()}"
+
+
+def kernels_cached() -> bool:
+    """True when this machine's numba disk cache holds compiled kernels of the current sources."""
+    folder = kernel_cache_folder()
+    return folder.is_dir() and any(folder.glob("*.nbi"))
 
 
 def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None):

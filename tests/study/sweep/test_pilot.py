@@ -1,13 +1,14 @@
 """A local dask sweep on a machine whose numba cache lacks the kernels compiles them once: one
 task (the pilot) first, the others after it."""
+from pathlib import Path
+
 import numba
 import numpy as np
 import pytest
 from conftest import SMALL_PAIR
 
-from solver.mbs import kernels
 from study.sweep import engine
-from study.sweep.engine import kernels_cached, run_sweep
+from study.sweep.engine import kernel_cache_folder, kernels_cached, run_sweep
 from study.sweep.grid import loads_study
 from study.sweep.outputs import STATUS
 
@@ -26,14 +27,19 @@ scalars = ["ste_p2p", "dte_rms"]
 """
 
 
-def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_the_current_sources(tmp_path, monkeypatch):
+def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_this_checkout(tmp_path, monkeypatch):
+    from solver.mbs.kernels.statics import solve_dense
+    # the folder is the one numba itself files this checkout's kernels in
+    assert kernel_cache_folder() == Path(solve_dense._cache._cache_path)
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
     assert not kernels_cached()
-    stale = tmp_path / "kernels-0000000000000000" / "solver" / "statics.nbi"   # another version's kernels
-    stale.parent.mkdir(parents=True)
-    stale.write_bytes(b"")
+    stale = tmp_path / "kernels-0000000000000000" / kernel_cache_folder().name / "statics.nbi"   # other sources
+    other = kernel_cache_folder().parent / "kernels_0123456789abcdef0123456789abcdef01234567" / "statics.nbi"
+    for f in (stale, other):                                                   # another checkout's
+        f.parent.mkdir(parents=True)
+        f.write_bytes(b"")
     assert not kernels_cached()
-    own = tmp_path / f"kernels-{kernels.KERNELS_FINGERPRINT}" / "solver" / "statics.nbi"
+    own = kernel_cache_folder() / "statics.solve_dense-31.py311.nbi"
     own.parent.mkdir(parents=True)
     own.write_bytes(b"")
     assert kernels_cached()
