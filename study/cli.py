@@ -396,8 +396,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def stop_on_sigterm():
+    """SIGTERM handled as Ctrl-C (KeyboardInterrupt: the running kernel stops, exit 130) while
+    a command runs; a context manager that restores the previous handler. Outside the main
+    thread (no signal handlers there) it does nothing."""
+    import contextlib
+    import signal
+    import threading
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    @contextlib.contextmanager
+    def handler():
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        old = signal.signal(signal.SIGTERM, interrupt)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGTERM, old)
+    return handler()
+
+
 def main(argv=None) -> int:
+    """Run the command of ``argv`` (None: the command line) and return its exit code."""
     args = build_parser().parse_args(argv)
+    with stop_on_sigterm():
+        code = _main(args)
+    if argv is None:
+        import gc
+        # the process ends now: spare it the final collection of every object (1-2 s after a
+        # run), so that an interrupted command is gone at once
+        gc.freeze()
+    return code
+
+
+def _main(args) -> int:
     import os
 
     from study.errors import BudgetError

@@ -200,7 +200,25 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=logging.ERROR, env=dict(WORKER_ENV))
     with cluster, Client(cluster) as client:
+        client.register_plugin(stop_kernels_plugin(), name="lightgear-stop-kernels")
         yield client
+
+
+def stop_kernels_plugin():
+    """Dask worker plugin: a worker of the LocalCluster that closes (its client stopped by
+    Ctrl-C or SIGTERM) stops the kernel it runs (`solver.mbs.interrupt.stop_all`) instead of
+    finishing the point first. (Not installed on an existing cluster: its workers outlive the
+    client, and the scheduler drops the client's tasks.)"""
+    from distributed import WorkerPlugin
+
+    class StopKernels(WorkerPlugin):
+        def teardown(self, worker):
+            import gc
+
+            from solver.mbs import interrupt
+            interrupt.stop_all()
+            gc.freeze()     # the process ends: no final collection of every object (seconds)
+    return StopKernels()
 
 
 def body_group(scene: Scene) -> str:
