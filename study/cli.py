@@ -44,13 +44,29 @@ def writable_folder(folder: Path, option: str = "-o") -> None:
         raise UsageError(option, f"cannot write in {folder}: {e.strerror or e}") from None
 
 
+# bytes that names derived from an archive's add to it: the temporary file of the atomic write
+# (".NAME.tmpPID.HOST-XXXXXXXX"), a sweep's ".NAME.parts", precision's NAME_dynamic.nc
+NAME_MARGIN = 40
+
+
 def checked_output(path, option: str = "-o") -> Path:
-    """An archive path that ends in .nc, is no directory and whose folder is writable."""
+    """An archive path that ends in .nc, is no directory, whose folder is writable and whose
+    name (with the names derived from it) the file system takes."""
+    import os
     path = Path(path)
+    try:
+        name_max = os.pathconf(path.parent if path.parent.is_dir() else ".", "PC_NAME_MAX")
+    except (OSError, ValueError):
+        name_max = 255
+    too_long = [part for part in path.parts if len(part.encode()) > name_max]
+    if too_long or len(path.name.encode()) + NAME_MARGIN > name_max:
+        raise UsageError(option, f"a name of {len((too_long or [path.name])[0].encode())} bytes is too long: this file "
+                                 f"system takes {name_max} bytes a name, and the archive's temporary and parts names "
+                                 f"add up to {NAME_MARGIN} to its own: give a name of at most {name_max - NAME_MARGIN} bytes")
     if path.is_dir():
         raise UsageError(option, f"{path} is a directory; give the archive's file name (e.g. {path / 'run.nc'})")
     if path.suffix != ".nc":
-        raise UsageError(option, f"archives are NetCDF files ending in .nc, got {path.name!r}")
+        raise UsageError(option, f"archives are NetCDF files ending in .nc, got {path.name[:60]!r}")
     writable_folder(path.parent, option)
     return path
 
@@ -197,6 +213,9 @@ def sweep_command(args) -> int:
     st = study.load_study(args.study)
     output = args.output or f"results/{Path(args.study).stem}.nc"
     checked_output(output)
+    if parts_folder(output).exists() and not parts_folder(output).is_dir():
+        raise UsageError("-o", f"{parts_folder(output)} is a file, where the sweep keeps its finished tasks: "
+                               "move it away or choose another output name")
     if args.workers is not None and args.workers < 0:
         raise UsageError("--workers", f"must be >= 0 (0 runs the points in this process), got {args.workers}")
     n = int(np.prod(st.shape))
@@ -312,6 +331,7 @@ def precision_command(args) -> int:
     import study
     from study.setup import build_scene_model
     from study.verify.precision import dynamic_study, plot, setting_label, static_study, table
+    check_precision_options(args)
     scene = study.load_scene(args.scene, args.overrides)
     base = checked_output(args.output)
     model = build_scene_model(scene)
@@ -334,6 +354,19 @@ def precision_command(args) -> int:
         print(table(ds))
         print(f"  archive: {path}\n  plot: {path.with_suffix('.png')}", flush=True)
     return 0
+
+
+def check_precision_options(args) -> None:
+    """The work-precision options, before any work (UsageError naming the option)."""
+    import math
+    for option, value in (("--duration", args.duration), ("--rotation", args.rotation)):
+        if not (math.isfinite(value) and value > 0):
+            raise UsageError(option, f"must be a positive number, got {value}")
+    if not 0 < args.ramp_fraction <= 1:
+        raise UsageError("--ramp-fraction", f"the ramps end at this fraction of the window: must lie in (0, 1], "
+                                            f"got {args.ramp_fraction}")
+    if args.repeats < 1:
+        raise UsageError("--repeats", f"must be at least 1, got {args.repeats}")
 
 
 # ---------------------------------------------------------------- reference
@@ -424,41 +457,56 @@ def main(argv=None) -> int:
     """Run the command of ``argv`` (None: the command line) and return its exit code."""
     args = build_parser().parse_args(argv)
     with stop_on_sigterm():
-        code = _main(args)
+        code = guarded(f"lightgear {args.command}", lambda: args._command(args))
     if argv is None:
-        import gc
-        # the process ends now: spare it the final collection of every object (1-2 s after a
-        # run), so that an interrupted command is gone at once
-        gc.freeze()
+        end_of_process()
     return code
 
 
-def _main(args) -> int:
+def end_of_process() -> None:
+    """The process ends now: spare it the final collection of every object (1-2 s after a
+    run), so that an interrupted command is gone at once."""
+    import gc
+    gc.freeze()
+
+
+def guarded(name: str, command) -> int:
+    """``command()``'s exit code, with the errors a user can meet turned into the exit codes of
+    `EXIT_CODES` and one line on stderr that starts with ``name``."""
     import os
 
+    from solver.geometry import GeometryError
     from study.errors import BudgetError
     from study.scene import SceneError
     try:
-        return int(args._command(args) or 0)
-    except SceneError as e:
-        print(f"lightgear {args.command}: invalid scene: {e}", file=sys.stderr)
+        return int(command() or 0)
+    except (SceneError, GeometryError) as e:
+        print(f"{name}: invalid scene: {e}", file=sys.stderr)
         return 2
     except UsageError as e:
-        print(f"lightgear {args.command}: {e}", file=sys.stderr)
+        print(f"{name}: {e}", file=sys.stderr)
         return 2
     except BudgetError as e:
-        print(f"lightgear {args.command}: refused before any work: {e}", file=sys.stderr)
+        print(f"{name}: refused before any work: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"lightgear {args.command}: interrupted", file=sys.stderr)
+        print(f"{name}: interrupted", file=sys.stderr)
         return 130
     except Exception as e:  # noqa: BLE001 - the backstop: one line, no traceback unless asked
         if os.environ.get("LIGHTGEAR_DEBUG", "") not in ("", "0"):
             raise
         first = str(e).splitlines()[0] if str(e) else ""
-        print(f"lightgear {args.command}: error: {type(e).__name__}: {first} (LIGHTGEAR_DEBUG=1 shows the traceback)",
-              file=sys.stderr)
+        print(f"{name}: error: {type(e).__name__}: {first} (LIGHTGEAR_DEBUG=1 shows the traceback)", file=sys.stderr)
         return 1
+
+
+def script_main(name: str, main_function) -> int:
+    """Exit code of a workflow script's ``main_function()`` run as a program (``python -m
+    workflows.NAME``): the command line's exit codes, SIGTERM as Ctrl-C, one line per error."""
+    with stop_on_sigterm():
+        code = guarded(name, main_function)
+    end_of_process()
+    return code
 
 
 if __name__ == "__main__":

@@ -30,11 +30,29 @@ FE_REF_ELEMENTS = 4e4
 OUTPUT_COPIES = 2.5               # the kernel's output array, the result's columns and the archive's
 
 
+# what makes a part of a run cheaper, by the start of the part's name (`check_time`'s advice)
+LEVERS = {
+    "FE bodies": "a coarser fe.mesh_size (each body is computed once, then read from the FE cache)",
+    "gear": "a coarser fe.mesh_size (the influence coefficients are cached once computed)",
+    "statics": "a larger quasi_static.angle_step or a shorter quasi_static.rotation",
+    "contact sweep": "a larger angle step (--step, quasi_static.angle_step) or a shorter quasi_static.rotation",
+    "dynamics": "a shorter dynamic.duration",
+    "sweep": "fewer grid points",
+}
+
+
 @dataclass
 class Estimate:
-    """What a run will cost: seconds by part, bytes by part (for the messages)."""
+    """What a run will cost: seconds by part, bytes by part (for the messages), and what makes
+    a part cheaper (part -> text; default: `LEVERS` by the part name's start)."""
     seconds: dict = field(default_factory=dict)     # part -> s
     memory: dict = field(default_factory=dict)      # part -> bytes
+    levers: dict = field(default_factory=dict)      # part -> advice
+
+    def lever(self, part: str) -> str:
+        if part in self.levers:
+            return self.levers[part]
+        return next((v for k, v in LEVERS.items() if part.startswith(k)), "a smaller run")
 
     @property
     def total_s(self) -> float:
@@ -106,24 +124,55 @@ def dynamic_seconds(model, choice, duration: float) -> float:
     return duration / choice.dt * per * model.n_teeth
 
 
+def static_angle_count(scene, step_deg: float | None = None) -> float:
+    """Driver angles of the quasi-static analysis (`study.setup.static_angles`) at
+    quasi_static.angle_step or ``step_deg`` [deg], counted without building them."""
+    from study.setup import static_rotation
+    step = scene.quasi_static.angle_step if step_deg is None else step_deg
+    return math.floor(static_rotation(scene) / step + 1e-9) + 1.0
+
+
+# bytes a driver angle holds in a static analysis: the kernel's results (S_* columns and the
+# force on each gear-1 tooth), the result's and the archive's copies; the FE reference holds
+# about four times that (contacts and load sharing per angle)
+STATIC_BYTES_PER_ANGLE_TOOTH = 3 * 8.0
+STATIC_BYTES_PER_ANGLE = 3 * 8.0 * (L.N_S_OUT + 8)
+
+
+def check_static_memory(scene, step_deg: float | None = None, factor: float = 1.0,
+                        field: str = "quasi_static.angle_step") -> float:
+    """Refuse, before the angles are built, a static analysis whose arrays do not fit in memory
+    (BudgetError naming ``field``, the lever); returns the number of angles."""
+    n = static_angle_count(scene, step_deg)
+    need = factor * n * (STATIC_BYTES_PER_ANGLE + STATIC_BYTES_PER_ANGLE_TOOTH * scene.gear1.teeth)
+    have = available_memory()
+    if need > 0.8 * have:
+        from study.setup import static_rotation
+        step = scene.quasi_static.angle_step if step_deg is None else step_deg
+        raise BudgetError(field, f"the static analysis needs about {bytes_text(need)} for its {n:.3g} driver angles "
+                                 f"({static_rotation(scene):.4g} deg at {step:.3g} deg), more than the "
+                                 f"{bytes_text(have)} of memory available; raise the angle step or shorten "
+                                 "quasi_static.rotation")
+    return n
+
+
 def static_seconds(scene, model) -> float:
     """Estimated run time [s] of the quasi-static analysis."""
-    from study.setup import static_angles
     qs = scene.quasi_static
     if qs.method == "static":
-        return static_angles(scene).size * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth
+        return static_angle_count(scene) * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth
     return 0.0      # the transient's steps are counted like a dynamic run's by the caller when needed
 
 
 def error_period_note(scene) -> str | None:
     """A line for the user when pitch errors or an eccentricity stretch the quasi-static range
     beyond quasi_static.rotation (`study.setup.static_rotation`) by more than 1.5 times; None otherwise."""
-    from study.setup import static_angles, static_rotation
+    from study.setup import static_rotation
     qs = scene.quasi_static
     rot = static_rotation(scene)
     if not qs.enabled or rot <= 1.5 * qs.rotation:
         return None
-    n = static_angles(scene).size
+    n = int(static_angle_count(scene))
     sec = n * STATIC_S_PER_ANGLE_TOOTH * (scene.gear1.teeth + scene.gear2.teeth) if qs.method == "static" else float("nan")
     return (f"quasi-static: the pitch errors and eccentricities repeat after {rot:.6g} deg of driver rotation: the STE "
             f"covers that instead of quasi_static.rotation = {qs.rotation:.6g} deg ({n} angles at {qs.angle_step:g} deg, "
@@ -222,9 +271,25 @@ def run_fe_bodies(scene, show: bool = True) -> None:
 def check_time(est: Estimate, max_time: float | None) -> None:
     """Refuse a run whose estimated time exceeds ``max_time`` [s] (None: no bound)."""
     if max_time is not None and est.total_s > max_time:
+        part = max(est.seconds, key=est.seconds.get)
         raise BudgetError("--max-time", f"the run is estimated at {duration_text(est.total_s)} ({est.describe()}), "
-                          f"more than the bound of {max_time:.4g} s; raise --max-time to run it anyway, "
-                          "or make it smaller (coarser fe.mesh_size, shorter dynamic.duration, fewer teeth)")
+                          f"more than the bound of {max_time:.4g} s; raise --max-time to run it anyway, or make "
+                          f"the {part.split(' (')[0]} cheaper: {est.lever(part)}")
+
+
+def dynamic_lever(scene, choice) -> str:
+    """What makes a dynamic run cheaper: its duration, and what sets its step."""
+    d = scene.dynamic
+    text = f"a shorter dynamic.duration ({d.duration:.4g} s)"
+    if d.time_step:
+        return text + f", or a larger dynamic.time_step ({d.time_step:.3g} s given)"
+    cause = ("the stability bound of the pair's stiffest mode: tooth and contact stiffness (contact.k_con, the "
+             "tooth springs) over the tooth inertia (material.density, the tooth size)")
+    if scene.contact.friction > 0:
+        cause += ", and the friction's regularisation (contact.friction_velocity: a smaller one stiffens it)"
+    if choice.method == "explicit" and d.method == "auto":
+        cause += "; dynamic.method = 'implicit' takes larger steps at a higher cost per step"
+    return text + f"; its step {choice.dt:.3g} s is {cause}"
 
 
 # ---------------------------------------------------------------- progress

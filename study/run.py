@@ -118,8 +118,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         est.seconds["statics"] = estimate.static_seconds(scene, model)
     if dynamic:
         choice = dynamic_choice(scene, model)
-        est.seconds[f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"] = \
-            estimate.dynamic_seconds(model, choice, scene.dynamic.duration)
+        part = f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"
+        est.seconds[part] = estimate.dynamic_seconds(model, choice, scene.dynamic.duration)
+        est.levers[part] = estimate.dynamic_lever(scene, choice)
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))

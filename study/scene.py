@@ -359,6 +359,18 @@ def _tables(text: str, source: str) -> dict:
         raise SceneError(source, f"not valid TOML: {e}") from None
 
 
+def read_text(path: str | Path, field: str = "scene") -> str:
+    """The text of a scene or study file; SceneError naming ``field`` when it cannot be read as
+    UTF-8 text (TOML files are UTF-8) or at all."""
+    p = Path(path)
+    try:
+        return p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise SceneError(field, f"{p} is not UTF-8 text (byte {e.start}: {e.reason}); TOML files are UTF-8") from None
+    except OSError as e:
+        raise SceneError(field, f"cannot read {p}: {e.strerror or e}") from None
+
+
 def loads_scene(text: str, source: str = "scene") -> Scene:
     """A checked Scene from TOML text; ``source`` names the text in a parse error."""
     return scene_from_dict(_tables(text, source))
@@ -368,7 +380,7 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
     """Read a scene file (default: the embedded paper example), apply ``key=value`` overrides."""
     if path is not None and not Path(path).is_file():
         raise SceneError("scene", f"no such file: {Path(path)}")
-    data = _tables(default_scene_text() if path is None else Path(path).read_text(), str(path or "scene"))
+    data = _tables(default_scene_text() if path is None else read_text(path), str(path or "scene"))
     items = [parse_override(item) for item in overrides]
     keys = {k for k, _v in items}
     for key, _v in items:

@@ -195,9 +195,11 @@ def static_rotation(scene: Scene) -> float:
 
 
 def static_angles(scene: Scene) -> np.ndarray:
-    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step)."""
+    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step);
+    `study.errors.BudgetError` before they are built when their arrays would not fit in memory."""
+    from study.estimate import check_static_memory
     qs = scene.quasi_static
-    n = int(math.floor(static_rotation(scene) / qs.angle_step + 1e-9)) + 1
+    n = int(check_static_memory(scene))
     return np.radians(np.arange(n) * qs.angle_step)
 
 

@@ -75,4 +75,5 @@ def _springs_of(ds):
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from study.cli import script_main
+    raise SystemExit(script_main("python -m workflows.paper_example", main))

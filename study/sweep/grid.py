@@ -51,6 +51,7 @@ from study.scene import (
     SceneError,
     default_scene_text,
     get_dotted,
+    read_text,
     scene_fields_from_dict,
     scene_from_dict,
     set_dotted,
@@ -248,7 +249,7 @@ def _base_scene(spec, folder: Path | None) -> dict:
         if not p.is_file():
             raise SceneError("scene", f"no such file: {p}")
         try:
-            return tomllib.loads(p.read_text())
+            return tomllib.loads(read_text(p))
         except tomllib.TOMLDecodeError as e:
             raise SceneError("scene", f"{p} is not valid TOML: {e}") from None
 
@@ -305,7 +306,7 @@ def load_study(path: str | Path) -> Study:
     p = Path(path)
     if not p.is_file():
         raise SceneError("study", f"no such file: {p}")
-    return loads_study(p.read_text(), p.parent)
+    return loads_study(read_text(p, "study"), p.parent)
 
 
 def dumps_study(raw: dict) -> str:
