@@ -237,6 +237,9 @@ def sweep_command(args) -> int:
     print("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v))
     for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:
         print(f"    {msg}")
+    partial = [str(m) for m in ds["message"].values.ravel() if "not stored" in str(m)]
+    if partial:     # ok points whose curves the archive could not hold: said, not only in `message`
+        print(f"  {len(partial)} points without some of their curves: {partial[0]}", file=sys.stderr)
     if res.pending:
         causes = sorted({str(m) for m in ds["message"].values.ravel() if str(m).startswith("lost: ")})
         print(f"  {res.pending} analyses lost (worker failures; {counts['pending']} points pending): "
@@ -394,7 +397,7 @@ def reference_command(args) -> int:
     study.write(ds, args.output)
     ste = ds["ste"].values
     print(f"FE reference STE -> {args.output}")
-    print(f"  mean {ste.mean():.3f} um (elastic part {ste.mean() - ds.attrs['backlash_offset_um']:.3f} um), "
+    print(f"  mean {ste.mean():.3f} um (elastic part {ste.mean() - np.sign(scene.quasi_static.torque or 1.0) * ds.attrs['backlash_offset_um']:.3f} um), "
           f"peak-to-peak {np.ptp(ste):.3f} um over {float(ds['angle'][-1]):.4g} deg, {ste.size} angles")
     print(f"  wall time: compliance {ds.attrs['wall_time_compliance_s']:.2f} s, contact {ds.attrs['wall_time_contact_s']:.2f} s, "
           f"total {ds.attrs['wall_time_reference_s']:.2f} s")

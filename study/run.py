@@ -43,9 +43,15 @@ def run_static(scene: Scene, model: Model):
     angles = static_angles(scene)
     if qs.method == "static":
         return solve_static(model, angles, qs.torque, raise_on_failure=False, friction_speed=qs.speed)
-    # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles
+    # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles.
+    # The angles the driver passes before the load is whole (speed * ramp_time / 2 of rotation)
+    # carry no STE: the samples start a whole number of angle steps past the ramp instead, and
+    # the archive's angle axis says so.
     from solver.mbs.dynamics import at_driver_angles, slow_ramp_window
     from solver.mbs.statics import StaticResult
+    ramp_angle = 0.5 * qs.speed * qs.ramp_time
+    step = math.radians(qs.angle_step)
+    angles = angles + math.ceil(ramp_angle / step - 1e-9) * step
     dt_out, t_end = slow_ramp_window(angles, math.radians(qs.angle_step), qs.speed, qs.ramp_time)
     dyn = simulate(model, qs.speed, qs.ramp_time, qs.torque, qs.ramp_time, t_end, output_step=dt_out)
     te, th2, nc = at_driver_angles(dyn, qs.speed, qs.ramp_time, angles)

@@ -293,6 +293,8 @@ def loads_study(text: str, folder: str | Path | None = None) -> Study:
         points.append({path: _check_value(base, path, v, f"points[{i}]") for path, v in flat.items()})
     if not axes and not points:
         raise SceneError("grid", "the study sweeps nothing: give a [grid] table or [[points]]")
+    check_swept_together([a.path for a in axes] + [q for pt in points for q in pt],
+                         outputs_from_table(raw.get("outputs", {})))
     seen = {}
     for path in dict.fromkeys([a.path for a in axes] + [q for pt in points for q in pt]):
         if dim_name(path) in seen:
@@ -300,6 +302,35 @@ def loads_study(text: str, folder: str | Path | None = None) -> Study:
         seen[dim_name(path)] = path
     return Study(str(raw.get("title", "lightgear study")), text, base, axes, tuple(points),
                  outputs_from_table(raw.get("outputs", {})))
+
+
+# scene fields that set the axis of a curve output (its length and spacing): a curve is
+# archived on one axis for the whole study, so a study cannot sweep them and ask for the curve
+CURVE_AXIS_FIELDS = {
+    "ste": ("quasi_static.rotation", "quasi_static.angle_step"),
+    "dte": ("dynamic.duration", "dynamic.output_step"),
+    "dte_amplitude": ("dynamic.duration", "dynamic.output_step", "dynamic.ramp_time", "dynamic.spectrum_start"),
+}
+
+
+def check_swept_together(paths, outputs: Outputs) -> None:
+    """SceneError for swept fields that cannot vary together or with the asked outputs: a
+    damper given two ways (a point takes one of them, the other axis would do nothing), or a
+    field that sets the axis of an asked-for curve."""
+    from study.damping import damping_partner
+    paths = list(dict.fromkeys(paths))
+    for path in paths:
+        partner = damping_partner(path.split("."))
+        if partner and f"{path.rsplit('.', 1)[0]}.{partner}" in paths:
+            other = f"{path.rsplit('.', 1)[0]}.{partner}"
+            raise SceneError(path, f"the study sweeps both {path} and {other}, which exclude each other (a point "
+                                   "takes the one set last, the other axis would change nothing): sweep one of them")
+    for name in outputs.curves:
+        for path in CURVE_AXIS_FIELDS.get(name, ()):
+            if path in paths:
+                raise SceneError(path, f"the curve {name!r} is archived on one axis for the whole study, and "
+                                       f"{path} changes that axis from point to point: ask only for scalars "
+                                       "(outputs.curves = []) or run one study per value")
 
 
 def load_study(path: str | Path) -> Study:

@@ -1,5 +1,8 @@
 """What a careless user or script meets: every bad input is exit 2 with the field or option
 named, before any work; every refusal names the lever that helps."""
+from pathlib import Path
+
+import numpy as np
 import pytest
 
 from study.cli import main
@@ -90,3 +93,74 @@ def test_a_refusal_names_the_lever_of_its_largest_part(tmp_path, capsys):
                            "--set", "contact.friction_velocity=1e-9", "-o", tmp_path / "r.nc")
     assert code == 2 and "make the dynamics cheaper" in err and "contact.friction_velocity" in err
     assert "fe.mesh_size" not in err
+
+
+# ---------------------------------------------------------------- results that would pass as ok
+
+def write_study(tmp_path, grid: str, outputs: str = 'scalars = ["dte_rms"]') -> str:
+    text = (Path("study/scenes/example_study.toml").read_text().split("[grid]")[0]
+            + f"[grid]\n{grid}\n[outputs]\n{outputs}\n")
+    path = tmp_path / "st.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def test_a_grid_over_two_ways_of_one_damper_is_refused(tmp_path, capsys):
+    st = write_study(tmp_path, '"contact.c_con" = [1000.0, 3640.0]\n"contact.damping_ratio" = [0.02, 0.05]')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0)
+    assert code == 2 and "sweeps both contact.c_con and contact.damping_ratio" in err
+    assert not (tmp_path / ".s.nc.parts").exists()
+
+
+@pytest.mark.parametrize("field, values, curve", [("dynamic.duration", "[0.01, 0.012]", "dte"),
+                                                  ("quasi_static.rotation", "[6.0, 8.0]", "ste"),
+                                                  ("dynamic.ramp_time", "[0.002, 0.003]", "dte_amplitude")])
+def test_a_curve_whose_axis_the_grid_changes_is_refused_up_front(tmp_path, capsys, field, values, curve):
+    st = write_study(tmp_path, f'"{field}" = {values}', f'scalars = ["dte_rms"]\ncurves = ["{curve}"]')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0)
+    assert code == 2 and f"{field}: the curve '{curve}' is archived on one axis" in err
+
+
+def small_scene(**overrides):
+    """The example study's 20-tooth pair (uniform springs, no FE), solid."""
+    from study.sweep.grid import load_study
+    scene = load_study("study/scenes/example_study.toml").points()[0].scene
+    return scene.replace(**overrides)
+
+
+def test_the_coast_flanks_elastic_mean_mirrors_the_drive_side():
+    """A solid, unmodified pair is symmetric: under -T it sits on the coast flanks at the mirror
+    image of its drive-flank equilibrium, so the elastic part of the mean STE (measured from
+    the backlash offset of the loaded side) changes sign and keeps its size. (Over one whole
+    mesh period, 18 deg for 20 teeth: the mirror image runs through the period backwards.)"""
+    from study.report.summary import summarize
+    from study.run import run_scene
+    period = {"quasi_static.rotation": 18.0 - 0.25, "quasi_static.angle_step": 0.25}
+    drive = summarize(run_scene(small_scene(**period), static=True, dynamic=False))
+    coast = summarize(run_scene(small_scene(**period, **{"quasi_static.torque": -50.0}), static=True, dynamic=False))
+    assert drive["ste_elastic_mean"] > 0
+    assert coast["ste_elastic_mean"] == pytest.approx(-drive["ste_elastic_mean"], rel=1e-3)
+    assert coast["ste_p2p"] == pytest.approx(drive["ste_p2p"], rel=1e-3)
+
+
+def test_the_transient_ste_holds_no_unloaded_sample():
+    """The slow-ramp transient samples only angles the driver reaches under the whole load: its
+    STE ripple is that of the equilibria (the first sample used to be the unloaded start)."""
+    from study.report.summary import summarize
+    from study.run import run_scene
+    static = run_scene(small_scene(), static=True, dynamic=False)
+    transient = run_scene(small_scene(**{"quasi_static.method": "transient"}), static=True, dynamic=False)
+    p2p_s, p2p_t = summarize(static)["ste_p2p"], summarize(transient)["ste_p2p"]
+    assert float(transient["angle"][0]) > 0.0 == float(static["angle"][0])     # past the load ramp
+    assert p2p_t < 1.5 * p2p_s and abs(summarize(transient)["ste_mean"] - summarize(static)["ste_mean"]) < 0.2 * p2p_s
+
+
+def test_the_sweep_scalar_of_the_mesh_order_is_the_value_the_summary_prints():
+    """A short run resolves orders coarsely: the scalar comes from the same named-peak table as
+    the printed summary, not from a window narrower than a bin (NaN at status ok)."""
+    from study.report.summary import summarize
+    from study.run import run_scene
+    ds = run_scene(small_scene(**{"dynamic.speed": 100.0}), static=False, dynamic=True)
+    s = summarize(ds)
+    table = dict(zip(map(str, ds["dte_peak"].values), ds["dte_peak_amplitude"].values))
+    assert np.isfinite(table["Z"]) and s["amp_mesh_order"] == table["Z"]
