@@ -202,13 +202,13 @@ def sweep_arguments(p) -> None:
                    help="LocalCluster workers (default: one per core); 0 runs the points in this process")
     p.add_argument("--keep-parts", action="store_true", help="keep the per-task files after the archive is complete")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    max_time_argument(p)
 
 
 def sweep_command(args) -> int:
-    import numpy as np
 
     import study
-    from study.sweep.engine import SchedulerUnreachable, parts_folder
+    from study.sweep.engine import SchedulerUnreachable, parts_folder, run_sweep
     from study.sweep.outputs import STATUS
     st = study.load_study(args.study)
     output = args.output or f"results/{Path(args.study).stem}.nc"
@@ -218,11 +218,12 @@ def sweep_command(args) -> int:
                                "move it away or choose another output name")
     if args.workers is not None and args.workers < 0:
         raise UsageError("--workers", f"must be >= 0 (0 runs the points in this process), got {args.workers}")
-    n = int(np.prod(st.shape))
+    from study.estimate import check_study_size
+    n = check_study_size(st, checked_max_time(args))      # before its points are built
     print(f"{st.title}: {n} points ({' x '.join(map(str, st.shape))}, {st.layout} layout) -> {output}")
     try:
-        res = study.run_sweep(st, output, workers=args.workers, scheduler=args.scheduler,
-                              progress=not args.no_progress, keep_parts=args.keep_parts)
+        res = run_sweep(st, output, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress,
+                        keep_parts=args.keep_parts, max_time=checked_max_time(args))
     except SchedulerUnreachable as e:
         raise UsageError("--scheduler", str(e)) from None
     except KeyboardInterrupt:

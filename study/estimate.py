@@ -12,6 +12,8 @@ import os
 import sys
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from solver.mbs.kernels import layout as L
 from study.errors import BudgetError
 
@@ -301,3 +303,82 @@ def progress_bar(expected_s: float, total: float, desc: str, unit: str, show: bo
     from tqdm import tqdm
     return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, leave=False, dynamic_ncols=True,
                 bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} {unit} [{elapsed}<{remaining}]")
+
+
+# ---------------------------------------------------------------- studies
+
+# Building and checking one study point (its Scene and the cross-field checks): 20-60 ms on
+# 2 shared cores; its Scene and Point hold about 5 KB, its task records as much again.
+POINT_CHECK_S = 0.03
+POINT_BYTES = 1e4
+DYNAMIC_SAMPLES = 3          # dynamic tasks whose model gives the step of the estimate
+
+
+def study_points(study) -> int:
+    """Points of a study (grid product plus explicit points), counted without building them."""
+    n = 1
+    for a in study.axes:
+        n *= len(a.values)
+    return (n if study.axes else 0) + len(study.extra)
+
+
+def check_study_size(study, max_time: float | None) -> int:
+    """Refuse, before its points are built, a study too large to enumerate: memory beyond what
+    the machine has, or its checks alone beyond ``max_time`` [s]. Returns its point count."""
+    n = study_points(study)
+    need = n * POINT_BYTES
+    have = available_memory()
+    sizes = " x ".join(str(len(a.values)) for a in study.axes) or "0"
+    if need > 0.5 * have:
+        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}{f' + {len(study.extra)}' if study.extra else ''}); "
+                                  f"only listing them needs about {bytes_text(need)}, more than half the {bytes_text(have)} "
+                                  "of memory available: sweep fewer values, or split the study")
+    if max_time is not None and n * POINT_CHECK_S > max_time:
+        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}); building and checking them alone takes "
+                                  f"about {duration_text(n * POINT_CHECK_S)}, beyond --max-time {max_time:.4g} s: "
+                                  "sweep fewer values, or split the study")
+    return n
+
+
+def estimate_model(scene):
+    """A model of ``scene`` for the step estimate that needs no FE: uniform tooth springs (an FE
+    map scales the calibrated spring by a ratio near 1) and no body coupling."""
+    from study.setup import build_scene_model
+    plain = scene.replace(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform",
+                             "coupling.model": "none"})
+    return build_scene_model(plain)
+
+
+def sweep_estimate(tasks) -> Estimate:
+    """Estimated seconds of a study's tasks (`study.sweep.tasks.Task`), summed: FE bodies (each
+    distinct body the cache lacks), statics (per static task, by its angles) and dynamics
+    (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
+    from study.run import dynamic_choice
+    from study.sweep.bodies import spring_maps
+    est = Estimate()
+    bodies = {}
+    static_s = 0.0
+    dyn = [t for t in tasks if t.outputs.dynamic]
+    for t in tasks:
+        for key, setup, _teeth in spring_maps(t.scene):
+            bodies.setdefault(key, setup)
+        if t.outputs.static and t.scene.quasi_static.method == "static":
+            static_s += static_angle_count(t.scene) * STATIC_S_PER_ANGLE_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
+    est.seconds["FE bodies"] = sum(body_seconds(s) for s in bodies.values())
+    est.seconds["statics"] = static_s
+    if dyn:
+        picks = [dyn[int(i)] for i in sorted({round(k * (len(dyn) - 1) / max(DYNAMIC_SAMPLES - 1, 1))
+                                               for k in range(min(DYNAMIC_SAMPLES, len(dyn)))})]
+        rates, dts, choice_of = [], [], []
+        for t in picks:
+            model = estimate_model(t.scene)
+            choice = dynamic_choice(t.scene, model)
+            rates.append(dynamic_seconds(model, choice, 1.0))      # s of run time per s simulated
+            dts.append(choice.dt)
+            choice_of.append(choice)
+        rate = max(rates)
+        part = f"dynamics ({len(dyn)} runs, dt down to {min(dts):.3g} s)"
+        est.seconds[part] = rate * sum(t.scene.dynamic.duration for t in dyn)
+        worst = int(np.argmax(rates))
+        est.levers[part] = dynamic_lever(picks[worst].scene, choice_of[worst]) + ", or fewer grid points"
+    return est

@@ -209,6 +209,9 @@ def _check_value(base: dict, path: str, value, where: str):
         raise SceneError(e.field, f"{where} value {value!r}: {e.reason}") from None
 
 
+MAX_AXIS_VALUES = 100_000     # values of one grid axis (each is checked against the scene: ~ms)
+
+
 def _axis_values(base: dict, path: str, spec) -> tuple:
     kind = _field_kind(base, path)
     if isinstance(spec, dict):
@@ -220,6 +223,9 @@ def _axis_values(base: dict, path: str, spec) -> tuple:
         num = spec["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             raise SceneError(path, f"range num must be a positive integer, got {num!r}")
+        if num > MAX_AXIS_VALUES:     # each value is checked against the scene: refused before
+            raise SceneError(path, f"range num = {num} values on one axis, more than the {MAX_AXIS_VALUES} a study "
+                                   "can check and list: sweep fewer values")
         for k in ("start", "stop"):
             if isinstance(spec[k], bool) or not isinstance(spec[k], (int, float)):
                 raise SceneError(path, f"range {k} must be a number, got {spec[k]!r}")

@@ -164,3 +164,29 @@ def test_the_sweep_scalar_of_the_mesh_order_is_the_value_the_summary_prints():
     s = summarize(ds)
     table = dict(zip(map(str, ds["dte_peak"].values), ds["dte_peak_amplitude"].values))
     assert np.isfinite(table["Z"]) and s["amp_mesh_order"] == table["Z"]
+
+
+# ---------------------------------------------------------------- a sweep's estimate
+
+def test_a_grid_too_large_to_list_is_refused_before_it_is_built(tmp_path, capsys, monkeypatch):
+    from study.sweep.grid import Study
+    built = []
+    monkeypatch.setattr(Study, "points", lambda self: built.append(1) or [])
+    st = write_study(tmp_path, '"dynamic.speed" = {start = 10.0, stop = 400.0, num = 1000}\n'
+                               '"dynamic.torque" = {start = 10.0, stop = 60.0, num = 1000}\n'
+                               '"gear2.body.holes" = [0, 2, 3, 4, 5, 6, 7, 8, 9, 10]')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0)
+    assert code == 2 and "grid: the study has 1e+07 points (1000 x 1000 x 10)" in err and not built
+    st = write_study(tmp_path, '"dynamic.speed" = {start = 10.0, stop = 400.0, num = 10000000}')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0)
+    assert code == 2 and "dynamic.speed: range num = 10000000 values on one axis" in err
+
+
+def test_a_sweep_gets_the_estimate_and_max_time_of_its_tasks(tmp_path, capsys):
+    """Four dynamic runs of 1 s each at the explicit step: tens of seconds of CPU, refused under
+    --max-time 5 with the parts and the lever, before any task runs."""
+    st = write_study(tmp_path, '"dynamic.speed" = [50.0, 100.0]\n"dynamic.duration" = [1.0, 2.0]')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--max-time", 5)
+    assert code == 2 and "--max-time: the run is estimated at" in err and "dynamics (4 runs" in err
+    assert "a shorter dynamic.duration" in err and "fewer grid points" in err
+    assert not (tmp_path / ".s.nc.parts").exists()
