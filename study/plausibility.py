@@ -5,6 +5,8 @@ naming the field, before any work.
 """
 from __future__ import annotations
 
+import math
+
 from solver import units
 from solver.geometry import gear_geometry
 from study.errors import SceneError
@@ -49,6 +51,15 @@ def check_dynamic_window(scene) -> None:
         return
     start = d.spectrum_start or 2 * d.ramp_time
     need = STEADY_SAMPLES * d.output_step
+    if d.speed_end > 0:
+        # a run-up's order tracking takes blocks of one driven revolution (`order_tracking`)
+        turns = 0.5 * d.speed_end * d.duration * scene.gear1.teeth / scene.gear2.teeth / (2 * math.pi)
+        if turns < 1.0:
+            need_end = 4 * math.pi * scene.gear2.teeth / scene.gear1.teeth / d.duration
+            raise SceneError("dynamic.speed_end",
+                             f"the driven gear turns {turns:.3g} revolutions over the run-up (0 -> {d.speed_end:.4g} rad/s "
+                             f"in dynamic.duration = {d.duration:.4g} s), and its order tracking needs at least one: "
+                             f"give speed_end >= {need_end:.4g} rad/s or a longer duration")
     if d.duration - start < need:
         what = "dynamic.spectrum_start" if d.spectrum_start else "twice dynamic.ramp_time"
         raise SceneError("dynamic.duration",

@@ -190,3 +190,24 @@ def test_a_sweep_gets_the_estimate_and_max_time_of_its_tasks(tmp_path, capsys):
     assert code == 2 and "--max-time: the run is estimated at" in err and "dynamics (4 runs" in err
     assert "a shorter dynamic.duration" in err and "fewer grid points" in err
     assert not (tmp_path / ".s.nc.parts").exists()
+
+
+# ---------------------------------------------------------------- run-ups and render
+
+@pytest.mark.parametrize("speed_end", ["1e-6", "100"])
+def test_a_run_up_without_one_whole_driven_revolution_is_refused(tmp_path, capsys, speed_end):
+    scene = tmp_path / "s.toml"
+    scene.write_text(small_scene().to_toml())
+    code, _, err = run_cli(capsys, "run", scene, "--no-static", "--set", f"dynamic.speed_end={speed_end}",
+                           "-o", tmp_path / "r.nc")
+    assert code == 2 and "dynamic.speed_end: the driven gear turns" in err and "at least one" in err
+
+
+def test_render_draws_a_run_at_standstill_or_says_what_it_skips(tmp_path, capsys):
+    import study
+    ds = study.run_scene(small_scene(**{"dynamic.speed": 0.0}), static=True, dynamic=True)
+    study.write(ds, tmp_path / "still.nc")
+    code, out, err = run_cli(capsys, "render", tmp_path / "still.nc", "--no-renders")
+    assert code == 0, err
+    assert "figure:" in out and "dte.png" in out
+    assert "skip spectrum plot: nothing to draw in this archive" in out and "driver speed 0" in out
