@@ -321,7 +321,7 @@ def check_scene(scene: Scene) -> None:
                 raise GeometryError(f"gear{g}.pivot_radius", f"must lie between half the base radius and the tip radius ({geo.tip_radius * 1e3:.4g} mm), got {gs.pivot_radius} mm")
             modification_spec(gs.modification, geo, f"gear{g}.modification")
             errors_spec(gs.errors, geo, f"gear{g}.errors")
-        pair_geometry(*geoms)
+        check_jamming(scene, pair_geometry(*geoms))
     except GeometryError as e:
         raise SceneError(e.field, e.reason) from None
     check_damping(scene)
@@ -337,6 +337,23 @@ def check_scene(scene: Scene) -> None:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
+
+
+def check_jamming(scene: Scene, pair) -> None:
+    """The eccentricities must not close the backlash: where both offsets point at the mate,
+    the centre distance shrinks by their sum and the normal backlash by 2 sin(alpha) times it;
+    beyond that the teeth are wedged on both flanks at once (a jammed pair, forces far above
+    the load). GeometryError naming the larger eccentricity."""
+    ecc = [scene.gear(g).errors.eccentricity * units.UM for g in (1, 2)]
+    closing = 2.0 * sum(ecc) * math.sin(pair.pressure_angle)
+    if closing >= pair.normal_backlash:
+        g = 1 if ecc[0] >= ecc[1] else 2
+        limit = pair.normal_backlash / (2.0 * math.sin(pair.pressure_angle)) / units.UM
+        raise GeometryError(f"gear{g}.errors.eccentricity",
+                            f"the eccentricities ({ecc[0] / units.UM:.4g} + {ecc[1] / units.UM:.4g} um) close the "
+                            f"backlash ({scene.pair.backlash * 1e3:.4g} um on the pitch circle) where they point at the "
+                            f"mate, which jams the pair: their sum must stay below {limit:.4g} um (or give more "
+                            "pair.backlash)")
 
 
 def scene_from_dict(data: dict) -> Scene:

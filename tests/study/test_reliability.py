@@ -211,3 +211,30 @@ def test_render_draws_a_run_at_standstill_or_says_what_it_skips(tmp_path, capsys
     assert code == 0, err
     assert "figure:" in out and "dte.png" in out
     assert "skip spectrum plot: nothing to draw in this archive" in out and "driver speed 0" in out
+
+
+# ---------------------------------------------------------------- geometry and physics bounds
+
+def test_eccentricities_that_close_the_backlash_are_refused(tmp_path, capsys):
+    """20-tooth pair, m 1.5 mm, 70 um backlash: the normal backlash 65.8 um closes where the
+    centre distance shrinks by 65.8 / (2 sin 20 deg) = 96.2 um; beyond that the pair jams (the
+    run used to say ok with ten times the nominal tooth force)."""
+    import study
+    scene = tmp_path / "s.toml"
+    scene.write_text(small_scene().to_toml())
+    code, _, err = run_cli(capsys, "run", scene, "--no-static", "--set", "gear1.errors.eccentricity=130",
+                           "-o", tmp_path / "r.nc")
+    assert code == 2 and "gear1.errors.eccentricity: the eccentricities (130 + 0 um) close the backlash" in err
+    assert "below 96.16 um" in err
+    with pytest.raises(study.SceneError, match="gear2.errors.eccentricity"):
+        small_scene(**{"gear1.errors.eccentricity": 40.0, "gear2.errors.eccentricity": 60.0})
+    small_scene(**{"gear1.errors.eccentricity": 40.0, "gear2.errors.eccentricity": 50.0})    # 90 um: meshes
+
+
+def test_a_tip_past_the_mates_root_circle_is_radial_interference():
+    import study
+    with pytest.raises(study.SceneError, match="gear1.addendum: the tip circle .* reaches past the mate's root circle"):
+        small_scene(**{"gear1.addendum": 1.3})
+    with pytest.raises(study.SceneError, match="gear2.addendum"):
+        small_scene(**{"gear2.addendum": 1.3, "gear1.dedendum": 1.25})
+    small_scene(**{"gear1.addendum": 1.2})
