@@ -54,7 +54,7 @@ class BodySection:
     holes: int = _f(0, "1", "N: number of lightening holes in the web", 0)
     hole_radius: float = _f(6.0, "mm", "R_h: hole radius", 0.0)
     hole_circle_radius: float = _f(32.36, "mm", "R_ch: radius of the circle through the hole centres", 0.0)
-    hole_phase: float = _f(0.0, "deg", "polar angle of the first hole centre from tooth 0's axis")
+    hole_phase: float = _f(0.0, "deg", "polar angle of the first hole centre from tooth 0's axis", -360.0, 360.0)
 
 
 @dataclass(frozen=True)

@@ -238,3 +238,19 @@ def test_a_tip_past_the_mates_root_circle_is_radial_interference():
     with pytest.raises(study.SceneError, match="gear2.addendum"):
         small_scene(**{"gear2.addendum": 1.3, "gear1.dedendum": 1.25})
     small_scene(**{"gear1.addendum": 1.2})
+
+
+def test_a_relief_deeper_than_the_tooth_is_thick_is_refused():
+    """m 1.5 mm, 67 teeth: each flank has about 0.52 mm of material to the centreline at the tip
+    (normal to the flank): a 2 mm tip relief would remove the tooth; 50 um is a relief."""
+    import study
+    start = {"gear1.modification.tip_start_roll": 25.0}
+    with pytest.raises(study.SceneError, match=r"gear1.modification.tip_relief: 2000 um removes the whole tooth"):
+        study.default_scene().replace(**start, **{"gear1.modification.tip_relief": 2000.0})
+    study.default_scene().replace(**start, **{"gear1.modification.tip_relief": 50.0})
+
+
+def test_a_hole_phase_beyond_a_turn_is_refused():
+    import study
+    with pytest.raises(study.SceneError, match="gear2.body.hole_phase"):
+        study.default_scene().replace(**{"gear2.body.hole_phase": 1e300})
