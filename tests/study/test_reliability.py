@@ -254,3 +254,21 @@ def test_a_hole_phase_beyond_a_turn_is_refused():
     import study
     with pytest.raises(study.SceneError, match="gear2.body.hole_phase"):
         study.default_scene().replace(**{"gear2.body.hole_phase": 1e300})
+
+
+def test_very_stiff_tooth_springs_keep_the_mesh_mode():
+    """At k_phi of 1e12..1e14 N mm/rad the teeth are rigid next to the contact: the mesh mode
+    tends to the rigid-tooth limit, a few tens of kHz, while the tooth modes climb to tens of
+    MHz; the mesh mode used to be dropped as 'rigid' next to them and a 33 MHz tooth mode
+    taken for it (and the dampers tuned to that)."""
+    from solver.mbs.modes import modal_analysis
+    from study.setup import build_scene_model
+    raw = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spring.c_phi": 0.062}
+    f = {}
+    for k in (1e12, 1e14):
+        model = build_scene_model(small_scene(**raw, **{"gear1.spring.k_phi": k, "gear2.spring.k_phi": k}))
+        f[k] = float(np.nanmean(modal_analysis(model, 50.0).frequency[0]))
+    assert f[1e14] < 1e5 and f[1e14] == pytest.approx(f[1e12], rel=0.01)
+    with pytest.raises(Exception, match="contact.damping_ratio"):    # a mesh ratio the joints cannot carry
+        small_scene(**{"gear1.spring.k_phi": 1e14, "gear2.spring.k_phi": 1e14}).replace()
+        build_scene_model(small_scene(**{"gear1.spring.k_phi": 1e14, "gear2.spring.k_phi": 1e14}))
