@@ -478,10 +478,18 @@ def guarded(name: str, command) -> int:
     """``command()``'s exit code, with the errors a user can meet turned into the exit codes of
     `EXIT_CODES` and one line on stderr that starts with ``name``."""
     import os
+    import warnings
 
     from solver.geometry import GeometryError
     from study.errors import BudgetError
     from study.scene import SceneError
+
+    def one_line(message, category, filename, lineno, file=None, line=None):
+        # a library's warning as one line that says who speaks, not its source line
+        print(f"{name}: warning: {category.__name__}: {str(message).splitlines()[0] if str(message) else ''}",
+              file=sys.stderr)
+    shown = warnings.showwarning
+    warnings.showwarning = one_line
     try:
         return int(command() or 0)
     except (SceneError, GeometryError) as e:
@@ -502,6 +510,8 @@ def guarded(name: str, command) -> int:
         first = str(e).splitlines()[0] if str(e) else ""
         print(f"{name}: error: {type(e).__name__}: {first} (LIGHTGEAR_DEBUG=1 shows the traceback)", file=sys.stderr)
         return 1
+    finally:
+        warnings.showwarning = shown
 
 
 def script_main(name: str, main_function) -> int:

@@ -78,7 +78,7 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
     args = (model, speed, speed_ramp, d.torque, d.ramp_time, d.duration)
     bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration), d.duration,
                                 f"dynamic run ({choice.method})", "s", show=progress)
-    watch = None if bar is None else (lambda t: bar.update(t - bar.n))
+    watch = None if bar is None else (lambda t: bar.update(max(min(t, bar.total) - bar.n, 0.0)))    # (within the bar)
     try:
         if choice.method == "implicit":
             res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha, load_table=table,

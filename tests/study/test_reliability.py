@@ -272,3 +272,28 @@ def test_very_stiff_tooth_springs_keep_the_mesh_mode():
     with pytest.raises(Exception, match="contact.damping_ratio"):    # a mesh ratio the joints cannot carry
         small_scene(**{"gear1.spring.k_phi": 1e14, "gear2.spring.k_phi": 1e14}).replace()
         build_scene_model(small_scene(**{"gear1.spring.k_phi": 1e14, "gear2.spring.k_phi": 1e14}))
+
+
+# ---------------------------------------------------------------- what reaches the terminal
+
+def test_a_library_warning_reaches_the_user_as_one_line(capsys):
+    import warnings
+
+    from study.cli import guarded
+
+    def noisy():
+        warnings.warn("something a library says\nwith a second line", RuntimeWarning, stacklevel=1)
+        return 0
+    assert guarded("lightgear run", noisy) == 0
+    err = capsys.readouterr().err
+    assert err == "lightgear run: warning: RuntimeWarning: something a library says\n"
+
+
+def test_an_undamped_run_warns_of_nothing(tmp_path, capsys):
+    """Zero damping: the free decay of the modal check fits exactly, and scipy cannot estimate
+    the fit's covariance (which is not used): no OptimizeWarning."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(small_scene(**{"contact.c_con": 0.0, "gear1.spring.c_phi": 0.0,
+                                    "gear2.spring.c_phi": 0.0}).to_toml())
+    code, _, err = run_cli(capsys, "run", scene, "--no-static", "-o", tmp_path / "r.nc")
+    assert code in (0, 3) and "Warning" not in err, err
