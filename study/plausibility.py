@@ -111,3 +111,25 @@ def check_plausibility(scene) -> None:
     that summarise a run: integrator studies run windows that end with the ramps on purpose."""
     check_fe_mesh(scene)
     check_loads(scene)
+
+
+def carrying_equilibria(scene, model, torque: float, positions: int = 12):
+    """`solver.mbs.equilibria.loaded_equilibria` of the scene's model under ``torque`` [N·m];
+    SceneError naming the load when the teeth cannot carry it: no equilibrium within the
+    deflection bound (DEFLECTION_FRACTION of the module) at any position. The torque check of
+    `check_loads` estimates from the scene's laws alone; this is what the springs actually
+    built (FE springs of a soft material or a thin face, a modification that opens the mesh)
+    make of the load."""
+    from solver.mbs.equilibria import loaded_equilibria
+    try:
+        return loaded_equilibria(model, torque, positions)
+    except ValueError:
+        d = scene.dynamic
+        field = "dynamic.torque" if d.enabled and d.torque == torque else "quasi_static.torque"
+        bound = DEFLECTION_FRACTION * min(scene.gear1.module, scene.gear2.module)
+        raise SceneError(field, f"implausible load: under {torque:.4g} N*m the pair finds no equilibrium with the "
+                                f"flanks approaching less than {DEFLECTION_FRACTION:g} x module = {bound:.4g} mm: the teeth "
+                                "are too soft for it or the flanks do not meet (the tooth springs of "
+                                "material.youngs_modulus, gearN.face_width and gearN.spring, the flank deviations of "
+                                "gearN.modification): lower the torque or check those fields") from None
+

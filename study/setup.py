@@ -143,9 +143,9 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
     ratios = damping_ratios(scene)
     if not ratios:
         return model
-    from solver.mbs.equilibria import loaded_equilibria
     from solver.mbs.modes import joint_damping_for_ratio, tooth_damping_for_ratio, with_damping
-    eqs = loaded_equilibria(model, mean_load(scene))
+    from study.plausibility import carrying_equilibria
+    eqs = carrying_equilibria(scene, model, mean_load(scene))      # SceneError when the teeth cannot carry it
     c_phi = tuple(tooth_damping_for_ratio(model, eqs, ratios[f"gear{g}"], g) if f"gear{g}" in ratios
                   else float(model.gear_par[g - 1, L.C_PHI]) for g in (1, 2))
     model = with_damping(model, c_phi=c_phi)

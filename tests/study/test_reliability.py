@@ -297,3 +297,12 @@ def test_an_undamped_run_warns_of_nothing(tmp_path, capsys):
                                     "gear2.spring.c_phi": 0.0}).to_toml())
     code, _, err = run_cli(capsys, "run", scene, "--no-static", "-o", tmp_path / "r.nc")
     assert code in (0, 3) and "Warning" not in err, err
+
+
+def test_teeth_too_soft_for_the_load_are_named_not_a_solver_error(tmp_path, capsys, private_fe_cache):
+    """FE springs of a 1 MPa material: the teeth would bend by metres under 50 N·m; the torque
+    check (from the scene's laws) cannot see it, the springs built from the FE do."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(small_scene(**{"gear2.spring.stiffness": "fe", "material.youngs_modulus": 1.0}).to_toml())
+    code, _, err = run_cli(capsys, "run", scene, "--no-static", "-o", tmp_path / "r.nc")
+    assert code == 2 and "dynamic.torque: implausible load" in err and "material.youngs_modulus" in err
