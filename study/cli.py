@@ -114,6 +114,9 @@ def run_command(args) -> int:
         check_dynamic_memory(scene)       # at once, before the solver is even loaded
     checked_output(args.output)
     max_time = checked_max_time(args)
+    from study.plausibility import face_width_note
+    if face_width_note(scene):
+        print(face_width_note(scene))
     if not args.no_static:
         from study.estimate import error_period_note
         note = error_period_note(scene)
@@ -220,6 +223,9 @@ def sweep_command(args) -> int:
         raise UsageError("--workers", f"must be >= 0 (0 runs the points in this process), got {args.workers}")
     from study.estimate import check_study_size
     n = check_study_size(st, checked_max_time(args))      # before its points are built
+    from study.plausibility import face_width_note
+    if any(f.endswith(".face_width") for f in st.fields) and face_width_note(st.base_scene(), swept=True):
+        print(face_width_note(st.base_scene(), swept=True))
     print(f"{st.title}: {n} points ({' x '.join(map(str, st.shape))}, {st.layout} layout) -> {output}")
     try:
         res = run_sweep(st, output, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress,

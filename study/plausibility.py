@@ -133,3 +133,21 @@ def carrying_equilibria(scene, model, torque: float, positions: int = 12):
                                 "material.youngs_modulus, gearN.face_width and gearN.spring, the flank deviations of "
                                 "gearN.modification): lower the torque or check those fields") from None
 
+
+
+FACE_WIDTH_REF_MM = 17.0      # face width the paper's per-tooth laws were calibrated at [mm]
+
+
+def face_width_note(scene, swept: bool = False) -> str | None:
+    """A line for the user when the face width cannot act on the STE: the contact law (k_con)
+    and, unless a gear's springs come from the FE directly (spring.stiffness = 'fe'), the tooth
+    springs are given per tooth, so a face width other than the calibration's (or a swept
+    one) changes only masses and inertias. None when it does act or stays at 17 mm."""
+    gears = [g for g in (1, 2) if scene.gear(g).spring.stiffness != "fe"]
+    widths = {scene.gear(g).face_width for g in (1, 2)}
+    if not gears or (not swept and widths == {FACE_WIDTH_REF_MM}):
+        return None
+    return ("note: the face width acts on masses and inertias only: contact.k_con and the tooth springs of "
+            + " and ".join(f"gear {g} (spring.stiffness = {scene.gear(g).spring.stiffness!r})" for g in gears)
+            + " are per tooth, calibrated at 17 mm; for stiffness that follows the face width use "
+              "gearN.spring.stiffness = 'fe' and refit k_con (lightgear fit-contact)")
