@@ -333,6 +333,7 @@ def precision_arguments(p, output: str = "results/work_precision.nc") -> None:
     p.add_argument("--rotation", type=float, default=6.0, help="quasi-static driver rotation [deg] (default 6)")
     p.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best is kept)")
     p.add_argument("--only", choices=("dynamic", "static"), help="run only one of the two studies")
+    max_time_argument(p)
 
 
 def precision_command(args) -> int:
@@ -344,7 +345,13 @@ def precision_command(args) -> int:
     check_precision_options(args)
     scene = study.load_scene(args.scene, args.overrides)
     base = checked_output(args.output)
+    max_time = checked_max_time(args)
     model = build_scene_model(scene)
+    from study import estimate
+    est = estimate.precision_estimate(scene, model, args.duration, args.rotation, args.repeats, args.only)
+    estimate.check_time(est, max_time)
+    print(f"estimated {estimate.duration_text(est.total_s)} ({est.describe()}); each run is listed as it ends",
+          flush=True)
 
     def progress(i, s, e, w, msg):
         setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)

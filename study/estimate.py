@@ -382,3 +382,42 @@ def sweep_estimate(tasks) -> Estimate:
         worst = int(np.argmax(rates))
         est.levers[part] = dynamic_lever(picks[worst].scene, choice_of[worst]) + ", or fewer grid points"
     return est
+
+
+# ---------------------------------------------------------------- work-precision study
+
+# The scipy runs of `lightgear precision` integrate plain-Python forces: the DOP853 reference
+# at rtol 1e-10 took 6-20 ms per explicit stability step of the window on 2 shared cores (the
+# paper pair and the 20-tooth example pair); its four Radau/LSODA runs at most
+# SCIPY_RUN_CAP_S each. The static cross-check (scipy.optimize.root on the same forces) about
+# 50 ms an angle.
+SCIPY_S_PER_BOUND_STEP = 2e-2
+SCIPY_RUN_CAP_S = 120.0
+SCIPY_RUNS = 4
+SCIPY_ROOT_S_PER_ANGLE = 5e-2
+# stability steps the numba ladders take per step of the window and per repeat: explicit at
+# 1, 2, 4, 8 x finer in three variants and the 1/32 cross-check; HHT at 1/8 .. 2 x coarser, two alphas
+PRECISION_EXPLICIT_STEPS = 3 * (1 + 2 + 4 + 8) + 32
+PRECISION_IMPLICIT_STEPS = 2 * (1 / 8 + 1 / 4 + 1 / 2 + 1 + 2)
+
+
+def precision_estimate(scene, model, duration: float, rotation_deg: float, repeats: int, only=None) -> Estimate:
+    """Estimated seconds of `lightgear precision`'s dynamic study over ``duration`` [s] and its
+    static study over ``rotation_deg`` [deg], ``repeats`` timed runs each (`study.verify.precision`)."""
+    from solver.mbs.stability import stable_time_step
+    est = Estimate()
+    if only in (None, "dynamic"):
+        dt_b, _w = stable_time_step(model, scene.dynamic.torque)
+        steps = duration / dt_b
+        ref = steps * SCIPY_S_PER_BOUND_STEP
+        est.seconds["dynamic: scipy reference and runs"] = ref + SCIPY_RUNS * min(SCIPY_RUN_CAP_S, ref)
+        est.seconds["dynamic: numba runs"] = steps * (repeats + 1) * model.n_teeth * (
+            PRECISION_EXPLICIT_STEPS * EXPLICIT_S_PER_STEP_TOOTH + PRECISION_IMPLICIT_STEPS * IMPLICIT_S_PER_STEP_TOOTH)
+        est.levers["dynamic: scipy reference and runs"] = est.levers["dynamic: numba runs"] = \
+            f"a shorter --duration ({duration:g} s = {steps:.3g} stability steps of {dt_b:.3g} s)"
+    if only in (None, "static"):
+        angles = rotation_deg / scene.quasi_static.angle_step + 1
+        est.seconds["static"] = angles * (SCIPY_ROOT_S_PER_ANGLE
+                                          + (4 * repeats + 1) * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth)
+        est.levers["static"] = f"a smaller --rotation ({rotation_deg:g} deg) or a larger quasi_static.angle_step"
+    return est

@@ -326,3 +326,15 @@ def test_a_face_width_that_only_changes_the_inertia_is_said(tmp_path, capsys):
     scene.write_text(thin.to_toml())
     code, out, _ = run_cli(capsys, "run", scene, "--no-dynamic", "-o", tmp_path / "r.nc")
     assert code == 0 and "face width acts on masses and inertias only" in out
+
+
+def test_precision_gets_an_estimate_and_max_time(tmp_path, capsys):
+    """A 10 s window is some 2e7 stability steps of plain-Python scipy integration: refused
+    before any run with the lever (--duration); a 1 deg static study alone is cheap and says
+    what it expects."""
+    code, out, err = run_cli(capsys, "precision", "--duration", "10", "-o", tmp_path / "p.nc")
+    assert code == 2 and "days" in err and "a shorter --duration (10 s" in err and "study ..." not in out
+    code, out, err = run_cli(capsys, "precision", "--only", "static", "--rotation", "1", "--repeats", "1",
+                             "-o", tmp_path / "p.nc")
+    assert code == 0, err
+    assert out.startswith("estimated ") and "static" in out.splitlines()[0]
