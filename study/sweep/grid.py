@@ -299,8 +299,7 @@ def loads_study(text: str, folder: str | Path | None = None) -> Study:
         points.append({path: _check_value(base, path, v, f"points[{i}]") for path, v in flat.items()})
     if not axes and not points:
         raise SceneError("grid", "the study sweeps nothing: give a [grid] table or [[points]]")
-    check_swept_together([a.path for a in axes] + [q for pt in points for q in pt],
-                         outputs_from_table(raw.get("outputs", {})))
+    check_swept_together([[a.path for a in axes]] + [list(pt) for pt in points], outputs_from_table(raw.get("outputs", {})))
     seen = {}
     for path in dict.fromkeys([a.path for a in axes] + [q for pt in points for q in pt]):
         if dim_name(path) in seen:
@@ -319,18 +318,20 @@ CURVE_AXIS_FIELDS = {
 }
 
 
-def check_swept_together(paths, outputs: Outputs) -> None:
+def check_swept_together(groups, outputs: Outputs) -> None:
     """SceneError for swept fields that cannot vary together or with the asked outputs: a
-    damper given two ways (a point takes one of them, the other axis would do nothing), or a
+    damper given two ways in one group of fields that are set together (the grid's axes, or
+    one explicit point: a point takes the one set last, the other axis would do nothing), or a
     field that sets the axis of an asked-for curve."""
     from study.damping import damping_partner
-    paths = list(dict.fromkeys(paths))
-    for path in paths:
-        partner = damping_partner(path.split("."))
-        if partner and f"{path.rsplit('.', 1)[0]}.{partner}" in paths:
-            other = f"{path.rsplit('.', 1)[0]}.{partner}"
-            raise SceneError(path, f"the study sweeps both {path} and {other}, which exclude each other (a point "
-                                   "takes the one set last, the other axis would change nothing): sweep one of them")
+    for group in groups:
+        for path in group:
+            partner = damping_partner(path.split("."))
+            if partner and f"{path.rsplit('.', 1)[0]}.{partner}" in group:
+                other = f"{path.rsplit('.', 1)[0]}.{partner}"
+                raise SceneError(path, f"the study sweeps both {path} and {other}, which exclude each other (a point "
+                                       "takes the one set last, the other axis would change nothing): sweep one of them")
+    paths = list(dict.fromkeys(p for group in groups for p in group))
     for name in outputs.curves:
         for path in CURVE_AXIS_FIELDS.get(name, ()):
             if path in paths:

@@ -338,3 +338,13 @@ def test_precision_gets_an_estimate_and_max_time(tmp_path, capsys):
                              "-o", tmp_path / "p.nc")
     assert code == 0, err
     assert out.startswith("estimated ") and "static" in out.splitlines()[0]
+
+
+def test_explicit_points_may_each_give_a_damper_their_own_way(tmp_path):
+    from study.sweep.grid import load_study
+    path = tmp_path / "p.toml"
+    path.write_text(Path("study/scenes/example_study.toml").read_text().split("[grid]")[0]
+                    + '[[points]]\n"contact.c_con" = 3640.0\n"gear1.spring.c_phi" = 0.062\n"gear2.spring.c_phi" = 0.062\n'
+                      '[[points]]\n"contact.damping_ratio" = 0.03\n[outputs]\nscalars = ["ste_p2p"]\n')
+    st = load_study(path)
+    assert [p.scene is not None for p in st.points()] == [True, True]
