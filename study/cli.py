@@ -224,8 +224,13 @@ def sweep_command(args) -> int:
     from study.estimate import check_study_size
     n = check_study_size(st, checked_max_time(args))      # before its points are built
     from study.plausibility import face_width_note
-    if any(f.endswith(".face_width") for f in st.fields) and face_width_note(st.base_scene(), swept=True):
-        print(face_width_note(st.base_scene(), swept=True))
+    if any(f.endswith(".face_width") for f in st.fields):
+        try:
+            note = face_width_note(st.base_scene(), swept=True)
+        except study.SceneError:      # a base that only the grid's values make valid: no note
+            note = None
+        if note:
+            print(note)
     print(f"{st.title}: {n} points ({' x '.join(map(str, st.shape))}, {st.layout} layout) -> {output}")
     try:
         res = run_sweep(st, output, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress,

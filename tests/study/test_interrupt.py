@@ -127,9 +127,12 @@ def test_run_stops_on_a_signal(tmp_path, sig):
 @pytest.mark.parametrize("workers", [0, 2])
 def test_sweep_stops_on_sigint_and_sigterm_and_resumes(tmp_path, workers):
     study = slow_study(tmp_path)
-    out = tmp_path / "s.nc"
-    parts = tmp_path / ".s.nc.parts"
+    fast = tmp_path / "fast"
+    fast.mkdir()
+    fast = slow_study(fast, "0.0")
     for sig in (signal.SIGINT, signal.SIGTERM):
+        out = tmp_path / f"{sig.name}.nc"
+        parts = tmp_path / f".{sig.name}.nc.parts"
         proc = cli(["sweep", study, "-o", out, "--workers", workers, "--no-progress"], tmp_path)
         # the static task (shared by the three speeds) is stored first; the dynamic ones then run
         code, took = stop_after(proc, lambda: parts.is_dir() and any(parts.glob("*.pkl")), sig)
@@ -137,9 +140,8 @@ def test_sweep_stops_on_sigint_and_sigterm_and_resumes(tmp_path, workers):
         assert code == 130 and took < STOP_WITHIN_S, err
         assert "interrupted" in err and not out.exists()
         assert len(list(parts.glob("*.pkl"))) == 1
-    # resumable: the same study at a sane step reuses the stored static task
-    fast = slow_study(tmp_path, "0.0")
-    done = cli(["sweep", fast, "-o", out, "--workers", 0, "--no-progress"], tmp_path)
-    assert done.wait(timeout=600) == 0, (tmp_path / "err.txt").read_text()
-    text = (tmp_path / "out.txt").read_text()
-    assert "computed 3, reused 1" in text and "ok 3" in text
+        # resumable: the same study at a sane step reuses the stored static task
+        done = cli(["sweep", fast, "-o", out, "--workers", 0, "--no-progress"], tmp_path)
+        assert done.wait(timeout=600) == 0, (tmp_path / "err.txt").read_text()
+        text = (tmp_path / "out.txt").read_text()
+        assert "computed 3, reused 1" in text and "ok 3" in text
