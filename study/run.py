@@ -153,6 +153,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         **results.provenance(),
     }
     t0 = time.perf_counter()
+    if not damping_ratios(scene):    # (with ratios the damping conversion has checked it)
+        from study.plausibility import carrying_equilibria
+        carrying_equilibria(scene, model, mean_load(scene), positions=2)     # SceneError: teeth too soft for the load
     c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
     coords.update(c); data.update(v); attrs.update(a)
     attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))

@@ -306,6 +306,11 @@ def test_teeth_too_soft_for_the_load_are_named_not_a_solver_error(tmp_path, caps
     scene.write_text(small_scene(**{"gear2.spring.stiffness": "fe", "material.youngs_modulus": 1.0}).to_toml())
     code, _, err = run_cli(capsys, "run", scene, "--no-static", "-o", tmp_path / "r.nc")
     assert code == 2 and "dynamic.torque: implausible load" in err and "material.youngs_modulus" in err
+    # with raw damping coefficients (no ratio to convert), the modal analysis meets it first
+    raw = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spring.c_phi": 0.062}
+    scene.write_text(small_scene(**raw, **{"gear2.spring.stiffness": "fe", "material.youngs_modulus": 1.0}).to_toml())
+    code, _, err = run_cli(capsys, "run", scene, "--no-static", "-o", tmp_path / "r.nc")
+    assert code == 2 and "dynamic.torque: implausible load" in err
 
 
 def test_a_face_width_that_only_changes_the_inertia_is_said(tmp_path, capsys):
