@@ -119,6 +119,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     springs = springs or scene_springs(scene)
     t_springs = time.perf_counter() - t0
     model = build_scene_model(scene, springs)
+    if not damping_ratios(scene):    # (with ratios the damping conversion has checked it)
+        from study.plausibility import carrying_equilibria
+        carrying_equilibria(scene, model, mean_load(scene), positions=2)     # SceneError: teeth too soft for the load
     choice = None
     if static:
         est.seconds["statics"] = estimate.static_seconds(scene, model)
@@ -153,9 +156,6 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         **results.provenance(),
     }
     t0 = time.perf_counter()
-    if not damping_ratios(scene):    # (with ratios the damping conversion has checked it)
-        from study.plausibility import carrying_equilibria
-        carrying_equilibria(scene, model, mean_load(scene), positions=2)     # SceneError: teeth too soft for the load
     c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
     coords.update(c); data.update(v); attrs.update(a)
     attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
