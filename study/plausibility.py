@@ -44,6 +44,9 @@ def check_fe_mesh(scene) -> None:
                              "(a finer fe.mesh_size allows a thinner rim)")
 
 
+RUNUP_REVOLUTIONS = 2.0       # driven revolutions a run-up must give its order tracking
+
+
 def check_dynamic_window(scene) -> None:
     """The run must leave a steady part after the ramps for the DTE summary and spectrum."""
     d = scene.dynamic
@@ -52,14 +55,16 @@ def check_dynamic_window(scene) -> None:
     start = d.spectrum_start or 2 * d.ramp_time
     need = STEADY_SAMPLES * d.output_step
     if d.speed_end > 0:
-        # a run-up's order tracking takes blocks of one driven revolution (`order_tracking`)
+        # a run-up's order tracking takes blocks of one driven revolution, one every 1/8
+        # revolution (`order_tracking`): two revolutions give a map of nine blocks over speed
         turns = 0.5 * d.speed_end * d.duration * scene.gear1.teeth / scene.gear2.teeth / (2 * math.pi)
-        if turns < 1.0:
-            need_end = 4 * math.pi * scene.gear2.teeth / scene.gear1.teeth / d.duration
+        if turns < RUNUP_REVOLUTIONS:
+            need_end = RUNUP_REVOLUTIONS * 4 * math.pi * scene.gear2.teeth / scene.gear1.teeth / d.duration
             raise SceneError("dynamic.speed_end",
                              f"the driven gear turns {turns:.3g} revolutions over the run-up (0 -> {d.speed_end:.4g} rad/s "
-                             f"in dynamic.duration = {d.duration:.4g} s), and its order tracking needs at least one: "
-                             f"give speed_end >= {need_end:.4g} rad/s or a longer duration")
+                             f"in dynamic.duration = {d.duration:.4g} s), and its order tracking over speed needs at least "
+                             f"{RUNUP_REVOLUTIONS:g} (blocks of one revolution): give speed_end >= {need_end:.4g} rad/s "
+                             "or a longer duration")
     if d.duration - start < need:
         what = "dynamic.spectrum_start" if d.spectrum_start else "twice dynamic.ramp_time"
         raise SceneError("dynamic.duration",

@@ -200,7 +200,7 @@ def test_a_run_up_without_one_whole_driven_revolution_is_refused(tmp_path, capsy
     scene.write_text(small_scene().to_toml())
     code, _, err = run_cli(capsys, "run", scene, "--no-static", "--set", f"dynamic.speed_end={speed_end}",
                            "-o", tmp_path / "r.nc")
-    assert code == 2 and "dynamic.speed_end: the driven gear turns" in err and "at least one" in err
+    assert code == 2 and "dynamic.speed_end: the driven gear turns" in err and "needs at least 2" in err
 
 
 def test_render_draws_a_run_at_standstill_or_says_what_it_skips(tmp_path, capsys):
