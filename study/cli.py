@@ -209,7 +209,6 @@ def sweep_arguments(p) -> None:
 
 
 def sweep_command(args) -> int:
-
     import study
     from study.sweep.engine import SchedulerUnreachable, parts_folder, run_sweep
     from study.sweep.outputs import STATUS
