@@ -21,7 +21,7 @@ EXIT_CODES = """exit codes:
        run time beyond --max-time)
   3    a run that diverged, whose energy balance does not close (inaccurate) or whose statics
        did not converge (archive written, cause and count on stderr)
-  130  interrupted (a sweep keeps its finished points)"""
+  130  interrupted by Ctrl-C or SIGTERM (a sweep keeps its finished points)"""
 
 
 class UsageError(Exception):
