@@ -354,8 +354,7 @@ def precision_command(args) -> int:
     from study import estimate
     est = estimate.precision_estimate(scene, model, args.duration, args.rotation, args.repeats, args.only)
     estimate.check_time(est, max_time)
-    print(f"estimated {estimate.duration_text(est.total_s)} ({est.describe()}); each run is listed as it ends",
-          flush=True)
+    print(f"estimated {estimate.duration_text(est.total_s)} ({est.describe()})", flush=True)
 
     def progress(i, s, e, w, msg):
         setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
@@ -364,7 +363,9 @@ def precision_command(args) -> int:
     for kind in ("static", "dynamic"):
         if args.only and args.only != kind:
             continue
-        print(f"{kind} study ...", flush=True)
+        part_s = sum(v for k, v in est.seconds.items() if k.startswith(kind))
+        print(f"{kind} study ... (about {estimate.duration_text(part_s)}; its reference runs first, then each run "
+              "is listed as it ends)", flush=True)
         if kind == "dynamic":
             ds = dynamic_study(scene, model, args.duration, args.ramp_fraction, args.repeats, progress)
         else:
