@@ -353,3 +353,12 @@ def test_explicit_points_may_each_give_a_damper_their_own_way(tmp_path):
                       '[[points]]\n"contact.damping_ratio" = 0.03\n[outputs]\nscalars = ["ste_p2p"]\n')
     st = load_study(path)
     assert [p.scene is not None for p in st.points()] == [True, True]
+
+
+def test_a_point_whose_curve_the_archive_cannot_hold_is_said_on_the_terminal(tmp_path, capsys):
+    """An eccentricity stretches the STE to a whole revolution (its period): that point's
+    angle axis differs from the others', its curve is not stored, and the sweep says so on
+    stderr, not only in the point's message."""
+    st = write_study(tmp_path, '"gear1.errors.eccentricity" = [0.0, 5.0]', 'scalars = ["ste_p2p"]\ncurves = ["ste"]')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--no-progress")
+    assert code == 0 and "1 points without some of their curves" in err and "ste not stored" in err
