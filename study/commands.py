@@ -90,14 +90,14 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
 
 
 def precision(scene: Scene, output: str | Path | None = None, duration: float = 0.002, ramp_fraction: float = 0.5,
-              rotation: float = 6.0, repeats: int = 3, only: str | None = None, progress=None) -> dict:
+              rotation: float = 6.0, repeats: int = 3, only: str | None = None, progress=None, model=None) -> dict:
     """Work-precision studies of a scene: TE error [um] against wall time [s] for every solver
     -> {"static": Dataset, "dynamic": Dataset} (`study.verify.precision`). ``duration`` [s]: the
     dynamic window, its ramps ending at ``ramp_fraction`` of it; ``rotation`` [deg]: the
     quasi-static range; ``repeats``: timed runs per setting (the best is kept); ``only``:
     'static' or 'dynamic'. With ``output`` (BASE.nc) each study is written to BASE_static.nc and
     BASE_dynamic.nc with its plot (.png). ``progress(i, spec, errors, wall, message)`` is called
-    after each run."""
+    after each run. ``model``: the scene's model when the caller has built it already."""
     from study.report.results import write_netcdf
     from study.setup import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
@@ -109,7 +109,7 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
             raise ValueError(f"precision: {name} takes {what}, got {value!r}")
     if only not in (None, "static", "dynamic"):
         raise ValueError(f"precision: only takes 'static', 'dynamic' or None, got {only!r}")
-    model = build_scene_model(scene)
+    model = model if model is not None else build_scene_model(scene)
     out = {}
     for kind in ("static", "dynamic"):
         if only and only != kind:

@@ -143,9 +143,9 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
     ratios = damping_ratios(scene)
     if not ratios:
         return model
-    from solver.mbs.equilibria import loaded_equilibria
     from solver.mbs.modes import joint_damping_for_ratio, tooth_damping_for_ratio, with_damping
-    eqs = loaded_equilibria(model, mean_load(scene))
+    from study.plausibility import carrying_equilibria
+    eqs = carrying_equilibria(scene, model, mean_load(scene))      # SceneError when the teeth cannot carry it
     c_phi = tuple(tooth_damping_for_ratio(model, eqs, ratios[f"gear{g}"], g) if f"gear{g}" in ratios
                   else float(model.gear_par[g - 1, L.C_PHI]) for g in (1, 2))
     model = with_damping(model, c_phi=c_phi)
@@ -195,9 +195,11 @@ def static_rotation(scene: Scene) -> float:
 
 
 def static_angles(scene: Scene) -> np.ndarray:
-    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step)."""
+    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step);
+    `study.errors.BudgetError` before they are built when their arrays would not fit in memory."""
+    from study.estimate import check_static_memory
     qs = scene.quasi_static
-    n = int(math.floor(static_rotation(scene) / qs.angle_step + 1e-9)) + 1
+    n = int(check_static_memory(scene))
     return np.radians(np.arange(n) * qs.angle_step)
 
 

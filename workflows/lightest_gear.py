@@ -304,4 +304,5 @@ def _bad(what: str, why: str) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from study.cli import script_main
+    raise SystemExit(script_main("python -m workflows.lightest_gear", main))

@@ -74,4 +74,5 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from study.cli import script_main
+    raise SystemExit(script_main("python -m workflows.stability", main))

@@ -66,7 +66,7 @@ def _system(model: Model, eq: Equilibrium) -> LinearSystem:
 def _modes(M, K):
     """(w [rad/s], mass-normalised modes) of the modes with stiffness."""
     lam, x = scipy.linalg.eigh(K, M)
-    keep = lam > 1e-8 * max(lam.max(), 0.0)
+    keep = lam > 1e-8 * max(K[0, 0] / M[0, 0], 0.0)      # (see `_damped_modes`)
     return np.sqrt(lam[keep]), x[:, keep]
 
 
@@ -93,7 +93,11 @@ def _damped_modes(sy: LinearSystem, C):
     mi = np.linalg.inv(M)
     lam, v = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [-mi @ K, -mi @ C]]))
     wn = np.abs(lam)
-    keep = (lam.imag > 1e-9 * max(wn.max(), 1.0)) & (wn > 1e-4 * max(wn.max(), 1.0))
+    # rigid-like modes (unloaded teeth on their regularised springs) are left out by comparison
+    # with the driven hub on its own stiffness, not with the highest mode: with very stiff
+    # tooth springs the tooth modes lie 1e4 above the mesh mode, which must stay in
+    w_ref = math.sqrt(max(K[0, 0] / M[0, 0], 0.0)) or max(wn.max(), 1.0)
+    keep = (lam.imag > 1e-9 * max(wn.max(), 1.0)) & (wn > 1e-4 * w_ref)
     lam, u = lam[keep], v[:n, keep]
     share = np.real(np.conj(u) * (M @ u))
     share = share / share.sum(0)

@@ -105,7 +105,8 @@ ENERGY_TOL = 8      # relative energy growth that stops a run [-]
 HHT_ALPHA = 9       # HHT-alpha parameter [-]
 NEWTON_TOL = 10     # Newton stops when no flank point moves more than this [m]
 IMEX = 11           # 1: the linear tooth-root dampers taken implicitly in the Verlet kicks (`explicit`)
-N_PAR = 12
+ABORT = 12          # nonzero: stop at the end of the step (set from another thread: `solver.mbs.interrupt`)
+N_PAR = 13
 # control integers: int array ``ipar``
 N_STEPS = 0
 OUT_EVERY = 1       # steps per output record
@@ -167,7 +168,8 @@ S_TORQUE = 0        # resisting torque on gear 2 [N m]
 S_THETA2 = 1        # driven angle at the first driver angle, the start guess [rad]
 S_TOL = 2           # residual tolerance relative to the torque [-]
 S_W1 = 3            # driver speed [rad/s] that sets the kinematic sliding speed of the friction (0: none)
-N_S_PAR = 4
+S_ABORT = 4         # nonzero: stop before the next driver angle (`solver.mbs.interrupt`)
+N_S_PAR = 5
 # control integers: int array ``ipar``
 S_MAX_ITER = 0      # Newton iterations per angle
 N_S_IPAR = 1
