@@ -345,15 +345,12 @@ def export_arguments(p) -> None:
 
 
 def export_command(args) -> int:
-    import xarray as xr
-
-    from study.report.export import export_csv
+    import study
     path = checked_archive(args.archive)
     outdir = Path(args.output) if args.output else path.with_name(f"{path.stem}_csv")
     writable_folder(outdir)
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        for p in export_csv(ds, outdir):
-            print(f"  csv: {p}")
+    for p in study.export(path, outdir):
+        print(f"  csv: {p}")
     return 0
 
 

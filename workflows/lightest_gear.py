@@ -304,5 +304,4 @@ def _bad(what: str, why: str) -> int:
 
 
 if __name__ == "__main__":
-    from study.cli import script_main
-    raise SystemExit(script_main("python -m workflows.lightest_gear", main))
+    raise SystemExit(study.script_main("python -m workflows.lightest_gear", main))

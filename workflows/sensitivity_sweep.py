@@ -88,5 +88,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    from study.cli import script_main
-    raise SystemExit(script_main("python -m workflows.sensitivity_sweep", main))
+    raise SystemExit(study.script_main("python -m workflows.sensitivity_sweep", main))
