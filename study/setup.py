@@ -139,11 +139,19 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
       tooth springs, so even 1 % of critical on the mesh mode needs c_con some 200 000 times
       the old 3640 N·s/mm^2.5, which overdamps the tooth-on-contact modes near 200 kHz, cuts
       the explicit step twenty-fold and still lets a run from rest grow energy (Table 1);
-      5 % is beyond what it can give at all (at most about 2.6 % with 2 % tooth dampers)."""
+      5 % is beyond what it can give at all (at most about 2.6 % with 2 % tooth dampers).
+      A body-coupled pair whose joint dampers alone cannot reach the ratio (a very stiff joint
+      locks; about 4.7 % at most on a small 24-tooth pair with a thin web) scales its body
+      dampers with them, all at one ratio of their own modes."""
     ratios = damping_ratios(scene)
     if not ratios:
         return model
-    from solver.mbs.modes import joint_damping_for_ratio, tooth_damping_for_ratio, with_damping
+    from solver.mbs.modes import (
+        joint_and_body_damping_for_ratio,
+        joint_damping_for_ratio,
+        tooth_damping_for_ratio,
+        with_damping,
+    )
     from study.plausibility import carrying_equilibria
     eqs = carrying_equilibria(scene, model, mean_load(scene))      # SceneError when the teeth cannot carry it
     c_phi = tuple(tooth_damping_for_ratio(model, eqs, ratios[f"gear{g}"], g) if f"gear{g}" in ratios
@@ -157,7 +165,13 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
     except SceneError:
         raise
     except ValueError as e:
+        if not model.coupled:
+            raise SceneError("contact.damping_ratio", str(e)) from None
+    try:   # a coupled pair whose joints alone cannot: the body dampers take part too
+        c_phi, c_body = joint_and_body_damping_for_ratio(model, eqs, ratios["contact"])
+    except ValueError as e:
         raise SceneError("contact.damping_ratio", str(e)) from None
+    return with_damping(model, c_con=0.0, c_phi=c_phi, c_body=c_body)
 
 
 def geometry_model(scene: Scene) -> Model:

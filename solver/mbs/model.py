@@ -132,6 +132,18 @@ class Model:
         return float(self.gear_par[0, L.I_TOT]), float(self.gear_par[1, L.I_TOT])
 
 
+def body_critical_damping(gp: np.ndarray, i: int) -> float:
+    """Critical damping [N·m·s/rad] of gear ``i``'s (0 driver, 1 driven) body mode: its rim
+    (with the teeth) against its hub on the body spring, 2 sqrt(k_body I_eff); the driver's hub
+    is prescribed (I_eff the rim's), the driven hub free (I_eff rim and hub in series).
+    0 for a rigid body."""
+    if not gp[i, L.K_BODY] > 0:
+        return 0.0
+    i_rim = gp[i, L.I_TOT] - gp[i, L.I_HUB]
+    i_eff = i_rim if i == 0 else i_rim * gp[i, L.I_HUB] / gp[i, L.I_TOT]
+    return 2.0 * math.sqrt(gp[i, L.K_BODY] * i_eff)
+
+
 def hub_side_inertia(g: GearGeometry, body: BodySpec, density: float) -> float:
     """Inertia [kg·m²] on the hub side of the body spring: the hub ring and half the web (the
     web's wind-up is the spring; its inertia is split between its ends)."""
@@ -202,10 +214,7 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
             gp[i, L.K_BODY] = gi.body_stiffness
         gp[i, L.I_HUB] = hub_side_inertia(g, gi.body, material.density)
         if gp[i, L.K_BODY] > 0:
-            # body mode: rim (with the teeth) against the hub; the driver's hub is prescribed
-            i_rim = gp[i, L.I_TOT] - gp[i, L.I_HUB]
-            i_eff = i_rim if i == 0 else i_rim * gp[i, L.I_HUB] / gp[i, L.I_TOT]
-            gp[i, L.C_BODY] = 2.0 * gi.body_damping_ratio * math.sqrt(gi.body_stiffness * i_eff)
+            gp[i, L.C_BODY] = gi.body_damping_ratio * body_critical_damping(gp, i)
     pp = np.zeros(L.N_PAIR_PAR)
     pp[L.JN_HALF] = 0.5 * pair.normal_backlash
     pp[L.ALPHA] = pair.pressure_angle

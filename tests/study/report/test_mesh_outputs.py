@@ -39,9 +39,6 @@ SMALL_LIGHTENED = {
     "gear2.body.hole_circle_radius": 12.5, "fe.mesh_size": 1.0,
     "quasi_static.rotation": 30.0, "quasi_static.angle_step": 0.25,
     "dynamic.ramp_time": 0.002, "dynamic.duration": 0.01,
-    # the paper's model: on this pair the compliance model's joint dampers give the mesh mode at
-    # most 4.7 % of critical, below the default 5 %
-    "coupling.model": "paper",
 }
 
 
