@@ -371,10 +371,12 @@ def precision_command(args) -> int:
 
     import study
     from study import estimate
+    from study.commands import precision as run_precision
+    from study.commands import precision_scene
     from study.setup import build_scene_model
     from study.verify.precision import setting_label
     check_precision_options(args)
-    scene = args_scene(args)
+    scene = precision_scene(args_scene(args))
     base = checked_output(args.output)
     max_time = checked_max_time(args)
     model = build_scene_model(scene)
@@ -392,8 +394,8 @@ def precision_command(args) -> int:
         part_s = sum(v for k, v in est.seconds.items() if k.startswith(kind))
         print(f"{kind} study ... (about {estimate.duration_text(part_s)}; its reference runs first, then each run "
               "is listed as it ends)", flush=True)
-        ds = study.precision(scene, base, args.duration, args.ramp_fraction, args.rotation, args.repeats, kind,
-                             progress, model=model)[kind]
+        ds = run_precision(scene, base, args.duration, args.ramp_fraction, args.rotation, args.repeats, kind,
+                           progress, model=model)[kind]
         path = ds.attrs["archive"]
         print(study.precision_table(ds))
         print(f"  archive: {path}\n  plot: {path[:-3]}.png", flush=True)

@@ -54,6 +54,8 @@ LEVERS = {
     "FE bodies": "a coarser fe.mesh_size (each body is computed once, then read from the FE cache)",
     "gear": "a coarser fe.mesh_size (the influence coefficients are cached once computed)",
     "statics": "a larger quasi_static.angle_step or a shorter quasi_static.rotation",
+    "mesh stiffness": "a larger quasi_static.angle_step or a shorter quasi_static.rotation (one linearisation per "
+                      "STE angle)",
     "contact sweep": "a larger angle step (--step, quasi_static.angle_step) or a shorter quasi_static.rotation",
     "dynamics": "a shorter dynamic.duration",
     "sweep": "fewer grid points",

@@ -96,6 +96,8 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True,
             import matplotlib.pyplot as plt
             plt.close("all")
             skip(what, f"nothing to draw in this archive ({str(e).splitlines()[0] if str(e) else type(e).__name__})")
+    if "dte_amplitude" in ds and "order" in ds.coords and not np.isfinite(ds["order"].values).any():
+        skip("DTE spectrum panel", "no orders of the driven gear's rotation at driver speed 0")
     if not renders:
         skip("renders", "not asked for")
         return out
