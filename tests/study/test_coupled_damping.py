@@ -3,19 +3,8 @@ the body dampers take part, and the modal analysis of the model built reads the 
 import numpy as np
 import pytest
 
+from conftest import SMALL_LIGHTENED
 from study.scene import default_scene
-
-# a small pair (24 teeth, m 2 mm) whose driven gear has a thin, holed web: on the compliance
-# model its joint dampers give the mesh mode at most about 4.7 % of critical
-SMALL_THIN_WEB = {
-    "gear1.module": 2.0, "gear1.teeth": 24, "gear2.module": 2.0, "gear2.teeth": 24,
-    "gear1.body.rim_height": 3.0, "gear1.body.web_height": 12.0, "gear1.body.hub_height": 3.0,
-    "gear1.body.web_thickness": 17.0, "gear1.body.holes": 0,
-    "gear2.body.rim_height": 3.0, "gear2.body.web_height": 12.0, "gear2.body.hub_height": 3.0,
-    "gear2.body.web_thickness": 8.0, "gear2.body.holes": 8, "gear2.body.hole_radius": 3.0,
-    "gear2.body.hole_circle_radius": 12.5, "fe.mesh_size": 1.0,
-}
-
 
 def test_body_dampers_join_the_joints_where_they_cannot_reach_the_mesh_ratio(private_fe_cache):
     from solver.mbs.equilibria import loaded_equilibria
@@ -24,7 +13,7 @@ def test_body_dampers_join_the_joints_where_they_cannot_reach_the_mesh_ratio(pri
     from solver.mbs.modes import joint_damping_for_ratio, modal_analysis
     from study.setup import build_scene_model, mean_load
 
-    scene = default_scene().replace(**SMALL_THIN_WEB)
+    scene = default_scene().replace(**SMALL_LIGHTENED)   # joints alone: at most about 4.7 %
     assert scene.coupling_model == "compliance"
     raw = build_scene_model(scene, convert_damping=False)
     eqs = loaded_equilibria(raw, mean_load(scene))
