@@ -2,9 +2,10 @@
 the body dampers take part, and the modal analysis of the model built reads the ratio asked for."""
 import numpy as np
 import pytest
-
 from conftest import SMALL_LIGHTENED
+
 from study.scene import default_scene
+
 
 def test_body_dampers_join_the_joints_where_they_cannot_reach_the_mesh_ratio(private_fe_cache):
     from solver.mbs.equilibria import loaded_equilibria
