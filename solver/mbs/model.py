@@ -199,7 +199,7 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
             gi.modification.check(g.u_form, g.u_tip, ("gear1", "gear2")[i])
         sample(gi.modification, g.u_form, g.u_tip, gp[i])
         if gi.contact_compliance is not None:
-            _sample_local_compliance(gi.contact_compliance, g.u_form, g.u_tip, gp[i], ("gear1", "gear2")[i])
+            sample_local_compliance(gi.contact_compliance, g.u_form, g.u_tip, gp[i], ("gear1", "gear2")[i])
         if gi.body_stiffness != math.inf:
             if not gi.body_stiffness > 0:
                 raise ValueError(f"{('gear1', 'gear2')[i]}: body torsion stiffness must be positive, got {gi.body_stiffness}")
@@ -249,7 +249,7 @@ def _check_compliance(gi: GearInput, z: int, name: str) -> None:
         raise ValueError(f"{name}.tooth_compliance: must be positive definite") from None
 
 
-def _sample_local_compliance(table, u_form: float, u_tip: float, row: np.ndarray, name: str) -> None:
+def sample_local_compliance(table, u_form: float, u_tip: float, row: np.ndarray, name: str) -> None:
     """Write the CLOC_* columns of a gear_par row: the local compliance ``table`` = (rolls [-],
     c_loc [m/N]) resampled on N_CLOC rolls from u_form to u_tip (a monotone cubic through the
     table's points, constant beyond them)."""

@@ -108,46 +108,45 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def flank_deviation(row, u):
-    """Deviation [m] of the flanks of the gear whose gear_par row is ``row`` at roll parameter
-    u, and its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV
-    grid, so that the slope is continuous (Newton in the statics does not chatter across grid
-    nodes) and linear stretches are exact; constant beyond the grid's ends."""
-    x = (u - row[L.DEV_U0]) / row[L.DEV_DU]
-    last = L.N_DEV - 1
+def _catmull_rom(row, u, u0, du, first, n):
+    """Value and slope d/du of the cubic Hermite (Catmull-Rom) curve through the n values
+    row[first:first + n] on the grid u0 + i*du: the slope is continuous (Newton in the statics
+    does not chatter across grid nodes) and linear stretches are exact; constant beyond the
+    grid's ends."""
+    x = (u - u0) / du
+    last = n - 1
     if x <= 0.0:
-        return row[L.DEV0], 0.0
+        return row[first], 0.0
     if x >= last:
-        return row[L.DEV0 + last], 0.0
+        return row[first + last], 0.0
     i = int(x)
     t = x - i
-    p1 = row[L.DEV0 + i]
-    p2 = row[L.DEV0 + i + 1]
-    m1 = p2 - p1 if i == 0 else 0.5 * (p2 - row[L.DEV0 + i - 1])
-    m2 = p2 - p1 if i + 1 == last else 0.5 * (row[L.DEV0 + i + 2] - p1)
+    p1 = row[first + i]
+    p2 = row[first + i + 1]
+    m1 = p2 - p1 if i == 0 else 0.5 * (p2 - row[first + i - 1])
+    m2 = p2 - p1 if i + 1 == last else 0.5 * (row[first + i + 2] - p1)
     t2 = t * t
     t3 = t2 * t
     dev = (2.0 * t3 - 3.0 * t2 + 1.0) * p1 + (t3 - 2.0 * t2 + t) * m1 + (3.0 * t2 - 2.0 * t3) * p2 + (t3 - t2) * m2
     dx = (6.0 * t2 - 6.0 * t) * (p1 - p2) + (3.0 * t2 - 4.0 * t + 1.0) * m1 + (3.0 * t2 - 2.0 * t) * m2
-    return dev, dx / row[L.DEV_DU]
+    return dev, dx / du
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def flank_deviation(row, u):
+    """Deviation [m] of the flanks of the gear whose gear_par row is ``row`` at roll parameter
+    u, and its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV
+    grid (`_catmull_rom`)."""
+    return _catmull_rom(row, u, row[L.DEV_U0], row[L.DEV_DU], L.DEV0, L.N_DEV)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def local_compliance(row, u):
     """Local compliance [m/N] of the gear whose gear_par row is ``row`` at roll parameter u and
-    its slope d c_loc/d u [m/N]: piecewise linear on the CLOC grid (the slope is the exact
-    derivative of what is read, so the series spring stays conservative), constant beyond it."""
-    x = (u - row[L.CLOC_U0]) / row[L.CLOC_DU]
-    last = L.N_CLOC - 1
-    if x <= 0.0:
-        return row[L.CLOC0], 0.0
-    if x >= last:
-        return row[L.CLOC0 + last], 0.0
-    i = int(x)
-    t = x - i
-    a = row[L.CLOC0 + i]
-    b = row[L.CLOC0 + i + 1]
-    return a + t * (b - a), (b - a) / row[L.CLOC_DU]
+    its slope d c_loc/d u [m/N]: the same Catmull-Rom curve through the CLOC grid (a continuous
+    slope: the force term of c_loc's change along the profile has no jump at grid nodes, and
+    the slope is the exact derivative of what is read, so the series spring stays conservative)."""
+    return _catmull_rom(row, u, row[L.CLOC_U0], row[L.CLOC_DU], L.CLOC0, L.N_CLOC)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -218,7 +217,7 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser):
     entries +(x - centre) x n, the other gear's negative, plus dg, the same four of the flank
     deviations' part [m]. blend = (c [1/m], v [-]): the curvature d2 delta/dq2 = c * v v^T of a
     modified tip corner's blend into its flank (c = 0 otherwise), stored times the force.
-    ser = (c_loc [m/N], d c_loc/d(theta1, phi_A, theta2, phi_B) [m/N]): the local compliance in
+    ser = (c_loc [m/N], -d c_loc/d(theta1, phi_A, theta2, phi_B) [m/N]): the local compliance in
     series with the contact law (0 and zeros: the plain law)."""
     delta, px, py, nx, ny = hit
     o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
@@ -239,12 +238,13 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser):
         if lp[L.C_CON] != 0.0:
             f += lp[L.C_CON] * signed_pow(ddelta, lp[L.M2]) * delta ** lp[L.M3]
         if f > 0.0:
-            # the series spring's energy also changes with c_loc along the profile
+            # the series spring's energy also changes with c_loc along the profile (gc is
+            # -d c_loc/dq, as `_deviation_gradient` gives a deviation's effect on the penetration)
             w = 0.5 * fe * fe / f
-            g1 -= w * gc[0]
-            ga -= w * gc[1]
-            g2 -= w * gc[2]
-            gb -= w * gc[3]
+            g1 += w * gc[0]
+            ga += w * gc[1]
+            g2 += w * gc[2]
+            gb += w * gc[3]
         else:
             f = 0.0
     rec[nc, L.C_DELTA] = delta
