@@ -128,7 +128,7 @@ def series_contact(delta, c_loc, k, m1):
     compliance c_loc [m/N] at the penetration delta [m] of both; c_loc = 0: the plain law,
     bit for bit. A scalar Newton on h(x) = x + c_loc*k*x^m1 - delta from x = delta: h is
     monotone and convex (c_loc > 0) or concave (c_loc < 0), so the iterates approach the root
-    from one side."""
+    from one side; 3-4 steps for FE tooth data."""
     if delta <= 0.0:
         return delta, 0.0, 0.0
     if c_loc == 0.0:
@@ -149,7 +149,8 @@ def series_contact(delta, c_loc, k, m1):
         x -= dx
         if x <= 0.0:
             x = 1e-3 * delta
-        if abs(dx) <= 1e-14 * delta:
+        # quadratic convergence: the step after one of 1e-8*delta would be below rounding
+        if abs(dx) <= 1e-8 * delta:
             break
     f = k * x ** m1
     kx = m1 * f / x
