@@ -78,11 +78,13 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
     for setup, (k_phi, _) in zip(setups, springs):
         sp = setup.spring
         fit = coupling_fit(scene, setup.gear, setups=setups)
-        cmat = None
+        cmat = cloc = None
         if fit is not None:
             k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
             if scene.coupling_model == "compliance":
                 cmat = fit.compliance
+                if fit.local_compliance is not None:
+                    cloc = (fit.local_u, fit.local_compliance)
         else:
             k_body, n_k, pivot = math.inf, sp.n_k, setup.pivot_radius
         gears.append(GearInput(tooth=setup.tooth, body=setup.body, pivot_radius=pivot,
@@ -90,7 +92,7 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
                                n_k=n_k, c_phi=units.spring_damping_to_si(0.0 if math.isnan(sp.c_phi) else sp.c_phi),
                                n_c=sp.n_c, body_stiffness=k_body, tooth_compliance=cmat,
                                modification=scene.modification_spec(setup.gear),
-                               errors=scene.errors_spec(setup.gear)))
+                               errors=scene.errors_spec(setup.gear), contact_compliance=cloc))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3,
