@@ -286,6 +286,13 @@ def pair_geometry(g1: GearGeometry, g2: GearGeometry) -> PairGeometry:
     rb1, rb2 = g1.base_radius, g2.base_radius
     l1 = math.sqrt(g1.tip_radius**2 - rb1**2)
     l2 = math.sqrt(g2.tip_radius**2 - rb2**2)
+    for g, mate, name in ((g1, g2, "gear1"), (g2, g1, "gear2")):
+        # a tip circle past the mate's root circle: the tip would cut the mate's root (radial
+        # interference); no mesh, and no contact ratio to speak of
+        if g.tip_radius + mate.root_radius >= a:
+            raise GeometryError(f"{name}.addendum", f"the tip circle (radius {g.tip_radius * 1e3:.4g} mm) reaches past the "
+                                f"mate's root circle ({mate.root_radius * 1e3:.4g} mm) at the centre distance "
+                                f"{a * 1e3:.4g} mm (radial interference): the addendum must stay below the mate's dedendum")
     line = a * math.sin(alpha)
     path = l1 + l2 - line
     pb = 2 * math.pi * rb1 / g1.teeth

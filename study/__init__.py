@@ -450,10 +450,73 @@ def validation_misses(ds, model: str = "compliance") -> list:
     return check_targets(ds, model)
 
 
+# ---------------------------------------------------------------- sampled (tolerance) studies
+
+def sample_outputs(ds) -> list:
+    """The scalar outputs of a sampled study's archive (over ``sample`` and the grid dimensions)."""
+    from study.report.distributions import sample_outputs as outputs_of
+    return outputs_of(ds)
+
+
+def sample_tables(ds, outputs=None, limits=None):
+    """The statistics of a sampled study's archive -> Dataset: per output and grid point the mean
+    and percentiles with their confidence intervals, per limit ({output: value}) the probability
+    of exceeding it, and the Sobol indices of a Saltelli design (`study.report.distributions`)."""
+    from study.report.distributions import sample_tables as tables
+    return tables(ds, outputs, limits)
+
+
+def sample_points(ds) -> list:
+    """Every grid point of a sampled study's archive as {dimension: index} ([{}] without a grid)."""
+    from study.report.distributions import grid_points
+    return grid_points(ds)
+
+
+def sample_point_label(ds, at: dict) -> str:
+    """'gear1.errors.grade = 5' for a grid point {dimension: index} of a sampled study ('all builds' for {})."""
+    from study.report.distributions import point_label
+    return point_label(ds, at)
+
+
+def study_from_dict(raw: dict, folder=None):
+    """A study from the tables of a study file as a dict (title, scene, grid, points, sample,
+    outputs), checked like the file; relative scene paths are read from ``folder``."""
+    from study.sweep.grid import dumps_study, loads_study
+    _check(isinstance(raw, dict), "study_from_dict", "raw", "a dict of study tables", raw)
+    return loads_study(dumps_study(raw), folder)
+
+
+def export(archive, outdir=None) -> list:
+    """The variables of an archive (path or Dataset) as CSV files in ``outdir`` (default: beside
+    the archive), one per dimension group, with units in the headers -> their paths
+    (`study.report.export`)."""
+    from pathlib import Path
+
+    import xarray as xr
+
+    from study.report.export import export_csv
+    if isinstance(archive, xr.Dataset):
+        _check(outdir is not None, "export", "outdir", "a folder (needed for a Dataset)", outdir)
+        return export_csv(archive, Path(outdir))
+    _check(_is_path(archive), "export", "archive", "a NetCDF path or a Dataset", archive)
+    path = Path(archive)
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        return export_csv(ds, Path(outdir) if outdir is not None else path.with_name(f"{path.stem}_csv"))
+
+
+def script_main(name: str, main) -> int:
+    """Run a script's ``main()`` as the command line runs a command: the errors a user can meet
+    as one line on stderr starting with ``name`` and the exit codes of `lightgear --help` (2 bad
+    input, 130 interrupted by Ctrl-C or SIGTERM), no traceback."""
+    from study.cli import script_main as run
+    return run(name, main)
+
+
 __all__ = ["Scene", "SceneError", "StudyError", "BudgetError", "Study", "Outputs", "SweepResult", "STATUS",
            "scenes", "fields", "outputs", "parse_overrides", "load_scene", "default_scene", "solid_scene",
            "check_dynamic_window", "plausibility_warnings", "run_scene", "write", "read", "summarize",
            "print_summary", "load_study", "make_study", "run_sweep", "local_cluster", "pareto", "tradeoff_figure",
            "render", "stiffness", "identify_spring", "fit_contact", "reference", "precision", "precision_table",
            "stability_suite", "validation", "validate_design_space", "validate_relief", "validation_errors",
-           "validation_misses"]
+           "validation_misses", "sample_outputs", "sample_tables", "sample_points", "sample_point_label",
+           "study_from_dict", "export", "script_main"]

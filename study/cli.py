@@ -21,7 +21,7 @@ EXIT_CODES = """exit codes:
        run time beyond --max-time)
   3    a run that diverged, whose energy balance does not close (inaccurate) or whose statics
        did not converge (archive written, cause and count on stderr)
-  130  interrupted (a sweep keeps its finished points)"""
+  130  interrupted by Ctrl-C or SIGTERM (a sweep keeps its finished points)"""
 
 
 class UsageError(Exception):
@@ -44,13 +44,29 @@ def writable_folder(folder: Path, option: str = "-o") -> None:
         raise UsageError(option, f"cannot write in {folder}: {e.strerror or e}") from None
 
 
+# bytes that names derived from an archive's add to it: the temporary file of the atomic write
+# (".NAME.tmpPID.HOST-XXXXXXXX"), a sweep's ".NAME.parts", precision's NAME_dynamic.nc
+NAME_MARGIN = 40
+
+
 def checked_output(path, option: str = "-o") -> Path:
-    """An archive path that ends in .nc, is no directory and whose folder is writable."""
+    """An archive path that ends in .nc, is no directory, whose folder is writable and whose
+    name (with the names derived from it) the file system takes."""
+    import os
     path = Path(path)
+    try:
+        name_max = os.pathconf(path.parent if path.parent.is_dir() else ".", "PC_NAME_MAX")
+    except (OSError, ValueError):
+        name_max = 255
+    too_long = [part for part in path.parts if len(part.encode()) > name_max]
+    if too_long or len(path.name.encode()) + NAME_MARGIN > name_max:
+        raise UsageError(option, f"a name of {len((too_long or [path.name])[0].encode())} bytes is too long: this file "
+                                 f"system takes {name_max} bytes a name, and the archive's temporary and parts names "
+                                 f"add up to {NAME_MARGIN} to its own: give a name of at most {name_max - NAME_MARGIN} bytes")
     if path.is_dir():
         raise UsageError(option, f"{path} is a directory; give the archive's file name (e.g. {path / 'run.nc'})")
     if path.suffix != ".nc":
-        raise UsageError(option, f"archives are NetCDF files ending in .nc, got {path.name!r}")
+        raise UsageError(option, f"archives are NetCDF files ending in .nc, got {path.name[:60]!r}")
     writable_folder(path.parent, option)
     return path
 
@@ -110,6 +126,9 @@ def run_command(args) -> int:
         check_dynamic_memory(scene)       # at once, before the solver is even loaded
     checked_output(args.output)
     max_time = checked_max_time(args)
+    from study.plausibility import face_width_note
+    if face_width_note(scene):
+        print(face_width_note(scene))
     if not args.no_static:
         from study.estimate import error_period_note
         note = error_period_note(scene)
@@ -194,24 +213,35 @@ def sweep_arguments(p) -> None:
                    help="LocalCluster workers (default: one per core); 0 runs the points in this process")
     p.add_argument("--keep-parts", action="store_true", help="keep the per-task files after the archive is complete")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    max_time_argument(p)
 
 
 def sweep_command(args) -> int:
-    import numpy as np
-
     import study
-    from study.sweep.engine import SchedulerUnreachable, parts_folder
+    from study.sweep.engine import SchedulerUnreachable, parts_folder, run_sweep
     from study.sweep.outputs import STATUS
     st = study.load_study(args.study)
     output = args.output or f"results/{Path(args.study).stem}.nc"
     checked_output(output)
+    if parts_folder(output).exists() and not parts_folder(output).is_dir():
+        raise UsageError("-o", f"{parts_folder(output)} is a file, where the sweep keeps its finished tasks: "
+                               "move it away or choose another output name")
     if args.workers is not None and args.workers < 0:
         raise UsageError("--workers", f"must be >= 0 (0 runs the points in this process), got {args.workers}")
-    n = int(np.prod(st.shape))
+    from study.estimate import check_study_size
+    n = check_study_size(st, checked_max_time(args))      # before its points are built
+    from study.plausibility import face_width_note
+    if any(f.endswith(".face_width") for f in st.fields):
+        try:
+            note = face_width_note(st.base_scene(), swept=True)
+        except study.SceneError:      # a base that only the grid's values make valid: no note
+            note = None
+        if note:
+            print(note)
     print(f"{st.title}: {n} points ({' x '.join(map(str, st.shape))}, {st.layout} layout) -> {output}")
     try:
-        res = study.run_sweep(st, output, workers=args.workers, scheduler=args.scheduler,
-                              progress=not args.no_progress, keep_parts=args.keep_parts)
+        res = run_sweep(st, output, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress,
+                        keep_parts=args.keep_parts, max_time=checked_max_time(args))
     except SchedulerUnreachable as e:
         raise UsageError("--scheduler", str(e)) from None
     except KeyboardInterrupt:
@@ -226,6 +256,9 @@ def sweep_command(args) -> int:
     print("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items() if v))
     for msg in sorted({str(m) for m, s in zip(ds["message"].values.ravel(), ds["status"].values.ravel()) if s > 1})[:5]:
         print(f"    {msg}")
+    partial = [str(m) for m in ds["message"].values.ravel() if "not stored" in str(m)]
+    if partial:     # ok points whose curves the archive could not hold: said, not only in `message`
+        print(f"  {len(partial)} points without some of their curves: {partial[0]}", file=sys.stderr)
     if res.pending:
         causes = sorted({str(m) for m in ds["message"].values.ravel() if str(m).startswith("lost: ")})
         print(f"  {res.pending} analyses lost (worker failures; {counts['pending']} points pending): "
@@ -312,15 +345,12 @@ def export_arguments(p) -> None:
 
 
 def export_command(args) -> int:
-    import xarray as xr
-
-    from study.report.export import export_csv
+    import study
     path = checked_archive(args.archive)
     outdir = Path(args.output) if args.output else path.with_name(f"{path.stem}_csv")
     writable_folder(outdir)
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        for p in export_csv(ds, outdir):
-            print(f"  csv: {p}")
+    for p in study.export(path, outdir):
+        print(f"  csv: {p}")
     return 0
 
 
@@ -333,15 +363,26 @@ def precision_arguments(p, output: str = "results/work_precision.nc") -> None:
     p.add_argument("--rotation", type=float, default=6.0, help="quasi-static driver rotation [deg] (default 6)")
     p.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best is kept)")
     p.add_argument("--only", choices=("dynamic", "static"), help="run only one of the two studies")
+    max_time_argument(p)
 
 
 def precision_command(args) -> int:
     import math
 
     import study
+    from study import estimate
+    from study.commands import precision as run_precision
+    from study.commands import precision_scene
+    from study.setup import build_scene_model
     from study.verify.precision import setting_label
-    scene = args_scene(args)
+    check_precision_options(args)
+    scene = precision_scene(args_scene(args))
     base = checked_output(args.output)
+    max_time = checked_max_time(args)
+    model = build_scene_model(scene)
+    est = estimate.precision_estimate(scene, model, args.duration, args.rotation, args.repeats, args.only)
+    estimate.check_time(est, max_time)
+    print(f"estimated {estimate.duration_text(est.total_s)} ({est.describe()})", flush=True)
 
     def progress(i, s, e, w, msg):
         setting = setting_label(s.method, s.step if math.isfinite(s.step) else s.rtol)
@@ -350,13 +391,28 @@ def precision_command(args) -> int:
     for kind in ("static", "dynamic"):
         if args.only and args.only != kind:
             continue
-        print(f"{kind} study ...", flush=True)
-        ds = study.precision(scene, base, args.duration, args.ramp_fraction, args.rotation, args.repeats, kind,
-                             progress)[kind]
+        part_s = sum(v for k, v in est.seconds.items() if k.startswith(kind))
+        print(f"{kind} study ... (about {estimate.duration_text(part_s)}; its reference runs first, then each run "
+              "is listed as it ends)", flush=True)
+        ds = run_precision(scene, base, args.duration, args.ramp_fraction, args.rotation, args.repeats, kind,
+                           progress, model=model)[kind]
         path = ds.attrs["archive"]
         print(study.precision_table(ds))
         print(f"  archive: {path}\n  plot: {path[:-3]}.png", flush=True)
     return 0
+
+
+def check_precision_options(args) -> None:
+    """The work-precision options, before any work (UsageError naming the option)."""
+    import math
+    for option, value in (("--duration", args.duration), ("--rotation", args.rotation)):
+        if not (math.isfinite(value) and value > 0):
+            raise UsageError(option, f"must be a positive number, got {value}")
+    if not 0 < args.ramp_fraction <= 1:
+        raise UsageError("--ramp-fraction", f"the ramps end at this fraction of the window: must lie in (0, 1], "
+                                            f"got {args.ramp_fraction}")
+    if args.repeats < 1:
+        raise UsageError("--repeats", f"must be at least 1, got {args.repeats}")
 
 
 # ---------------------------------------------------------------- reference
@@ -380,7 +436,7 @@ def reference_command(args) -> int:
     study.write(ds, args.output)
     ste = ds["ste"].values
     print(f"FE reference STE -> {args.output}")
-    print(f"  mean {ste.mean():.3f} um (elastic part {ste.mean() - ds.attrs['backlash_offset_um']:.3f} um), "
+    print(f"  mean {ste.mean():.3f} um (elastic part {ste.mean() - np.sign(scene.quasi_static.torque or 1.0) * ds.attrs['backlash_offset_um']:.3f} um), "
           f"peak-to-peak {np.ptp(ste):.3f} um over {float(ds['angle'][-1]):.4g} deg, {ste.size} angles")
     print(f"  wall time: compliance {ds.attrs['wall_time_compliance_s']:.2f} s, contact {ds.attrs['wall_time_contact_s']:.2f} s, "
           f"total {ds.attrs['wall_time_reference_s']:.2f} s")
@@ -460,34 +516,95 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
-    import os
+def stop_on_sigterm():
+    """SIGTERM handled as Ctrl-C (KeyboardInterrupt: the running kernel stops, exit 130) while
+    a command runs; a context manager that restores the previous handler. Outside the main
+    thread (no signal handlers there) it does nothing."""
+    import contextlib
+    import signal
+    import threading
 
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    @contextlib.contextmanager
+    def handler():
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        old = signal.signal(signal.SIGTERM, interrupt)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGTERM, old)
+    return handler()
+
+
+def main(argv=None) -> int:
+    """Run the command of ``argv`` (None: the command line) and return its exit code."""
+    args = build_parser().parse_args(argv)
+    with stop_on_sigterm():
+        code = guarded(f"lightgear {args.command}", lambda: args._command(args))
+    if argv is None:
+        end_of_process()
+    return code
+
+
+def end_of_process() -> None:
+    """The process ends now: spare it the final collection of every object (1-2 s after a
+    run), so that an interrupted command is gone at once."""
+    import gc
+    gc.freeze()
+
+
+def guarded(name: str, command) -> int:
+    """``command()``'s exit code, with the errors a user can meet turned into the exit codes of
+    `EXIT_CODES` and one line on stderr that starts with ``name``."""
+    import os
+    import warnings
+
+    from solver.geometry import GeometryError
     from study.errors import BudgetError, StudyError
     from study.scene import SceneError
+
+    def one_line(message, category, filename, lineno, file=None, line=None):
+        # a library's warning as one line that says who speaks, not its source line
+        print(f"{name}: warning: {category.__name__}: {str(message).splitlines()[0] if str(message) else ''}",
+              file=sys.stderr)
+    shown = warnings.showwarning
+    warnings.showwarning = one_line
     try:
-        return int(args._command(args) or 0)
-    except SceneError as e:
+        return int(command() or 0)
+    except (SceneError, GeometryError) as e:
         what = "study" if isinstance(e, StudyError) else "scene"
-        print(f"lightgear {args.command}: invalid {what}: {e}", file=sys.stderr)
+        print(f"{name}: invalid {what}: {e}", file=sys.stderr)
         return 2
     except UsageError as e:
-        print(f"lightgear {args.command}: {e}", file=sys.stderr)
+        print(f"{name}: {e}", file=sys.stderr)
         return 2
     except BudgetError as e:
-        print(f"lightgear {args.command}: refused before any work: {e}", file=sys.stderr)
+        print(f"{name}: refused before any work: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"lightgear {args.command}: interrupted", file=sys.stderr)
+        print(f"{name}: interrupted", file=sys.stderr)
         return 130
     except Exception as e:  # noqa: BLE001 - the backstop: one line, no traceback unless asked
         if os.environ.get("LIGHTGEAR_DEBUG", "") not in ("", "0"):
             raise
         first = str(e).splitlines()[0] if str(e) else ""
-        print(f"lightgear {args.command}: error: {type(e).__name__}: {first} (LIGHTGEAR_DEBUG=1 shows the traceback)",
-              file=sys.stderr)
+        print(f"{name}: error: {type(e).__name__}: {first} (LIGHTGEAR_DEBUG=1 shows the traceback)", file=sys.stderr)
         return 1
+    finally:
+        warnings.showwarning = shown
+
+
+def script_main(name: str, main_function) -> int:
+    """Exit code of a workflow script's ``main_function()`` run as a program (``python -m
+    workflows.NAME``): the command line's exit codes, SIGTERM as Ctrl-C, one line per error."""
+    with stop_on_sigterm():
+        code = guarded(name, main_function)
+    end_of_process()
+    return code
 
 
 if __name__ == "__main__":

@@ -89,15 +89,31 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
     return reference_dataset(scene, angles, progress=progress)
 
 
+def precision_scene(scene: Scene) -> Scene:
+    """The scene a work-precision study runs: the integrators it compares (explicit, implicit
+    HHT, the scipy reference) all exist for the paper's plain model only, so the default
+    ``coupling.model = "auto"`` runs as ``"paper"``; a coupled model named by the scene is
+    refused (SceneError naming coupling.model)."""
+    from study.scene import SceneError
+    if scene.coupling.model == "auto":
+        return scene.replace(**{"coupling.model": "paper"})
+    if scene.coupling_model != "none":
+        raise SceneError("coupling.model", f"the work-precision study compares the explicit, implicit and scipy "
+                                           f"integrators, which exist together for the paper's model only, not for "
+                                           f"{scene.coupling.model!r}: set coupling.model = 'paper'")
+    return scene
+
+
 def precision(scene: Scene, output: str | Path | None = None, duration: float = 0.002, ramp_fraction: float = 0.5,
-              rotation: float = 6.0, repeats: int = 3, only: str | None = None, progress=None) -> dict:
+              rotation: float = 6.0, repeats: int = 3, only: str | None = None, progress=None, model=None) -> dict:
     """Work-precision studies of a scene: TE error [um] against wall time [s] for every solver
     -> {"static": Dataset, "dynamic": Dataset} (`study.verify.precision`). ``duration`` [s]: the
     dynamic window, its ramps ending at ``ramp_fraction`` of it; ``rotation`` [deg]: the
     quasi-static range; ``repeats``: timed runs per setting (the best is kept); ``only``:
     'static' or 'dynamic'. With ``output`` (BASE.nc) each study is written to BASE_static.nc and
     BASE_dynamic.nc with its plot (.png). ``progress(i, spec, errors, wall, message)`` is called
-    after each run."""
+    after each run. ``model``: the model of `precision_scene` when the caller has built it
+    already. The integrators compared exist for the paper's model: `precision_scene`."""
     from study.report.results import write_netcdf
     from study.setup import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
@@ -109,7 +125,8 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
             raise ValueError(f"precision: {name} takes {what}, got {value!r}")
     if only not in (None, "static", "dynamic"):
         raise ValueError(f"precision: only takes 'static', 'dynamic' or None, got {only!r}")
-    model = build_scene_model(scene)
+    scene = precision_scene(scene)
+    model = model if model is not None else build_scene_model(scene)
     out = {}
     for kind in ("static", "dynamic"):
         if only and only != kind:

@@ -15,6 +15,8 @@ import os
 import sys
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from solver.mbs.kernels import layout as L
 from study.errors import BudgetError
 
@@ -47,11 +49,31 @@ FE_REF_ELEMENTS = 4e4
 OUTPUT_COPIES = 2.5               # the kernel's output array, the result's columns and the archive's
 
 
+# what makes a part of a run cheaper, by the start of the part's name (`check_time`'s advice)
+LEVERS = {
+    "FE bodies": "a coarser fe.mesh_size (each body is computed once, then read from the FE cache)",
+    "gear": "a coarser fe.mesh_size (the influence coefficients are cached once computed)",
+    "statics": "a larger quasi_static.angle_step or a shorter quasi_static.rotation",
+    "mesh stiffness": "a larger quasi_static.angle_step or a shorter quasi_static.rotation (one linearisation per "
+                      "STE angle)",
+    "contact sweep": "a larger angle step (--step, quasi_static.angle_step) or a shorter quasi_static.rotation",
+    "dynamics": "a shorter dynamic.duration",
+    "sweep": "fewer grid points",
+}
+
+
 @dataclass
 class Estimate:
-    """What a run will cost: seconds by part, bytes by part (for the messages)."""
+    """What a run will cost: seconds by part, bytes by part (for the messages), and what makes
+    a part cheaper (part -> text; default: `LEVERS` by the part name's start)."""
     seconds: dict = field(default_factory=dict)     # part -> s
     memory: dict = field(default_factory=dict)      # part -> bytes
+    levers: dict = field(default_factory=dict)      # part -> advice
+
+    def lever(self, part: str) -> str:
+        if part in self.levers:
+            return self.levers[part]
+        return next((v for k, v in LEVERS.items() if part.startswith(k)), "a smaller run")
 
     @property
     def total_s(self) -> float:
@@ -142,12 +164,43 @@ def dynamic_seconds(model, choice, duration: float, scene=None) -> float:
     return (DYNAMIC_S_PER_RUN + steps * per_step) * (RUNUP_RUNS if runup else 1.0) * load_factor()
 
 
+def static_angle_count(scene, step_deg: float | None = None) -> float:
+    """Driver angles of the quasi-static analysis (`study.setup.static_angles`) at
+    quasi_static.angle_step or ``step_deg`` [deg], counted without building them."""
+    from study.setup import static_rotation
+    step = scene.quasi_static.angle_step if step_deg is None else step_deg
+    return math.floor(static_rotation(scene) / step + 1e-9) + 1.0
+
+
+# bytes a driver angle holds in a static analysis: the kernel's results (S_* columns and the
+# force on each gear-1 tooth), the result's and the archive's copies; the FE reference holds
+# about four times that (contacts and load sharing per angle)
+STATIC_BYTES_PER_ANGLE_TOOTH = 3 * 8.0
+STATIC_BYTES_PER_ANGLE = 3 * 8.0 * (L.N_S_OUT + 8)
+
+
+def check_static_memory(scene, step_deg: float | None = None, factor: float = 1.0,
+                        field: str = "quasi_static.angle_step") -> float:
+    """Refuse, before the angles are built, a static analysis whose arrays do not fit in memory
+    (BudgetError naming ``field``, the lever); returns the number of angles."""
+    n = static_angle_count(scene, step_deg)
+    need = factor * n * (STATIC_BYTES_PER_ANGLE + STATIC_BYTES_PER_ANGLE_TOOTH * scene.gear1.teeth)
+    have = available_memory()
+    if need > 0.8 * have:
+        from study.setup import static_rotation
+        step = scene.quasi_static.angle_step if step_deg is None else step_deg
+        raise BudgetError(field, f"the static analysis needs about {bytes_text(need)} for its {n:.3g} driver angles "
+                                 f"({static_rotation(scene):.4g} deg at {step:.3g} deg), more than the "
+                                 f"{bytes_text(have)} of memory available; raise the angle step or shorten "
+                                 "quasi_static.rotation")
+    return n
+
+
 def static_seconds(scene, model) -> float:
     """Estimated run time [s] of the quasi-static analysis."""
-    from study.setup import static_angles
     qs = scene.quasi_static
     if qs.method == "static":
-        return static_angles(scene).size * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth * load_factor()
+        return static_angle_count(scene) * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth * load_factor()
     return 0.0      # the transient's steps are counted like a dynamic run's by the caller when needed
 
 
@@ -166,12 +219,12 @@ def mesh_seconds(scene) -> float:
 def error_period_note(scene) -> str | None:
     """A line for the user when pitch errors or an eccentricity stretch the quasi-static range
     beyond quasi_static.rotation (`study.setup.static_rotation`) by more than 1.5 times; None otherwise."""
-    from study.setup import static_angles, static_rotation
+    from study.setup import static_rotation
     qs = scene.quasi_static
     rot = static_rotation(scene)
     if not qs.enabled or rot <= 1.5 * qs.rotation:
         return None
-    n = static_angles(scene).size
+    n = int(static_angle_count(scene))
     sec = (n * STATIC_S_PER_ANGLE_TOOTH * (scene.gear1.teeth + scene.gear2.teeth) * load_factor()
            if qs.method == "static" else float("nan"))
     return (f"quasi-static: the pitch errors and eccentricities repeat after {rot:.6g} deg of driver rotation: the STE "
@@ -283,9 +336,25 @@ def run_fe_bodies(scene, show: bool = True) -> None:
 def check_time(est: Estimate, max_time: float | None) -> None:
     """Refuse a run whose estimated time exceeds ``max_time`` [s] (None: no bound)."""
     if max_time is not None and est.total_s > max_time:
+        part = max(est.seconds, key=est.seconds.get)
         raise BudgetError("--max-time", f"the run is estimated at {duration_text(est.total_s)} ({est.describe()}), "
-                          f"more than the bound of {max_time:.4g} s; raise --max-time to run it anyway, "
-                          "or make it smaller (coarser fe.mesh_size, shorter dynamic.duration, fewer teeth)")
+                          f"more than the bound of {max_time:.4g} s; raise --max-time to run it anyway, or make "
+                          f"the {part.split(' (')[0]} cheaper: {est.lever(part)}")
+
+
+def dynamic_lever(scene, choice) -> str:
+    """What makes a dynamic run cheaper: its duration, and what sets its step."""
+    d = scene.dynamic
+    text = f"a shorter dynamic.duration ({d.duration:.4g} s)"
+    if d.time_step:
+        return text + f", or a larger dynamic.time_step ({d.time_step:.3g} s given)"
+    cause = ("the stability bound of the pair's stiffest mode: tooth and contact stiffness (contact.k_con, the "
+             "tooth springs) over the tooth inertia (material.density, the tooth size)")
+    if scene.contact.friction > 0:
+        cause += ", and the friction's regularisation (contact.friction_velocity: a smaller one stiffens it)"
+    if choice.method == "explicit" and d.method == "auto":
+        cause += "; dynamic.method = 'implicit' takes larger steps at a higher cost per step"
+    return text + f"; its step {choice.dt:.3g} s is {cause}"
 
 
 # ---------------------------------------------------------------- progress
@@ -297,3 +366,121 @@ def progress_bar(expected_s: float, total: float, desc: str, unit: str, show: bo
     from tqdm import tqdm
     return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, leave=False, dynamic_ncols=True,
                 bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} {unit} [{elapsed}<{remaining}]")
+
+
+# ---------------------------------------------------------------- studies
+
+# Building and checking one study point (its Scene and the cross-field checks): 20-60 ms on
+# 2 shared cores; its Scene and Point hold about 5 KB, its task records as much again.
+POINT_CHECK_S = 0.03
+POINT_BYTES = 1e4
+DYNAMIC_SAMPLES = 3          # dynamic tasks whose model gives the step of the estimate
+
+
+def study_points(study) -> int:
+    """Points of a study (grid product plus explicit points), counted without building them."""
+    n = 1
+    for a in study.axes:
+        n *= len(a.values)
+    return (n if study.axes else 0) + len(study.extra)
+
+
+def check_study_size(study, max_time: float | None) -> int:
+    """Refuse, before its points are built, a study too large to enumerate: memory beyond what
+    the machine has, or its checks alone beyond ``max_time`` [s]. Returns its point count."""
+    n = study_points(study)
+    need = n * POINT_BYTES
+    have = available_memory()
+    sizes = " x ".join(str(len(a.values)) for a in study.axes) or "0"
+    if need > 0.5 * have:
+        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}{f' + {len(study.extra)}' if study.extra else ''}); "
+                                  f"only listing them needs about {bytes_text(need)}, more than half the {bytes_text(have)} "
+                                  "of memory available: sweep fewer values, or split the study")
+    if max_time is not None and n * POINT_CHECK_S > max_time:
+        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}); building and checking them alone takes "
+                                  f"about {duration_text(n * POINT_CHECK_S)}, beyond --max-time {max_time:.4g} s: "
+                                  "sweep fewer values, or split the study")
+    return n
+
+
+def estimate_model(scene):
+    """A model of ``scene`` for the step estimate that needs no FE: uniform tooth springs (an FE
+    map scales the calibrated spring by a ratio near 1) and no body coupling."""
+    from study.setup import build_scene_model
+    plain = scene.replace(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform",
+                             "coupling.model": "none"})
+    return build_scene_model(plain)
+
+
+def sweep_estimate(tasks) -> Estimate:
+    """Estimated seconds of a study's tasks (`study.sweep.tasks.Task`), summed: FE bodies (each
+    distinct body the cache lacks), statics (per static task, by its angles) and dynamics
+    (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
+    from study.run import dynamic_choice
+    from study.sweep.bodies import spring_maps
+    est = Estimate()
+    bodies = {}
+    static_s = 0.0
+    dyn = [t for t in tasks if t.outputs.dynamic]
+    for t in tasks:
+        for key, setup, _teeth in spring_maps(t.scene):
+            bodies.setdefault(key, setup)
+        if t.outputs.static and t.scene.quasi_static.method == "static":
+            static_s += static_angle_count(t.scene) * STATIC_S_PER_ANGLE_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
+    est.seconds["FE bodies"] = sum(body_seconds(s) for s in bodies.values())
+    est.seconds["statics"] = static_s
+    if dyn:
+        picks = [dyn[int(i)] for i in sorted({round(k * (len(dyn) - 1) / max(DYNAMIC_SAMPLES - 1, 1))
+                                               for k in range(min(DYNAMIC_SAMPLES, len(dyn)))})]
+        rates, dts, choice_of = [], [], []
+        for t in picks:
+            model = estimate_model(t.scene)
+            choice = dynamic_choice(t.scene, model)
+            rates.append(dynamic_seconds(model, choice, 1.0))      # s of run time per s simulated
+            dts.append(choice.dt)
+            choice_of.append(choice)
+        rate = max(rates)
+        part = f"dynamics ({len(dyn)} runs, dt down to {min(dts):.3g} s)"
+        est.seconds[part] = rate * sum(t.scene.dynamic.duration for t in dyn)
+        worst = int(np.argmax(rates))
+        est.levers[part] = dynamic_lever(picks[worst].scene, choice_of[worst]) + ", or fewer grid points"
+    return est
+
+
+# ---------------------------------------------------------------- work-precision study
+
+# The scipy runs of `lightgear precision` integrate plain-Python forces: the DOP853 reference
+# at rtol 1e-10 took 6-20 ms per explicit stability step of the window on 2 shared cores (the
+# paper pair and the 20-tooth example pair); its four Radau/LSODA runs at most
+# SCIPY_RUN_CAP_S each. The static cross-check (scipy.optimize.root on the same forces) about
+# 50 ms an angle.
+SCIPY_S_PER_BOUND_STEP = 2e-2
+SCIPY_RUN_CAP_S = 120.0
+SCIPY_RUNS = 4
+SCIPY_ROOT_S_PER_ANGLE = 5e-2
+# stability steps the numba ladders take per step of the window and per repeat: explicit at
+# 1, 2, 4, 8 x finer in three variants and the 1/32 cross-check; HHT at 1/8 .. 2 x coarser, two alphas
+PRECISION_EXPLICIT_STEPS = 3 * (1 + 2 + 4 + 8) + 32
+PRECISION_IMPLICIT_STEPS = 2 * (1 / 8 + 1 / 4 + 1 / 2 + 1 + 2)
+
+
+def precision_estimate(scene, model, duration: float, rotation_deg: float, repeats: int, only=None) -> Estimate:
+    """Estimated seconds of `lightgear precision`'s dynamic study over ``duration`` [s] and its
+    static study over ``rotation_deg`` [deg], ``repeats`` timed runs each (`study.verify.precision`)."""
+    from solver.mbs.stability import stable_time_step
+    est = Estimate()
+    if only in (None, "dynamic"):
+        dt_b, _w = stable_time_step(model, scene.dynamic.torque)
+        steps = duration / dt_b
+        ref = steps * SCIPY_S_PER_BOUND_STEP
+        est.seconds["dynamic: scipy reference and runs"] = ref + SCIPY_RUNS * min(SCIPY_RUN_CAP_S, ref)
+        est.seconds["dynamic: numba runs"] = steps * (repeats + 1) * model.n_teeth * (
+            PRECISION_EXPLICIT_STEPS * EXPLICIT_S_PER_STEP_TOOTH + PRECISION_IMPLICIT_STEPS * IMPLICIT_S_PER_STEP_TOOTH)
+        est.levers["dynamic: scipy reference and runs"] = est.levers["dynamic: numba runs"] = \
+            f"a shorter --duration ({duration:g} s = {steps:.3g} stability steps of {dt_b:.3g} s)"
+    if only in (None, "static"):
+        angles = rotation_deg / scene.quasi_static.angle_step + 1
+        est.seconds["static"] = angles * (SCIPY_ROOT_S_PER_ANGLE
+                                          + (4 * repeats + 1) * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth)
+        est.levers["static"] = f"a smaller --rotation ({rotation_deg:g} deg) or a larger quasi_static.angle_step"
+    return est

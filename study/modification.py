@@ -97,6 +97,14 @@ def _table(m: ModificationSection, g: GearGeometry, prefix: str) -> tuple[tuple,
     return tuple(float(x) for x in u), tuple(float(x) * units.UM for x in dev)
 
 
+def half_thickness_normal(g: GearGeometry, r: float) -> float:
+    """Material between a flank and the tooth's centreline at radius r [m], normal to the flank
+    [m]: half the tooth's arc thickness there, times the cosine of the profile angle."""
+    alpha = math.acos(min(g.base_radius / r, 1.0))
+    half_arc = r * (g.psi_base - (math.tan(alpha) - alpha))
+    return half_arc * math.cos(alpha)
+
+
 def modification_spec(m: ModificationSection, g: GearGeometry, prefix: str) -> ProfileModification | None:
     """The SI modification of a gear (None: perfect involutes); SceneError naming the field."""
     if m.is_zero:
@@ -106,6 +114,13 @@ def modification_spec(m: ModificationSection, g: GearGeometry, prefix: str) -> P
         amount = getattr(m, f"{which}_relief")
         start = _start(m, which, g, prefix) if amount > 0 else 0.0
         reliefs[which] = Relief(amount * units.UM, start, SHAPES[getattr(m, f"{which}_shape")])
+    for which, r in (("tip", g.tip_radius), ("root", g.form_radius)):
+        amount = getattr(m, f"{which}_relief") * units.UM
+        bound = half_thickness_normal(g, r)
+        if amount >= bound:     # the relief would cut the tooth through at that circle
+            raise SceneError(f"{prefix}.{which}_relief", f"{amount / units.UM:.4g} um removes the whole tooth at the "
+                             f"{'tip' if which == 'tip' else 'form'} circle, where each flank has only "
+                             f"{bound / units.UM:.4g} um of material to its centreline (normal to the flank)")
     if m.tip_relief > 0 and m.root_relief > 0 and reliefs["root"].start > reliefs["tip"].start:
         raise SceneError(f"{prefix}.root_relief", "the root relief starts above the tip relief's start")
     roll, dev = _table(m, g, prefix)

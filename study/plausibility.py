@@ -5,6 +5,8 @@ naming the field, before any work.
 """
 from __future__ import annotations
 
+import math
+
 from solver import units
 from solver.geometry import gear_geometry
 from study.errors import SceneError
@@ -42,6 +44,9 @@ def check_fe_mesh(scene) -> None:
                              "(a finer fe.mesh_size allows a thinner rim)")
 
 
+RUNUP_REVOLUTIONS = 2.0       # driven revolutions a run-up must give its order tracking
+
+
 def check_dynamic_window(scene) -> None:
     """The run must leave a steady part after the ramps for the DTE summary and spectrum."""
     d = scene.dynamic
@@ -49,6 +54,17 @@ def check_dynamic_window(scene) -> None:
         return
     start = d.spectrum_start or 2 * d.ramp_time
     need = STEADY_SAMPLES * d.output_step
+    if d.speed_end > 0:
+        # a run-up's order tracking takes blocks of one driven revolution, one every 1/8
+        # revolution (`order_tracking`): two revolutions give a map of nine blocks over speed
+        turns = 0.5 * d.speed_end * d.duration * scene.gear1.teeth / scene.gear2.teeth / (2 * math.pi)
+        if turns < RUNUP_REVOLUTIONS:
+            need_end = RUNUP_REVOLUTIONS * 4 * math.pi * scene.gear2.teeth / scene.gear1.teeth / d.duration
+            raise SceneError("dynamic.speed_end",
+                             f"the driven gear turns {turns:.3g} revolutions over the run-up (0 -> {d.speed_end:.4g} rad/s "
+                             f"in dynamic.duration = {d.duration:.4g} s), and its order tracking over speed needs at least "
+                             f"{RUNUP_REVOLUTIONS:g} (blocks of one revolution): give speed_end >= {need_end:.4g} rad/s "
+                             "or a longer duration")
     if d.duration - start < need:
         what = "dynamic.spectrum_start" if d.spectrum_start else "twice dynamic.ramp_time"
         raise SceneError("dynamic.duration",
@@ -100,6 +116,46 @@ def check_plausibility(scene) -> None:
     that summarise a run: integrator studies run windows that end with the ramps on purpose."""
     check_fe_mesh(scene)
     check_loads(scene)
+
+
+def carrying_equilibria(scene, model, torque: float, positions: int = 12):
+    """`solver.mbs.equilibria.loaded_equilibria` of the scene's model under ``torque`` [N·m];
+    SceneError naming the load when the teeth cannot carry it: no equilibrium within the
+    deflection bound (DEFLECTION_FRACTION of the module) at any position. The torque check of
+    `check_loads` estimates from the scene's laws alone; this is what the springs actually
+    built (FE springs of a soft material or a thin face, a modification that opens the mesh)
+    make of the load."""
+    from solver.mbs.equilibria import loaded_equilibria
+    try:
+        return loaded_equilibria(model, torque, positions)
+    except ValueError:
+        d = scene.dynamic
+        field = "dynamic.torque" if d.enabled and d.torque == torque else "quasi_static.torque"
+        bound = DEFLECTION_FRACTION * min(scene.gear1.module, scene.gear2.module)
+        raise SceneError(field, f"implausible load: under {torque:.4g} N*m the pair finds no equilibrium with the "
+                                f"flanks approaching less than {DEFLECTION_FRACTION:g} x module = {bound:.4g} mm: the teeth "
+                                "are too soft for it or the flanks do not meet (the tooth springs of "
+                                "material.youngs_modulus, gearN.face_width and gearN.spring, the flank deviations of "
+                                "gearN.modification): lower the torque or check those fields") from None
+
+
+
+FACE_WIDTH_REF_MM = 17.0      # face width the paper's per-tooth laws were calibrated at [mm]
+
+
+def face_width_note(scene, swept: bool = False) -> str | None:
+    """A line for the user when the face width cannot act on the STE: the contact law (k_con)
+    and, unless a gear's springs come from the FE directly (spring.stiffness = 'fe'), the tooth
+    springs are given per tooth, so a face width other than the calibration's (or a swept
+    one) changes only masses and inertias. None when it does act or stays at 17 mm."""
+    gears = [g for g in (1, 2) if scene.gear(g).spring.stiffness != "fe"]
+    widths = {scene.gear(g).face_width for g in (1, 2)}
+    if not gears or (not swept and widths == {FACE_WIDTH_REF_MM}):
+        return None
+    return ("note: the face width acts on masses and inertias only: contact.k_con and the tooth springs of "
+            + " and ".join(f"gear {g} (spring.stiffness = {scene.gear(g).spring.stiffness!r})" for g in gears)
+            + " are per tooth, calibrated at 17 mm; for stiffness that follows the face width use "
+              "gearN.spring.stiffness = 'fe' and refit k_con (lightgear fit-contact)")
 
 
 # ---------------------------------------------------------------- warnings (valid, but almost certainly a slip)

@@ -47,9 +47,15 @@ def run_static(scene: Scene, model: Model):
     angles = static_angles(scene)
     if qs.method == "static":
         return solve_static(model, angles, qs.torque, raise_on_failure=False, friction_speed=qs.speed)
-    # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles
+    # slow-ramp transient: the driver reaches qs.speed after ramp_time; sample TE at the angles.
+    # The angles the driver passes before the load is whole (speed * ramp_time / 2 of rotation)
+    # carry no STE: the samples start a whole number of angle steps past the ramp instead, and
+    # the archive's angle axis says so.
     from solver.mbs.dynamics import at_driver_angles, slow_ramp_window
     from solver.mbs.statics import StaticResult
+    ramp_angle = 0.5 * qs.speed * qs.ramp_time
+    step = math.radians(qs.angle_step)
+    angles = angles + math.ceil(ramp_angle / step - 1e-9) * step
     dt_out, t_end = slow_ramp_window(angles, math.radians(qs.angle_step), qs.speed, qs.ramp_time)
     dyn = simulate(model, qs.speed, qs.ramp_time, qs.torque, qs.ramp_time, t_end, output_step=dt_out)
     te, th2, nc = at_driver_angles(dyn, qs.speed, qs.ramp_time, angles)
@@ -76,7 +82,7 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
     args = (model, speed, speed_ramp, d.torque, d.ramp_time, d.duration)
     bar = estimate.progress_bar(estimate.dynamic_seconds(model, choice, d.duration, scene), d.duration,
                                 f"dynamic run ({choice.method})", "s", show=progress)
-    watch = None if bar is None else (lambda t: bar.update(t - bar.n))
+    watch = None if bar is None else (lambda t: bar.update(max(min(t, bar.total) - bar.n, 0.0)))    # (within the bar)
     try:
         if choice.method == "implicit":
             res = simulate_implicit(*args, dt=choice.dt, output_step=d.output_step, alpha=d.alpha, load_table=table,
@@ -139,6 +145,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     springs = springs or scene_springs(scene)
     t_springs = time.perf_counter() - t0
     model = (kept_scene_model if keep_model else build_scene_model)(scene, springs)
+    if not damping_ratios(scene):    # (with ratios the damping conversion has checked it)
+        from study.plausibility import carrying_equilibria
+        carrying_equilibria(scene, model, mean_load(scene), positions=2)     # SceneError: teeth too soft for the load
     choice = None
     if static:
         est.seconds["statics"] = estimate.static_seconds(scene, model)
@@ -146,8 +155,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
             est.seconds["mesh stiffness"] = estimate.mesh_seconds(scene)
     if dynamic:
         choice = dynamic_choice(scene, model)
-        est.seconds[f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"] = \
-            estimate.dynamic_seconds(model, choice, scene.dynamic.duration, scene)
+        part = f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"
+        est.seconds[part] = estimate.dynamic_seconds(model, choice, scene.dynamic.duration, scene)
+        est.levers[part] = estimate.dynamic_lever(scene, choice)
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))

@@ -56,7 +56,7 @@ class BodySection:
     holes: int = _f(0, "1", "N: number of lightening holes in the web", 0)
     hole_radius: float = _f(6.0, "mm", "R_h: hole radius", 0.0)
     hole_circle_radius: float = _f(32.36, "mm", "R_ch: radius of the circle through the hole centres", 0.0)
-    hole_phase: float = _f(0.0, "deg", "polar angle of the first hole centre from tooth 0's axis")
+    hole_phase: float = _f(0.0, "deg", "polar angle of the first hole centre from tooth 0's axis", -360.0, 360.0)
 
 
 @dataclass(frozen=True)
@@ -360,7 +360,7 @@ def check_scene(scene: Scene) -> None:
                 raise GeometryError(f"gear{g}.pivot_radius", f"must lie between half the base radius and the tip radius ({geo.tip_radius * 1e3:.4g} mm), got {gs.pivot_radius} mm")
             modification_spec(gs.modification, geo, f"gear{g}.modification")
             errors_spec(gs.errors, geo, f"gear{g}.errors")
-        pair_geometry(*geoms)
+        check_jamming(scene, pair_geometry(*geoms))
     except GeometryError as e:
         raise SceneError(e.field, e.reason) from None
     check_damping(scene)
@@ -376,6 +376,23 @@ def check_scene(scene: Scene) -> None:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
+
+
+def check_jamming(scene: Scene, pair) -> None:
+    """The eccentricities must not close the backlash: where both offsets point at the mate,
+    the centre distance shrinks by their sum and the normal backlash by 2 sin(alpha) times it;
+    beyond that the teeth are wedged on both flanks at once (a jammed pair, forces far above
+    the load). GeometryError naming the larger eccentricity."""
+    ecc = [scene.gear(g).errors.eccentricity * units.UM for g in (1, 2)]
+    closing = 2.0 * sum(ecc) * math.sin(pair.pressure_angle)
+    if closing >= pair.normal_backlash:
+        g = 1 if ecc[0] >= ecc[1] else 2
+        limit = pair.normal_backlash / (2.0 * math.sin(pair.pressure_angle)) / units.UM
+        raise GeometryError(f"gear{g}.errors.eccentricity",
+                            f"the eccentricities ({ecc[0] / units.UM:.4g} + {ecc[1] / units.UM:.4g} um) close the "
+                            f"backlash ({scene.pair.backlash * 1e3:.4g} um on the pitch circle) where they point at the "
+                            f"mate, which jams the pair: their sum must stay below {limit:.4g} um (or give more "
+                            "pair.backlash)")
 
 
 def scene_from_dict(data: dict) -> Scene:
@@ -396,6 +413,18 @@ def _tables(text: str, source: str) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise SceneError(source, f"not valid TOML: {e}") from None
+
+
+def read_text(path: str | Path, field: str = "scene") -> str:
+    """The text of a scene or study file; SceneError naming ``field`` when it cannot be read as
+    UTF-8 text (TOML files are UTF-8) or at all."""
+    p = Path(path)
+    try:
+        return p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise SceneError(field, f"{p} is not UTF-8 text (byte {e.start}: {e.reason}); TOML files are UTF-8") from None
+    except OSError as e:
+        raise SceneError(field, f"cannot read {p}: {e.strerror or e}") from None
 
 
 def loads_scene(text: str, source: str = "scene") -> Scene:
@@ -439,7 +468,7 @@ def scene_path(name: str | Path, what: str = "scene") -> Path:
 def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] = ()) -> Scene:
     """Read a scene file or an embedded scene by name (default: the embedded paper example),
     apply ``key=value`` overrides."""
-    text = default_scene_text() if path is None else scene_path(path).read_text()
+    text = default_scene_text() if path is None else read_text(scene_path(path))
     data = _tables(text, str(path or "scene"))
     items = [parse_override(item) for item in overrides]
     keys = {k for k, _v in items}

@@ -122,11 +122,13 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
     for setup, (k_phi, _) in zip(setups, springs):
         sp = setup.spring
         fit = coupling_fit(scene, setup.gear, setups=setups)
-        cmat = None
+        cmat = cloc = None
         if fit is not None:
             k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
             if scene.coupling_model == "compliance":
                 cmat = fit.compliance
+                if fit.local_compliance is not None:
+                    cloc = (fit.local_u, fit.local_compliance)
         else:
             k_body, n_k, pivot = math.inf, sp.n_k, setup.pivot_radius
         gears.append(GearInput(tooth=setup.tooth, body=setup.body, pivot_radius=pivot,
@@ -134,7 +136,7 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
                                n_k=n_k, c_phi=units.spring_damping_to_si(0.0 if math.isnan(sp.c_phi) else sp.c_phi),
                                n_c=sp.n_c, body_stiffness=k_body, tooth_compliance=cmat,
                                modification=scene.modification_spec(setup.gear),
-                               errors=scene.errors_spec(setup.gear)))
+                               errors=scene.errors_spec(setup.gear), contact_compliance=cloc))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3,
@@ -183,13 +185,21 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
       tooth springs, so even 1 % of critical on the mesh mode needs c_con some 200 000 times
       the old 3640 N·s/mm^2.5, which overdamps the tooth-on-contact modes near 200 kHz, cuts
       the explicit step twenty-fold and still lets a run from rest grow energy (Table 1);
-      5 % is beyond what it can give at all (at most about 2.6 % with 2 % tooth dampers)."""
+      5 % is beyond what it can give at all (at most about 2.6 % with 2 % tooth dampers).
+      A body-coupled pair whose joint dampers alone cannot reach the ratio (a very stiff joint
+      locks; about 4.7 % at most on a small 24-tooth pair with a thin web) scales its body
+      dampers with them, all at one ratio of their own modes."""
     ratios = damping_ratios(scene)
     if not ratios:
         return model
-    from solver.mbs.equilibria import loaded_equilibria
-    from solver.mbs.modes import joint_damping_for_ratio, tooth_damping_for_ratio, with_damping
-    eqs = loaded_equilibria(model, mean_load(scene))
+    from solver.mbs.modes import (
+        joint_and_body_damping_for_ratio,
+        joint_damping_for_ratio,
+        tooth_damping_for_ratio,
+        with_damping,
+    )
+    from study.plausibility import carrying_equilibria
+    eqs = carrying_equilibria(scene, model, mean_load(scene))      # SceneError when the teeth cannot carry it
     c_phi = tuple(tooth_damping_for_ratio(model, eqs, ratios[f"gear{g}"], g) if f"gear{g}" in ratios
                   else float(model.gear_par[g - 1, L.C_PHI]) for g in (1, 2))
     model = with_damping(model, c_phi=c_phi)
@@ -201,7 +211,13 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
     except SceneError:
         raise
     except ValueError as e:
+        if not model.coupled:
+            raise SceneError("contact.damping_ratio", str(e)) from None
+    try:   # a coupled pair whose joints alone cannot: the body dampers take part too
+        c_phi, c_body = joint_and_body_damping_for_ratio(model, eqs, ratios["contact"])
+    except ValueError as e:
         raise SceneError("contact.damping_ratio", str(e)) from None
+    return with_damping(model, c_con=0.0, c_phi=c_phi, c_body=c_body)
 
 
 def geometry_model(scene: Scene) -> Model:
@@ -239,9 +255,11 @@ def static_rotation(scene: Scene) -> float:
 
 
 def static_angles(scene: Scene) -> np.ndarray:
-    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step)."""
+    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step);
+    `study.errors.BudgetError` before they are built when their arrays would not fit in memory."""
+    from study.estimate import check_static_memory
     qs = scene.quasi_static
-    n = int(math.floor(static_rotation(scene) / qs.angle_step + 1e-9)) + 1
+    n = int(check_static_memory(scene))
     return np.radians(np.arange(n) * qs.angle_step)
 
 

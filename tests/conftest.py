@@ -17,6 +17,18 @@ for _g in (1, 2):
                        f"gear{_g}.body.web_thickness": 20.0, f"gear{_g}.body.holes": 0})
 
 
+# a small lightened pair (24 teeth, m 2 mm, a coarse FE body) whose driven gear has a thin web
+# with 8 holes
+SMALL_LIGHTENED = {
+    "gear1.module": 2.0, "gear1.teeth": 24, "gear2.module": 2.0, "gear2.teeth": 24,
+    "gear1.body.rim_height": 3.0, "gear1.body.web_height": 12.0, "gear1.body.hub_height": 3.0,
+    "gear1.body.web_thickness": 17.0, "gear1.body.holes": 0,
+    "gear2.body.rim_height": 3.0, "gear2.body.web_height": 12.0, "gear2.body.hub_height": 3.0,
+    "gear2.body.web_thickness": 8.0, "gear2.body.holes": 8, "gear2.body.hole_radius": 3.0,
+    "gear2.body.hole_circle_radius": 12.5, "fe.mesh_size": 1.0,
+}
+
+
 # the raw damping coefficients the scenes had before the damping ratio (mesh mode at 0.14 %)
 RAW_DAMPING = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spring.c_phi": 0.062}
 

@@ -156,7 +156,11 @@ def base_scene(path, overrides, speed: float, duration: float | None, angle_step
 
 
 def solid_of(scene):
-    return scene.replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": scene.gear2.face_width})
+    """The reference: the driven gear solid, run by the model the lightened bodies run (the
+    default 'auto' would put a solid pair on the paper's model, and a factor between two
+    models' STE would measure the models, not the lightening)."""
+    lightened = scene.replace(**{"gear2.body.holes": max(scene.gear2.body.holes, 1)})
+    return study.solid_scene(scene, gears=(2,)).replace(**{"coupling.model": lightened.coupling_model_name})
 
 
 def answer(best: dict, solid: dict, speed: float) -> str:
@@ -304,4 +308,4 @@ def _bad(what: str, why: str) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(study.script_main("python -m workflows.lightest_gear", main))

@@ -1,25 +1,8 @@
 """Stability suite: stiff and extreme variants of the paper pair, each run with every integrator.
 
-Every scene ends either bounded and physically plausible, or with a named failure (the
-guard's cause, time and step; a Newton failure; a solver's wall-time limit): never with a
-silent NaN. Checks of plausibility on a run that the guards let through: TE and contact force
-finite and bounded (|TE| below the backlash offset plus a tenth of the module, the force below
-that of 20 um of penetration or 20 times the static mesh force), and no energy growth (work in >= stored + dissipated energy
-within 2 % of the larger of work and stored energy).
-
-Scenes (overrides of the scene given, default the paper example; short runs: ``--duration``,
-the ramps ending at half of it):
-  paper, contact stiffness x100 and x0.01, no damping at all, teeth 100x lighter (density
-  / 100: hub and teeth lighter alike), holes leaving a 0.5 mm ligament to the rim, a 1 mm web,
-  1 hole, 24 holes, driver at 1000 rad/s, mesh frequency at the torsional resonance, zero
-  torque (rattle in the backlash), reversed torque (-50 N·m: the load drives, coast flanks in
-  contact), a torque reversal during the run (+50 -> -50 N·m from 60 to 80 % of the run: the
-  mesh crosses the backlash and hits the coast flanks), tenfold overload (deep penetration,
-  corner contact).
-Lightened bodies take FE springs (cached on disk; ``--mesh-size`` mm, coarse by default).
-Methods: explicit (at its stability step), implicit HHT alpha = 0 and alpha = -0.1 (at four
-times that step), and the scipy peer LSODA (rtol 1e-4, every tooth free, stopped after
-``--scipy-wall`` seconds).
+The suite is `study.stability_suite` (`study.verify.stability`, whose docstring lists the
+scenes, the methods and the plausibility checks); this script runs it and prints, archives and
+draws the result.
 
     python -m workflows.stability [SCENE] [-o results/stability/stability.nc] [--duration 0.002]
 """
@@ -74,4 +57,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(study.script_main("python -m workflows.stability", main))

@@ -30,7 +30,6 @@ import numpy as np
 import xarray as xr
 
 import study
-from study.scene import SceneError, parse_override
 
 DEFAULT_STUDY = Path(__file__).resolve().parents[1] / "study" / "scenes" / "tolerance.toml"
 DEFAULT_OUT = "results/tolerance"
@@ -54,39 +53,35 @@ GRID_WORDS = {"gear1.errors.grade": "driver class {}", "gear2.errors.grade": "dr
 
 def grid_label(ds: xr.Dataset, at: dict) -> str:
     """'driver class 5' for a grid point of the grade, else 'field = value'."""
-    from study.report.distributions import point_label
     words = []
     for d, i in at.items():
         field = ds[d].attrs.get("scene_field", d) if d in ds.coords else d
         value = ds[d].values[i] if d in ds.coords else i
-        words.append(GRID_WORDS[field].format(value) if field in GRID_WORDS else point_label(ds, {d: i}))
+        words.append(GRID_WORDS[field].format(value) if field in GRID_WORDS else study.sample_point_label(ds, {d: i}))
     return ", ".join(words) or "all builds"
 
 
 def reduced_study(path: Path, size: int | None, overrides: list[str]) -> study.Study:
     """The study at ``path`` with ``size`` draws (when given) and scene overrides."""
-    from study.sweep.grid import dumps_study, loads_study
     text = path.read_text()
     if size is None and not overrides:
-        return loads_study(text, path.parent)
+        return study.load_study(path)
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise SceneError("study", f"{path} is not valid TOML: {e}") from None
+        raise study.SceneError("study", f"{path} is not valid TOML: {e}") from None
     if size is not None:
         if "sample" not in raw:
-            raise SceneError("--size", f"{path} has no [sample] table")
+            raise study.SceneError("--size", f"{path} has no [sample] table")
         raw["sample"]["size"] = size
     if overrides:
         scene = raw.get("scene")
         table = dict(scene) if isinstance(scene, dict) else ({"file": scene} if scene else {})
         if isinstance(table.get("file"), str) and not Path(table["file"]).is_absolute():
             table["file"] = str(path.parent / table["file"])
-        for item in overrides:
-            key, value = parse_override(item)
-            table[key] = value
+        table.update(study.parse_overrides(overrides))
         raw["scene"] = table
-    return loads_study(dumps_study(raw), path.parent)
+    return study.study_from_dict(raw, path.parent)
 
 
 def _pct(tab: xr.Dataset, out: str, at: dict, q: float = 0.95) -> tuple[float, float, float]:
@@ -96,9 +91,8 @@ def _pct(tab: xr.Dataset, out: str, at: dict, q: float = 0.95) -> tuple[float, f
 
 def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
     """The one-paragraph answer from a sampled study's archive and tables."""
-    from study.report.distributions import grid_points
     unit = ds[out].attrs.get("units", "")
-    points = grid_points(ds)
+    points = study.sample_points(ds)
     labels = [grid_label(ds, at) for at in points]
     p95 = [_pct(tab, out, at) for at in points]
     p50 = [_pct(tab, out, at, 0.5) for at in points]
@@ -157,7 +151,7 @@ def run(args) -> int:
         try:
             limits[key] = float(value)
         except ValueError:
-            raise SceneError("--limit", f"expected OUTPUT=VALUE, got {item!r}") from None
+            raise study.SceneError("--limit", f"expected OUTPUT=VALUE, got {item!r}") from None
     outdir = Path(args.output_dir)
     outdir.mkdir(parents=True, exist_ok=True)
     archive = outdir / "tolerance.nc"
@@ -166,16 +160,15 @@ def run(args) -> int:
     print(f"  {res.computed} analyses computed, {res.reused} reused (a build's statics and its dynamics are two), "
           f"{res.wall_time:.0f} s wall", flush=True)
     ds = res.dataset
-    from study.report.distributions import sample_outputs, sample_tables
-    outputs = sample_outputs(ds)
+    outputs = study.sample_outputs(ds)
     answers = [o for o in (args.answer or DEFAULT_ANSWER) if o in outputs] or outputs[:1]
     if not args.limit and DEFAULT_LIMIT.split("=")[0] not in outputs:
         limits = {}             # the default limit, on an output this study does not have
     for k in limits:
         if k not in outputs:
-            raise SceneError("--limit", f"{k!r} is not an output of the study ({', '.join(outputs)})")
+            raise study.SceneError("--limit", f"{k!r} is not an output of the study ({', '.join(outputs)})")
     study.render(ds, outdir, limits=limits)
-    tab = sample_tables(ds, outputs, limits)
+    tab = study.sample_tables(ds, outputs, limits)
     text = "\n\n".join([*(answer(ds, tab, out, limits) for out in answers), cost(ds)])
     (outdir / "tolerance.txt").write_text(text + "\n")
     print("\n" + text)
@@ -206,7 +199,7 @@ def main(argv=None) -> int:
         return _bad("study", f"no such file: {args.study}")
     try:
         return run(args)
-    except SceneError as e:
+    except study.SceneError as e:
         return _bad(e.field, e.reason)
 
 
@@ -216,4 +209,4 @@ def _bad(what: str, why: str) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(study.script_main("python -m workflows.tolerance", main))

@@ -1,21 +1,8 @@
-"""Validation of the pseudo-rigid models against the FE reference (LTCA) for the solid and the
-lightened pair: STE, load sharing, and the error figures.
+"""Validation of the pseudo-rigid models against the FE reference (LTCA): STE, load sharing and
+the error figures of the solid and the lightened pair.
 
-Models (all at the scene's quasi-static torque, static equilibrium at every angle):
-  fe-reference  loaded-tooth-contact analysis with FE influence coefficients (`study.verify.fe_reference`)
-  plain         MUBOCO-PR as the scene defines it (the paper's calibrated springs)
-  plain-fe      MUBOCO-PR with each tooth's spring from the same FE body (linear, k = k_fe):
-                the paper's structure with our FE, so the difference to the reference is
-                the missing foundation coupling alone
-  coupled       body-torsion coupling (`coupling.model = "body-torsion"`), same FE body
-                (body spring, tooth springs without the body wind-up, tooth pivot refitted)
-  compliance    the full coupling (`coupling.model = "compliance"`): body spring plus tooth
-                springs coupled through the FE compliance between every pair of teeth
-
-Figures per model against the reference: mean STE, peak-to-peak, the hole-order amplitude
-(order N of the driven gear, least-squares fit together with the mesh harmonics and their
-hole sidebands), mean and RMS error where the rigid geometry has one and two pairs in the
-path of contact, and the worst load-sharing error of one driver tooth through the mesh.
+The comparison is `study.validation` (`study.verify.validation`, whose docstring lists the
+models and the figures); this script runs it and prints, archives and draws the result.
 
     python -m workflows.validation [SCENE] [-o results/validation/validation.nc] [--step DEG]
 
@@ -222,4 +209,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(study.script_main("python -m workflows.validation", main))

@@ -90,6 +90,9 @@ class ToothComplianceFit:
     pivot_radius: float      # tooth pivot [m]
     reach: int               # teeth up to this many pitches apart are coupled [-]
     rms_rel_error: float     # RMS relative residual of the fitted influence coefficients [-]
+    # local compliance in series with the contact (`local_compliance`): rolls [-] and c_loc [m/N]
+    local_u: np.ndarray | None = None
+    local_compliance: np.ndarray | None = None
 
     @property
     def k_own(self) -> np.ndarray:
@@ -187,3 +190,22 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
             raise ValueError(f"value: the fitted compliance of teeth {a}..{a + w - 1} is not positive "
                              "definite (not a valid stiffness)") from None
     return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / weight.sum())))
+
+
+def local_compliance(fit: ToothComplianceFit, u, own, base_radius: float, psi_base: float) -> np.ndarray:
+    """The tooth compliance [m/N] along the profile that the rigid tooth on its pivot misses:
+    c_loc(u) = own(u) - c_body - lever(u)**2 * C[a, a], averaged over the teeth a (one table
+    per gear). ``u``: rolls [-] of the profile grid, ``own``: (teeth, n_u) or (n_u,) FE
+    compliance [m/N] of each tooth at u under its own load there. In series with the contact
+    law (`solver.mbs.kernels.laws.series_contact`) a single loaded tooth then has the FE
+    compliance at every profile point. Signed: the best single pivot is too soft at
+    mid-profile (c_loc < 0 there, a few 1e-11 m/N, a tenth of the contact law's own
+    compliance at the rated load, so the series spring stays monotone) and too stiff towards
+    the tip."""
+    u = np.asarray(u, float)
+    own = np.atleast_2d(np.asarray(own, float))
+    if own.shape[1] != u.size:
+        raise ValueError(f"own: need {u.size} values per tooth (one per roll), got shape {own.shape}")
+    lev = np.abs(base_radius - fit.pivot_radius * np.cos(psi_base - u))
+    caa = np.diag(fit.compliance)[: own.shape[0]]
+    return np.mean(own - fit.c_body - lev[None, :] ** 2 * caa[:, None], axis=0)

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.geometry import GearGeometry, Material
+from solver.geometry import GearGeometry, GeometryError, Material
 
 
 @dataclass(frozen=True)
@@ -66,7 +66,7 @@ def fit_contact(g1: GearGeometry, g2: GearGeometry, material: Material, force_re
                 span: tuple = (0.5, 1.0), depth_fraction: float = 0.5, samples: int = 40) -> ContactFit:
     """Fit F = k_con * delta**m1 to Weber's deflection over force_ref * span [N]."""
     if not force_ref > 0:
-        raise ValueError(f"quasi_static.torque: must be positive to set the fit's load range, got {force_ref}")
+        raise GeometryError("quasi_static.torque", f"must be positive to set the fit's load range, got {force_ref}")
     a = math.tan(g1.spec.pressure_angle)
     r1, r2 = g1.base_radius * a, g2.base_radius * a
     R = r1 * r2 / (r1 + r2)
@@ -75,7 +75,14 @@ def fit_contact(g1: GearGeometry, g2: GearGeometry, material: Material, force_re
     depths = (depth_fraction * pitch_point_depth(g1), depth_fraction * pitch_point_depth(g2))
     b = min(g1.spec.face_width, g2.spec.face_width)
     F = force_ref * np.geomspace(span[0], span[1], samples)
-    d = weber_deflection(F, b, R, depths, material)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = weber_deflection(F, b, R, depths, material)
+    if not np.all(np.isfinite(d) & (d > 0)):
+        # the contact half-width 2b reaches the depth of the tooth: Weber's half-space
+        # flattening has no meaning there (its log turns negative)
+        raise GeometryError("material.youngs_modulus", f"the contact of {F[-1]:.4g} N over {b * 1e3:.4g} mm of face is "
+                            f"wider than the teeth are deep with E = {material.youngs_modulus / 1e6:.4g} MPa: no Weber "
+                            "contact deflection to fit (a stiffer material, a smaller quasi_static.torque)")
     A = np.column_stack([np.log(d), np.ones_like(d)])
     (m1, logk), *_ = np.linalg.lstsq(A, np.log(F), rcond=None)
     res = np.log(F) - A @ np.array([m1, logk])

@@ -214,8 +214,10 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     IMEX).
     ``all_teeth``: every tooth active from the start (phi = 1e-300 rad) and none frozen.
     ``progress``: None, or a callable taking the time reached [s], called about every
-    PROGRESS_PERIOD_S while the kernel runs (`watched`).
+    PROGRESS_PERIOD_S while the kernel runs. The kernel stops at the end of its step on
+    Ctrl-C or SIGTERM (`solver.mbs.interrupt`: KeyboardInterrupt raised here).
     """
+    from solver.mbs import interrupt
     speed, speed_ramp, torque, torque_ramp, table, side = loads
     dt, out_every, n_steps, n_out = grid
     phi_quiet = 0.0 if all_teeth else par["PHI_QUIET"]
@@ -238,7 +240,8 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     out = np.zeros((n_out, L.N_OUT + L.CONTACT_SLOTS * L.O_CONTACT_COLS))
     mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance)
     args = (mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out, work_arrays(model.n_teeth))
-    ret = kernel(*args) if progress is None else watched(kernel, args, out, progress)
+    poll = None if progress is None else (lambda: progress(float(out[last_record(out), L.O_TIME])))
+    ret = interrupt.call(kernel, args, p, L.ABORT, poll, PROGRESS_PERIOD_S)
     return ret, out[:min(n_out, ret[1] // out_every + 1)]
 
 
@@ -256,29 +259,6 @@ def last_record(out: np.ndarray) -> int:
         else:
             hi = mid - 1
     return lo
-
-
-def watched(kernel, args: tuple, out: np.ndarray, progress):
-    """Run ``kernel(*args)`` in a thread (the stepping kernels release the GIL) and report the
-    time of its last output record [s] to ``progress`` between polls; the kernel itself does
-    no I/O. Ctrl-C stops the wait at once (the thread, a daemon, ends with the process)."""
-    import threading
-    ret = []
-    err = []
-
-    def target():
-        try:
-            ret.append(kernel(*args))
-        except BaseException as e:  # noqa: BLE001 - handed to the caller's thread
-            err.append(e)
-    th = threading.Thread(target=target, name="lightgear-kernel", daemon=True)
-    th.start()
-    while th.is_alive():
-        th.join(PROGRESS_PERIOD_S)
-        progress(float(out[last_record(out), L.O_TIME]))
-    if err:
-        raise err[0]
-    return ret[0]
 
 
 def result_fields(out: np.ndarray) -> tuple:

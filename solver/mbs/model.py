@@ -47,6 +47,8 @@ class GearInput:
     tooth_compliance: np.ndarray | None = None  # (Z, Z) rad/(N·m): teeth coupled through the body
     modification: ProfileModification | None = None  # flank deviation (relief, table); None: perfect involutes
     errors: GearErrors | None = None    # pitch deviations and eccentricity; None: a perfect gear
+    # local compliance in series with the contact law: (rolls [-], c_loc [m/N]); None: c_loc = 0
+    contact_compliance: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -132,6 +134,18 @@ class Model:
         return float(self.gear_par[0, L.I_TOT]), float(self.gear_par[1, L.I_TOT])
 
 
+def body_critical_damping(gp: np.ndarray, i: int) -> float:
+    """Critical damping [N·m·s/rad] of gear ``i``'s (0 driver, 1 driven) body mode: its rim
+    (with the teeth) against its hub on the body spring, 2 sqrt(k_body I_eff); the driver's hub
+    is prescribed (I_eff the rim's), the driven hub free (I_eff rim and hub in series).
+    0 for a rigid body."""
+    if not gp[i, L.K_BODY] > 0:
+        return 0.0
+    i_rim = gp[i, L.I_TOT] - gp[i, L.I_HUB]
+    i_eff = i_rim if i == 0 else i_rim * gp[i, L.I_HUB] / gp[i, L.I_TOT]
+    return 2.0 * math.sqrt(gp[i, L.K_BODY] * i_eff)
+
+
 def hub_side_inertia(g: GearGeometry, body: BodySpec, density: float) -> float:
     """Inertia [kg·m²] on the hub side of the body spring: the hub ring and half the web (the
     web's wind-up is the spring; its inertia is split between its ends)."""
@@ -196,16 +210,15 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
         if gi.modification is not None:
             gi.modification.check(g.u_form, g.u_tip, ("gear1", "gear2")[i])
         sample(gi.modification, g.u_form, g.u_tip, gp[i])
+        if gi.contact_compliance is not None:
+            sample_local_compliance(gi.contact_compliance, g.u_form, g.u_tip, gp[i], ("gear1", "gear2")[i])
         if gi.body_stiffness != math.inf:
             if not gi.body_stiffness > 0:
                 raise ValueError(f"{('gear1', 'gear2')[i]}: body torsion stiffness must be positive, got {gi.body_stiffness}")
             gp[i, L.K_BODY] = gi.body_stiffness
         gp[i, L.I_HUB] = hub_side_inertia(g, gi.body, material.density)
         if gp[i, L.K_BODY] > 0:
-            # body mode: rim (with the teeth) against the hub; the driver's hub is prescribed
-            i_rim = gp[i, L.I_TOT] - gp[i, L.I_HUB]
-            i_eff = i_rim if i == 0 else i_rim * gp[i, L.I_HUB] / gp[i, L.I_TOT]
-            gp[i, L.C_BODY] = 2.0 * gi.body_damping_ratio * math.sqrt(gi.body_stiffness * i_eff)
+            gp[i, L.C_BODY] = gi.body_damping_ratio * body_critical_damping(gp, i)
     pp = np.zeros(L.N_PAIR_PAR)
     pp[L.JN_HALF] = 0.5 * pair.normal_backlash
     pp[L.ALPHA] = pair.pressure_angle
@@ -243,3 +256,18 @@ def _check_compliance(gi: GearInput, z: int, name: str) -> None:
         np.linalg.cholesky(c)
     except np.linalg.LinAlgError:
         raise ValueError(f"{name}.tooth_compliance: must be positive definite") from None
+
+
+def sample_local_compliance(table, u_form: float, u_tip: float, row: np.ndarray, name: str) -> None:
+    """Write the CLOC_* columns of a gear_par row: the local compliance ``table`` = (rolls [-],
+    c_loc [m/N]) resampled on N_CLOC rolls from u_form to u_tip (a monotone cubic through the
+    table's points, constant beyond them)."""
+    from scipy.interpolate import PchipInterpolator
+    u, c = (np.asarray(x, float) for x in table)
+    if u.ndim != 1 or u.shape != c.shape or u.size < 2 or np.any(np.diff(u) <= 0) or not np.all(np.isfinite(c)):
+        raise ValueError(f"{name}.contact_compliance: need finite values on at least two increasing rolls")
+    grid = np.linspace(u_form, u_tip, L.N_CLOC)
+    row[L.CLOC_U0] = u_form
+    row[L.CLOC_DU] = grid[1] - grid[0]
+    row[L.CLOC0:L.CLOC0 + L.N_CLOC] = PchipInterpolator(u, c, extrapolate=False)(np.clip(grid, u[0], u[-1]))
+    row[L.CLOC_ON] = 1.0 if np.any(row[L.CLOC0:L.CLOC0 + L.N_CLOC] != 0.0) else 0.0

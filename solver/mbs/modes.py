@@ -46,13 +46,18 @@ from solver.mbs.linearization import LinearSystem, at_equilibrium
 from solver.mbs.model import Model
 
 
-def with_damping(model: Model, c_con: float | None = None, c_phi: tuple | None = None) -> Model:
-    """A copy of ``model`` with the contact damping c_con [SI] and/or the tooth dampers
-    c_phi (gear 1, gear 2) [N·m·s/rad] replaced (the arrays are copied, the rest shared)."""
+def with_damping(model: Model, c_con: float | None = None, c_phi: tuple | None = None,
+                 c_body: tuple | None = None) -> Model:
+    """A copy of ``model`` with the contact damping c_con [SI], the tooth dampers c_phi
+    (gear 1, gear 2) [N·m·s/rad] and/or the body dampers c_body (gear 1, gear 2) [N·m·s/rad]
+    replaced (the arrays are copied, the rest shared)."""
     gp, lp = model.gear_par, model.law_par
-    if c_phi is not None:
+    if c_phi is not None or c_body is not None:
         gp = gp.copy()
+    if c_phi is not None:
         gp[:, L.C_PHI] = c_phi
+    if c_body is not None:
+        gp[:, L.C_BODY] = c_body
     if c_con is not None:
         lp = lp.copy()
         lp[L.C_CON] = c_con
@@ -66,7 +71,7 @@ def _system(model: Model, eq: Equilibrium) -> LinearSystem:
 def _modes(M, K):
     """(w [rad/s], mass-normalised modes) of the modes with stiffness."""
     lam, x = scipy.linalg.eigh(K, M)
-    keep = lam > 1e-8 * max(lam.max(), 0.0)
+    keep = lam > 1e-8 * max(K[0, 0] / M[0, 0], 0.0)      # (see `_damped_modes`)
     return np.sqrt(lam[keep]), x[:, keep]
 
 
@@ -93,7 +98,11 @@ def _damped_modes(sy: LinearSystem, C):
     mi = np.linalg.inv(M)
     lam, v = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [-mi @ K, -mi @ C]]))
     wn = np.abs(lam)
-    keep = (lam.imag > 1e-9 * max(wn.max(), 1.0)) & (wn > 1e-4 * max(wn.max(), 1.0))
+    # rigid-like modes (unloaded teeth on their regularised springs) are left out by comparison
+    # with the driven hub on its own stiffness, not with the highest mode: with very stiff
+    # tooth springs the tooth modes lie 1e4 above the mesh mode, which must stay in
+    w_ref = math.sqrt(max(K[0, 0] / M[0, 0], 0.0)) or max(wn.max(), 1.0)
+    keep = (lam.imag > 1e-9 * max(wn.max(), 1.0)) & (wn > 1e-4 * w_ref)
     lam, u = lam[keep], v[:n, keep]
     share = np.real(np.conj(u) * (M @ u))
     share = share / share.sum(0)
@@ -220,3 +229,22 @@ def joint_damping_for_ratio(model: Model, equilibria, zeta: float) -> tuple[floa
         parts.append((sy, sy.c_body, unit[0] * sy.joint_unit[0] + unit[1] * sy.joint_unit[1]))
     s = _solve_scale(parts, zeta, "tooth-root joint dampers")
     return unit[0] * s, unit[1] * s
+
+
+def joint_and_body_damping_for_ratio(model: Model, equilibria, zeta: float) -> tuple[tuple, tuple]:
+    """((c_phi gear 1, gear 2), (c_body gear 1, gear 2)) [N·m·s/rad]: the tooth-root joint
+    dampers and the body dampers of a body-coupled model, all at the same ratio of their own
+    modes (the tooth on its spring, the rim on its body spring), that give the mesh mode the
+    ratio ``zeta`` on average over the equilibria. For a pair whose joint dampers alone cannot
+    (`joint_damping_for_ratio`): a coupled mesh mode also winds up the bodies, so their
+    dampers carry the rest."""
+    from solver.mbs.model import body_critical_damping
+    unit_j = (tooth_damping_for_ratio(model, equilibria, 1.0, 1), tooth_damping_for_ratio(model, equilibria, 1.0, 2))
+    unit_b = tuple(body_critical_damping(model.gear_par, i) for i in (0, 1))
+    bodies = with_damping(model, c_body=unit_b)
+    parts = []
+    for eq in equilibria:
+        sy = _system(bodies, eq)
+        parts.append((sy, np.zeros_like(sy.M), sy.c_body + unit_j[0] * sy.joint_unit[0] + unit_j[1] * sy.joint_unit[1]))
+    s = _solve_scale(parts, zeta, "tooth-root joint and body dampers")
+    return (unit_j[0] * s, unit_j[1] * s), (unit_b[0] * s, unit_b[1] * s)

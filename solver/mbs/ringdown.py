@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -83,7 +84,10 @@ def ring_down(model: Model, torque: float, frequency: float, damping: float, cyc
     amp = float(np.ptp(x)) / 2 or 1e-12
     p0 = (float(x[-1]), amp, 0.0, damping * 2 * math.pi * frequency, wd0)
     scale = amp
-    p, _cov = scipy.optimize.curve_fit(lambda tt, *q: model_fn(tt, *q) / scale, t, x / scale, p0=p0, maxfev=20000)
+    with warnings.catch_warnings():
+        # an undamped decay fits exactly, and its covariance (unused here) cannot be estimated
+        warnings.simplefilter("ignore", scipy.optimize.OptimizeWarning)
+        p, _cov = scipy.optimize.curve_fit(lambda tt, *q: model_fn(tt, *q) / scale, t, x / scale, p0=p0, maxfev=20000)
     s, wd = abs(p[3]), abs(p[4])
     wn = math.hypot(s, wd)
     return RingDown(wn / (2 * math.pi), s / wn, t + t_fit, x, model_fn(t, *p))

@@ -12,7 +12,9 @@ influence coefficients of every tooth with itself and its neighbours along the p
 lightened body: every tooth loaded; a solid body: one, the rest by symmetry), read at the
 contact points the mesh loads together (`mesh_samples` of the pair's rigid geometry, weighted by
 the load the mesh puts there), fitted as body wind-up plus coupled tooth springs
-(`solver.identify.coupling.tooth_compliance_fit`).
+(`solver.identify.coupling.tooth_compliance_fit`), and the local compliance along the profile
+that the rigid teeth miss (`solver.identify.coupling.local_compliance`, in series with the
+contact law).
 
 All take a prepared `study.inputs.gearsetup.GearSetup`; the FE comes from
 `study.inputs.compliance.gear_compliance` (cached).
@@ -20,11 +22,12 @@ All take a prepared `study.inputs.gearsetup.GearSetup`; the FE comes from
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from solver.fe.body import load_case
-from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, tooth_compliance_fit
+from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, local_compliance, tooth_compliance_fit
 from solver.mbs.model import Model
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import GearSetup
@@ -130,8 +133,11 @@ def tooth_compliance(setup: GearSetup, samples: dict[int, np.ndarray]) -> ToothC
     # the pivot lies in the rim under the tooth
     bounds = (geo.root_radius - setup.body.rim_height, geo.root_radius)
     cat = np.concatenate
-    return tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z,
-                                geo.base_radius, geo.psi_base, bounds, cat(wt))
+    fit = tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z,
+                               geo.base_radius, geo.psi_base, bounds, cat(wt))
+    n = c.u.size
+    own = np.array([[block(a, 0)[i, i] for i in range(n)] for a in range(z if setup.lightened else 1)])
+    return replace(fit, local_u=np.array(c.u), local_compliance=local_compliance(fit, c.u, own, geo.base_radius, geo.psi_base))
 
 
 def tooth_pivot(setup: GearSetup, c_body: float) -> tuple[float, float]:

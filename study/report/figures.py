@@ -85,10 +85,19 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True,
     if swept:
         return _sweep_figures(ds, swept, name, skip)
     for variables, stem, plot, what, why in run_plots():
-        if any(v in ds for v in variables):
-            out.append(plot(ds, name(stem)))
-        else:
+        if not any(v in ds for v in variables):
             skip(what, why(ds) if callable(why) else why)
+            continue
+        try:
+            out.append(plot(ds, name(stem)))
+        except (ValueError, KeyError, IndexError) as e:
+            # an archive run accepted whose data this plot cannot show (no orders at speed 0,
+            # too short a record): said, and the other figures still drawn
+            import matplotlib.pyplot as plt
+            plt.close("all")
+            skip(what, f"nothing to draw in this archive ({str(e).splitlines()[0] if str(e) else type(e).__name__})")
+    if "dte_amplitude" in ds and "order" in ds.coords and not np.isfinite(ds["order"].values).any():
+        skip("DTE spectrum panel", "no orders of the driven gear's rotation at driver speed 0")
     if not renders:
         skip("renders", "not asked for")
         return out

@@ -17,7 +17,7 @@ def summarize(ds: xr.Dataset) -> dict:
     if "ste" in ds:
         ste = ds["ste"].values
         out["ste_mean"] = float(np.nanmean(ste))
-        out["ste_elastic_mean"] = float(np.nanmean(ste) - off)
+        out["ste_elastic_mean"] = float(np.nanmean(ste) - flank_side(ds) * off)
         out["ste_p2p"] = float(np.nanmax(ste) - np.nanmin(ste))
     for name in ("mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
                  "c_gamma_alpha_iso6336", "loaded_contact_ratio", "dynamic_factor"):
@@ -34,8 +34,15 @@ def summarize(ds: xr.Dataset) -> dict:
         out["mesh_efficiency"] = float(ds["mesh_efficiency"]) if "mesh_efficiency" in ds else nan
     if "dte_amplitude" in ds:
         z = ds.attrs["mesh_order"]
-        for name, order in (("mesh", z), ("mesh2", 2 * z), ("mesh3", 3 * z), ("hole", ds.attrs["hole_order"])):
-            out[f"amp_{name}_order"] = amplitude_at_order(ds, order) if order > 0 else nan
+        named = named_amplitudes(ds)
+        for name, label, order in (("mesh", "Z", z), ("mesh2", "2Z", 2 * z), ("mesh3", "3Z", 3 * z),
+                                   ("hole", "N", ds.attrs["hole_order"])):
+            if not order > 0:
+                out[f"amp_{name}_order"] = nan
+            elif label in named:    # the value the summary prints (`spectra.named_peaks`)
+                out[f"amp_{name}_order"] = named[label]
+            else:
+                out[f"amp_{name}_order"] = amplitude_at_order(ds, order)
     if "mode_frequency" in ds:
         out["mesh_mode_frequency"] = float(ds.attrs["mesh_mode_frequency_hz"])
         out["mesh_mode_damping"] = float(ds.attrs["mesh_mode_damping"])
@@ -59,6 +66,20 @@ def summarize_sweep(ds: xr.Dataset) -> dict:
     from study.sweep.outputs import SCALARS, STATUS
     ok = ds["status"] == STATUS.index("ok")
     return {k: ds[k].where(ok) for k in SCALARS if k in ds.data_vars}
+
+
+def flank_side(ds: xr.Dataset) -> float:
+    """+1 when the static load drives on the drive flanks, -1 on the coast flanks (a negative
+    torque): the side of the backlash offset the elastic TE is measured from."""
+    return -1.0 if ds.attrs.get("static_torque_N_m", 1.0) < 0 else 1.0
+
+
+def named_amplitudes(ds: xr.Dataset) -> dict:
+    """DTE amplitude [um] of each named order of the archive's peak table (NaN where no peak
+    is resolved), by name ('Z', '2Z', 'N', ...); {} without the table."""
+    if "dte_peak_amplitude" not in ds:
+        return {}
+    return {str(n): float(a) for n, a in zip(ds["dte_peak"].values, ds["dte_peak_amplitude"].values)}
 
 
 def amplitude_at_order(ds: xr.Dataset, order: float, half_width: float = 0.5) -> float:

@@ -276,10 +276,11 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
 
     Blue lines: hole order N and harmonics; red: mesh order Z and harmonics; green dotted:
     sidebands kZ +- jN (those the record resolves); purple triangles: the largest peaks no named order explains."""
-    has_dte = "dte_amplitude" in ds and "order" in ds.coords
+    # (a run at dynamic.speed = 0 has no orders: its DTE spectrum has no order axis to draw on)
+    has_dte = "dte_amplitude" in ds and "order" in ds.coords and bool(np.isfinite(ds["order"].values).any())
     has_ste = "ste_amplitude" in ds
     if not (has_dte or has_ste):
-        raise KeyError("dataset lacks dte_amplitude and ste_amplitude")
+        raise KeyError("no STE spectrum, and no DTE spectrum over orders (driver speed 0)")
     z = float(ds.attrs.get("mesh_order", 0.0)) or 100.0
     nrow = int(has_dte) + int(has_ste)
     fig, axes = plt.subplots(nrow, 1, figsize=(13, 3.8 * nrow + 1.0), constrained_layout=True, squeeze=False)

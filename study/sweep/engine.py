@@ -250,7 +250,25 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=logging.ERROR, env=dict(WORKER_ENV))
     with cluster, Client(cluster) as client:
+        client.register_plugin(stop_kernels_plugin(), name="lightgear-stop-kernels")
         yield client
+
+
+def stop_kernels_plugin():
+    """Dask worker plugin: a worker of the LocalCluster that closes (its client stopped by
+    Ctrl-C or SIGTERM) stops the kernel it runs (`solver.mbs.interrupt.stop_all`) instead of
+    finishing the point first. (Not installed on an existing cluster: its workers outlive the
+    client, and the scheduler drops the client's tasks.)"""
+    from distributed import WorkerPlugin
+
+    class StopKernels(WorkerPlugin):
+        def teardown(self, worker):
+            import gc
+
+            from solver.mbs import interrupt
+            interrupt.stop_all()
+            gc.freeze()     # the process ends: no final collection of every object (seconds)
+    return StopKernels()
 
 
 def body_group(scene: Scene) -> str:
@@ -366,18 +384,22 @@ class SweepResult:
 
 
 def run_sweep(study: Study, output: str | Path, workers: int | None = None, scheduler: str | None = None,
-              progress: bool = True, keep_parts: bool = False) -> SweepResult:
+              progress: bool = True, keep_parts: bool = False, max_time: float | None = None) -> SweepResult:
     """Compute the study's missing tasks, store each as it arrives, write the archive atomically.
 
     ``workers=0``: in this process; None: one dask worker per core; ``scheduler``: an existing
     dask cluster. The part files are removed once the archive holds every point (unless
-    ``keep_parts``).
+    ``keep_parts``). ``max_time`` [s]: refuse (`study.errors.BudgetError`, before any work) a
+    study too large to list or whose missing tasks are estimated to take longer in all
+    (`study.estimate.sweep_estimate`, CPU seconds summed over the tasks).
     """
     from tqdm import tqdm
 
+    from study import estimate
     from study.report.results import write_netcdf
 
     t0 = time.perf_counter()
+    estimate.check_study_size(study, max_time)
     points = check_points(study)
     out = study.outputs
     n_invalid = sum(p.scene is None for p in points)
@@ -394,6 +416,8 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
         else:
             todo[key] = task.scene
     reused = len(results)
+    if max_time is not None and todo:
+        estimate.check_time(estimate.sweep_estimate([tasks[k] for k in todo]), max_time)
     lost = {}
     todo = interleave(todo)
     if todo:

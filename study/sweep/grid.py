@@ -56,6 +56,7 @@ from study.scene import (
     SceneError,
     default_scene_text,
     get_dotted,
+    read_text,
     scene_fields_from_dict,
     scene_from_dict,
     scene_path,
@@ -236,6 +237,9 @@ def _check_value(base: dict, path: str, value, where: str):
         raise SceneError(e.field, f"{where} value {value!r}: {e.reason}") from None
 
 
+MAX_AXIS_VALUES = 100_000     # values of one grid axis (each is checked against the scene: ~ms)
+
+
 def _axis_values(base: dict, path: str, spec) -> tuple:
     kind = _field_kind(base, path)
     if isinstance(spec, dict):
@@ -247,6 +251,9 @@ def _axis_values(base: dict, path: str, spec) -> tuple:
         num = spec["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             raise SceneError(path, f"range num must be a positive integer, got {num!r}")
+        if num > MAX_AXIS_VALUES:     # each value is checked against the scene: refused before
+            raise SceneError(path, f"range num = {num} values on one axis, more than the {MAX_AXIS_VALUES} a study "
+                                   "can check and list: sweep fewer values")
         for k in ("start", "stop"):
             if isinstance(spec[k], bool) or not isinstance(spec[k], (int, float)):
                 raise SceneError(path, f"range {k} must be a number, got {spec[k]!r}")
@@ -275,7 +282,7 @@ def _base_scene(spec, folder: Path | None) -> dict:
             p = folder / p
         p = scene_path(p)      # a file, or an embedded scene by name
         try:
-            return tomllib.loads(p.read_text())
+            return tomllib.loads(read_text(p))
         except tomllib.TOMLDecodeError as e:
             raise SceneError("scene", f"{p} is not valid TOML: {e}") from None
 
@@ -333,6 +340,7 @@ def _loads_study(text: str, folder: str | Path | None = None) -> Study:
                                    "not [[points]]")
     if not axes and not points and not sample:
         raise SceneError("grid", "the study sweeps nothing: give a [grid] table, [[points]] or a [sample]")
+    check_swept_together([[a.path for a in axes]] + [list(pt) for pt in points], outputs_from_table(raw.get("outputs", {})))
     seen = {}
     for path in dict.fromkeys([a.path for a in axes] + [q for pt in points for q in pt]):
         if dim_name(path) in seen:
@@ -342,13 +350,45 @@ def _loads_study(text: str, folder: str | Path | None = None) -> Study:
                  outputs_from_table(raw.get("outputs", {})), sample)
 
 
+# scene fields that set the axis of a curve output (its length and spacing): a curve is
+# archived on one axis for the whole study, so a study cannot sweep them and ask for the curve
+CURVE_AXIS_FIELDS = {
+    "ste": ("quasi_static.rotation", "quasi_static.angle_step"),
+    "mesh_stiffness": ("quasi_static.rotation", "quasi_static.angle_step"),
+    "dte": ("dynamic.duration", "dynamic.output_step"),
+    "dte_amplitude": ("dynamic.duration", "dynamic.output_step", "dynamic.ramp_time", "dynamic.spectrum_start"),
+}
+
+
+def check_swept_together(groups, outputs: Outputs) -> None:
+    """SceneError for swept fields that cannot vary together or with the asked outputs: a
+    damper given two ways in one group of fields that are set together (the grid's axes, or
+    one explicit point: a point takes the one set last, the other axis would do nothing), or a
+    field that sets the axis of an asked-for curve."""
+    from study.damping import damping_partner
+    for group in groups:
+        for path in group:
+            partner = damping_partner(path.split("."))
+            if partner and f"{path.rsplit('.', 1)[0]}.{partner}" in group:
+                other = f"{path.rsplit('.', 1)[0]}.{partner}"
+                raise SceneError(path, f"the study sweeps both {path} and {other}, which exclude each other (a point "
+                                       "takes the one set last, the other axis would change nothing): sweep one of them")
+    paths = list(dict.fromkeys(p for group in groups for p in group))
+    for name in outputs.curves:
+        for path in CURVE_AXIS_FIELDS.get(name, ()):
+            if path in paths:
+                raise SceneError(path, f"the curve {name!r} is archived on one axis for the whole study, and "
+                                       f"{path} changes that axis from point to point: ask only for scalars "
+                                       "(outputs.curves = []) or run one study per value")
+
+
 def load_study(path: str | Path) -> Study:
     """A study file, or an embedded study by name (``"sensitivity"``), read and checked."""
     try:
         p = scene_path(path, "study")
     except SceneError as e:
         raise StudyError(e.field, e.reason) from None
-    return loads_study(p.read_text(), p.parent)
+    return loads_study(read_text(p, "study"), p.parent)
 
 
 def dumps_study(raw: dict) -> str:

@@ -23,15 +23,18 @@ from solver.fe.ltca import ltca_sweep, mesh_points
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
 from study.scene import Scene, SceneError
-from study.setup import geometry_model, static_rotation
+from study.setup import geometry_model
 
 
 def static_angles(scene: Scene, step_deg: float | None = None) -> np.ndarray:
     """Driver angles [rad]: the scene's quasi-static rotation (whole periods of its pitch errors
     and eccentricities: `study.setup.static_rotation`) at its step (or ``step_deg``)."""
+    from study.estimate import check_static_memory
     qs = scene.quasi_static
     step = qs.angle_step if step_deg is None else step_deg
-    n = int(math.floor(static_rotation(scene) / step + 1e-9)) + 1
+    if not (math.isfinite(step) and step > 0):
+        raise SceneError("--step", f"the driver angle step must be a positive number of degrees, got {step}")
+    n = int(check_static_memory(scene, step, factor=4.0, field="quasi_static.angle_step" if step_deg is None else "--step"))
     return np.radians(np.arange(n) * step)
 
 

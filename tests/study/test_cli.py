@@ -28,7 +28,8 @@ def small_scene(tmp_path_factory):
     (["dynamic.duration=0.015"], "dynamic.duration", "twice dynamic.ramp_time"),
     (["dynamic.torque=1e6"], "dynamic.torque", "implausible load"),
     (["quasi_static.torque=1e9", "dynamic.enabled=false"], "quasi_static.torque", "implausible load"),
-    (["gear1.spring.k_phi=1060", "gear2.spring.k_phi=1060"], "quasi_static.torque", "implausible load"),
+    (["gear1.spring.k_phi=1060", "gear2.spring.k_phi=1060", "coupling.model=paper"], "quasi_static.torque",
+     "implausible load"),
 ])
 def test_bad_scenes_exit_2_naming_the_field_before_any_output(overrides, field, words, tmp_path, capsys):
     out = tmp_path / "x.nc"

@@ -144,7 +144,9 @@ def test_small_pair_end_to_end_gives_the_lightest_body_its_figure_and_archives(t
     with xr.open_dataset(out / "refine.nc") as fine, xr.open_dataset(out / "solid.nc") as solid:
         assert fine["hole_radius"].values.tolist() == [2.5]             # half-way to the lighter neighbour
         assert float(solid["root_stress_ratio_gear2"].squeeze()) == 1.0 and float(solid["mass_saving_gear2"]) == 0.0
-    with xr.open_dataset(out / "coarse.nc") as coarse:
+    with xr.open_dataset(out / "coarse.nc") as coarse, xr.open_dataset(out / "solid.nc") as solid:
+        # the solid reference runs by the model the lightened bodies run
+        assert solid.attrs["coupling_model"] == coarse.attrs["coupling_model"] == "compliance"
         best = coarse.sel(hole_radius=3.0).squeeze()
         assert f"save {float(best['mass_saving_gear2']):.1f} % mass" in said
         assert f"root stress {float(best['root_stress_max_gear2']):.1f} MPa" in said

@@ -25,6 +25,14 @@ the tip deviation plus slope*TIP_BLEND*(1 - exp(-(u - u_tip)/TIP_BLEND)), u the 
 roll parameter beyond the tip: the penetration is C1 across the switch and differs from the
 plain corner's by at most slope*TIP_BLEND (below 1 nm for any relief steeper than real ones).
 
+Local compliance in series with the contact (gear_par CLOC_*, compliance model only): a contact
+at rolls (u1, u2) has c_loc = c1(u1) + c2(u2) [m/N] (a tip corner: its gear's value at the tip)
+in series with the contact law (`laws.series_contact`). Since c_loc changes with the rolls, the
+potential of the series spring depends on the state through it too: d E/d c_loc = -F_e**2/2 at
+fixed penetration, so the recorded gradient is G - F_e**2/(2F) * d c_loc/dq (exact for flank
+contacts; a tip corner takes the roll derivative of the flank contact it continues, its own
+differs by the corner's slide along the flank, a small energy leak where c_loc's slope is).
+
 Pitch errors and eccentricity (`solver.errors`, the pair_par block E_*, present only when a
 gear has them): each tooth's axis turns by its offset eps about the teeth's centre, which sits
 off the bearing axis by the eccentricity; the flanks follow exactly, the moment arms of the hub
@@ -48,7 +56,7 @@ import numpy as np
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
 from solver.mbs.kernels.contact import cross, flank_flank, moved_center, point_flank, tip_corner, wrap
-from solver.mbs.kernels.laws import contact_force, contact_tangent, spring_tangent, spring_torque
+from solver.mbs.kernels.laws import contact_force, contact_tangent, series_contact, signed_pow, spring_tangent, spring_torque
 
 # roll-parameter length [-] over which a modified tip corner blends into its flank (see above)
 TIP_BLEND = 1e-6
@@ -100,28 +108,45 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def flank_deviation(row, u):
-    """Deviation [m] of the flanks of the gear whose gear_par row is ``row`` at roll parameter
-    u, and its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV
-    grid, so that the slope is continuous (Newton in the statics does not chatter across grid
-    nodes) and linear stretches are exact; constant beyond the grid's ends."""
-    x = (u - row[L.DEV_U0]) / row[L.DEV_DU]
-    last = L.N_DEV - 1
+def _catmull_rom(row, u, u0, du, first, n):
+    """Value and slope d/du of the cubic Hermite (Catmull-Rom) curve through the n values
+    row[first:first + n] on the grid u0 + i*du: the slope is continuous (Newton in the statics
+    does not chatter across grid nodes) and linear stretches are exact; constant beyond the
+    grid's ends."""
+    x = (u - u0) / du
+    last = n - 1
     if x <= 0.0:
-        return row[L.DEV0], 0.0
+        return row[first], 0.0
     if x >= last:
-        return row[L.DEV0 + last], 0.0
+        return row[first + last], 0.0
     i = int(x)
     t = x - i
-    p1 = row[L.DEV0 + i]
-    p2 = row[L.DEV0 + i + 1]
-    m1 = p2 - p1 if i == 0 else 0.5 * (p2 - row[L.DEV0 + i - 1])
-    m2 = p2 - p1 if i + 1 == last else 0.5 * (row[L.DEV0 + i + 2] - p1)
+    p1 = row[first + i]
+    p2 = row[first + i + 1]
+    m1 = p2 - p1 if i == 0 else 0.5 * (p2 - row[first + i - 1])
+    m2 = p2 - p1 if i + 1 == last else 0.5 * (row[first + i + 2] - p1)
     t2 = t * t
     t3 = t2 * t
     dev = (2.0 * t3 - 3.0 * t2 + 1.0) * p1 + (t3 - 2.0 * t2 + t) * m1 + (3.0 * t2 - 2.0 * t3) * p2 + (t3 - t2) * m2
     dx = (6.0 * t2 - 6.0 * t) * (p1 - p2) + (3.0 * t2 - 4.0 * t + 1.0) * m1 + (3.0 * t2 - 2.0 * t) * m2
-    return dev, dx / row[L.DEV_DU]
+    return dev, dx / du
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def flank_deviation(row, u):
+    """Deviation [m] of the flanks of the gear whose gear_par row is ``row`` at roll parameter
+    u, and its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV
+    grid (`_catmull_rom`)."""
+    return _catmull_rom(row, u, row[L.DEV_U0], row[L.DEV_DU], L.DEV0, L.N_DEV)
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def local_compliance(row, u):
+    """Local compliance [m/N] of the gear whose gear_par row is ``row`` at roll parameter u and
+    its slope d c_loc/d u [m/N]: the same Catmull-Rom curve through the CLOC grid (a continuous
+    slope: the force term of c_loc's change along the profile has no jump at grid nodes, and
+    the slope is the exact derivative of what is read, so the series spring stays conservative)."""
+    return _catmull_rom(row, u, row[L.CLOC_U0], row[L.CLOC_DU], L.CLOC0, L.N_CLOC)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -183,7 +208,7 @@ def _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend):
+def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
     flank-flank case), -1 when gear 2 does; ids = (gear-1 tooth, gear-2 tooth, kind);
@@ -191,7 +216,9 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend):
     phi_B') [rad/s]. The gradient G = d delta/d(theta1, phi_A, theta2, phi_B): the owner's
     entries +(x - centre) x n, the other gear's negative, plus dg, the same four of the flank
     deviations' part [m]. blend = (c [1/m], v [-]): the curvature d2 delta/dq2 = c * v v^T of a
-    modified tip corner's blend into its flank (c = 0 otherwise), stored times the force."""
+    modified tip corner's blend into its flank (c = 0 otherwise), stored times the force.
+    ser = (c_loc [m/N], -d c_loc/d(theta1, phi_A, theta2, phi_B) [m/N]): the local compliance in
+    series with the contact law (0 and zeros: the plain law)."""
     delta, px, py, nx, ny = hit
     o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
     w1, wa, w2, wb = vel
@@ -200,8 +227,29 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend):
     g2 = -own * cross(px - o2x, py - o2y, nx, ny) + dg[2]
     gb = -own * cross(px - pvbx, py - pvby, nx, ny) + dg[3]
     ddelta = g1 * w1 + ga * wa + g2 * w2 + gb * wb
-    f = contact_force(delta, ddelta, lp[L.K_CON], lp[L.M1], lp[L.C_CON], lp[L.M2], lp[L.M3])
+    cl, gc = ser
+    if cl == 0.0:
+        f = contact_force(delta, ddelta, lp[L.K_CON], lp[L.M1], lp[L.C_CON], lp[L.M2], lp[L.M3])
+        dcon = delta
+        kt = contact_tangent(delta, lp[L.K_CON], lp[L.M1])
+    else:
+        dcon, fe, kt = series_contact(delta, cl, lp[L.K_CON], lp[L.M1])
+        f = fe
+        if lp[L.C_CON] != 0.0:
+            f += lp[L.C_CON] * signed_pow(ddelta, lp[L.M2]) * delta ** lp[L.M3]
+        if f > 0.0:
+            # the series spring's energy also changes with c_loc along the profile (gc is
+            # -d c_loc/dq, as `_deviation_gradient` gives a deviation's effect on the penetration)
+            w = 0.5 * fe * fe / f
+            g1 += w * gc[0]
+            ga += w * gc[1]
+            g2 += w * gc[2]
+            gb += w * gc[3]
+        else:
+            f = 0.0
     rec[nc, L.C_DELTA] = delta
+    rec[nc, L.C_DCON] = dcon
+    rec[nc, L.C_CLOC] = cl
     rec[nc, L.C_DDELTA] = ddelta
     rec[nc, L.C_FORCE] = f
     rec[nc, L.C_G1] = g1
@@ -212,7 +260,7 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend):
     rec[nc, L.C_PY] = py
     rec[nc, L.C_NX] = nx
     rec[nc, L.C_NY] = ny
-    rec[nc, L.C_KT] = contact_tangent(delta, lp[L.K_CON], lp[L.M1])
+    rec[nc, L.C_KT] = kt
     rec[nc, L.C_TOOTH1], rec[nc, L.C_TOOTH2], rec[nc, L.C_KIND] = ids
     rec[nc, L.C_KGEO] = f * blend[0]
     rec[nc, L.C_DG1], rec[nc, L.C_DGA], rec[nc, L.C_DG2], rec[nc, L.C_DGB] = blend[1]
@@ -240,6 +288,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     te = gp[0, L.RB] * theta1 + gp[1, L.RB] * theta2
     bound = s * te - pp[L.JN_HALF] + abs(pa) * gp[0, L.R_BND] + abs(pb) * gp[1, L.R_BND]
     modified = gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0
+    series = gp[0, L.CLOC_ON] + gp[1, L.CLOC_ON] > 0.0
     if modified:
         bound += gp[0, L.DEV_NEG] + gp[1, L.DEV_NEG]
     errs = pp.shape[0] > L.N_PAIR_PAR
@@ -283,8 +332,13 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             delta -= da + db
             dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
         if delta > 0.0 and nc < rec.shape[0]:
+            ser = (0.0, (0.0, 0.0, 0.0, 0.0))
+            if series:
+                c1, s1 = local_compliance(gp[0], ua)
+                c2, s2 = local_compliance(gp[1], ub)
+                ser = (c1 + c2, _deviation_gradient(s1, s2, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
             # owner A (gear 1)
-            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg))
+            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg), ser)
             nc += 1
         return nc
     flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
@@ -314,8 +368,14 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
                     dg = (sw * du[0], sw * du[1], sw * du[2], sw * du[3])
                     blend = sw / TIP_BLEND
             if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
+                ser = (0.0, (0.0, 0.0, 0.0, 0.0))
+                if series:
+                    cf, sf = local_compliance(gp[f], uf)
+                    ser = (local_compliance(gp[g], gp[g, L.U_HI])[0] + cf,
+                           _deviation_gradient(sf if f == 0 else 0.0, sf if f == 1 else 0.0, s,
+                                               (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
                 _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
-                        frame, vel, lp, dg, (blend, du))
+                        frame, vel, lp, dg, (blend, du), ser)
                 nc += 1
     return nc
 

@@ -33,7 +33,15 @@ DEV_DU = 23     # grid step [-]
 DEV_NEG = 24    # bound on the material addition (-min deviation, >= 0, plus the cubic's undershoot) [m]
 DEV0 = 25       # first of the N_DEV deviations [m]
 N_DEV = 257
-N_GEAR_PAR = DEV0 + N_DEV
+# local tooth compliance in series with the contact law (compliance model; `laws.series_contact`):
+# the FE tooth's own compliance less the rigid tooth's on its pivot, [m/N] on N_CLOC roll
+# parameters from the form circle to the tip, read piecewise linearly at the contact's roll
+CLOC_ON = DEV0 + N_DEV  # 1: the gear has a local compliance table (0: c_loc = 0, the plain law)
+CLOC_U0 = CLOC_ON + 1   # roll parameter of the first grid point [-]
+CLOC_DU = CLOC_ON + 2   # grid step [-]
+CLOC0 = CLOC_ON + 3     # first of the N_CLOC compliances [m/N]
+N_CLOC = 33
+N_GEAR_PAR = CLOC0 + N_CLOC
 
 # law_par (contact law, eq. 1.3)
 K_CON = 0       # [N/m^m1]
@@ -88,7 +96,11 @@ C_H1 = 23       # d v_s / d theta1' [m]: lever arm of t about O1
 C_HA = 24       # d v_s / d phi' of the gear-1 tooth [m]
 C_H2 = 25       # d v_s / d theta2' [m]
 C_HB = 26       # d v_s / d phi' of the gear-2 tooth [m]
-N_C_COLS = 27
+# series compliance (`laws.series_contact`): C_DELTA is the penetration of the whole series
+# spring, C_DCON the contact law's own share of it; equal where c_loc = 0
+C_DCON = 27     # penetration of the contact law [m]
+C_CLOC = 28     # local compliance c_loc1(u1) + c_loc2(u2) in series with the contact law [m/N]
+N_C_COLS = 29
 MAX_CONTACTS = 64
 
 # ---- the time-stepping kernels (`stepping`, `explicit`, `explicit_coupled`, `implicit`)
@@ -105,7 +117,8 @@ ENERGY_TOL = 8      # relative energy growth that stops a run [-]
 HHT_ALPHA = 9       # HHT-alpha parameter [-]
 NEWTON_TOL = 10     # Newton stops when no flank point moves more than this [m]
 IMEX = 11           # 1: the linear tooth-root dampers taken implicitly in the Verlet kicks (`explicit`)
-N_PAR = 12
+ABORT = 12          # nonzero: stop at the end of the step (set from another thread: `solver.mbs.interrupt`)
+N_PAR = 13
 # control integers: int array ``ipar``
 N_STEPS = 0
 OUT_EVERY = 1       # steps per output record
@@ -167,7 +180,8 @@ S_TORQUE = 0        # resisting torque on gear 2 [N m]
 S_THETA2 = 1        # driven angle at the first driver angle, the start guess [rad]
 S_TOL = 2           # residual tolerance relative to the torque [-]
 S_W1 = 3            # driver speed [rad/s] that sets the kinematic sliding speed of the friction (0: none)
-N_S_PAR = 4
+S_ABORT = 4         # nonzero: stop before the next driver angle (`solver.mbs.interrupt`)
+N_S_PAR = 5
 # control integers: int array ``ipar``
 S_MAX_ITER = 0      # Newton iterations per angle
 N_S_IPAR = 1

@@ -7,7 +7,7 @@ tooth_compliance) as the stepping kernels take them. SI units.
 """
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
-from solver.mbs.kernels.laws import contact_energy, signed_pow, spring_energy
+from solver.mbs.kernels.laws import contact_energy, series_energy, signed_pow, spring_energy
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -99,7 +99,10 @@ def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
         ke += gp[g, L.I_CPL] * w * dphi[i] + 0.5 * gp[g, L.I_P] * dphi[i] * dphi[i]
         pe += spring_energy(phi[i], kphi[i], gp[g, L.N_K])
     for c in range(nc):
-        pe += contact_energy(rec[c, L.C_DELTA], lp[L.K_CON], lp[L.M1])
+        if rec[c, L.C_CLOC] == 0.0:
+            pe += contact_energy(rec[c, L.C_DELTA], lp[L.K_CON], lp[L.M1])
+        else:
+            pe += series_energy(rec[c, L.C_DCON], rec[c, L.C_CLOC], lp[L.K_CON], lp[L.M1])
     return ke, pe
 
 

@@ -194,13 +194,13 @@ def _store(out, force1, a, rec, nc, row):
     out[a, L.S_T1] = t1
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, nogil=True, no_cfunc_wrapper=True)
 def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     """Equilibrium at each driver angle theta1s[a] [rad].
 
     mdl: (gear_par, pair_par, law_par, k_phi); ctl: (par, ipar) with the `layout` S_*
     columns (resisting torque [N m], start guess of theta2 [rad], tolerance, driver speed of
-    the friction's sliding [rad/s]; Newton iterations). ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth
+    the friction's sliding [rad/s], abort flag; Newton iterations). ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth
     are coupled through the body (`toothcoupling`; its k_phi are then zero), or None. The
     coupled code sits under ``if ctooth is not None`` (and ``ks``) so that numba prunes it
     from the plain model's compiled version (a switch inside a tuple would not be pruned).
@@ -208,7 +208,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     phi (Z1+Z2) is the start guess and is updated in place. Writes out[a, S_*] (TE [m],
     theta2 [rad], loaded contacts, Newton iterations, negative when not converged) and the
     force on each gear-1 tooth [N] force1[a, k]. Returns the number of angles that did not
-    converge.
+    converge. Stops before the next angle once par[S_ABORT] is set (from another thread:
+    `solver.mbs.interrupt`); the angles not reached keep their zero rows.
     """
     gp, pp, lp, _kphi = mdl
     par, ipar = ctl
@@ -242,6 +243,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     nc = np.int64(0)        # not a literal 0: numba would compile the callees once more for it
     npair = np.int64(0)
     for a in range(theta1s.shape[0]):
+        if par[L.S_ABORT] != 0.0:
+            break
         theta1 = theta1s[a]
         if a > 0:
             theta2 -= rb1 / rb2 * (theta1s[a] - theta1s[a - 1])

@@ -3,7 +3,8 @@ status codes, work arrays, the active-tooth set, and the end of a step (guards, 
 bookkeeping, output records).
 
 Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy growth,
-4 Newton failure (implicit).
+4 Newton failure (implicit), 5 interrupted (par[ABORT] set from another thread, checked at
+the end of every step: `solver.mbs.interrupt`).
 
 Teeth away from the mesh are left out of the integration, rigid to their hub; a tooth joins
 the set when the pre-search names it a candidate and leaves it once it is outside the
@@ -28,6 +29,7 @@ NONFINITE = 1
 PENETRATION = 2
 ENERGY = 3
 NEWTON = 4
+INTERRUPTED = 5
 
 
 def work_arrays(ntooth):
@@ -92,10 +94,13 @@ def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     acceleration jumps) and dissipation power p_d [W]; sets the quiet teeth outside the
     candidates exactly to rest (rotation, rate, acceleration and generalised force zero: rigid
     to the hub, whose inertia already holds them) and drops them from the set; resets the
-    candidate flags of the npair pre-search pairs (gear-2 teeth offset by tz2). Returns (status, new number of active teeth).
+    candidate flags of the npair pre-search pairs (gear-2 teeth offset by tz2); status
+    INTERRUPTED once par[ABORT] is set. Returns (status, new number of active teeth).
     """
     rec, pairs, q, tset, book = ws[0], ws[1], ws[2], ws[4], ws[5]
     p_in_left, p_in, p_d = powers
+    if par[L.ABORT] != 0.0:
+        status = INTERRUPTED
     for c in range(nc):
         if rec[c, L.C_FORCE] > book[L.B_FMAX]:
             book[L.B_FMAX] = rec[c, L.C_FORCE]

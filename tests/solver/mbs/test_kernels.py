@@ -88,7 +88,7 @@ def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
         n = angles.size
         res = (np.zeros((n, L.N_S_OUT)), np.zeros((n, m.teeth[0])))
         phi = np.zeros(m.n_teeth)
-        ctl = (np.array([50.0, theta2, 1e-10, 0.0]), np.array([60]))
+        ctl = (np.array([50.0, theta2, 1e-10, 0.0, 0.0]), np.array([60]))     # (S_ABORT last)
         fails = f((m.gear_par, m.pair_par, m.law_par, m.k_phi), None, ctl, angles, phi, *res)
         assert fails == 0
         out.append((*res, phi))

@@ -6,7 +6,7 @@ import pytest
 from PIL import Image
 
 from study.cli import main
-from tests.conftest import solid_scene
+from tests.conftest import SMALL_LIGHTENED, solid_scene
 
 
 def test_dynamic_factor_is_one_near_zero_speed_and_tooth_forces_carry_the_load():
@@ -29,17 +29,9 @@ def test_dynamic_factor_is_one_near_zero_speed_and_tooth_forces_carry_the_load()
     assert np.all(ds["dte_contact_tooth2"].values[ds["dte_contact_force"].values > 0] >= 0)
 
 
-# a small lightened pair (24 teeth, m 2 mm, a coarse FE body) whose driven gear takes 8 holes
-SMALL_LIGHTENED = {
-    "gear1.module": 2.0, "gear1.teeth": 24, "gear2.module": 2.0, "gear2.teeth": 24,
-    "gear1.body.rim_height": 3.0, "gear1.body.web_height": 12.0, "gear1.body.hub_height": 3.0,
-    "gear1.body.web_thickness": 17.0, "gear1.body.holes": 0,
-    "gear2.body.rim_height": 3.0, "gear2.body.web_height": 12.0, "gear2.body.hub_height": 3.0,
-    "gear2.body.web_thickness": 8.0, "gear2.body.holes": 8, "gear2.body.hole_radius": 3.0,
-    "gear2.body.hole_circle_radius": 12.5, "fe.mesh_size": 1.0,
-    "quasi_static.rotation": 30.0, "quasi_static.angle_step": 0.25,
-    "dynamic.ramp_time": 0.002, "dynamic.duration": 0.01,
-}
+# the small lightened pair, with short runs
+SMALL_RUN = {**SMALL_LIGHTENED, "quasi_static.rotation": 30.0, "quasi_static.angle_step": 0.25,
+             "dynamic.ramp_time": 0.002, "dynamic.duration": 0.01}
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +39,7 @@ def eight_holes(tmp_path_factory):
     """`lightgear run` of the embedded paper scene (its free-text title says 6 holes) with
     ``--set gear2.body.holes=8`` on a small pair, and every figure `lightgear render` draws."""
     out = tmp_path_factory.mktemp("h8")
-    args = ["run", "-o", str(out / "h8.nc")] + [a for k, v in SMALL_LIGHTENED.items() for a in ("--set", f"{k}={v}")]
+    args = ["run", "-o", str(out / "h8.nc")] + [a for k, v in SMALL_RUN.items() for a in ("--set", f"{k}={v}")]
     assert main(args) == 0
     assert main(["render", str(out / "h8.nc")]) == 0
     return out

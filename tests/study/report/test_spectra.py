@@ -104,7 +104,8 @@ def test_dte_spectrum_in_the_archive_has_orders_and_named_peaks():
     t = np.arange(int(round(T / dt)) + 1) * dt
     te = 40e-6 + 0.3e-6 * np.sin(2 * np.pi * z * f_rot * t) + 0.05e-6 * np.sin(2 * np.pi * n_holes * f_rot * t)
     res = SimpleNamespace(time=t, te=te, force_max=np.zeros_like(t), n_contacts=np.zeros(t.size, int),
-                          driver_torque=np.zeros_like(t), energy_error=np.zeros_like(t), status=0, dt=dt,
+                          driver_torque=np.zeros_like(t), energy_error=np.zeros_like(t), potential=np.zeros_like(t),
+                          dissipated=np.zeros_like(t), status=0, dt=dt,
                           steps=t.size, omega_max=1.0, message="ok", max_active_teeth=4)
     coords, data, _ = results.dynamic_variables(res, 0.02, speed, n_holes, z)
     order = coords["order"].values

@@ -34,14 +34,18 @@ def test_the_default_model_of_a_lightened_pair_agrees_with_the_fe_reference():
 
 
 def test_the_relief_that_minimises_the_ste_agrees_with_the_fe_reference():
+    """At a light and a heavy load: the compliance model's optimum relief within the target of
+    the FE reference's, its STE within the targets without relief (the local tooth compliance
+    in series with the contact is what gets the heavy load's optimum right)."""
     scene = solid_scene(default_scene().replace(**SMALL_PAIR))
-    ds = mv.relief_dataset({"small": scene}, reliefs=(0.0, 2.0, 4.0, 6.0), torques=(25.0,),
+    ds = mv.relief_dataset({"small": scene}, reliefs=(0.0, 2.0, 4.0, 6.0, 8.0, 10.0), torques=(25.0, 100.0),
                            rotations={"small": 15.0}, step=0.25, models=("fe-reference", "compliance"))
-    opt = ds["optimum_relief"].sel(pair="small", torque=25.0)
-    p2p = ds["ste_p2p"].sel(pair="small", torque=25.0, model="fe-reference").values
-    assert p2p.min() < 0.5 * p2p[0]                               # the relief matters at this load
-    assert 2.0 < float(opt.sel(model="fe-reference")) < 6.0       # an optimum inside the grid, refined
-    assert abs(float(opt.sel(model="compliance") - opt.sel(model="fe-reference"))) < mv.TARGETS["relief_um"]
+    for torque in (25.0, 100.0):
+        opt = ds["optimum_relief"].sel(pair="small", torque=torque)
+        p2p = ds["ste_p2p"].sel(pair="small", torque=torque, model="fe-reference").values
+        assert p2p.min() < 0.7 * p2p[0]                           # the relief matters at this load
+        assert 0.0 < float(opt.sel(model="fe-reference")) < 10.0  # an optimum inside the grid, refined
+        assert abs(float(opt.sel(model="compliance") - opt.sel(model="fe-reference"))) < mv.TARGETS["relief_um"]
     assert mv.check_targets(ds.isel(relief=[0]), "compliance") == []
 
 

@@ -126,3 +126,15 @@ def test_stability_suite_subset_ends_ok_or_named():
         assert ds["te_min"].values[zt, 0] < 0 < ds["te_max"].values[zt, 0]
     # the scipy peer at 1 s of wall time stops with its named limit
     assert all(("wall-time limit" in m or s == "ok") for m, s in zip(msg[:, 2], st[:, 2]))
+
+
+def test_precision_runs_the_papers_model_and_refuses_a_coupled_one():
+    """The integrators it compares exist together for the paper's model only: the default
+    'auto' runs as 'paper', a coupled model named by the scene is refused before any work."""
+    import pytest
+
+    from study.commands import precision_scene
+    from study.scene import SceneError, default_scene
+    assert precision_scene(default_scene()).coupling_model == "none"
+    with pytest.raises(SceneError, match="coupling.model"):
+        precision_scene(default_scene().replace(**{"coupling.model": "compliance"}))

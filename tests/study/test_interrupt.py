@@ -1,0 +1,147 @@
+"""Ctrl-C (SIGINT) and SIGTERM stop the compiled loops: `run` and `sweep` (in process and on
+two dask workers) exit 130 within seconds, and a sweep keeps its finished tasks."""
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from solver.mbs import interrupt
+
+ROOT = Path(__file__).resolve().parents[2]
+# the example study's 20-tooth pair (uniform springs: no FE) at a time step a thousand times
+# below its stability bound: one run would take hours
+SMALL = """
+"gear1.teeth" = 20
+"gear2.teeth" = 20
+"gear1.body" = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0}
+"gear2.body" = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0, holes = 0}
+"gear2.spring.stiffness" = "uniform"
+"quasi_static" = {rotation = 6.0, angle_step = 0.5}
+"""
+STEP = "1e-10"
+STOP_WITHIN_S = 5.0
+
+
+def slow_study(folder: Path, step: str = STEP) -> Path:
+    path = folder / "slow.toml"
+    path.write_text(f'title = "slow"\n[scene]\n{SMALL}"dynamic" = {{duration = 0.01, ramp_time = 0.002, time_step = {step}}}\n'
+                    '[grid]\n"dynamic.speed" = [50.0, 60.0, 70.0]\n[outputs]\nscalars = ["ste_p2p", "dte_rms"]\n')
+    return path
+
+
+def small_scene(folder: Path) -> Path:
+    from study.sweep.grid import load_study
+    path = folder / "small.toml"
+    st = load_study(slow_study(folder, "0.0"))
+    path.write_text(st.points()[0].scene.to_toml())
+    return path
+
+
+def cli(args, cwd):
+    """``lightgear ARGS`` in a child process; its stdout and stderr go to cwd/out.txt, err.txt."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    with open(cwd / "out.txt", "w") as out, open(cwd / "err.txt", "w") as err:
+        return subprocess.Popen([sys.executable, "-m", "study.cli", *map(str, args)], cwd=cwd, env=env,
+                                stdout=out, stderr=err, text=True)
+
+
+def stop_after(proc, ready, sig, timeout=240.0):
+    """Wait until ``ready()`` (the loop is running), send ``sig``; (exit code, seconds to exit)."""
+    t_end = time.monotonic() + timeout
+    while not ready():
+        assert proc.poll() is None, "the command ended before it was stopped"
+        assert time.monotonic() < t_end, "the command never reached its time integration"
+        time.sleep(0.2)
+    time.sleep(1.0)         # well inside the loop
+    t0 = time.monotonic()
+    proc.send_signal(sig)
+    try:
+        proc.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+        pytest.fail(f"{sig!r} did not stop the command within 60 s")
+    return proc.returncode, time.monotonic() - t0
+
+
+# ---------------------------------------------------------------- the mechanism, in process
+
+def ctrl_c():
+    os.kill(os.getpid(), signal.SIGINT)
+
+
+def test_an_interrupt_stops_the_time_integration_within_a_step(paper_solid_model):
+    from solver.mbs.dynamics import simulate
+    timer = threading.Timer(1.5, ctrl_c)
+    t0 = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        # about 40 min of stepping at this step
+        simulate(paper_solid_model, 100.0, 0.01, 50.0, 0.01, 0.2, dt=1e-10, output_step=1e-4)
+    assert time.monotonic() - t0 < 1.5 + 1.0
+
+
+def test_an_interrupt_stops_the_statics_before_the_next_angle(paper_solid_model):
+    from solver.mbs.statics import solve_static
+    angles = np.radians(np.arange(0.0, 3600.0, 1e-3))        # 3.6 million angles: minutes
+    timer = threading.Timer(1.0, ctrl_c)
+    t0 = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        solve_static(paper_solid_model, angles, 50.0, raise_on_failure=False)
+    assert time.monotonic() - t0 < 1.0 + 1.0
+
+
+def test_stop_all_ends_a_running_kernel_and_refuses_new_ones(paper_solid_model, monkeypatch):
+    """What a closing dask worker does (`study.sweep.engine.stop_kernels_plugin`)."""
+    from solver.mbs.dynamics import simulate
+    monkeypatch.setattr(interrupt, "_stopping", threading.Event())
+    threading.Timer(1.0, interrupt.stop_all).start()
+    t0 = time.monotonic()
+    with pytest.raises(interrupt.Interrupted):
+        simulate(paper_solid_model, 100.0, 0.01, 50.0, 0.01, 0.2, dt=1e-10, output_step=1e-4)
+    assert time.monotonic() - t0 < 2.0
+    with pytest.raises(interrupt.Interrupted):
+        simulate(paper_solid_model, 100.0, 0.01, 50.0, 0.01, 0.2, output_step=1e-4)
+
+
+# ---------------------------------------------------------------- the command line
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_run_stops_on_a_signal(tmp_path, sig):
+    scene = small_scene(tmp_path)
+    proc = cli(["run", scene, "--no-static", "--set", f"dynamic.time_step={STEP}", "--max-time", "1e9",
+                "-o", tmp_path / "r.nc"], tmp_path)
+    # the progress bar of the time integration is on stderr
+    code, took = stop_after(proc, lambda: "dynamic run" in (tmp_path / "err.txt").read_text(), sig)
+    assert code == 130 and took < STOP_WITHIN_S
+    assert "interrupted" in (tmp_path / "err.txt").read_text() and not (tmp_path / "r.nc").exists()
+
+
+@pytest.mark.parametrize("workers", [0, 2])
+def test_sweep_stops_on_sigint_and_sigterm_and_resumes(tmp_path, workers):
+    study = slow_study(tmp_path)
+    fast = tmp_path / "fast"
+    fast.mkdir()
+    fast = slow_study(fast, "0.0")
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        out = tmp_path / f"{sig.name}.nc"
+        parts = tmp_path / f".{sig.name}.nc.parts"
+        proc = cli(["sweep", study, "-o", out, "--workers", workers, "--no-progress"], tmp_path)
+        # the static task (shared by the three speeds) is stored first; the dynamic ones then run
+        code, took = stop_after(proc, lambda: parts.is_dir() and any(parts.glob("*.pkl")), sig)
+        err = (tmp_path / "err.txt").read_text()
+        assert code == 130 and took < STOP_WITHIN_S, err
+        assert "interrupted" in err and not out.exists()
+        assert len(list(parts.glob("*.pkl"))) == 1
+        # resumable: the same study at a sane step reuses the stored static task
+        done = cli(["sweep", fast, "-o", out, "--workers", 0, "--no-progress"], tmp_path)
+        assert done.wait(timeout=600) == 0, (tmp_path / "err.txt").read_text()
+        text = (tmp_path / "out.txt").read_text()
+        assert "computed 3, reused 1" in text and "ok 3" in text
