@@ -129,7 +129,7 @@ def cheap_study_row(speeds: int) -> dict:
                      f"{n / wall:.1f} points/s; load {load()}")
 
 
-NO_16 = "not measured (no 16-core machine in this session)"
+NO_16 = "not measured (no 16-core machine was at hand for it)"
 SIXTEEN_CORE_ROWS = [
     dict(target="standard study, FE cache warm, empty numba cache, 16 workers", unit="s wall",
          note="target: <= the warm-cache study + one compile"),
