@@ -39,3 +39,21 @@ def swept(tmp_path_factory):
     Tests only read it (and copy the archive before they change anything)."""
     out = tmp_path_factory.mktemp("sweep") / "tiny.nc"
     return run_sweep(tiny_study(), out, workers=0, progress=False), out
+
+
+def count_points(monkeypatch, stop_after: int | None = None) -> list:
+    """Patch `study.sweep.engine.run_point` to record each point's scene in the returned list,
+    and, with ``stop_after``, to raise KeyboardInterrupt (a Ctrl-C mid-study) when that many
+    points have run."""
+    import study.sweep.engine as engine
+    real = engine.run_point
+    calls = []
+
+    def run(scene, outputs):
+        if stop_after is not None and len(calls) == stop_after:
+            raise KeyboardInterrupt
+        calls.append(scene)
+        return real(scene, outputs)
+
+    monkeypatch.setattr(engine, "run_point", run)
+    return calls

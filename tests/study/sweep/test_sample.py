@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from scipy import stats
-from sweep_cases import BASE
+from sweep_cases import BASE, count_points
 
 import study.sweep.engine as engine
 from study.cli import main
@@ -192,21 +192,12 @@ def test_a_sampled_archive_holds_the_draws_and_every_output_over_grid_and_sample
 def test_a_sampled_study_resumes_after_an_interruption(sampled_run, tmp_path, monkeypatch):
     res, _ = sampled_run
     out = tmp_path / "resumed.nc"
-    real = engine.run_point
-    calls = []
-
-    def stop_on_fifth(scene, outputs):
-        if len(calls) == 4:
-            raise KeyboardInterrupt
-        calls.append(scene)
-        return real(scene, outputs)
-
-    monkeypatch.setattr(engine, "run_point", stop_on_fifth)
+    count_points(monkeypatch, stop_after=4)
     with pytest.raises(KeyboardInterrupt):
         run_sweep(sampled(RESUME, RESUME_GRID), out, workers=0, progress=False)
     assert not out.exists() and len(list(parts_folder(out).glob("*.pkl"))) == 4
-    calls.clear()
-    monkeypatch.setattr(engine, "run_point", lambda s, o: calls.append(s) or real(s, o))
+    monkeypatch.undo()
+    calls = count_points(monkeypatch)
     again = run_sweep(sampled(RESUME, RESUME_GRID), out, workers=0, progress=False)
     assert len(calls) == 8 and again.reused == 4
     drop = ["wall_time"]

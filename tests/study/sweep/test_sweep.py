@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 import xarray as xr
-from sweep_cases import BASE, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
+from sweep_cases import BASE, count_points, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
 
 import study.sweep.engine as sweep
 from study.report.summary import summarize
@@ -86,16 +86,7 @@ def test_changed_code_recomputes_every_point(swept, tmp_path, monkeypatch):
 def test_interrupt_and_resume_give_the_same_archive(swept, tmp_path, monkeypatch):
     res, _ = swept
     out = tmp_path / "resumed.nc"
-    real = sweep.run_point
-    calls = []
-
-    def stop_on_fifth(scene, outputs):
-        if len(calls) == 4:
-            raise KeyboardInterrupt
-        calls.append(scene)
-        return real(scene, outputs)
-
-    monkeypatch.setattr(sweep, "run_point", stop_on_fifth)
+    count_points(monkeypatch, stop_after=4)
     with pytest.raises(KeyboardInterrupt):
         run_sweep(tiny_study(), out, workers=0, progress=False)
     assert not out.exists()  # no half archive
@@ -104,8 +95,8 @@ def test_interrupt_and_resume_give_the_same_archive(swept, tmp_path, monkeypatch
     # a process killed while writing leaves a temporary file; a damaged record is recomputed
     (parts_folder(out) / ".junk.123.tmp").write_bytes(b"\0" * 10)
     parts[0].write_bytes(b"not a pickle")
-    calls.clear()
-    monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or real(s, o))
+    monkeypatch.undo()
+    calls = count_points(monkeypatch)
     again = run_sweep(tiny_study(), out, workers=0, progress=False)
     assert len(calls) == 9 and again.computed == 9 and again.reused == 3
     drop = ["wall_time"]
