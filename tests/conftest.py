@@ -95,3 +95,65 @@ def slow_transient_against_statics(model, torque=50.0):
     sel = th1 > math.radians(1.5)
     st = solve_static(model, th1[sel], torque)
     return r.te[sel] - st.te, r, st
+
+
+def loaded_mesh_state(m, angle_deg: float, phi_scale: float, seed: int = 3):
+    """(theta1, theta2 [rad], tooth rotations phi [rad], teeth near the mesh, contact records,
+    their count) of model ``m`` at driver angle ``angle_deg``, 5 um into the mesh, the teeth near
+    the mesh turned at random by about ``phi_scale`` [rad]."""
+    import math
+
+    import numpy as np
+
+    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    th1 = math.radians(angle_deg)
+    th2 = m.theta2_for_te(th1, m.backlash_offset + 5.0e-6)
+    phi = np.zeros(m.n_teeth)
+    rec, pairs = new_contact_buffer()
+    _nc, npair = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    teeth = sorted({int(p) for p in pairs[:npair, 0]} | {m.teeth[0] + int(p) for p in pairs[:npair, 1]})
+    phi[teeth] = np.random.default_rng(seed).normal(scale=phi_scale, size=len(teeth))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    return th1, th2, phi, teeth, rec, nc
+
+
+def mesh_potential(m, th1, th2, phi) -> float:
+    """Plain-Python potential energy [J] of model ``m``: the tooth springs and the contacts, from
+    the kernel's contact records: k delta^(m1+1)/(m1+1) of the penetration, or with a local
+    compliance in series the law's share plus c F^2/2 (`laws.series_energy`)."""
+    import numpy as np
+
+    from solver.mbs.kernels import layout as L
+    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.laws import series_energy
+    rec, pairs = new_contact_buffer()
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    n = m.gear_par[:, L.N_K]
+    z1 = m.teeth[0]
+    e = sum(m.k_phi[i] * abs(phi[i]) ** (n[0 if i < z1 else 1] + 1) / (n[0 if i < z1 else 1] + 1) for i in range(len(phi)))
+    k, m1 = m.law_par[L.K_CON], m.law_par[L.M1]
+    return e + sum(series_energy.py_func(rec[c, L.C_DCON], rec[c, L.C_CLOC], k, m1) if rec[c, L.C_CLOC] != 0.0
+                   else k * rec[c, L.C_DELTA] ** (m1 + 1) / (m1 + 1) for c in range(nc))
+
+
+def assert_forces_are_minus_the_energy_gradient(m, th1, th2, phi, teeth, rec, nc):
+    """The kernel's generalised forces on both hubs and the teeth near the mesh equal
+    -d(mesh_potential)/dq by central differences."""
+    import numpy as np
+    import pytest
+
+    from solver.mbs.kernels.gearmesh import generalized_forces
+    act = np.array(teeth, dtype=np.int64)
+    q = np.zeros(m.n_teeth + 2)
+    generalized_forces(rec, nc, phi, np.zeros_like(phi), act, len(act), m.k_phi, m.gear_par, 0.0, q)
+    h = 1e-8  # rad: central differences of energies ~1e-3 J lose digits below this
+    fd1 = -(mesh_potential(m, th1 + h, th2, phi) - mesh_potential(m, th1 - h, th2, phi)) / (2 * h)
+    fd2 = -(mesh_potential(m, th1, th2 + h, phi) - mesh_potential(m, th1, th2 - h, phi)) / (2 * h)
+    assert q[0] == pytest.approx(fd1, rel=1e-5)
+    assert q[1] == pytest.approx(fd2, rel=1e-5)
+    for i in teeth:
+        p1, p0 = phi.copy(), phi.copy()
+        p1[i] += h
+        p0[i] -= h
+        fd = -(mesh_potential(m, th1, th2, p1) - mesh_potential(m, th1, th2, p0)) / (2 * h)
+        assert q[2 + i] == pytest.approx(fd, rel=1e-5, abs=1e-6)

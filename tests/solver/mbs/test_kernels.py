@@ -1,11 +1,10 @@
 """Numba kernels against slow plain-numpy versions of the same formulas."""
-import math
 
 import numpy as np
 import pytest
+from conftest import assert_forces_are_minus_the_energy_gradient, loaded_mesh_state
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
 from solver.mbs.kernels.laws import contact_energy, contact_force, contact_tangent, spring_energy, spring_tangent, spring_torque
 
 
@@ -37,43 +36,9 @@ def test_contact_law_against_numpy_and_clipped_at_zero():
         (contact_energy(2e-6 + h, k, m1) - 2 * contact_energy(2e-6, k, m1) + contact_energy(2e-6 - h, k, m1)) / h**2, rel=1e-3)
 
 
-def _potential(m, th1, th2, phi):
-    """Plain-numpy potential energy: springs + contacts (contacts from the kernel's penetrations)."""
-    rec, pairs = new_contact_buffer()
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    n = m.gear_par[:, L.N_K]
-    z1 = m.teeth[0]
-    e = sum(m.k_phi[i] * abs(phi[i]) ** (n[0 if i < z1 else 1] + 1) / (n[0 if i < z1 else 1] + 1) for i in range(len(phi)))
-    d = rec[:nc, L.C_DELTA]
-    k, m1 = m.law_par[L.K_CON], m.law_par[L.M1]
-    return e + np.sum(k * d ** (m1 + 1) / (m1 + 1))
-
-
 def test_generalized_forces_are_minus_the_energy_gradient(paper_solid_model):
     m = paper_solid_model
-    th1 = math.radians(3.85)
-    th2 = m.theta2_for_te(th1, m.backlash_offset + 5.0e-6)
-    rng = np.random.default_rng(3)
-    phi = np.zeros(m.n_teeth)
-    rec, pairs = new_contact_buffer()
-    nc, npair = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    teeth = sorted({int(p) for p in pairs[:npair, 0]} | {m.teeth[0] + int(p) for p in pairs[:npair, 1]})
-    phi[teeth] = rng.normal(scale=1e-3, size=len(teeth))
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    act = np.array(teeth, dtype=np.int64)
-    q = np.zeros(m.n_teeth + 2)
-    generalized_forces(rec, nc, phi, np.zeros_like(phi), act, len(act), m.k_phi, m.gear_par, 0.0, q)
-    h = 1e-8  # rad: central differences of energies ~1e-3 J lose digits below this
-    fd1 = -(_potential(m, th1 + h, th2, phi) - _potential(m, th1 - h, th2, phi)) / (2 * h)
-    fd2 = -(_potential(m, th1, th2 + h, phi) - _potential(m, th1, th2 - h, phi)) / (2 * h)
-    assert q[0] == pytest.approx(fd1, rel=1e-5)
-    assert q[1] == pytest.approx(fd2, rel=1e-5)
-    for i in teeth:
-        p1, p0 = phi.copy(), phi.copy()
-        p1[i] += h
-        p0[i] -= h
-        fd = -(_potential(m, th1, th2, p1) - _potential(m, th1, th2, p0)) / (2 * h)
-        assert q[2 + i] == pytest.approx(fd, rel=1e-5, abs=1e-6)
+    assert_forces_are_minus_the_energy_gradient(m, *loaded_mesh_state(m, 3.85, 1e-3))
 
 
 def test_static_kernel_matches_its_plain_python_run(paper_solid_model):

@@ -1,14 +1,13 @@
 """The contact law in series with a local tooth compliance (compliance model): the scalar law
 against its closed form, and the mesh forces it gives against the energy they derive from."""
 import dataclasses
-import math
 
 import numpy as np
 import pytest
+from conftest import assert_forces_are_minus_the_energy_gradient, loaded_mesh_state
 from scipy.integrate import quad
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
 from solver.mbs.kernels.laws import contact_energy, contact_tangent, series_contact, series_energy
 from solver.mbs.model import sample_local_compliance
 
@@ -62,46 +61,15 @@ def _with_local_compliance(m, scale=1.0):
     return dataclasses.replace(m, gear_par=gp)
 
 
-def _potential(m, th1, th2, phi):
-    rec, pairs = new_contact_buffer()
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    n = m.gear_par[:, L.N_K]
-    z1 = m.teeth[0]
-    e = sum(m.k_phi[i] * abs(phi[i]) ** (n[0 if i < z1 else 1] + 1) / (n[0 if i < z1 else 1] + 1) for i in range(len(phi)))
-    k, m1 = m.law_par[L.K_CON], m.law_par[L.M1]
-    return e + sum(series_energy.py_func(rec[c, L.C_DCON], rec[c, L.C_CLOC], k, m1) for c in range(nc))
-
-
 @pytest.mark.parametrize("angle_deg", [1.0, 2.0, 5.1])
 def test_series_mesh_forces_are_minus_the_energy_gradient(paper_solid_model, angle_deg):
     """With c_loc changing along the profile, the generalised forces of the contacts are still
     -dE/dq of the series springs' energy: the force term of c_loc's change is in the records."""
     m = _with_local_compliance(paper_solid_model)
-    th1 = math.radians(angle_deg)
-    th2 = m.theta2_for_te(th1, m.backlash_offset + 5.0e-6)
-    rng = np.random.default_rng(3)
-    phi = np.zeros(m.n_teeth)
-    rec, pairs = new_contact_buffer()
-    nc, npair = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    teeth = sorted({int(p) for p in pairs[:npair, 0]} | {m.teeth[0] + int(p) for p in pairs[:npair, 1]})
-    phi[teeth] = rng.normal(scale=2e-4, size=len(teeth))
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    th1, th2, phi, teeth, rec, nc = loaded_mesh_state(m, angle_deg, 2e-4)
     assert nc > 0 and np.all(rec[:nc, L.C_CLOC] != 0.0)
     assert np.all(np.abs(rec[:nc, L.C_KIND]) == 1)       # flank contacts: the exact case
-    act = np.array(teeth, dtype=np.int64)
-    q = np.zeros(m.n_teeth + 2)
-    generalized_forces(rec, nc, phi, np.zeros_like(phi), act, len(act), m.k_phi, m.gear_par, 0.0, q)
-    h = 1e-8
-    fd1 = -(_potential(m, th1 + h, th2, phi) - _potential(m, th1 - h, th2, phi)) / (2 * h)
-    fd2 = -(_potential(m, th1, th2 + h, phi) - _potential(m, th1, th2 - h, phi)) / (2 * h)
-    assert q[0] == pytest.approx(fd1, rel=1e-5)
-    assert q[1] == pytest.approx(fd2, rel=1e-5)
-    for i in teeth:
-        p1, p0 = phi.copy(), phi.copy()
-        p1[i] += h
-        p0[i] -= h
-        fd = -(_potential(m, th1, th2, p1) - _potential(m, th1, th2, p0)) / (2 * h)
-        assert q[2 + i] == pytest.approx(fd, rel=1e-5, abs=1e-6)
+    assert_forces_are_minus_the_energy_gradient(m, th1, th2, phi, teeth, rec, nc)
 
 
 def test_series_compliance_softens_the_static_mesh(paper_solid_model):

@@ -1,4 +1,6 @@
 """The tiny study the sweep, grid and archive tests share, and its sweep run once per session."""
+import contextlib
+
 import pytest
 
 from study.sweep.engine import run_sweep
@@ -57,3 +59,24 @@ def count_points(monkeypatch, stop_after: int | None = None) -> list:
 
     monkeypatch.setattr(engine, "run_point", run)
     return calls
+
+
+@contextlib.contextmanager
+def ctrl_c_after_stored(monkeypatch, n: int):
+    """Within: the client's `PartStore.put` raises KeyboardInterrupt once ``n`` parts are stored
+    (a Ctrl-C mid-study, with workers); after: the real put again."""
+    import study.sweep.engine as engine
+    real_put = engine.PartStore.put
+    stored = []
+
+    def put(self, key, result):
+        if len(stored) == n:
+            raise KeyboardInterrupt
+        stored.append(key)
+        real_put(self, key, result)
+
+    monkeypatch.setattr(engine.PartStore, "put", put)
+    try:
+        yield stored
+    finally:
+        monkeypatch.setattr(engine.PartStore, "put", real_put)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from scipy import stats
-from sweep_cases import BASE, count_points
+from sweep_cases import BASE, count_points, ctrl_c_after_stored
 
 import study.sweep.engine as engine
 from study.cli import main
@@ -265,19 +265,8 @@ def test_a_sampled_study_on_dask_interrupted_and_resumed_in_process_gives_the_sa
     """Builds are ordinary tasks: two stored by a 2-worker LocalCluster, Ctrl-C, the rest here."""
     res, _ = sampled_run
     out = tmp_path / "dask.nc"
-    real_put = engine.PartStore.put
-    stored = []
-
-    def put(self, key, result):
-        if len(stored) == 2:
-            raise KeyboardInterrupt
-        stored.append(key)
-        real_put(self, key, result)
-
-    monkeypatch.setattr(engine.PartStore, "put", put)
-    with pytest.raises(KeyboardInterrupt):
+    with ctrl_c_after_stored(monkeypatch, 2), pytest.raises(KeyboardInterrupt):
         run_sweep(sampled(RESUME, RESUME_GRID), out, workers=2, progress=False)
-    monkeypatch.setattr(engine.PartStore, "put", real_put)
     again = run_sweep(sampled(RESUME, RESUME_GRID), out, workers=0, progress=False)
     assert again.reused == 2 and again.computed == 10
     xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created="", history=""),

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 import xarray as xr
-from sweep_cases import BASE, count_points, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
+from sweep_cases import BASE, count_points, ctrl_c_after_stored, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
 
 import study.sweep.engine as sweep
 from study.report.summary import summarize
@@ -174,31 +174,18 @@ def test_dask_sweep_is_interruptible_closes_its_cluster_and_resumes(swept, tmp_p
     from distributed.deploy.spec import SpecCluster
     res, _ = swept
     out = tmp_path / "dask.nc"
-    real_put = sweep.PartStore.put
-    stored = []
-
-    def put(self, key, result):
-        if len(stored) == 2:
-            raise KeyboardInterrupt
-        stored.append(key)
-        real_put(self, key, result)
-
     import distributed
     started = []
     real_cluster = distributed.LocalCluster
     monkeypatch.setattr(distributed, "LocalCluster", lambda **kw: started.append(kw) or real_cluster(**kw))
-    monkeypatch.setattr(sweep.PartStore, "put", put)
-    with pytest.raises(KeyboardInterrupt):
+    with ctrl_c_after_stored(monkeypatch, 2), pytest.raises(KeyboardInterrupt):
         run_sweep(tiny_study(), out, workers=2, progress=False)
     assert SpecCluster._instances and all(c.status.name == "closed" for c in SpecCluster._instances)
     (kw,) = started
     assert kw["n_workers"] == 2 and kw["threads_per_worker"] == 1 and kw["processes"]
     assert kw["env"]["NUMBA_NUM_THREADS"] == "1"
-    monkeypatch.setattr(sweep.PartStore, "put", real_put)
     # the two points computed on the workers are kept; the rest is computed here
-    calls = []
-    real = sweep.run_point
-    monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or real(s, o))
+    calls = count_points(monkeypatch)
     again = run_sweep(tiny_study(), out, workers=0, progress=False)
     assert again.reused == 2 and len(calls) == 10
     xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created="", history=""),
