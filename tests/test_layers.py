@@ -1,0 +1,183 @@
+"""The layers of the code, read from the import statements (every import, deferred ones too):
+
+- `solver` never imports `study` (nor the workflows): the solver runs without the study layer;
+- the numba kernels (`solver/mbs/kernels`) import only numpy, math, numba and each other
+  (their package also hashes its own sources with hashlib, os and pathlib for the disk cache);
+- the base solver modules (solver/*.py, solver/fe, solver/identify) import no `solver.mbs`: the
+  multibody model is built from them, not the other way round. The FE reference
+  (`solver/fe/ltca.py`) and the peers (`solver/peers`) stand above the model they check;
+- the pictures (`study/report/`) import only the run archive and its NetCDF I/O, the scene,
+  the solver's units and geometry, each other and libraries: they draw what an archive holds
+  and start no run, sweep or FE solve;
+- no cycle between packages (a subpackage or a top-level module of `solver`/`study`) through
+  the imports a module runs when it is loaded.
+
+The workflows' rule (only `study`'s public API) is tests/workflows/test_imports.py.
+"""
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PROJECT = ("solver", "study", "workflows", "benchmarks")
+
+# The run archive, which the pictures read: its schema, variables, NetCDF I/O and provenance.
+ARCHIVE = ("study.archive",)
+
+# Imports that break a rule today, (rule, importing file, imported module), each to delete when
+# its import goes; the test fails on an entry that no longer happens.
+KNOWN = {
+    # pictures that still compute: the archive's schema, provenance and derived variables live
+    # in study/report/ until they move to the archive package; the renders of the FE inputs
+    # solve them instead of reading the archive; the limits parser sits in the CLI
+    ("pictures", "study/report/results.py", "solver.mbs.energy_guard"),
+    ("pictures", "study/report/summary.py", "study.sweep.outputs"),
+    ("pictures", "study/report/render_limits.py", "study.cli"),
+    ("pictures", "study/report/lightening.py", "solver.inertia"),
+    ("pictures", "study/report/lightening.py", "study.inputs.gearsetup"),
+    ("pictures", "study/report/lightening.py", "study.inputs.springs"),
+    ("pictures", "study/report/modes.py", "solver.mbs.kernels.layout"),
+    ("pictures", "study/report/modes.py", "solver.mbs.model"),
+    ("pictures", "study/report/modes.py", "solver.mbs.modes"),
+    ("pictures", "study/report/modes.py", "solver.mbs.ringdown"),
+    ("pictures", "study/report/mesh_outputs.py", "solver.mbs.kernels.layout"),
+    ("pictures", "study/report/mesh_outputs.py", "solver.mbs.mesh_stiffness"),
+    ("pictures", "study/report/mesh_outputs.py", "solver.peers.iso6336"),
+    ("pictures", "study/report/render_inputs.py", "study.inputs.gearsetup"),
+    ("pictures", "study/report/render_inputs.py", "study.inputs.springs"),
+    ("pictures", "study/report/stress_render.py", "solver.fe.body"),
+    ("pictures", "study/report/stress_render.py", "study.inputs.springs"),
+    # the pitch-error and profile-modification tables are packed in the kernels' column layout
+    ("base", "solver/errors.py", "solver.mbs.kernels.layout"),
+    ("base", "solver/modification.py", "solver.mbs.kernels.layout"),
+}
+
+
+def _module(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+FILES = {_module(p): p for top in ("solver", "study") for p in sorted((ROOT / top).rglob("*.py"))}
+
+
+def _imports(path: Path, loaded_only: bool = False):
+    """(line, imported module) of each import in the file; ``from a import b`` gives ``a.b`` when
+    that is a module of the project, else ``a``. ``loaded_only``: the imports run when the
+    module is loaded (not those in functions or under TYPE_CHECKING)."""
+    tree = ast.parse(path.read_text())
+    me = _module(path)
+    package = me if path.name == "__init__.py" else me.rpartition(".")[0]
+
+    def statements(body):
+        for node in body:
+            if isinstance(node, ast.Import | ast.ImportFrom):
+                yield node
+            elif isinstance(node, ast.If) and "TYPE_CHECKING" not in ast.unparse(node.test):
+                yield from statements(node.body + node.orelse)
+            elif isinstance(node, ast.Try):
+                yield from statements(node.body + node.orelse + node.finalbody + [s for h in node.handlers for s in h.body])
+            elif isinstance(node, ast.With):
+                yield from statements(node.body)
+
+    nodes = statements(tree.body) if loaded_only else (n for n in ast.walk(tree) if isinstance(n, ast.Import | ast.ImportFrom))
+    for node in nodes:
+        if isinstance(node, ast.Import):
+            yield from ((node.lineno, a.name) for a in node.names)
+            continue
+        base = node.module or ""
+        if node.level:
+            up = package.split(".")[: len(package.split(".")) - node.level + 1]
+            base = ".".join(up + ([node.module] if node.module else []))
+        for a in node.names:
+            yield node.lineno, f"{base}.{a.name}" if f"{base}.{a.name}" in FILES else base
+
+
+def _under(name: str, *prefixes: str) -> bool:
+    return any(name == p or name.startswith(p + ".") for p in prefixes)
+
+
+def _is_base(module: str) -> bool:
+    """solver's own modules (solver/*.py) and the FE and identification packages, less the FE reference."""
+    if _under(module, "solver.fe", "solver.identify"):
+        return module != "solver.fe.ltca"
+    return module == "solver" or (module.count(".") == 1 and module.startswith("solver.")
+                                  and FILES[module].name != "__init__.py")
+
+
+def _kernels_refuse(name: str, module: str) -> bool:
+    if module == "solver.mbs.kernels" and name in ("hashlib", "os", "pathlib"):
+        return False        # the package hashes the kernel sources for its disk-cache folder
+    return not _under(name, "numpy", "math", "numba", "solver.mbs.kernels")
+
+
+PICTURES_READ = ("study.report", *ARCHIVE, "study.scene", "study.errors", "solver.units", "solver.geometry")
+
+# rule -> (the modules it binds, the imports it refuses (imported name, importing module), what it says)
+RULES = {
+    "solver": (lambda m: _under(m, "solver"), lambda name, m: _under(name, "study", "workflows", "benchmarks"),
+               "solver never imports study"),
+    "kernels": (lambda m: _under(m, "solver.mbs.kernels"), _kernels_refuse,
+                "the kernels import only numpy, math, numba and kernels"),
+    "base": (_is_base, lambda name, m: _under(name, "solver.mbs"),
+             "the base solver modules (solver/*.py, solver/fe, solver/identify) import no solver.mbs"),
+    "pictures": (lambda m: _under(m, "study.report"),
+                 lambda name, m: _under(name, *PROJECT) and not _under(name, *PICTURES_READ),
+                 "the pictures (study/report) import only the archive and its I/O, the scene, "
+                 "solver units and geometry"),
+}
+
+
+def _breaks(rule: str):
+    binds, refuses, _text = RULES[rule]
+    for module, path in FILES.items():
+        if not binds(module):
+            continue
+        for line, name in _imports(path):
+            if refuses(name, module):
+                yield str(path.relative_to(ROOT)), line, name
+
+
+@pytest.mark.parametrize("rule", list(RULES))
+def test_a_layer_imports_only_what_lies_below(rule):
+    found = list(_breaks(rule))
+    known = {(f, n) for r, f, n in KNOWN if r == rule}
+    new = [f"{f}:{line} imports {name}, against the rule \"{rule}\": {RULES[rule][2]}" for f, line, name in found if (f, name) not in known]
+    gone = [f"{f} no longer imports {n}: delete it from KNOWN" for f, n in sorted(known - {(f, n) for f, _l, n in found})]
+    if new + gone:
+        pytest.fail("\n".join(new + gone), pytrace=False)
+
+
+def _unit(module: str) -> str:
+    """The package a module counts in: its subpackage or top-level module of solver/study (the
+    kernels a package of their own, the bottom layer)."""
+    return "solver.mbs.kernels" if _under(module, "solver.mbs.kernels") else ".".join(module.split(".")[:2])
+
+
+def test_no_import_cycle_between_packages():
+    edges = {}     # (unit, unit) -> first 'file:line' of an import that makes it
+    for module, path in FILES.items():
+        for line, name in _imports(path, loaded_only=True):
+            if _under(name, "solver", "study") and _unit(module) != _unit(name):
+                edges.setdefault((_unit(module), _unit(name)), f"{path.relative_to(ROOT)}:{line} imports {name}")
+    graph = {}
+    for a, b in edges:
+        graph.setdefault(a, set()).add(b)
+
+    def path_back(start, goal, seen):
+        for nxt in sorted(graph.get(start, ())):
+            if nxt == goal:
+                return [start, nxt]
+            if nxt not in seen:
+                seen.add(nxt)
+                rest = path_back(nxt, goal, seen)
+                if rest:
+                    return [start] + rest
+        return None
+
+    for a in sorted(graph):
+        cycle = path_back(a, a, set())
+        if cycle:
+            pytest.fail("import cycle between packages:\n" + "\n".join(
+                edges[(u, v)] for u, v in zip(cycle, cycle[1:], strict=False)), pytrace=False)
