@@ -1,42 +1,13 @@
-"""Shared fixtures: small solid scenes that need no FE, and their models."""
+"""Shared fixtures: a private FE cache, the example study's small scene as a file, the paper pair
+with a solid driven gear and its model.
+The scenes and checks the tests share are in helpers.py."""
 import os
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 import pytest  # noqa: E402
-
-from study.scene import default_scene  # noqa: E402
-
-# 24 teeth, m = 3 mm, small solid bodies: a coarse, fast FE body (about 1 s)
-SMALL_PAIR = {"pair.backlash": 0.1}
-for _g in (1, 2):
-    SMALL_PAIR.update({f"gear{_g}.module": 3.0, f"gear{_g}.teeth": 24, f"gear{_g}.fillet_radius": 0.9,
-                       f"gear{_g}.face_width": 20.0, f"gear{_g}.body.rim_height": 4.0,
-                       f"gear{_g}.body.web_height": 14.0, f"gear{_g}.body.hub_height": 6.0,
-                       f"gear{_g}.body.web_thickness": 20.0, f"gear{_g}.body.holes": 0})
-
-
-# a small lightened pair (24 teeth, m 2 mm, a coarse FE body) whose driven gear has a thin web
-# with 8 holes
-SMALL_LIGHTENED = {
-    "gear1.module": 2.0, "gear1.teeth": 24, "gear2.module": 2.0, "gear2.teeth": 24,
-    "gear1.body.rim_height": 3.0, "gear1.body.web_height": 12.0, "gear1.body.hub_height": 3.0,
-    "gear1.body.web_thickness": 17.0, "gear1.body.holes": 0,
-    "gear2.body.rim_height": 3.0, "gear2.body.web_height": 12.0, "gear2.body.hub_height": 3.0,
-    "gear2.body.web_thickness": 8.0, "gear2.body.holes": 8, "gear2.body.hole_radius": 3.0,
-    "gear2.body.hole_circle_radius": 12.5, "fe.mesh_size": 1.0,
-}
-
-
-# the raw damping coefficients the scenes had before the damping ratio (mesh mode at 0.14 %)
-RAW_DAMPING = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spring.c_phi": 0.062}
-
-
-def solid_scene(**overrides):
-    """The paper pair with a solid driven gear (no FE needed), plus overrides."""
-    from study import setup
-    return setup.solid_scene(default_scene(), gears=(2,)).replace(**overrides)
+from helpers import solid_scene  # noqa: E402
 
 
 @pytest.fixture
@@ -50,6 +21,15 @@ def private_fe_cache(tmp_path, monkeypatch):
     FE_CACHE.clear()
 
 
+@pytest.fixture(scope="module")
+def example_scene_file(tmp_path_factory):
+    """The example study's 20-tooth base scene (uniform springs: no FE) as a scene file."""
+    import study
+    path = tmp_path_factory.mktemp("scene") / "small.toml"
+    path.write_text(study.load_study("example_study").base_scene().to_toml())
+    return path
+
+
 @pytest.fixture(scope="session")
 def paper_solid_scene():
     return solid_scene()
@@ -59,101 +39,3 @@ def paper_solid_scene():
 def paper_solid_model(paper_solid_scene):
     from study.setup import build_scene_model
     return build_scene_model(paper_solid_scene)
-
-
-def assert_energy_closes_at_second_order(model, torque=50.0):
-    """Undamped run from the paper's ramps (4 ms, no tooth frozen, so the balance measures the
-    integrator alone): the energy residual stays bounded (no secular drift) and falls about
-    4x per halved step."""
-    import numpy as np
-
-    from solver.mbs.dynamics import simulate
-    from solver.mbs.stability import stable_time_step
-    dt0, _ = stable_time_step(model, torque)
-    errs = []
-    for dt in (dt0, dt0 / 2):
-        r = simulate(model, 100.0, 0.01, torque, 0.01, 0.004, dt=dt, output_step=1e-5, phi_quiet=0.0)
-        assert r.status == 0 and np.all(r.dissipated == 0)
-        errs.append(np.max(np.abs(r.energy_error)))
-        assert errs[-1] < 1e-5 * np.max(np.abs(r.work))
-    assert 3.0 < errs[0] / errs[1] < 5.5
-
-
-def slow_transient_against_statics(model, torque=50.0):
-    """Dynamics at 1 rad/s (1 ms ramps, 50 ms) against the static STE at the same driver
-    angles past 1.5 deg: (TE difference [m], the run, the static result)."""
-    import math
-
-    import numpy as np
-
-    from solver.mbs.dynamics import simulate
-    from solver.mbs.kernels.mechanics import driver_motion
-    from solver.mbs.statics import solve_static
-    r = simulate(model, 1.0, 0.001, torque, 0.001, 0.05, output_step=1e-4)
-    assert r.status == 0
-    th1 = np.array([driver_motion(t, 1.0, 0.001)[0] for t in r.time])
-    sel = th1 > math.radians(1.5)
-    st = solve_static(model, th1[sel], torque)
-    return r.te[sel] - st.te, r, st
-
-
-def loaded_mesh_state(m, angle_deg: float, phi_scale: float, seed: int = 3):
-    """(theta1, theta2 [rad], tooth rotations phi [rad], teeth near the mesh, contact records,
-    their count) of model ``m`` at driver angle ``angle_deg``, 5 um into the mesh, the teeth near
-    the mesh turned at random by about ``phi_scale`` [rad]."""
-    import math
-
-    import numpy as np
-
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
-    th1 = math.radians(angle_deg)
-    th2 = m.theta2_for_te(th1, m.backlash_offset + 5.0e-6)
-    phi = np.zeros(m.n_teeth)
-    rec, pairs = new_contact_buffer()
-    _nc, npair = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    teeth = sorted({int(p) for p in pairs[:npair, 0]} | {m.teeth[0] + int(p) for p in pairs[:npair, 1]})
-    phi[teeth] = np.random.default_rng(seed).normal(scale=phi_scale, size=len(teeth))
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    return th1, th2, phi, teeth, rec, nc
-
-
-def mesh_potential(m, th1, th2, phi) -> float:
-    """Plain-Python potential energy [J] of model ``m``: the tooth springs and the contacts, from
-    the kernel's contact records: k delta^(m1+1)/(m1+1) of the penetration, or with a local
-    compliance in series the law's share plus c F^2/2 (`laws.series_energy`)."""
-    import numpy as np
-
-    from solver.mbs.kernels import layout as L
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
-    from solver.mbs.kernels.laws import series_energy
-    rec, pairs = new_contact_buffer()
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
-    n = m.gear_par[:, L.N_K]
-    z1 = m.teeth[0]
-    e = sum(m.k_phi[i] * abs(phi[i]) ** (n[0 if i < z1 else 1] + 1) / (n[0 if i < z1 else 1] + 1) for i in range(len(phi)))
-    k, m1 = m.law_par[L.K_CON], m.law_par[L.M1]
-    return e + sum(series_energy.py_func(rec[c, L.C_DCON], rec[c, L.C_CLOC], k, m1) if rec[c, L.C_CLOC] != 0.0
-                   else k * rec[c, L.C_DELTA] ** (m1 + 1) / (m1 + 1) for c in range(nc))
-
-
-def assert_forces_are_minus_the_energy_gradient(m, th1, th2, phi, teeth, rec, nc):
-    """The kernel's generalised forces on both hubs and the teeth near the mesh equal
-    -d(mesh_potential)/dq by central differences."""
-    import numpy as np
-    import pytest
-
-    from solver.mbs.kernels.gearmesh import generalized_forces
-    act = np.array(teeth, dtype=np.int64)
-    q = np.zeros(m.n_teeth + 2)
-    generalized_forces(rec, nc, phi, np.zeros_like(phi), act, len(act), m.k_phi, m.gear_par, 0.0, q)
-    h = 1e-8  # rad: central differences of energies ~1e-3 J lose digits below this
-    fd1 = -(mesh_potential(m, th1 + h, th2, phi) - mesh_potential(m, th1 - h, th2, phi)) / (2 * h)
-    fd2 = -(mesh_potential(m, th1, th2 + h, phi) - mesh_potential(m, th1, th2 - h, phi)) / (2 * h)
-    assert q[0] == pytest.approx(fd1, rel=1e-5)
-    assert q[1] == pytest.approx(fd2, rel=1e-5)
-    for i in teeth:
-        p1, p0 = phi.copy(), phi.copy()
-        p1[i] += h
-        p0[i] -= h
-        fd = -(mesh_potential(m, th1, th2, p1) - mesh_potential(m, th1, th2, p0)) / (2 * h)
-        assert q[2 + i] == pytest.approx(fd, rel=1e-5, abs=1e-6)

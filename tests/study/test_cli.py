@@ -11,14 +11,6 @@ from study.cli import main
 STUDY = "study/scenes/example_study.toml"
 
 
-@pytest.fixture(scope="module")
-def small_scene(tmp_path_factory):
-    """The example study's 20-tooth base scene (uniform springs: no FE) as a scene file."""
-    path = tmp_path_factory.mktemp("scene") / "small.toml"
-    path.write_text(study.load_study(STUDY).base_scene().to_toml())
-    return path
-
-
 @pytest.mark.parametrize("overrides, field, words", [
     (["gear1.module=1e6", "gear2.module=1e6"], "gear1.module", "<= 100"),
     (["fe.mesh_size=100"], "fe.mesh_size", "module = 1.5 mm"),
@@ -54,19 +46,19 @@ def test_the_rim_criterion_follows_the_mesh_size():
     (lambda p: p.with_suffix(".txt"), "ending in .nc"),
     (lambda p: p.parent / "file" / "x.nc", "is a file, not a directory"),
 ])
-def test_output_path_is_checked_before_the_work(make, words, tmp_path, capsys, small_scene):
+def test_output_path_is_checked_before_the_work(make, words, tmp_path, capsys, example_scene_file):
     (tmp_path / "file").write_text("x")
     out = make(tmp_path / "out.nc")
-    for args in (["run", str(small_scene)], ["stiffness", str(small_scene)], ["reference", str(small_scene)],
-                 ["precision", str(small_scene)], ["sweep", STUDY, "--workers", "0", "--no-progress"]):
+    for args in (["run", str(example_scene_file)], ["stiffness", str(example_scene_file)], ["reference", str(example_scene_file)],
+                 ["precision", str(example_scene_file)], ["sweep", STUDY, "--workers", "0", "--no-progress"]):
         assert main(args + ["-o", str(out)]) == 2, args
         err = capsys.readouterr().err
         assert "-o" in err and words in err and "Traceback" not in err
 
 
-def test_unwritable_output_folder_is_refused(capsys, small_scene):
+def test_unwritable_output_folder_is_refused(capsys, example_scene_file):
     # /proc refuses new files even to root (a chmod'ed folder would not stop root)
-    assert main(["run", str(small_scene), "-o", "/proc/lightgear/run.nc"]) == 2
+    assert main(["run", str(example_scene_file), "-o", "/proc/lightgear/run.nc"]) == 2
     assert "cannot write in /proc/lightgear" in capsys.readouterr().err
 
 
@@ -96,21 +88,21 @@ def test_render_refuses_what_is_not_a_lightgear_archive(tmp_path, capsys):
     assert not list(tmp_path.glob("*.png"))
 
 
-def test_unexpected_errors_are_one_line_with_exit_1(monkeypatch, capsys, small_scene, tmp_path):
+def test_unexpected_errors_are_one_line_with_exit_1(monkeypatch, capsys, example_scene_file, tmp_path):
     def boom(*a, **k):
         raise RuntimeError("disk on fire\nsecond line")
     monkeypatch.setattr(study, "run_scene", boom)
-    assert main(["run", str(small_scene), "-o", str(tmp_path / "r.nc")]) == 1
+    assert main(["run", str(example_scene_file), "-o", str(tmp_path / "r.nc")]) == 1
     err = capsys.readouterr().err
     assert err.strip() == ("lightgear run: error: RuntimeError: disk on fire (LIGHTGEAR_DEBUG=1 shows the traceback)")
     monkeypatch.setenv("LIGHTGEAR_DEBUG", "1")
     with pytest.raises(RuntimeError, match="disk on fire"):
-        main(["run", str(small_scene), "-o", str(tmp_path / "r.nc")])
+        main(["run", str(example_scene_file), "-o", str(tmp_path / "r.nc")])
 
 
-def test_a_diverged_run_exits_3_with_its_cause_and_keeps_the_archive(small_scene, tmp_path, capsys):
+def test_a_diverged_run_exits_3_with_its_cause_and_keeps_the_archive(example_scene_file, tmp_path, capsys):
     out = tmp_path / "div.nc"
-    assert main(["run", str(small_scene), "-o", str(out), "--no-static", "--set", "dynamic.time_step=1e-5"]) == 3
+    assert main(["run", str(example_scene_file), "-o", str(out), "--no-static", "--set", "dynamic.time_step=1e-5"]) == 3
     err = capsys.readouterr().err
     assert "dynamic run diverged: energy growth" in err
     with netCDF4.Dataset(out) as nc:

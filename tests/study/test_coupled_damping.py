@@ -2,7 +2,7 @@
 the body dampers take part, and the modal analysis of the model built reads the ratio asked for."""
 import numpy as np
 import pytest
-from conftest import SMALL_LIGHTENED
+from helpers import SMALL_LIGHTENED
 
 from study.scene import default_scene
 

@@ -12,21 +12,14 @@ STUDY = "study/scenes/example_study.toml"
 
 
 @pytest.fixture(scope="module")
-def small_scene(tmp_path_factory):
-    path = tmp_path_factory.mktemp("scene") / "small.toml"
-    path.write_text(study.load_study(STUDY).base_scene().to_toml())
-    return path
-
-
-@pytest.fixture(scope="module")
 def small_model():
     from study.setup import build_scene_model
     return build_scene_model(study.load_study(STUDY).base_scene())
 
 
-def test_a_run_whose_outputs_do_not_fit_in_memory_is_refused_at_once(small_scene, tmp_path, capsys):
+def test_a_run_whose_outputs_do_not_fit_in_memory_is_refused_at_once(example_scene_file, tmp_path, capsys):
     out = tmp_path / "x.nc"
-    assert main(["run", str(small_scene), "-o", str(out), "--set", "dynamic.duration=1e6"]) == 2
+    assert main(["run", str(example_scene_file), "-o", str(out), "--set", "dynamic.duration=1e6"]) == 2
     err = capsys.readouterr().err
     # 1e11 records of 11 float64 columns: terabytes, named with the field to change
     assert "dynamic.duration" in err and "TiB" in err and "1e+11 records" in err and "Traceback" not in err
@@ -39,17 +32,17 @@ def test_a_run_whose_outputs_do_not_fit_in_memory_is_refused_at_once(small_scene
     (["reference", "--set", "fe.mesh_size=0.01"], "gear 2 FE body"),
     (["run", "--set", "gear2.teeth=10000", "--set", "gear2.body.holes=0"], "FE bodies"),
 ])
-def test_runs_estimated_beyond_max_time_are_refused_with_the_estimate(args, words, small_scene, tmp_path, capsys):
+def test_runs_estimated_beyond_max_time_are_refused_with_the_estimate(args, words, example_scene_file, tmp_path, capsys):
     out = tmp_path / "x.nc"
-    args = [a.replace("{small}", str(small_scene)) for a in args]
+    args = [a.replace("{small}", str(example_scene_file)) for a in args]
     assert main(args + ["-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert "--max-time" in err and "estimated at" in err and words in err and "Traceback" not in err
     assert not out.exists()
 
 
-def test_max_time_must_be_positive_and_is_in_the_help(small_scene, tmp_path, capsys):
-    assert main(["run", str(small_scene), "-o", str(tmp_path / "x.nc"), "--max-time", "0"]) == 2
+def test_max_time_must_be_positive_and_is_in_the_help(example_scene_file, tmp_path, capsys):
+    assert main(["run", str(example_scene_file), "-o", str(tmp_path / "x.nc"), "--max-time", "0"]) == 2
     assert "--max-time: must be a positive" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["stiffness", "--help"])
@@ -88,10 +81,11 @@ def test_a_contact_too_stiff_for_its_step_is_flagged_inaccurate(paper_solid_mode
     small enough to follow these contacts.) The default step (0.9 of the bound with the
     tooth-root dampers implicit) does not stay there: its guards see the force spikes and the
     energy balance, and the run is repeated at a smaller step, which completes."""
+    from helpers import RAW_DAMPING, solid_scene
+
     from solver.mbs.dynamics import INACCURATE, simulate
     from solver.mbs.stability import stable_time_step
     from study.setup import build_scene_model
-    from tests.conftest import RAW_DAMPING, solid_scene
     stiff = build_scene_model(solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9}))
     dt_static, _w = stable_time_step(stiff, 50.0)
     r = simulate(stiff, 100.0, 0.01, 50.0, 0.01, 0.02, dt=dt_static)
@@ -126,13 +120,13 @@ def test_statics_beyond_the_deflection_bound_are_not_a_result(small_model):
         solve_static(small_model, angles, 2000.0)
 
 
-def test_unconverged_statics_exit_3_with_the_count(small_scene, tmp_path, capsys, monkeypatch):
+def test_unconverged_statics_exit_3_with_the_count(example_scene_file, tmp_path, capsys, monkeypatch):
     """A run past the scene checks whose statics fail: the archive is written, the count and
     cause are on stderr, exit 3 (the load bound of the scene check is lifted for the test)."""
     from study import plausibility
     monkeypatch.setattr(plausibility, "DEFLECTION_FRACTION", 10.0)
     out = tmp_path / "x.nc"
-    assert main(["run", str(small_scene), "-o", str(out), "--no-dynamic", "--set", "quasi_static.torque=2000"]) == 3
+    assert main(["run", str(example_scene_file), "-o", str(out), "--no-dynamic", "--set", "quasi_static.torque=2000"]) == 3
     err = capsys.readouterr().err
     assert "static equilibrium not reached at 37 of 37 angles" in err and "beyond 0.2 x module" in err
     assert out.exists()
@@ -159,7 +153,7 @@ def test_a_coarse_implicit_run_of_a_rattling_150_tooth_pair_is_flagged():
 
 
 @pytest.mark.parametrize("k_phi", ["10600", "1060"])
-def test_soft_tooth_springs_are_refused_before_the_statics(k_phi, small_scene, tmp_path, capsys):
+def test_soft_tooth_springs_are_refused_before_the_statics(k_phi, example_scene_file, tmp_path, capsys):
     # 100 x and 1000 x softer than the paper's springs: the paper torque bends a pair by 0.8 / 6.6 mm
     # (k_phi is the paper model's spring; the coupled models take theirs from the FE body)
     out = tmp_path / "x.nc"
@@ -170,11 +164,12 @@ def test_soft_tooth_springs_are_refused_before_the_statics(k_phi, small_scene, t
 
 
 def test_a_sweep_point_whose_run_is_inaccurate_keeps_its_scalars_flagged():
+    from helpers import RAW_DAMPING, solid_scene
+
     from solver.mbs.stability import stable_time_step
     from study.setup import build_scene_model
     from study.sweep.engine import run_point
     from study.sweep.outputs import Outputs
-    from tests.conftest import RAW_DAMPING, solid_scene
     sc = solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9, "dynamic.duration": 0.021})
     # the step of the static linearisation, given (the default step's load guard would repair it)
     sc = sc.replace(**{"dynamic.time_step": stable_time_step(build_scene_model(sc), 50.0)[0]})

@@ -1,7 +1,7 @@
 """A study's worker keeps a scene's model for the points that differ only in the dynamic run:
 the same model, the same numbers as one built afresh."""
 import numpy as np
-from conftest import solid_scene
+from helpers import solid_scene
 
 from study import setup
 from study.run import run_scene

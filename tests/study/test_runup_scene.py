@@ -75,9 +75,10 @@ def test_render_says_why_a_run_has_no_order_map():
 def test_a_flagged_runup_keeps_its_order_map_with_the_flag(monkeypatch):
     """A run-up that completes but is flagged inaccurate keeps its order tracking, the flag
     beside it (the guard made to flag every run here)."""
+    from helpers import solid_scene
+
     import solver.mbs.dynamics as dyn
     from study.run import run_scene
-    from tests.conftest import solid_scene
 
     def flag(res, alpha=0.0):
         res.status, res.message = dyn.INACCURATE, "inaccurate: energy balance error (made to flag)"

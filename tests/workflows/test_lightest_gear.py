@@ -124,7 +124,7 @@ def test_fields_are_the_driven_gear_body():
 def test_small_pair_end_to_end_gives_the_lightest_body_its_figure_and_archives(tmp_path, capsys, private_fe_cache):
     """24-tooth pair, coarse FE mesh, two hole radii and one refined between them: the lightest
     body is the larger holes, its answer is measured against the solid gear's run."""
-    from conftest import SMALL_PAIR
+    from helpers import SMALL_PAIR
 
     from study.scene import default_scene
     scene = default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,

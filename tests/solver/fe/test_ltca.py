@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR, solid_scene
+from helpers import SMALL_PAIR, solid_scene
 
 from solver.fe.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
 from study.inputs.compliance import gear_compliance
@@ -15,7 +15,7 @@ pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
 
 def small_scene(**kw):
-    """The small 24-tooth pair of conftest (contact ratio 1.6), one mesh pitch of rotation."""
+    """The small 24-tooth pair of helpers.py (contact ratio 1.6), one mesh pitch of rotation."""
     return default_scene().replace(**{**SMALL_PAIR, "quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.25,
                                       "quasi_static.torque": 100.0, **kw})
 

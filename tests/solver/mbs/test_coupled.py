@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
+from helpers import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 from test_ltca import LIGHT, small_scene
 
 from solver.fe.ltca import mesh_points

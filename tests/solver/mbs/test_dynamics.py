@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import RAW_DAMPING, assert_energy_closes_at_second_order, solid_scene
+from helpers import RAW_DAMPING, assert_energy_closes_at_second_order, solid_scene
 
 from solver.mbs.dynamics import DivergenceError, simulate
 from solver.mbs.stability import stable_time_step

@@ -6,7 +6,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import RAW_DAMPING, solid_scene
+from helpers import RAW_DAMPING, solid_scene
 
 from solver.mbs.dynamics import simulate
 from solver.mbs.implicit import simulate_implicit

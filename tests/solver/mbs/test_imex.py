@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import RAW_DAMPING, solid_scene
+from helpers import RAW_DAMPING, solid_scene
 
 from solver.mbs.dynamics import simulate
 from solver.mbs.kernels import layout as L

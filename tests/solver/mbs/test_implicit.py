@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import RAW_DAMPING, solid_scene
+from helpers import RAW_DAMPING, solid_scene
 
 from solver.mbs.dynamics import DivergenceError, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import assert_forces_are_minus_the_energy_gradient, loaded_mesh_state
+from helpers import assert_forces_are_minus_the_energy_gradient, loaded_mesh_state
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.laws import contact_energy, contact_force, contact_tangent, spring_energy, spring_tangent, spring_torque

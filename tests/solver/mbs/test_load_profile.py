@@ -2,7 +2,7 @@
 that carries the mesh across the backlash onto the coast flanks."""
 import numpy as np
 import pytest
-from conftest import solid_scene
+from helpers import solid_scene
 
 from solver.mbs.dynamics import load_profile, run_loads, simulate
 from solver.mbs.kernels.mechanics import load_torque

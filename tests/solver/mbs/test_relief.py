@@ -3,7 +3,7 @@ geometric construction, and the Harris map of a relief designed for a load."""
 import math
 
 import numpy as np
-from conftest import SMALL_PAIR
+from helpers import SMALL_PAIR
 from scipy.spatial import cKDTree
 
 from solver.fe.ltca import mesh_points
@@ -23,7 +23,7 @@ RELIEF = {"gear1.modification.tip_relief": 10.0, "gear1.modification.tip_length"
 
 
 def small(**kw):
-    """The 24-tooth pair of conftest (m = 3 mm, contact ratio 1.6), solid, uniform springs."""
+    """The 24-tooth pair of helpers.py (m = 3 mm, contact ratio 1.6), solid, uniform springs."""
     return default_scene().replace(**{**SMALL_PAIR, "gear2.spring.stiffness": "uniform", **kw})
 
 

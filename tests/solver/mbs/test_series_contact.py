@@ -4,7 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import assert_forces_are_minus_the_energy_gradient, loaded_mesh_state
+from helpers import assert_forces_are_minus_the_energy_gradient, loaded_mesh_state
 from scipy.integrate import quad
 
 from solver.mbs.kernels import layout as L

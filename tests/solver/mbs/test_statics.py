@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import solid_scene
+from helpers import solid_scene
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR, assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
+from helpers import SMALL_PAIR, assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 
 from solver.identify.coupling import tooth_compliance_fit
 from solver.identify.pivot import lever

@@ -41,12 +41,12 @@ def test_fe_fillet_stress_of_the_solid_paper_gear_against_iso_6336_3():
     own fillet radius in Y_S the two agree within 8 %. The von Mises peak (compression fillet,
     what the archive stores) is higher still."""
     import numpy as np
+    from helpers import solid_scene
 
     from solver.fe import body as fe
     from solver.fe.mesh import mesh_body
     from solver.geometry import pair_geometry
     from study.inputs.gearsetup import gear_setups
-    from tests.conftest import solid_scene
     s1, s = gear_setups(solid_scene())
     geo = s.geometry
     m, z, a, b = geo.spec.module, geo.teeth, geo.spec.pressure_angle, geo.spec.face_width

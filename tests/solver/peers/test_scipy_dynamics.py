@@ -2,7 +2,7 @@
 methods, closes the energy balance, and reports failures by name."""
 import numpy as np
 import pytest
-from conftest import solid_scene
+from helpers import solid_scene
 
 from solver.mbs.dynamics import DivergenceError, simulate
 from solver.peers.pair_equations import PairEquations

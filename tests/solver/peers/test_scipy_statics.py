@@ -2,7 +2,7 @@
 every tooth free, so it must give the same STE and contact count as `solve_static`."""
 import numpy as np
 import pytest
-from conftest import solid_scene
+from helpers import solid_scene
 
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_statics import static_te_root

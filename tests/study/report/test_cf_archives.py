@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from cf_check import cf_errors
-from conftest import SMALL_PAIR
+from helpers import SMALL_PAIR
 
 import study
 from study.report.results import clean_stale_temporaries, write_netcdf

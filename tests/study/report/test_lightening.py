@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR
+from helpers import SMALL_PAIR
 
 from solver.inertia import gear_mass
 from study.inputs import springs
@@ -13,7 +13,7 @@ from study.scene import default_scene
 
 
 def small_scene(**kw):
-    """The small 24-tooth pair of conftest, the driven gear with a web of 8 mm and 4 holes."""
+    """The small 24-tooth pair of helpers.py, the driven gear with a web of 8 mm and 4 holes."""
     return default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
                                       "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
 

@@ -3,10 +3,10 @@ the scene as run, and the CSV export."""
 import numpy as np
 import pandas as pd
 import pytest
+from helpers import SMALL_LIGHTENED, solid_scene
 from PIL import Image
 
 from study.cli import main
-from tests.conftest import SMALL_LIGHTENED, solid_scene
 
 
 def test_dynamic_factor_is_one_near_zero_speed_and_tooth_forces_carry_the_load():

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import solid_scene
+from helpers import solid_scene
 
 from study.report.campbell import campbell_plot
 from study.report.summary import summarize

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import solid_scene
+from helpers import solid_scene
 
 from solver.mbs.dynamics import simulate
 from study.report.modes import critical_speeds

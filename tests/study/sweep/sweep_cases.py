@@ -80,3 +80,14 @@ def ctrl_c_after_stored(monkeypatch, n: int):
         yield stored
     finally:
         monkeypatch.setattr(engine.PartStore, "put", real_put)
+
+
+def assert_refused_before_any_work(monkeypatch, make_study, text: str, field: str, reason: str) -> None:
+    """``make_study(text)`` raises a SceneError naming ``field``, with ``reason`` in its message,
+    and no point of the study starts to run."""
+    import study.sweep.engine as engine
+    from study.scene import SceneError
+    monkeypatch.setattr(engine, "run_point", lambda *a: pytest.fail("work started"))
+    with pytest.raises(SceneError) as e:
+        make_study(text)
+    assert e.value.field == field and reason in str(e.value), str(e.value)

@@ -2,7 +2,7 @@
 sweep's numbers unchanged by it."""
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR
+from helpers import SMALL_PAIR
 
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import gear_setup

@@ -5,7 +5,7 @@ from pathlib import Path
 import numba
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR
+from helpers import SMALL_PAIR
 
 from study.sweep import engine
 from study.sweep.engine import kernel_cache_folder, kernels_cached, run_sweep

@@ -2,7 +2,7 @@
 tip relief that minimises the STE, and the default's name in scenes, studies and archives."""
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR
+from helpers import SMALL_PAIR
 
 from study.scene import SceneError, default_scene
 from study.setup import build_scene_model, solid_scene
@@ -13,7 +13,7 @@ LIGHT = {**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "
 
 
 def small_light(**kw):
-    """The small 24-tooth pair of conftest, the driven gear with a web of 8 mm and 4 holes."""
+    """The small 24-tooth pair of helpers.py, the driven gear with a web of 8 mm and 4 holes."""
     return default_scene().replace(**{**LIGHT, **kw})
 
 

@@ -6,31 +6,20 @@ import math
 
 import numpy as np
 import pytest
-from conftest import solid_scene
+from helpers import solid_scene
 
-from study.setup import build_scene_model
 from study.verify.precision_cases import Spec
 from study.verify.precision_report import cheapest, plot
 from study.verify.precision_study import dynamic_study, run_study, static_study
 
 
 @pytest.fixture(scope="module")
-def scene():
-    return solid_scene()
-
-
-@pytest.fixture(scope="module")
-def model(scene):
-    return build_scene_model(scene)
-
-
-@pytest.fixture(scope="module")
-def dyn(scene, model):
+def dyn(paper_solid_scene, paper_solid_model):
     """1 ms window (ramps end at 0.5 ms): explicit (all explicit, and with implicit tooth-root
     dampers) at 1 and 1/2 of its stability step, the production path, the
     implicit one at 1 and 4 times it (the scipy stiff solvers take minutes here: they run in
     the workflow, their code path is tested in tests/solver/peers/test_scipy_dynamics.py)."""
-    return dynamic_study(scene, model, duration=0.001, repeats=1, explicit_fractions=(1, 2),
+    return dynamic_study(paper_solid_scene, paper_solid_model, duration=0.001, repeats=1, explicit_fractions=(1, 2),
                            implicit_multiples=(4, 1), alphas=(0.0,), scipy_methods=(), active_set=True)
 
 
@@ -69,8 +58,8 @@ def test_errors_fall_with_the_step_at_least_at_second_order(dyn):
     assert im[0] > 8 * im[1]                            # 4x smaller step: error / 16
 
 
-def test_static_study_and_failed_run_kept(scene, model, tmp_path):
-    ds = static_study(scene, model, rotation_deg=0.5, repeats=1, tols=(1e-2, 1e-8),
+def test_static_study_and_failed_run_kept(paper_solid_scene, paper_solid_model, tmp_path):
+    ds = static_study(paper_solid_scene, paper_solid_model, rotation_deg=0.5, repeats=1, tols=(1e-2, 1e-8),
                         explicit_fractions=(1,), implicit_multiples=(4,), alphas=(0.0,))
     e = ds["te_error"].sel(norm="linf").values
     m = ds["method"].values
