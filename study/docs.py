@@ -1,6 +1,6 @@
 """The scene field and sweep output reference, generated from the declarations the validation
 uses (`study.scene` fields, `study.sweep.outputs.SCALARS` and `CURVES`), so it cannot drift
-from what the code accepts.
+from what the code accepts; and the list of the embedded scenes and studies (study/scenes/).
 
     lightgear fields [PREFIX]          # every scene field: unit, default, range, meaning
     lightgear outputs                  # the sweep scalars and curves with their units
@@ -8,7 +8,7 @@ from what the code accepts.
     python -m study.docs --check       # exit 1 when the committed tables are out of date
 
 In the Markdown files the generated part sits between ``<!-- generated: NAME -->`` and
-``<!-- end generated: NAME -->`` (NAME: ``fields`` or ``outputs``); the rest is hand-written.
+``<!-- end generated: NAME -->`` (NAME: ``fields``, ``outputs`` or ``scenes``); the rest is hand-written.
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
-GENERATED = {"fields": "scenes.md", "outputs": "numbers.md"}    # block name -> file in docs/
+GENERATED = {"fields": "scenes.md", "outputs": "numbers.md", "scenes": "scenes.md"}    # block name -> file in docs/
 
 
 @dataclass(frozen=True)
@@ -155,7 +155,16 @@ def outputs_markdown() -> str:
     return "\n".join(out) + "\n"
 
 
-BLOCKS = {"fields": fields_markdown, "outputs": outputs_markdown}
+def scenes_markdown() -> str:
+    """The embedded scenes and studies as one Markdown table: name, kind, title."""
+    from study.scene import embedded_scenes
+    out = ["| name | kind | title |", "|---|---|---|"]
+    for name, (_path, kind, title) in embedded_scenes().items():
+        out.append(f"| `{name}` | {kind} | {_cell(title)} |")
+    return "\n".join(out) + "\n"
+
+
+BLOCKS = {"fields": fields_markdown, "outputs": outputs_markdown, "scenes": scenes_markdown}
 
 
 def _markers(name: str) -> tuple[str, str]:

@@ -1,36 +1,31 @@
 """Shared test scenes and checks, imported by the tests as ``from helpers import ...`` (pytest puts
-tests/ on the path): small solid scenes that need no FE, and checks of the mechanics."""
-from study.scene import default_scene
-
-# 24 teeth, m = 3 mm, small solid bodies: a coarse, fast FE body (about 1 s)
-SMALL_PAIR = {"pair.backlash": 0.1}
-for _g in (1, 2):
-    SMALL_PAIR.update({f"gear{_g}.module": 3.0, f"gear{_g}.teeth": 24, f"gear{_g}.fillet_radius": 0.9,
-                       f"gear{_g}.face_width": 20.0, f"gear{_g}.body.rim_height": 4.0,
-                       f"gear{_g}.body.web_height": 14.0, f"gear{_g}.body.hub_height": 6.0,
-                       f"gear{_g}.body.web_thickness": 20.0, f"gear{_g}.body.holes": 0})
-
-
-# a small lightened pair (24 teeth, m 2 mm, a coarse FE body) whose driven gear has a thin web
-# with 8 holes
-SMALL_LIGHTENED = {
-    "gear1.module": 2.0, "gear1.teeth": 24, "gear2.module": 2.0, "gear2.teeth": 24,
-    "gear1.body.rim_height": 3.0, "gear1.body.web_height": 12.0, "gear1.body.hub_height": 3.0,
-    "gear1.body.web_thickness": 17.0, "gear1.body.holes": 0,
-    "gear2.body.rim_height": 3.0, "gear2.body.web_height": 12.0, "gear2.body.hub_height": 3.0,
-    "gear2.body.web_thickness": 8.0, "gear2.body.holes": 8, "gear2.body.hole_radius": 3.0,
-    "gear2.body.hole_circle_radius": 12.5, "fe.mesh_size": 1.0,
-}
-
+tests/ on the path): the solid paper pair, the scenes as overrides, the raw damping, and checks of
+the mechanics. The small pairs are embedded scenes: load_scene("small_pair"), load_scene("small_lightened")."""
+from study.scene import load_scene
 
 # the raw damping coefficients the scenes had before the damping ratio (mesh mode at 0.14 %)
 RAW_DAMPING = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spring.c_phi": 0.062}
 
 
 def solid_scene(**overrides):
-    """The paper pair with a solid driven gear (no FE needed), plus overrides."""
-    from study import setup
-    return setup.solid_scene(default_scene(), gears=(2,)).replace(**overrides)
+    """The paper pair with a solid driven gear (no FE needed; the embedded scene paper_solid), plus overrides."""
+    return load_scene("paper_solid").replace(**overrides)
+
+
+def scene_overrides(name: str) -> dict:
+    """The fields an embedded scene sets over the paper example, by dotted path (its title
+    aside): ``--set`` or a study's [scene] table that give the scene on the paper example."""
+    import tomllib
+
+    from study.scene import scene_path
+
+    def flat(table, prefix=""):
+        for k, v in table.items():
+            if isinstance(v, dict):
+                yield from flat(v, f"{prefix}{k}.")
+            elif prefix or k != "title":
+                yield f"{prefix}{k}", v
+    return dict(flat(tomllib.loads(scene_path(name).read_text())))
 
 
 def assert_energy_closes_at_second_order(model, torque=50.0):

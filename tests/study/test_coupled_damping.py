@@ -2,9 +2,8 @@
 the body dampers take part, and the modal analysis of the model built reads the ratio asked for."""
 import numpy as np
 import pytest
-from helpers import SMALL_LIGHTENED
 
-from study.scene import default_scene
+from study.scene import load_scene
 
 
 def test_body_dampers_join_the_joints_where_they_cannot_reach_the_mesh_ratio(private_fe_cache):
@@ -14,7 +13,7 @@ def test_body_dampers_join_the_joints_where_they_cannot_reach_the_mesh_ratio(pri
     from solver.mbs.modes import joint_damping_for_ratio, modal_analysis
     from study.setup import build_scene_model, mean_load
 
-    scene = default_scene().replace(**SMALL_LIGHTENED)   # joints alone: at most about 4.7 %
+    scene = load_scene("small_lightened")   # joints alone: at most about 4.7 %
     assert scene.coupling_model == "compliance"
     raw = build_scene_model(scene, convert_damping=False)
     eqs = loaded_equilibria(raw, mean_load(scene))

@@ -124,12 +124,11 @@ def test_fields_are_the_driven_gear_body():
 def test_small_pair_end_to_end_gives_the_lightest_body_its_figure_and_archives(tmp_path, capsys, private_fe_cache):
     """24-tooth pair, coarse FE mesh, two hole radii and one refined between them: the lightest
     body is the larger holes, its answer is measured against the solid gear's run."""
-    from helpers import SMALL_PAIR
 
-    from study.scene import default_scene
-    scene = default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
-                                       "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
-                                       "quasi_static.rotation": 30.0, "dynamic.ramp_time": 0.002})
+    from study.scene import load_scene
+    scene = load_scene("small_pair").replace(**{"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+                                                "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
+                                                "quasi_static.rotation": 30.0, "dynamic.ramp_time": 0.002})
     (tmp_path / "scene.toml").write_text(scene.to_toml())
     out = tmp_path / "out"
     rc = main([str(tmp_path / "scene.toml"), "--grid", "gear2.body.holes=4", "--grid", "gear2.body.hole_radius=2.0,3.0",

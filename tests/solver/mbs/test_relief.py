@@ -3,13 +3,12 @@ geometric construction, and the Harris map of a relief designed for a load."""
 import math
 
 import numpy as np
-from helpers import SMALL_PAIR
 from scipy.spatial import cKDTree
 
 from solver.fe.ltca import mesh_points
 from solver.mbs.kernels import layout as L
 from solver.mbs.statics import solve_static
-from study.scene import default_scene
+from study.scene import load_scene
 from study.setup import geometry_model
 
 PERIOD = 15.0          # deg: one mesh pitch of the 24-tooth pair
@@ -23,8 +22,8 @@ RELIEF = {"gear1.modification.tip_relief": 10.0, "gear1.modification.tip_length"
 
 
 def small(**kw):
-    """The 24-tooth pair of helpers.py (m = 3 mm, contact ratio 1.6), solid, uniform springs."""
-    return default_scene().replace(**{**SMALL_PAIR, "gear2.spring.stiffness": "uniform", **kw})
+    """The 24-tooth pair of the small_pair scene (m = 3 mm, contact ratio 1.6), solid, uniform springs."""
+    return load_scene("small_pair").replace(**{"gear2.spring.stiffness": "uniform", **kw})
 
 
 def modified_flanks(scene, model, g, theta, n=1500):

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import SMALL_PAIR, assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
+from helpers import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 
 from solver.identify.coupling import tooth_compliance_fit
 from solver.identify.pivot import lever
@@ -80,8 +80,9 @@ def test_coupling_softens_double_contact_and_leaves_single_contact():
     """A neighbour's load turns a tooth too: where two pairs carry the load the mesh is softer;
     where one pair carries it alone the unloaded neighbours change nothing (the small pair,
     contact ratio 1.6)."""
+    from study.scene import load_scene
     from study.setup import build_scene_model
-    small = build_scene_model(solid_scene(**{**SMALL_PAIR, "gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
+    small = build_scene_model(load_scene("small_pair").replace(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
     angles = np.radians(np.arange(0.0, 15.0, 0.1))
     z1, z2 = small.teeth
     k = float(small.k_phi[0])

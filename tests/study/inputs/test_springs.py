@@ -4,7 +4,6 @@ import math
 
 import numpy as np
 import pytest
-from helpers import SMALL_PAIR
 
 from solver.fe import body as fe
 from solver.geometry import gear_geometry
@@ -13,16 +12,16 @@ from solver.peers.energy_method import tooth_compliance
 from solver.peers.iso6336 import blank_factor, single_stiffness
 from study.inputs import springs
 from study.inputs.gearsetup import gear_setup
-from study.scene import default_scene
+from study.scene import default_scene, load_scene
 from study.setup import solid_scene
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
 
 def small_scene(**kw):
-    """The small 24-tooth pair of helpers.py, the driven gear with a web of 8 mm and 4 holes."""
-    return default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
-                                      "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
+    """The small 24-tooth pair (the small_pair scene), the driven gear with a web of 8 mm and 4 holes."""
+    return load_scene("small_pair").replace(**{"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+                                               "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
 
 
 def test_solid_body_gives_the_same_stiffness_to_every_tooth():

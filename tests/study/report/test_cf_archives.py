@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 import xarray as xr
 from cf_check import cf_errors
-from helpers import SMALL_PAIR
 
 import study
 from study.report.results import clean_stale_temporaries, write_netcdf
@@ -42,8 +41,8 @@ def test_run_archive_passes_cf_and_keeps_names_values_and_float_time(small_scene
 def test_stiffness_and_reference_archives_pass_cf(private_fe_cache, tmp_path):
     from study.inputs.springs import stiffness_dataset
     from study.verify.fe_reference import reference_dataset
-    scene = study.default_scene().replace(**{**SMALL_PAIR, "gear2.body.holes": 4, "gear2.body.hole_radius": 2.5,
-                                              "gear2.body.hole_circle_radius": 20.0})
+    scene = study.load_scene("small_pair").replace(**{"gear2.body.holes": 4, "gear2.body.hole_radius": 2.5,
+                                                      "gear2.body.hole_circle_radius": 20.0})
     stiff = study.write(stiffness_dataset(scene), tmp_path / "stiffness.nc")
     assert cf_errors(stiff) == []
     ref = study.write(reference_dataset(scene, np.radians([0.0, 1.0, 2.0])), tmp_path / "ref.nc")

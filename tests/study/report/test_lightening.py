@@ -3,19 +3,18 @@ import math
 
 import numpy as np
 import pytest
-from helpers import SMALL_PAIR
 
 from solver.inertia import gear_mass
 from study.inputs import springs
 from study.inputs.gearsetup import gear_setups
 from study.report.lightening import lightening_dataset
-from study.scene import default_scene
+from study.scene import load_scene
 
 
 def small_scene(**kw):
-    """The small 24-tooth pair of helpers.py, the driven gear with a web of 8 mm and 4 holes."""
-    return default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
-                                      "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
+    """The small 24-tooth pair (the small_pair scene), the driven gear with a web of 8 mm and 4 holes."""
+    return load_scene("small_pair").replace(**{"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+                                               "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
 
 
 def _no_fe(monkeypatch):

@@ -3,7 +3,7 @@ the scene as run, and the CSV export."""
 import numpy as np
 import pandas as pd
 import pytest
-from helpers import SMALL_LIGHTENED, solid_scene
+from helpers import scene_overrides, solid_scene
 from PIL import Image
 
 from study.cli import main
@@ -29,8 +29,8 @@ def test_dynamic_factor_is_one_near_zero_speed_and_tooth_forces_carry_the_load()
     assert np.all(ds["dte_contact_tooth2"].values[ds["dte_contact_force"].values > 0] >= 0)
 
 
-# the small lightened pair, with short runs
-SMALL_RUN = {**SMALL_LIGHTENED, "quasi_static.rotation": 30.0, "quasi_static.angle_step": 0.25,
+# the small lightened pair set over the paper example, with short runs
+SMALL_RUN = {**scene_overrides("small_lightened"), "quasi_static.rotation": 30.0, "quasi_static.angle_step": 0.25,
              "dynamic.ramp_time": 0.002, "dynamic.duration": 0.01}
 
 

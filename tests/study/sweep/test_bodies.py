@@ -2,7 +2,7 @@
 sweep's numbers unchanged by it."""
 import numpy as np
 import pytest
-from helpers import SMALL_PAIR
+from helpers import scene_overrides
 
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import gear_setup
@@ -17,7 +17,7 @@ from study.sweep.tasks import plan
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
 SCENE = "\n".join(f'"{k}" = {v!r}' if not isinstance(v, str) else f'"{k}" = "{v}"' for k, v in {
-    **SMALL_PAIR, "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
+    **scene_overrides("small_pair"), "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
     "quasi_static.rotation": 6.0, "quasi_static.angle_step": 1.0, "dynamic.duration": 0.004,
     "dynamic.ramp_time": 0.001, "fe.mesh_size": 1.5,
     "coupling.model": "paper"}.items())     # the maps computed ahead are the paper model's springs

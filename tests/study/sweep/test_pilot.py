@@ -5,7 +5,7 @@ from pathlib import Path
 import numba
 import numpy as np
 import pytest
-from helpers import SMALL_PAIR
+from helpers import scene_overrides
 
 from study.sweep import engine
 from study.sweep.engine import kernel_cache_folder, kernels_cached, run_sweep
@@ -14,7 +14,7 @@ from study.sweep.outputs import STATUS
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
-SCENE = "\n".join(f'"{k}" = {v!r}' for k, v in {**SMALL_PAIR, "quasi_static.rotation": 6.0,
+SCENE = "\n".join(f'"{k}" = {v!r}' for k, v in {**scene_overrides("small_pair"), "quasi_static.rotation": 6.0,
                                                  "quasi_static.angle_step": 1.0, "dynamic.duration": 0.004,
                                                  "dynamic.ramp_time": 0.001}.items())
 STUDY = f"""title = "pilot"

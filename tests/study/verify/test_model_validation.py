@@ -2,19 +2,18 @@
 tip relief that minimises the STE, and the default's name in scenes, studies and archives."""
 import numpy as np
 import pytest
-from helpers import SMALL_PAIR
 
-from study.scene import SceneError, default_scene
+from study.scene import SceneError, default_scene, load_scene
 from study.setup import build_scene_model, solid_scene
 from study.verify import model_validation as mv
 
-LIGHT = {**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
+LIGHT = {"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
          "gear2.body.hole_circle_radius": 19.5, "quasi_static.torque": 100.0}
 
 
 def small_light(**kw):
-    """The small 24-tooth pair of helpers.py, the driven gear with a web of 8 mm and 4 holes."""
-    return default_scene().replace(**{**LIGHT, **kw})
+    """The small 24-tooth pair (the small_pair scene), the driven gear with a web of 8 mm and 4 holes."""
+    return load_scene("small_pair").replace(**{**LIGHT, **kw})
 
 
 def test_the_default_model_of_a_lightened_pair_agrees_with_the_fe_reference():
@@ -37,7 +36,7 @@ def test_the_relief_that_minimises_the_ste_agrees_with_the_fe_reference():
     """At a light and a heavy load: the compliance model's optimum relief within the target of
     the FE reference's, its STE within the targets without relief (the local tooth compliance
     in series with the contact is what gets the heavy load's optimum right)."""
-    scene = solid_scene(default_scene().replace(**SMALL_PAIR))
+    scene = solid_scene(load_scene("small_pair"))
     ds = mv.relief_dataset({"small": scene}, reliefs=(0.0, 2.0, 4.0, 6.0, 8.0, 10.0), torques=(25.0, 100.0),
                            rotations={"small": 15.0}, step=0.25, models=("fe-reference", "compliance"))
     for torque in (25.0, 100.0):
@@ -77,7 +76,7 @@ def test_a_study_over_solid_and_lightened_bodies_runs_one_model():
 
 def test_the_run_archive_names_the_model_it_ran():
     from study.run import run_scene
-    scene = solid_scene(default_scene().replace(**{**SMALL_PAIR, "quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5}))
+    scene = solid_scene(load_scene("small_pair").replace(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5}))
     ds = run_scene(scene, static=True, dynamic=False)
     assert ds.attrs["coupling_model"] == "paper" and ds.attrs["coupling_model_setting"] == "auto"
     lite = small_light(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})
