@@ -6,7 +6,7 @@ A scene file has the sections of `Scene` (``material``, ``pair``, ``gear1`` and 
 paper's example, Table 1, with solid bodies; ``study/scenes/paper.toml``, the embedded
 default scene, lightens the driven gear). Each field declares its unit (mm, deg, N·m, rad/s,
 s, MPa, kg/m³), description and range once (`field_unit`, `field_doc`). The conversion to
-the solver's SI happens in `Scene.tooth_spec`, `body_spec`, `material_spec` and `pivot_radius`.
+the solver's SI happens in `Scene.tooth_spec`, `geometry`, `body_spec`, `material_spec` and `pivot_radius`.
 
 Errors: `SceneError` names the dotted field and the reason, before any work starts.
 """
@@ -22,7 +22,16 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from solver import units
-from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
+from solver.geometry import (
+    BodySpec,
+    GearGeometry,
+    GeometryError,
+    Material,
+    ToothSpec,
+    gear_geometry,
+    pair_geometry,
+    validate_body,
+)
 from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
 from study.gear_errors import ErrorsSection, errors_spec
@@ -204,6 +213,11 @@ class Scene:
                          face_width=gs.face_width * units.MM,
                          thinning=0.5 * self.pair.backlash * units.MM)
 
+    def geometry(self, g: int) -> GearGeometry:
+        """Gear g's derived geometry (radii, flanks, fillet; SI) from `tooth_spec`; GeometryError
+        naming the gear's field when the teeth cannot be made."""
+        return gear_geometry(self.tooth_spec(g), prefix=f"gear{g}")
+
     def body_spec(self, g: int) -> BodySpec:
         b = self.gear(g).body
         return BodySpec(rim_height=b.rim_height * units.MM, web_height=b.web_height * units.MM,
@@ -246,11 +260,11 @@ class Scene:
 
     def modification_spec(self, g: int):
         """Gear g's profile modification in SI (`solver.modification`), None for perfect involutes."""
-        return modification_spec(self.gear(g).modification, gear_geometry(self.tooth_spec(g)), f"gear{g}.modification")
+        return modification_spec(self.gear(g).modification, self.geometry(g), f"gear{g}.modification")
 
     def errors_spec(self, g: int):
         """Gear g's pitch deviations and eccentricity in SI (`solver.errors`), None for a perfect gear."""
-        return errors_spec(self.gear(g).errors, gear_geometry(self.tooth_spec(g)), f"gear{g}.errors")
+        return errors_spec(self.gear(g).errors, self.geometry(g), f"gear{g}.errors")
 
     @property
     def has_errors(self) -> bool:
@@ -260,7 +274,7 @@ class Scene:
     def pivot_radius(self, g: int) -> float:
         """Tooth pivot radius [m]; the root circle when the scene gives 0."""
         r = self.gear(g).pivot_radius
-        return r * units.MM if r > 0 else gear_geometry(self.tooth_spec(g)).root_radius
+        return r * units.MM if r > 0 else self.geometry(g).root_radius
 
     # ---- text ----
     def to_toml(self) -> str:
@@ -352,7 +366,7 @@ def check_scene(scene: Scene) -> None:
     try:
         geoms = []
         for g in (1, 2):
-            geo = gear_geometry(scene.tooth_spec(g), prefix=f"gear{g}")
+            geo = scene.geometry(g)
             validate_body(geo, scene.body_spec(g), prefix=f"gear{g}.body")
             geoms.append(geo)
             gs = scene.gear(g)

@@ -7,7 +7,6 @@ import pytest
 from conftest import SMALL_PAIR
 
 from solver.fe import body as fe
-from solver.geometry import gear_geometry
 from solver.identify.weber import pitch_point_depth, weber_deflection
 from solver.peers.energy_method import tooth_compliance
 from solver.peers.iso6336 import blank_factor, single_stiffness
@@ -74,7 +73,7 @@ def test_spring_options_and_cache(monkeypatch, tmp_path, private_fe_cache):
     # 'fe': the nonlinear spring passes through the FE point at the reference moment
     s_fe = s.replace(**{"gear2.spring.stiffness": "fe"})
     k_nl, _ = springs.tooth_springs(gear_setup(s_fe, 2))
-    g = gear_geometry(s.tooth_spec(2))
+    g = s.geometry(2)
     lever = fe.load_case(g, 0, g.root_radius).lever
     m_ref = s.quasi_static.torque / g.base_radius * lever
     k_lin = springs.fe_stiffness(gear_setup(s, 2))
@@ -93,7 +92,7 @@ def table1():
         old = os.environ.get("LIGHTGEAR_CACHE")
         os.environ["LIGHTGEAR_CACHE"] = d
         s = default_scene()
-        g = gear_geometry(s.tooth_spec(1))
+        g = s.geometry(1)
         body = s.body_spec(1)
         setup = gear_setup(s, 1)
         k = {t: springs.fe_stiffness(dataclasses.replace(setup, body=dataclasses.replace(body, web_thickness=t * 1e-3)), teeth=[0])[0]
@@ -159,7 +158,7 @@ def test_identification_recovers_a_known_spring_and_reads_the_fe():
     fit, u, comp = springs.identify_spring(gear_setup(small_scene(), 1), radii=5)
     assert np.all(np.diff(comp) > 0)                     # higher load point: more compliant
     assert fit.n == pytest.approx(1.0, abs=1e-9)          # the body FE is linear
-    g = gear_geometry(small_scene().tooth_spec(1))
+    g = small_scene().geometry(1)
     assert 0.5 * g.root_radius < fit.pivot_radius < g.pitch_radius
     assert fit.rms_rel_error < 0.1
 
