@@ -33,8 +33,8 @@ w_start, c_start = time.perf_counter(), time.process_time()
 import json, os, resource
 import numpy as np
 from study.scene import default_scene
-from study.setup import solid_scene
-from study.verify.fe_reference import reference, static_angles
+from study.setup import solid_scene, static_angles
+from study.verify.fe_reference import reference
 s = default_scene()
 if {solid}:
     s = solid_scene(s)

@@ -402,14 +402,15 @@ def validation(scene, step: float | None = None):
     (pair, model, angle [degree]) with the error figures [um] (`study.verify.validation`)."""
     import time
 
-    from study.verify.fe_reference import static_angles
+    from study.setup import static_angles
+    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR
     from study.verify.validation import validation_dataset
     _check_scene("validation", scene)
     _check(step is None or _number(step), "validation", "step", "a number of degrees or None", step)
     if scene.coupling.model != "none":       # the plain model is the scene's own; the coupled ones are built from it
         scene = scene.replace(**{"coupling.model": "none"})
     t0 = time.perf_counter()
-    ds = validation_dataset(scene, static_angles(scene, step))
+    ds = validation_dataset(scene, static_angles(scene, step, REFERENCE_MEMORY_FACTOR))
     ds.attrs["wall_time_s"] = time.perf_counter() - t0
     return ds
 

@@ -81,10 +81,11 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
     bodies) -> xarray.Dataset (``ste`` [um] over ``angle`` [degree], ``ste_tooth_force`` [N], ...).
     ``step`` [deg]: the driver angle step (None: quasi_static.angle_step); ``max_time`` [s]: refuse
     a run estimated to take longer (BudgetError, before any work)."""
-    from study.verify.fe_reference import reference_dataset, static_angles
+    from study.setup import static_angles
+    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, reference_dataset
     if step is not None and not step > 0:
         raise SceneError("--step", f"must be positive, got {step}")
-    angles = static_angles(scene, step)
+    angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
     estimate.check_time(estimate.reference_estimate(scene, angles), max_time)
     return reference_dataset(scene, angles, progress=progress)
 
