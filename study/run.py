@@ -73,7 +73,7 @@ def dynamic_choice(scene: Scene, model: Model):
 def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False):
     """DTE run with the scene's integrator: dynamic.method 'explicit', 'implicit' or 'auto'
     (chosen from the stability step; see `solver.mbs.implicit.choose_method`), or ``choice``
-    when already made. The result carries ``choice`` (the MethodChoice) for the archive.
+    (a MethodChoice) when already made.
     ``progress``: a bar on stderr when the run is expected to take more than a few seconds."""
     d = scene.dynamic
     table = load_table(scene)
@@ -97,7 +97,6 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
             bar.close()
     if math.isfinite(choice.omega_max):
         res.omega_max = choice.omega_max
-    res.choice = choice
     return res
 
 
@@ -242,7 +241,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
                 coords.update(c); data.update(v)
             else:
                 attrs["order_tracking_skipped"] = f"the run-up stopped before its end: {dy.message}"
-        attrs["dynamic_method"] = dy.choice.method
-        attrs["dynamic_method_reason"] = dy.choice.reason
-        attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")
+        attrs["dynamic_method"] = choice.method
+        attrs["dynamic_method_reason"] = choice.reason
+        attrs["hht_alpha"] = d.alpha if choice.method == "implicit" else float("nan")
     return xr.Dataset(data, coords=coords, attrs=attrs)
