@@ -28,7 +28,7 @@ from study.scene import default_scene
 from study.setup import build_scene_model
 from solver.mbs.statics import solve_static
 from solver.mbs.dynamics import simulate
-m = build_scene_model(default_scene().replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}))
+m = build_scene_model(default_scene().solid(gears=(2,)))
 c1, t1 = time.process_time(), time.perf_counter()
 solve_static(m, np.radians(np.arange(0.0, 1.0, 0.1)), 50.0)
 c2, t2 = time.process_time(), time.perf_counter()

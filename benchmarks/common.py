@@ -40,12 +40,11 @@ def scene(kind: str, coupling: str | None = None):
     """The paper pair (Table 1) with a solid driven gear ('solid') or as published ('lightened':
     the default scene), with the default model or ``coupling`` (a `coupling.model`)."""
     from study.scene import default_scene
-    from study.setup import solid_scene
     s = default_scene()
     if coupling is not None:
         s = s.replace(**{"coupling.model": coupling})
     if kind == "solid":
-        return solid_scene(s, gears=(2,))
+        return s.solid(gears=(2,))
     if kind == "lightened":
         return s
     raise ValueError(f"scene kind: 'solid' or 'lightened', got {kind!r}")

@@ -258,6 +258,12 @@ class Scene:
         gs = self.gear(g)
         return gs.body.holes > 0 or (gs.body.web_height > 0 and gs.body.web_thickness < gs.face_width)
 
+    def solid(self, gears=(1, 2)) -> "Scene":
+        """The same scene with solid bodies for ``gears``: the web as thick as the face, no holes
+        (the scene-level twin of `solver.geometry.solid_body`, which a `GearSetup` uses)."""
+        return self.replace(**{k: v for g in gears for k, v in ((f"gear{g}.body.holes", 0),
+                                                                (f"gear{g}.body.web_thickness", self.gear(g).face_width))})
+
     def modification_spec(self, g: int):
         """Gear g's profile modification in SI (`solver.modification`), None for perfect involutes."""
         return modification_spec(self.gear(g).modification, self.geometry(g), f"gear{g}.modification")

@@ -24,15 +24,8 @@ from study.inputs.gearsetup import GearSetup, gear_setup, gear_setups
 from study.inputs.springs import tooth_springs
 from study.scene import MESH_DAMPING_RATIO, TOOTH_DAMPING_RATIO, Scene, SceneError
 
-__all__ = ["GearSetup", "gear_setup", "gear_setups", "solid_scene", "coupling_fit", "scene_springs",
+__all__ = ["GearSetup", "gear_setup", "gear_setups", "coupling_fit", "scene_springs",
            "build_scene_model", "kept_scene_model", "geometry_model", "static_angles", "load_table", "damping_ratios", "mean_load"]
-
-
-def solid_scene(scene: Scene, gears=(1, 2)) -> Scene:
-    """The same scene with solid bodies for ``gears``: the web as thick as the face, no holes
-    (the scene-level twin of `solver.geometry.solid_body`)."""
-    return scene.replace(**{k: v for g in gears for k, v in ((f"gear{g}.body.holes", 0),
-                                                               (f"gear{g}.body.web_thickness", scene.gear(g).face_width))})
 
 
 def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple | None = None):

@@ -35,8 +35,7 @@ RAW_DAMPING = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spri
 
 def solid_scene(**overrides):
     """The paper pair with a solid driven gear (no FE needed), plus overrides."""
-    from study import setup
-    return setup.solid_scene(default_scene(), gears=(2,)).replace(**overrides)
+    return default_scene().solid(gears=(2,)).replace(**overrides)
 
 
 @pytest.fixture
