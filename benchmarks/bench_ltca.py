@@ -33,7 +33,7 @@ w_start, c_start = time.perf_counter(), time.process_time()
 import json, os, resource
 import numpy as np
 from study.scene import default_scene
-from study.setup import static_angles
+from study.scene_model import static_angles
 from study.verify.fe_reference import reference
 s = default_scene()
 if {solid}:

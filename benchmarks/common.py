@@ -54,7 +54,7 @@ def model(kind: str, coupling: str | None = None):
     """Solver model of the scene (`scene`); the lightened gear's FE springs come from
     study.inputs.springs (computed once, then read from its disk cache)."""
     os.environ.setdefault("LIGHTGEAR_CACHE", str(ROOT / ".lightgear-cache"))
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     return build_scene_model(scene(kind, coupling))
 
 

@@ -401,7 +401,7 @@ def validation(scene, step: float | None = None):
     (pair, model, angle [degree]) with the error figures [um] (`study.verify.validation`)."""
     import time
 
-    from study.setup import static_angles
+    from study.scene_model import static_angles
     from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR
     from study.verify.validation import validation_dataset
     _check_scene("validation", scene)

@@ -26,7 +26,7 @@ from study.report.lightening import lightening_variables
 from study.report.mesh_outputs import dynamic_force_variables, mesh_variables
 from study.report.modes import modal_variables
 from study.scene import Scene
-from study.setup import (
+from study.scene_model import (
     build_scene_model,
     damping_ratios,
     error_period,
@@ -126,7 +126,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     reference over a revolution); a study leaves them out unless it asks for them.
     Plausibility warnings (`study.plausibility.scene_warnings`, and a speed far above the
     critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr.
-    ``keep_model``: take the model from `study.setup.kept_scene_model` (a study's worker: the
+    ``keep_model``: take the model from `study.scene_model.kept_scene_model` (a study's worker: the
     points of one body share it)."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic

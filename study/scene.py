@@ -115,7 +115,7 @@ class ContactSection:
     # neither: damping_ratio = MESH_DAMPING_RATIO. The coefficient the scenes used before,
     # c_con = 3640 (5 % of a local contact mode at 1 um), damps the Table 1 mesh mode at 0.003 %
     # (with c_phi = 0.062 at 0.14 %). A ratio is carried by the tooth-root joint dampers, the
-    # contact law then has none (why: study/setup.py, damping_from_ratios).
+    # contact law then has none (why: study/scene_model.py, damping_from_ratios).
     c_con: float = _f(NOT_GIVEN, "N*s/mm^(1+m3)", "contact damping coefficient (or damping_ratio)", 0.0, optional=True)
     damping_ratio: float = _f(NOT_GIVEN, "1", "mesh damping as a ratio of critical damping of the mesh mode (the "
                               "pair linearised at the mean load, mean over one mesh period), converted once per run to "

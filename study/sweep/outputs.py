@@ -102,7 +102,7 @@ CURVES = {
 #   static    STE: every field but the dynamic run's (study.run.run_static reads no 'dynamic.*')
 #   modes     the pair linearised at the mean load (its dampers given as ratios converted there):
 #             the static fields (damping included) and the mean load, the dynamic run's torque
-#             when it runs (study.setup.mean_load reads dynamic.enabled and dynamic.torque)
+#             when it runs (study.scene_model.mean_load reads dynamic.enabled and dynamic.torque)
 #   dynamic   DTE: every field
 ERRORS = ("gear1.errors", "gear2.errors")    # pitch errors and runout: no part of a gear's mass or FE body
 ANALYSIS_FIELDS = {

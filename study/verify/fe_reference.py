@@ -22,7 +22,7 @@ from solver.fe.ltca import ltca_sweep, mesh_points
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
 from study.scene import Scene, SceneError
-from study.setup import geometry_model, static_angles
+from study.scene_model import geometry_model, static_angles
 
 # the reference holds about four times the arrays of a static analysis an angle (contacts and
 # load sharing per angle): its angles are checked against memory with this factor

@@ -27,7 +27,7 @@ from solver import units
 from solver.mbs.statics import solve_static
 from study.report import results
 from study.scene import Scene
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from study.verify.fe_reference import reference
 
 MODELS = ("fe-reference", "paper", "body-torsion", "compliance")

@@ -39,7 +39,7 @@ from solver.mbs.stability import linearized_system
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_scipy
 from study.report import results
-from study.setup import build_scene_model, load_table
+from study.scene_model import build_scene_model, load_table
 
 METHODS = ("explicit", "implicit alpha=0", "implicit alpha=-0.1", "LSODA")
 

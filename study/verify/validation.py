@@ -30,7 +30,7 @@ from solver import units
 from solver.fe.ltca import mesh_points
 from solver.mbs.statics import solve_static
 from study.report import results
-from study.setup import build_scene_model, coupling_fit, gear_setup
+from study.scene_model import build_scene_model, coupling_fit, gear_setup
 from study.verify.fe_reference import reference
 from study.verify.model_validation import order_amplitude
 

@@ -81,7 +81,7 @@ def test_gear_inertia_is_the_models_total_inertia():
     """One formula: the archive's inertia is the I_TOT the dynamics integrate (lightened gear)."""
     import study
     from study.inputs.gearsetup import gear_setups
-    from study.setup import geometry_model
+    from study.scene_model import geometry_model
     scene = study.default_scene()
     model = geometry_model(scene)
     for s, i_tot in zip(gear_setups(scene), model.inertia_total):

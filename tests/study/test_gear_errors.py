@@ -9,7 +9,7 @@ from solver.errors import iso1328_pitch_tolerances
 from solver.mbs.kernels import layout as L
 from study.estimate import error_period_note
 from study.scene import SceneError, default_scene, loads_scene
-from study.setup import error_period, geometry_model, static_angles, static_rotation
+from study.scene_model import error_period, geometry_model, static_angles, static_rotation
 
 E = "gear1.errors."
 E2 = "gear2.errors."

@@ -7,7 +7,7 @@ import pytest
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import flank_deviation
 from study.scene import SceneError, default_scene, loads_scene
-from study.setup import geometry_model
+from study.scene_model import geometry_model
 
 M = "gear1.modification."
 

@@ -64,7 +64,7 @@ def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
 FIRST_RUN = r'''
 import numpy as np
 from study.scene import default_scene
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from solver.mbs.statics import solve_static
 from solver.mbs.dynamics import simulate
 from solver.mbs.kernels import contact

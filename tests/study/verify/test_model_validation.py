@@ -5,7 +5,7 @@ import pytest
 from conftest import SMALL_PAIR
 
 from study.scene import SceneError, default_scene
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from study.verify import model_validation as mv
 
 LIGHT = {**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,

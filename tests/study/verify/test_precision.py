@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import solid_scene
 
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from study.verify.precision_cases import Spec
 from study.verify.precision_report import cheapest, plot
 from study.verify.precision_study import dynamic_study, run_study, static_study
