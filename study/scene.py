@@ -269,7 +269,7 @@ class Scene:
         return modification_spec(self.gear(g).modification, self.geometry(g), f"gear{g}.modification")
 
     def errors_spec(self, g: int):
-        """Gear g's pitch deviations and eccentricity in SI (`solver.errors`), None for a perfect gear."""
+        """Gear g's pitch deviations and eccentricity in SI (`solver.pitch_errors`), None for a perfect gear."""
         return errors_spec(self.gear(g).errors, self.geometry(g), f"gear{g}.errors")
 
     @property

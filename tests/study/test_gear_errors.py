@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from solver.errors import iso1328_pitch_tolerances
 from solver.mbs.kernels import layout as L
+from solver.pitch_errors import iso1328_pitch_tolerances
 from study.estimate import error_period_note
 from study.scene import SceneError, default_scene, loads_scene
 from study.scene_model import error_period, geometry_model, static_angles, static_rotation
