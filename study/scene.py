@@ -34,8 +34,8 @@ from solver.geometry import (
 )
 from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
-from study.gear_errors import ErrorsSection, errors_spec
 from study.modification import ModificationSection, modification_spec
+from study.pitch_errors import ErrorsSection, errors_spec
 from study.toml_writer import dumps_toml
 
 
