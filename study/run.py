@@ -13,9 +13,10 @@ import xarray as xr
 
 from solver import units
 from solver.mbs.dynamics import INACCURATE, run_loads, simulate
-from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels.layout import R_PV
 from solver.mbs.mesh_stiffness import mesh_states
+from solver.mbs.method import choose_method
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study import estimate
@@ -64,7 +65,7 @@ def run_static(scene: Scene, model: Model):
 
 
 def dynamic_choice(scene: Scene, model: Model):
-    """Integrator and step of the scene's dynamic run (`solver.mbs.implicit.choose_method`)."""
+    """Integrator and step of the scene's dynamic run (`solver.mbs.method.choose_method`)."""
     d = scene.dynamic
     step_torque = run_loads(load_table(scene), d.torque)[1]
     return choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
@@ -72,7 +73,7 @@ def dynamic_choice(scene: Scene, model: Model):
 
 def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False):
     """DTE run with the scene's integrator: dynamic.method 'explicit', 'implicit' or 'auto'
-    (chosen from the stability step; see `solver.mbs.implicit.choose_method`), or ``choice``
+    (chosen from the stability step; see `solver.mbs.method.choose_method`), or ``choice``
     (a MethodChoice) when already made.
     ``progress``: a bar on stderr when the run is expected to take more than a few seconds."""
     d = scene.dynamic

@@ -34,7 +34,8 @@ import xarray as xr
 
 from solver import units
 from solver.mbs.dynamics import INACCURATE, simulate
-from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.implicit import simulate_implicit
+from solver.mbs.method import choose_method
 from solver.mbs.stability import linearized_system
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_scipy

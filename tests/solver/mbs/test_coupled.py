@@ -147,7 +147,8 @@ def test_scipy_peer_refuses_a_coupled_model(paper_solid_model):
 
 
 def test_implicit_integrator_refuses_and_auto_picks_explicit_for_a_coupled_model(paper_solid_model):
-    from solver.mbs.implicit import choose_method, simulate_implicit
+    from solver.mbs.implicit import simulate_implicit
+    from solver.mbs.method import choose_method
     coupled = with_body_springs(paper_solid_model, (1.5e6, 0.9e6))
     with pytest.raises(ValueError, match="dynamic.method"):
         simulate_implicit(coupled, 100.0, 0.002, 50.0, 0.002, 0.001, dt=1e-6)

@@ -8,7 +8,7 @@ import pytest
 from conftest import RAW_DAMPING, solid_scene
 
 from solver.mbs.dynamics import DivergenceError, simulate
-from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels.laws import (
     contact_damping_tangents,
     contact_force,
@@ -16,6 +16,7 @@ from solver.mbs.kernels.laws import (
     spring_damping_tangent,
     spring_torque,
 )
+from solver.mbs.method import choose_method
 from solver.mbs.stability import highest_frequency, linearized_system, stable_time_step
 from study.run import run_scene
 from study.scene import SceneError
