@@ -28,7 +28,7 @@ def main(argv=None) -> int:
     from solver.mbs.dynamics import simulate
     from solver.mbs.stability import implicit_dampers_apply, stable_time_step
     from solver.mbs.statics import solve_static
-    from study.setup import build_scene_model, static_angles
+    from study.scene_model import build_scene_model, static_angles
 
     rows = []
     kinds = ["solid"] if args.quick else ["solid", "lightened"]

@@ -33,11 +33,11 @@ w_start, c_start = time.perf_counter(), time.process_time()
 import json, os, resource
 import numpy as np
 from study.scene import default_scene
-from study.setup import solid_scene
-from study.verify.fe_reference import reference, static_angles
+from study.scene_model import static_angles
+from study.verify.fe_reference import reference
 s = default_scene()
 if {solid}:
-    s = solid_scene(s)
+    s = s.solid()
 angles = static_angles(s, 0.5)
 case = "solid" if {solid} else "lightened"
 rows, stages = [], [dict(case=case, gear="-", stage="imports", wall_s=time.perf_counter() - w_start,

@@ -32,7 +32,7 @@ ROOT_ANGLES = 60          # 6 deg: more than one mesh cycle (5.37 deg)
 def static_rows(kind, m, sc, rep):
     from solver.mbs.statics import solve_static
     from solver.peers.scipy_statics import static_te_root
-    from study.setup import static_angles
+    from study.scene_model import static_angles
     ang = static_angles(sc)
     tq = sc.quasi_static.torque
     solve_static(m, ang[:5], tq)

@@ -30,7 +30,7 @@ COLUMNS = ("series", "value", "wall_min_s", "wall_median_s", "cpu_min_s", "cost_
 
 
 def z_model(z: int):
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     s = common.scene("solid")
     f = (1.5 * z / 2 - 1.25 * 1.5) / (1.5 * 67 / 2 - 1.25 * 1.5)
     over = {}

@@ -25,10 +25,10 @@ import json, time
 c0, t0 = time.process_time(), time.perf_counter()
 import numpy as np
 from study.scene import default_scene
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from solver.mbs.statics import solve_static
 from solver.mbs.dynamics import simulate
-m = build_scene_model(default_scene().replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}))
+m = build_scene_model(default_scene().solid(gears=(2,)))
 c1, t1 = time.process_time(), time.perf_counter()
 solve_static(m, np.radians(np.arange(0.0, 1.0, 0.1)), 50.0)
 c2, t2 = time.process_time(), time.perf_counter()
@@ -58,7 +58,7 @@ def main(argv=None) -> int:
     from solver.mbs.stability import stable_time_step
     from solver.mbs.statics import solve_static
     from solver.peers.scipy_dynamics import simulate_scipy
-    from study.setup import static_angles
+    from study.scene_model import static_angles
 
     # --- compile and cache start (subprocesses, so nothing is warm here)
     with tempfile.TemporaryDirectory() as cache:

@@ -40,12 +40,11 @@ def scene(kind: str, coupling: str | None = None):
     """The paper pair (Table 1) with a solid driven gear ('solid') or as published ('lightened':
     the default scene), with the default model or ``coupling`` (a `coupling.model`)."""
     from study.scene import default_scene
-    from study.setup import solid_scene
     s = default_scene()
     if coupling is not None:
         s = s.replace(**{"coupling.model": coupling})
     if kind == "solid":
-        return solid_scene(s, gears=(2,))
+        return s.solid(gears=(2,))
     if kind == "lightened":
         return s
     raise ValueError(f"scene kind: 'solid' or 'lightened', got {kind!r}")
@@ -55,7 +54,7 @@ def model(kind: str, coupling: str | None = None):
     """Solver model of the scene (`scene`); the lightened gear's FE springs come from
     study.inputs.springs (computed once, then read from its disk cache)."""
     os.environ.setdefault("LIGHTGEAR_CACHE", str(ROOT / ".lightgear-cache"))
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     return build_scene_model(scene(kind, coupling))
 
 

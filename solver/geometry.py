@@ -83,6 +83,13 @@ class BodySpec:
     hole_phase: float = 0.0
 
 
+def hole_angles(holes: int, first: float, turn: float = 2.0 * math.pi) -> np.ndarray:
+    """Polar angles of the centres of ``holes`` equally spaced holes, the first at ``first``,
+    measured from tooth 0's axis, in the unit of ``first`` and ``turn`` (one full turn): rad by
+    default (`BodySpec.hole_phase`), deg with ``turn=360.0`` (a scene's ``body.hole_phase``)."""
+    return first + turn * np.arange(int(holes)) / holes
+
+
 @dataclass(frozen=True)
 class GearGeometry:
     """Derived geometry of one gear. Build with `gear_geometry`."""

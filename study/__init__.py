@@ -131,9 +131,8 @@ def default_scene():
 
 def solid_scene(scene, gears=(1, 2)):
     """The scene with the bodies of ``gears`` made solid (no holes, the web as thick as the face) -> Scene."""
-    from study.setup import solid_scene as solid
     _check_scene("solid_scene", scene)
-    return solid(scene, gears=tuple(gears))
+    return scene.solid(gears=tuple(gears))
 
 
 def check_dynamic_window(scene) -> None:
@@ -402,14 +401,15 @@ def validation(scene, step: float | None = None):
     (pair, model, angle [degree]) with the error figures [um] (`study.verify.validation`)."""
     import time
 
-    from study.verify.fe_reference import static_angles
+    from study.scene_model import static_angles
+    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR
     from study.verify.validation import validation_dataset
     _check_scene("validation", scene)
     _check(step is None or _number(step), "validation", "step", "a number of degrees or None", step)
     if scene.coupling.model != "none":       # the plain model is the scene's own; the coupled ones are built from it
         scene = scene.replace(**{"coupling.model": "none"})
     t0 = time.perf_counter()
-    ds = validation_dataset(scene, static_angles(scene, step))
+    ds = validation_dataset(scene, static_angles(scene, step, REFERENCE_MEMORY_FACTOR))
     ds.attrs["wall_time_s"] = time.perf_counter() - t0
     return ds
 
@@ -430,10 +430,9 @@ def validate_relief(scene, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=(25.0
     """STE peak-to-peak of every model and the FE reference for the scene's pair with its driven
     gear solid and as given, with a linear tip relief [um] of each amount on both gears at each
     torque [N·m], and the relief that minimises it -> Dataset (`study.verify.model_validation`)."""
-    from study.setup import solid_scene as solid
     from study.verify.model_validation import relief_dataset
     _check_scene("validate_relief", scene)
-    return relief_dataset({"solid": solid(scene), "paper": scene}, reliefs=reliefs, torques=torques,
+    return relief_dataset({"solid": scene.solid(), "paper": scene}, reliefs=reliefs, torques=torques,
                           rotations={"solid": 30.0, "paper": 60.0}, step=step, log=log)
 
 

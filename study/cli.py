@@ -373,7 +373,7 @@ def precision_command(args) -> int:
     from study import estimate
     from study.commands import precision as run_precision
     from study.commands import precision_scene
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     from study.verify.precision import setting_label
     check_precision_options(args)
     scene = precision_scene(args_scene(args))

@@ -38,7 +38,7 @@ def identify_spring(scene: Scene, gear: int) -> SpringIdentification:
     """Fit (pivot radius, k_phi, n) of gear ``gear``'s tooth 0 to FE compliance at several load
     radii along its profile (`study.inputs.springs.identify_spring`)."""
     from study.inputs.springs import identify_spring as fit
-    from study.setup import gear_setup
+    from study.scene_model import gear_setup
     if gear not in (1, 2):
         raise ValueError(f"identify_spring: gear takes 1 (driver) or 2 (driven), got {gear!r}")
     f, u, _c = fit(gear_setup(scene, gear))
@@ -64,7 +64,7 @@ def fit_contact(scene: Scene, depth_fraction: float = 0.5) -> ContactFit:
     match; 1.0: to the centreline, where the FE tooth spring is read)."""
     from solver import units
     from solver.identify.weber import fit_contact as weber_fit
-    from study.setup import gear_setups
+    from study.scene_model import gear_setups
     if not 0 < depth_fraction <= 1:
         raise ValueError(f"fit_contact: depth_fraction takes a number in (0, 1], got {depth_fraction!r}")
     if not scene.quasi_static.torque > 0:
@@ -81,10 +81,11 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
     bodies) -> xarray.Dataset (``ste`` [um] over ``angle`` [degree], ``ste_tooth_force`` [N], ...).
     ``step`` [deg]: the driver angle step (None: quasi_static.angle_step); ``max_time`` [s]: refuse
     a run estimated to take longer (BudgetError, before any work)."""
-    from study.verify.fe_reference import reference_dataset, static_angles
+    from study.scene_model import static_angles
+    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, reference_dataset
     if step is not None and not step > 0:
         raise SceneError("--step", f"must be positive, got {step}")
-    angles = static_angles(scene, step)
+    angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
     estimate.check_time(estimate.reference_estimate(scene, angles), max_time)
     return reference_dataset(scene, angles, progress=progress)
 
@@ -115,7 +116,7 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
     after each run. ``model``: the model of `precision_scene` when the caller has built it
     already. The integrators compared exist for the paper's model: `precision_scene`."""
     from study.report.results import write_netcdf
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
     for name, value, ok, what in (("duration", duration, lambda v: v > 0, "a positive number of seconds"),
                                   ("ramp_fraction", ramp_fraction, lambda v: 0 < v < 1, "a number in (0, 1)"),

@@ -3,7 +3,7 @@
 The contact (``c_con`` or ``damping_ratio`` of the mesh mode) and each gear's tooth springs
 (``c_phi`` or ``damping_ratio`` of the tooth's own mode) take exactly one of the two; a field
 left out is NaN (``NOT_GIVEN``, written as ``nan`` when a scene is saved). The conversion of
-ratios to coefficients is in `study.setup.damping_from_ratios`.
+ratios to coefficients is in `study.scene_model.damping_from_ratios`.
 """
 from __future__ import annotations
 
@@ -44,7 +44,7 @@ def resolve_exclusive(cls, kwargs: dict, path: str) -> None:
 
 def check_damping(scene) -> None:
     """A mesh damping ratio (contact.damping_ratio, the default) is carried by the tooth-root
-    joint dampers (`study.setup.damping_from_ratios`): the springs then give no damper of their
+    joint dampers (`study.scene_model.damping_from_ratios`): the springs then give no damper of their
     own and have linear dampers (n_c = 1). Raises SceneError naming the field."""
     if not math.isnan(scene.contact.c_con):
         return

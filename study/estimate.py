@@ -165,9 +165,9 @@ def dynamic_seconds(model, choice, duration: float, scene=None) -> float:
 
 
 def static_angle_count(scene, step_deg: float | None = None) -> float:
-    """Driver angles of the quasi-static analysis (`study.setup.static_angles`) at
+    """Driver angles of the quasi-static analysis (`study.scene_model.static_angles`) at
     quasi_static.angle_step or ``step_deg`` [deg], counted without building them."""
-    from study.setup import static_rotation
+    from study.scene_model import static_rotation
     step = scene.quasi_static.angle_step if step_deg is None else step_deg
     return math.floor(static_rotation(scene) / step + 1e-9) + 1.0
 
@@ -187,7 +187,7 @@ def check_static_memory(scene, step_deg: float | None = None, factor: float = 1.
     need = factor * n * (STATIC_BYTES_PER_ANGLE + STATIC_BYTES_PER_ANGLE_TOOTH * scene.gear1.teeth)
     have = available_memory()
     if need > 0.8 * have:
-        from study.setup import static_rotation
+        from study.scene_model import static_rotation
         step = scene.quasi_static.angle_step if step_deg is None else step_deg
         raise BudgetError(field, f"the static analysis needs about {bytes_text(need)} for its {n:.3g} driver angles "
                                  f"({static_rotation(scene):.4g} deg at {step:.3g} deg), more than the "
@@ -212,14 +212,14 @@ MESH_S_PER_ANGLE = 2e-3
 
 def mesh_seconds(scene) -> float:
     """Estimated run time [s] of the linearised mesh over the STE angles."""
-    from study.setup import static_angles
+    from study.scene_model import static_angles
     return static_angles(scene).size * MESH_S_PER_ANGLE
 
 
 def error_period_note(scene) -> str | None:
     """A line for the user when pitch errors or an eccentricity stretch the quasi-static range
-    beyond quasi_static.rotation (`study.setup.static_rotation`) by more than 1.5 times; None otherwise."""
-    from study.setup import static_rotation
+    beyond quasi_static.rotation (`study.scene_model.static_rotation`) by more than 1.5 times; None otherwise."""
+    from study.scene_model import static_rotation
     qs = scene.quasi_static
     rot = static_rotation(scene)
     if not qs.enabled or rot <= 1.5 * qs.rotation:
@@ -297,7 +297,7 @@ def reference_parts(scene, angles, teeth=None) -> dict:
     from study.inputs.compliance import compliance_cached
     from study.inputs.gearsetup import gear_setups
     if teeth is None and len(angles) <= TEETH_SEARCH_ANGLES:
-        from study.setup import geometry_model
+        from study.scene_model import geometry_model
         from study.verify.fe_reference import teeth_in_mesh
         teeth = teeth_in_mesh(geometry_model(scene), angles)
     parts = {}
@@ -406,7 +406,7 @@ def check_study_size(study, max_time: float | None) -> int:
 def estimate_model(scene):
     """A model of ``scene`` for the step estimate that needs no FE: uniform tooth springs (an FE
     map scales the calibrated spring by a ratio near 1) and no body coupling."""
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     plain = scene.replace(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform",
                              "coupling.model": "none"})
     return build_scene_model(plain)

@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 
 from solver import units
-from solver.geometry import gear_geometry
 from study.errors import SceneError
 
 # Elements of the outline size across the rim: fewer and the FE body has no element layer
@@ -79,7 +78,7 @@ def approach_estimate_mm(scene, torque_nm: float) -> float:
     normal force acting at the pitch circle, lever = pitch radius - pivot radius. A rough upper
     estimate (load sharing halves it); for the coupled body models, whose tooth springs come
     from the FE body, the springs of the paper's solid tooth stand in."""
-    g1, g2 = (gear_geometry(scene.tooth_spec(g)) for g in (1, 2))
+    g1, g2 = (scene.geometry(g) for g in (1, 2))
     force = abs(torque_nm) / g2.base_radius                      # N, along the line of action
     c = scene.contact
     k_con = units.contact_stiffness_to_si(c.k_con, c.m1)         # N/m^m1
@@ -181,7 +180,7 @@ def scene_warnings(scene) -> list[str]:
     d = scene.dynamic
     if d.enabled:
         field, speed = ("dynamic.speed_end", d.speed_end) if d.speed_end > 0 else ("dynamic.speed", d.speed)
-        v = speed * gear_geometry(scene.tooth_spec(1)).pitch_radius        # m/s
+        v = speed * scene.geometry(1).pitch_radius        # m/s
         if v > PITCH_LINE_VELOCITY_MAX:
             out.append(f"{field}: {speed:.4g} rad/s turns the pitch line at {v:.3g} m/s, above "
                        f"{PITCH_LINE_VELOCITY_MAX:g} m/s (rpm meant? {speed:.4g} rpm = {speed * 0.10471975511965977:.4g} rad/s)")

@@ -13,9 +13,10 @@ import xarray as xr
 
 from solver import units
 from solver.mbs.dynamics import INACCURATE, run_loads, simulate
-from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels.layout import R_PV
 from solver.mbs.mesh_stiffness import mesh_states
+from solver.mbs.method import choose_method
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study import estimate
@@ -26,7 +27,7 @@ from study.report.lightening import lightening_variables
 from study.report.mesh_outputs import dynamic_force_variables, mesh_variables
 from study.report.modes import modal_variables
 from study.scene import Scene
-from study.setup import (
+from study.scene_model import (
     build_scene_model,
     damping_ratios,
     error_period,
@@ -64,7 +65,7 @@ def run_static(scene: Scene, model: Model):
 
 
 def dynamic_choice(scene: Scene, model: Model):
-    """Integrator and step of the scene's dynamic run (`solver.mbs.implicit.choose_method`)."""
+    """Integrator and step of the scene's dynamic run (`solver.mbs.method.choose_method`)."""
     d = scene.dynamic
     step_torque = run_loads(load_table(scene), d.torque)[1]
     return choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
@@ -72,8 +73,8 @@ def dynamic_choice(scene: Scene, model: Model):
 
 def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False):
     """DTE run with the scene's integrator: dynamic.method 'explicit', 'implicit' or 'auto'
-    (chosen from the stability step; see `solver.mbs.implicit.choose_method`), or ``choice``
-    when already made. The result carries ``choice`` (the MethodChoice) for the archive.
+    (chosen from the stability step; see `solver.mbs.method.choose_method`), or ``choice``
+    (a MethodChoice) when already made.
     ``progress``: a bar on stderr when the run is expected to take more than a few seconds."""
     d = scene.dynamic
     table = load_table(scene)
@@ -97,7 +98,6 @@ def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False)
             bar.close()
     if math.isfinite(choice.omega_max):
         res.omega_max = choice.omega_max
-    res.choice = choice
     return res
 
 
@@ -127,7 +127,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     reference over a revolution); a study leaves them out unless it asks for them.
     Plausibility warnings (`study.plausibility.scene_warnings`, and a speed far above the
     critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr.
-    ``keep_model``: take the model from `study.setup.kept_scene_model` (a study's worker: the
+    ``keep_model``: take the model from `study.scene_model.kept_scene_model` (a study's worker: the
     points of one body share it)."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
@@ -242,7 +242,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
                 coords.update(c); data.update(v)
             else:
                 attrs["order_tracking_skipped"] = f"the run-up stopped before its end: {dy.message}"
-        attrs["dynamic_method"] = dy.choice.method
-        attrs["dynamic_method_reason"] = dy.choice.reason
-        attrs["hht_alpha"] = d.alpha if dy.choice.method == "implicit" else float("nan")
+        attrs["dynamic_method"] = choice.method
+        attrs["dynamic_method_reason"] = choice.reason
+        attrs["hht_alpha"] = d.alpha if choice.method == "implicit" else float("nan")
     return xr.Dataset(data, coords=coords, attrs=attrs)

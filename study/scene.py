@@ -6,7 +6,7 @@ A scene file has the sections of `Scene` (``material``, ``pair``, ``gear1`` and 
 paper's example, Table 1, with solid bodies; ``study/scenes/paper.toml``, the embedded
 default scene, lightens the driven gear). Each field declares its unit (mm, deg, N·m, rad/s,
 s, MPa, kg/m³), description and range once (`field_unit`, `field_doc`). The conversion to
-the solver's SI happens in `Scene.tooth_spec`, `body_spec`, `material_spec` and `pivot_radius`.
+the solver's SI happens in `Scene.tooth_spec`, `geometry`, `body_spec`, `material_spec` and `pivot_radius`.
 
 Errors: `SceneError` names the dotted field and the reason, before any work starts.
 """
@@ -22,11 +22,20 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from solver import units
-from solver.geometry import BodySpec, GeometryError, Material, ToothSpec, gear_geometry, pair_geometry, validate_body
+from solver.geometry import (
+    BodySpec,
+    GearGeometry,
+    GeometryError,
+    Material,
+    ToothSpec,
+    gear_geometry,
+    pair_geometry,
+    validate_body,
+)
 from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
-from study.gear_errors import ErrorsSection, errors_spec
 from study.modification import ModificationSection, modification_spec
+from study.pitch_errors import ErrorsSection, errors_spec
 from study.toml_writer import dumps_toml
 
 
@@ -106,7 +115,7 @@ class ContactSection:
     # neither: damping_ratio = MESH_DAMPING_RATIO. The coefficient the scenes used before,
     # c_con = 3640 (5 % of a local contact mode at 1 um), damps the Table 1 mesh mode at 0.003 %
     # (with c_phi = 0.062 at 0.14 %). A ratio is carried by the tooth-root joint dampers, the
-    # contact law then has none (why: study/setup.py, damping_from_ratios).
+    # contact law then has none (why: study/scene_model.py, damping_from_ratios).
     c_con: float = _f(NOT_GIVEN, "N*s/mm^(1+m3)", "contact damping coefficient (or damping_ratio)", 0.0, optional=True)
     damping_ratio: float = _f(NOT_GIVEN, "1", "mesh damping as a ratio of critical damping of the mesh mode (the "
                               "pair linearised at the mean load, mean over one mesh period), converted once per run to "
@@ -204,6 +213,11 @@ class Scene:
                          face_width=gs.face_width * units.MM,
                          thinning=0.5 * self.pair.backlash * units.MM)
 
+    def geometry(self, g: int) -> GearGeometry:
+        """Gear g's derived geometry (radii, flanks, fillet; SI) from `tooth_spec`; GeometryError
+        naming the gear's field when the teeth cannot be made."""
+        return gear_geometry(self.tooth_spec(g), prefix=f"gear{g}")
+
     def body_spec(self, g: int) -> BodySpec:
         b = self.gear(g).body
         return BodySpec(rim_height=b.rim_height * units.MM, web_height=b.web_height * units.MM,
@@ -244,13 +258,19 @@ class Scene:
         gs = self.gear(g)
         return gs.body.holes > 0 or (gs.body.web_height > 0 and gs.body.web_thickness < gs.face_width)
 
+    def solid(self, gears=(1, 2)) -> "Scene":
+        """The same scene with solid bodies for ``gears``: the web as thick as the face, no holes
+        (the scene-level twin of `solver.geometry.solid_body`, which a `GearSetup` uses)."""
+        return self.replace(**{k: v for g in gears for k, v in ((f"gear{g}.body.holes", 0),
+                                                                (f"gear{g}.body.web_thickness", self.gear(g).face_width))})
+
     def modification_spec(self, g: int):
         """Gear g's profile modification in SI (`solver.modification`), None for perfect involutes."""
-        return modification_spec(self.gear(g).modification, gear_geometry(self.tooth_spec(g)), f"gear{g}.modification")
+        return modification_spec(self.gear(g).modification, self.geometry(g), f"gear{g}.modification")
 
     def errors_spec(self, g: int):
-        """Gear g's pitch deviations and eccentricity in SI (`solver.errors`), None for a perfect gear."""
-        return errors_spec(self.gear(g).errors, gear_geometry(self.tooth_spec(g)), f"gear{g}.errors")
+        """Gear g's pitch deviations and eccentricity in SI (`solver.pitch_errors`), None for a perfect gear."""
+        return errors_spec(self.gear(g).errors, self.geometry(g), f"gear{g}.errors")
 
     @property
     def has_errors(self) -> bool:
@@ -260,7 +280,7 @@ class Scene:
     def pivot_radius(self, g: int) -> float:
         """Tooth pivot radius [m]; the root circle when the scene gives 0."""
         r = self.gear(g).pivot_radius
-        return r * units.MM if r > 0 else gear_geometry(self.tooth_spec(g)).root_radius
+        return r * units.MM if r > 0 else self.geometry(g).root_radius
 
     # ---- text ----
     def to_toml(self) -> str:
@@ -352,7 +372,7 @@ def check_scene(scene: Scene) -> None:
     try:
         geoms = []
         for g in (1, 2):
-            geo = gear_geometry(scene.tooth_spec(g), prefix=f"gear{g}")
+            geo = scene.geometry(g)
             validate_body(geo, scene.body_spec(g), prefix=f"gear{g}.body")
             geoms.append(geo)
             gs = scene.gear(g)

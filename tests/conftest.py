@@ -37,5 +37,5 @@ def paper_solid_scene():
 
 @pytest.fixture(scope="session")
 def paper_solid_model(paper_solid_scene):
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     return build_scene_model(paper_solid_scene)

@@ -194,6 +194,8 @@ def parse_grid(items: list[str]) -> dict:
 
 
 def run(args) -> int:
+    """The workflow for the parsed command line ``args`` (its options checked first) -> exit code."""
+    check_options(args)
     limits = Limits(args.ste_factor, args.dte_factor, args.stress_ratio, args.stress_max)
     scene = base_scene(args.scene, args.set, args.speed, args.duration, args.angle_step)
     grid = parse_grid(args.grid)
@@ -284,27 +286,27 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=int, default=None, help="LocalCluster workers (default: one per core; 0: in process)")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
-    for name in ("ste_factor", "dte_factor", "stress_ratio", "stress_max", "speed", "angle_step"):
-        v = getattr(args, name)
-        if not v > 0:
-            return _bad(f"--{name.replace('_', '-')}", f"must be positive, got {v:g}")
-    if args.duration is not None and not args.duration > 0:
-        return _bad("--duration", f"must be positive, got {args.duration:g}")
-    if args.refine < 0:
-        return _bad("--refine", f"must be >= 0, got {args.refine}")
-    if args.workers is not None and args.workers < 0:
-        return _bad("--workers", f"must be >= 0 (0 runs in this process), got {args.workers}")
-    if Path(args.output).is_file():
-        return _bad("--output", f"{args.output} is a file, not a folder")
     try:
         return run(args)
     except SceneError as e:
-        return _bad(e.field, e.reason)
+        print(f"error: {e.field}: {e.reason}", file=sys.stderr)    # one line, no traceback
+        return 2
 
 
-def _bad(what: str, why: str) -> int:
-    print(f"error: {what}: {why}", file=sys.stderr)
-    return 2
+def check_options(args) -> None:
+    """SceneError naming the option whose value cannot be used, before any work."""
+    for name in ("ste_factor", "dte_factor", "stress_ratio", "stress_max", "speed", "angle_step"):
+        v = getattr(args, name)
+        if not v > 0:
+            raise SceneError(f"--{name.replace('_', '-')}", f"must be positive, got {v:g}")
+    if args.duration is not None and not args.duration > 0:
+        raise SceneError("--duration", f"must be positive, got {args.duration:g}")
+    if args.refine < 0:
+        raise SceneError("--refine", f"must be >= 0, got {args.refine}")
+    if args.workers is not None and args.workers < 0:
+        raise SceneError("--workers", f"must be >= 0 (0 runs in this process), got {args.workers}")
+    if Path(args.output).is_file():
+        raise SceneError("--output", f"{args.output} is a file, not a folder")
 
 
 if __name__ == "__main__":

@@ -144,6 +144,8 @@ def cost(ds: xr.Dataset) -> str:
 
 
 def run(args) -> int:
+    """The workflow for the parsed command line ``args`` (its options checked first) -> exit code."""
+    check_options(args)
     st = reduced_study(Path(args.study), args.size, args.set)
     limits = {}
     for item in args.limit or [DEFAULT_LIMIT]:
@@ -189,23 +191,23 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=int, default=None, help="LocalCluster workers (default: one per core; 0: in process)")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
-    if args.size is not None and args.size < 2:
-        return _bad("--size", f"must be at least 2, got {args.size}")
-    if args.workers is not None and args.workers < 0:
-        return _bad("--workers", f"must be >= 0 (0 runs in this process), got {args.workers}")
-    if Path(args.output_dir).is_file():
-        return _bad("-o", f"{args.output_dir} is a file, not a folder")
-    if not Path(args.study).is_file():
-        return _bad("study", f"no such file: {args.study}")
     try:
         return run(args)
     except study.SceneError as e:
-        return _bad(e.field, e.reason)
+        print(f"error: {e.field}: {e.reason}", file=sys.stderr)    # one line, no traceback
+        return 2
 
 
-def _bad(what: str, why: str) -> int:
-    print(f"error: {what}: {why}", file=sys.stderr)
-    return 2
+def check_options(args) -> None:
+    """SceneError naming the option whose value cannot be used, before any work."""
+    if args.size is not None and args.size < 2:
+        raise study.SceneError("--size", f"must be at least 2, got {args.size}")
+    if args.workers is not None and args.workers < 0:
+        raise study.SceneError("--workers", f"must be >= 0 (0 runs in this process), got {args.workers}")
+    if Path(args.output_dir).is_file():
+        raise study.SceneError("-o", f"{args.output_dir} is a file, not a folder")
+    if not Path(args.study).is_file():
+        raise study.SceneError("study", f"no such file: {args.study}")
 
 
 if __name__ == "__main__":

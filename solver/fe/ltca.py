@@ -39,7 +39,7 @@ Profile modifications (`solver.modification`) add each flank's deviation at the 
 point's roll parameter (a tip corner: at the tip) to the initial separation e_i, as in the
 contact search of the pseudo-rigid model (first order: `solver.mbs.kernels.gearmesh`).
 
-Pitch errors and eccentricities (`solver.errors`) subtract each tooth pair's first-order
+Pitch errors and eccentricities (`solver.pitch_errors`) subtract each tooth pair's first-order
 approach along the line of action from e_i (`error_approach`); the candidate pairs and their
 rolls stay those of the perfect gears (the errors shift a roll by ~1e-4 rad).
 
@@ -301,7 +301,7 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
 
 
 def error_approach(model: Model, theta1: float, theta2: float, tooth1, tooth2) -> np.ndarray:
-    """How much closer [m] the pitch errors and eccentricities (`solver.errors`) bring the drive
+    """How much closer [m] the pitch errors and eccentricities (`solver.pitch_errors`) bring the drive
     flanks of the tooth pairs (tooth1[i], tooth2[i]) at hub angles theta1, theta2 [rad], to first
     order: each tooth's turn eps about the teeth's centre moves its flank rb*eps along the line of
     action, and the centre offsets d1, d2 move the flanks by (d1 - d2).n, n the drive line of

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.geometry import BodySpec, GearGeometry, bore_radius, validate_body
+from solver.geometry import BodySpec, GearGeometry, bore_radius, hole_angles, validate_body
 
 REGION_RIM, REGION_WEB, REGION_HUB = 0, 1, 2
 REGION_NAMES = ("teeth and rim", "web", "hub")
@@ -168,8 +168,7 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str) -> Bod
     if has_web:
         holes = []
         h_hole = min(h_body, 2 * math.pi * body.hole_radius / 24) if body.holes else h_body
-        for i in range(int(body.holes)):
-            t = body.hole_phase + 2 * math.pi * i / body.holes
+        for t in hole_angles(body.holes, body.hole_phase):
             holes.append(circle(body.hole_circle_radius * math.cos(t), body.hole_circle_radius * math.sin(t),
                                 body.hole_radius, h_hole))
         surfaces[REGION_WEB] = geo.addPlaneSurface([rim_in, *holes, hub_out if hub_out is not None else bore])

@@ -177,7 +177,7 @@ def check_positive(**values: float) -> None:
 
 def start_te(model: Model, side: float) -> float:
     """TE [m] at t = 0: the rigid teeth touching on the flank side of the first load (sign).
-    Perfect gears touch at +-jn/2; with pitch errors or eccentricity (`solver.errors`) the first
+    Perfect gears touch at +-jn/2; with pitch errors or eccentricity (`solver.pitch_errors`) the first
     touch at theta1 = 0 is found by bisection on the contact search within the errors' bound, so
     that the run starts in contact without penetration (a penetration of microns would start it
     with a kick)."""

@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from solver.errors import GearErrors, error_block
 from solver.geometry import (
     BodySpec,
     GearGeometry,
@@ -29,6 +28,7 @@ from solver.geometry import (
 from solver.inertia import body_inertia, hole_inertia, tooth_inertia
 from solver.mbs.kernels import layout as L
 from solver.modification import ProfileModification, sample
+from solver.pitch_errors import GearErrors, error_block
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ Damping as a ratio (`joint_damping_for_ratio`, `tooth_damping_for_ratio`):
   their own modes) is found by root finding on the state-space eigenvalues so that the mesh
   mode's ratio, averaged over the mesh positions, equals zeta_m. A contact damper
   (c*ddelta*delta^m3, in series with the tooth springs) could not do it without overdamping
-  the tooth-on-contact modes (see `study.setup.damping_from_ratios`).
+  the tooth-on-contact modes (see `study.scene_model.damping_from_ratios`).
 """
 from __future__ import annotations
 

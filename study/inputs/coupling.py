@@ -4,7 +4,7 @@
 for a solid body, by symmetry) and reads each tooth's and its neighbours' deflection along
 the line of action at the tooth centreline (`solver.fe.ltca` influence coefficients, same mesh
 and load patch as the FE tooth springs), then splits the body wind-up off the tooth springs
-(`solver.identify.coupling.body_torsion_fit`). Used by `study.setup.coupling_fit` when
+(`solver.identify.coupling.body_torsion_fit`). Used by `study.scene_model.coupling_fit` when
 ``coupling.model = "body-torsion"``.
 
 `tooth_compliance(setup, samples)`, the full version (``coupling.model = "compliance"``): the
@@ -63,7 +63,7 @@ def mesh_samples(model: Model, g: int, n_angles: int = 25) -> dict[int, np.ndarr
     """Where and how hard the mesh loads gear g's teeth together: for each index offset d
     (load tooth - read tooth), rows (u_read [-], u_load [-], weight [1]) of the contacts that
     coexist over one mesh pitch of the pair's rigid geometry ``model``
-    (`study.setup.geometry_model`; d = 0: each contact with itself).
+    (`study.scene_model.geometry_model`; d = 0: each contact with itself).
 
     The weight is the product of the two contacts' nominal load shares (1/n for each of the n
     flank contacts in the path of contact, `CORNER_SHARE` for a tip corner): the rigid tooth

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from solver import units
 from solver.fe.mesh import default_mesh_size
-from solver.geometry import BodySpec, GearGeometry, Material, ToothSpec, gear_geometry, pair_geometry, solid_body
+from solver.geometry import BodySpec, GearGeometry, Material, ToothSpec, pair_geometry, solid_body
 from study.inputs.cache import FE_CACHE
 from study.scene import Scene, SpringSection
 
@@ -98,7 +98,7 @@ def hertz_half_width(g1: GearGeometry, g2: GearGeometry, material: Material, fac
 
 def gear_setups(scene: Scene) -> tuple[GearSetup, GearSetup]:
     """Both gears of a (checked) scene, prepared for the FE."""
-    geos = tuple(gear_geometry(scene.tooth_spec(g), f"gear{g}") for g in (1, 2))
+    geos = tuple(scene.geometry(g) for g in (1, 2))
     pair = pair_geometry(*geos)
     material = scene.material_spec()
     torque = reference_torque(scene)

@@ -25,6 +25,7 @@ import time
 import numpy as np
 
 from solver import units
+from solver.geometry import hole_angles
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup, gear_setups
 from study.scene import Scene
@@ -133,7 +134,7 @@ def hole_offset(scene: Scene, g: int) -> np.ndarray:
     if b.holes == 0:
         return np.full(z, np.nan)
     tooth = np.arange(z) * 360.0 / z
-    holes = b.hole_phase + np.arange(b.holes) * 360.0 / b.holes
+    holes = hole_angles(b.holes, b.hole_phase, 360.0)
     d = (tooth[:, None] - holes[None, :] + 180.0) % 360.0 - 180.0
     return d[np.arange(z), np.argmin(np.abs(d), axis=1)] / (360.0 / z)
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver import units
-from solver.geometry import bore_radius, gear_geometry, gear_outline, pair_geometry
+from solver.geometry import bore_radius, gear_outline, pair_geometry
 
 
 @dataclass
@@ -40,7 +40,7 @@ def outline_body(scene, g: int) -> Body2D:
     """Body of a gear without holes from its outline: strips between the outline, the root
     circle, the rim/web/hub radii and the bore, each point at the outline point's polar angle
     (the outline is star-shaped about the centre, so the strips never overlap)."""
-    geo = gear_geometry(scene.tooth_spec(g))
+    geo = scene.geometry(g)
     body = scene.body_spec(g)
     x, y = gear_outline(geo)
     ang = np.arctan2(y, x)
@@ -80,16 +80,16 @@ def fe_body(field_) -> Body2D:
 
 def with_teeth(b: Body2D, scene, g: int) -> Body2D:
     """The body with each triangle's tooth index of gear g (an FE body comes without)."""
-    geo = gear_geometry(scene.tooth_spec(g))
+    geo = scene.geometry(g)
     return Body2D(b.points, b.triangles, b.thickness, _tooth_of(b.points, b.triangles, geo.root_radius / units.MM, geo.teeth))
 
 
 def placement(scene, g: int) -> tuple[float, np.ndarray]:
     """Rotation [rad] and centre [mm] of gear g at the nominal conjugate position."""
-    geo2 = gear_geometry(scene.tooth_spec(2))
+    geo2 = scene.geometry(2)
     if g == 1:
         return 0.0, np.zeros(2)
-    a = pair_geometry(gear_geometry(scene.tooth_spec(1)), geo2).center_distance / units.MM
+    a = pair_geometry(scene.geometry(1), geo2).center_distance / units.MM
     return math.pi + math.pi / geo2.teeth, np.array([a, 0.0])
 
 

@@ -10,6 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
+from solver.geometry import hole_angles
 from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, archive_scene, figure_title, need, save_figure, unit_text
 
 
@@ -43,8 +44,8 @@ def stiffness_plot(ds: xr.Dataset, path) -> Path:
                 continue
             pitch = 360.0 / sc.gear(g).teeth
             half = math.degrees(math.asin(min(1.0, b.hole_radius / b.hole_circle_radius))) / pitch
-            for h in range(b.holes):
-                c = ((b.hole_phase + h * 360.0 / b.holes) % 360.0) / pitch
+            for centre in hole_angles(b.holes, b.hole_phase, 360.0):
+                c = (centre % 360.0) / pitch
                 ax.axvspan(c - half, c + half, color=C_HOLE, alpha=0.15, lw=0,
                            label=f"hole of gear {g} (angular extent)" if first else None)
                 ax.axvline(c, color=C_HOLE, ls="--", lw=0.8, label="hole centre" if first else None)

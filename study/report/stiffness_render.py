@@ -18,7 +18,6 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.geometry import gear_geometry
 from study.report.plot_style import archive_title
 from study.report.render_canvas import NAN_COLOR, WINDOW, RenderResult, fit_parallel, plotter, project, write_png
 from study.report.render_geometry import extrude, placement
@@ -77,7 +76,7 @@ def gear_pair_render(ds: xr.Dataset, path, fields: dict | None = None) -> Render
     p.render()
     probes = []
     for g in coloured:
-        geo = gear_geometry(sc.tooth_spec(g))
+        geo = sc.geometry(g)
         r_mid = 0.5 * (geo.root_radius + geo.pitch_radius) / units.MM
         rot, centre = placement(sc, g)
         k = tooth_stiffness(ds, g)

@@ -15,7 +15,6 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.geometry import gear_geometry
 from study.report.plot_style import archive_title
 from study.report.render_canvas import RenderResult, fit_parallel, plotter, write_png
 from study.report.render_geometry import Body2D, extrude, fe_body, transform
@@ -47,7 +46,7 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
     undeformed outline in grey. The arrow is the load on the drive flank at the pitch circle."""
     import pyvista as pv
     sc = required_scene(ds)
-    geo = gear_geometry(sc.tooth_spec(g))
+    geo = sc.geometry(g)
     body = sc.body_spec(g)
     k = tooth_stiffness(ds, g)
     if teeth is None:

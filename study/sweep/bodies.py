@@ -59,7 +59,7 @@ def _reach(scene: Scene, setups: tuple, g: int) -> int:
     """How many pitches apart the mesh loads gear g's teeth together (`mesh_samples`): the spread
     of a solid body's compliance."""
     from study.inputs.coupling import mesh_samples
-    from study.setup import geometry_model
+    from study.scene_model import geometry_model
     key = (setups[0].key, setups[1].key, g)
     if key not in _REACH:
         _REACH[key] = max(abs(d) for d in mesh_samples(geometry_model(scene), g))
@@ -107,7 +107,7 @@ def compute_body(scene: Scene, g: int) -> None:
     `compute_map`)."""
     from study.inputs.gearsetup import gear_setups
     from study.inputs.springs import fe_stiffness, uses_fe_springs
-    from study.setup import coupling_fit
+    from study.scene_model import coupling_fit
     try:
         setups = gear_setups(scene)
         setup = setups[g - 1]

@@ -102,7 +102,7 @@ CURVES = {
 #   static    STE: every field but the dynamic run's (study.run.run_static reads no 'dynamic.*')
 #   modes     the pair linearised at the mean load (its dampers given as ratios converted there):
 #             the static fields (damping included) and the mean load, the dynamic run's torque
-#             when it runs (study.setup.mean_load reads dynamic.enabled and dynamic.torque)
+#             when it runs (study.scene_model.mean_load reads dynamic.enabled and dynamic.torque)
 #   dynamic   DTE: every field
 ERRORS = ("gear1.errors", "gear2.errors")    # pitch errors and runout: no part of a gear's mass or FE body
 ANALYSIS_FIELDS = {
@@ -142,6 +142,11 @@ def analysis_of(output: str) -> str:
     return (SCALARS.get(output) or CURVES[output]).analysis
 
 
+def _needs(analysis: str, what: str) -> property:
+    """A read-only flag of `Outputs`: True when an output needs ``analysis`` (`Outputs.needs`)."""
+    return property(lambda self: self.needs(analysis), doc=f"True when an output needs {what}.")
+
+
 @dataclass(frozen=True)
 class Outputs:
     """What each point of a study computes and archives: scalar names and full curves."""
@@ -152,25 +157,10 @@ class Outputs:
         """True when an output needs ``analysis`` ('static', 'dynamic', 'modes', 'fe', 'geometry')."""
         return any(analysis_of(x) == analysis for x in self.scalars + self.curves)
 
-    @property
-    def static(self) -> bool:
-        """True when a quasi-static (STE) analysis is needed."""
-        return self.needs("static")
-
-    @property
-    def dynamic(self) -> bool:
-        """True when a dynamic (DTE) analysis is needed."""
-        return self.needs("dynamic")
-
-    @property
-    def modes(self) -> bool:
-        """True when an output needs the modal analysis of the loaded pair."""
-        return self.needs("modes")
-
-    @property
-    def fe(self) -> bool:
-        """True when an output needs the FE body of the springs (root stress)."""
-        return self.needs("fe")
+    static = _needs("static", "a quasi-static (STE) analysis")
+    dynamic = _needs("dynamic", "a dynamic (DTE) analysis")
+    modes = _needs("modes", "the modal analysis of the loaded pair")
+    fe = _needs("fe", "the FE body of the springs (root stress)")
 
     @property
     def widest(self) -> str:

@@ -12,7 +12,6 @@ CLI: ``lightgear reference [SCENE] [-o OUT.nc] [--set k=v] [--step DEG]``.
 """
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -23,19 +22,11 @@ from solver.fe.ltca import ltca_sweep, mesh_points
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
 from study.scene import Scene, SceneError
-from study.setup import geometry_model
+from study.scene_model import geometry_model, static_angles
 
-
-def static_angles(scene: Scene, step_deg: float | None = None) -> np.ndarray:
-    """Driver angles [rad]: the scene's quasi-static rotation (whole periods of its pitch errors
-    and eccentricities: `study.setup.static_rotation`) at its step (or ``step_deg``)."""
-    from study.estimate import check_static_memory
-    qs = scene.quasi_static
-    step = qs.angle_step if step_deg is None else step_deg
-    if not (math.isfinite(step) and step > 0):
-        raise SceneError("--step", f"the driver angle step must be a positive number of degrees, got {step}")
-    n = int(check_static_memory(scene, step, factor=4.0, field="quasi_static.angle_step" if step_deg is None else "--step"))
-    return np.radians(np.arange(n) * step)
+# the reference holds about four times the arrays of a static analysis an angle (contacts and
+# load sharing per angle): its angles are checked against memory with this factor
+REFERENCE_MEMORY_FACTOR = 4.0
 
 
 def teeth_in_mesh(model, angles) -> tuple[list, list, int]:
@@ -64,7 +55,7 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     qs = scene.quasi_static
     if not qs.torque > 0:
         raise SceneError("quasi_static.torque", f"the FE reference needs a positive (drive-side) torque, got {qs.torque}")
-    angles = static_angles(scene) if angles is None else np.asarray(angles, float)
+    angles = static_angles(scene, memory_factor=REFERENCE_MEMORY_FACTOR) if angles is None else np.asarray(angles, float)
     model = geometry_model(scene)        # the LTCA takes its compliance from the FE, not springs
     teeth = None if rigid else teeth_in_mesh(model, angles)
     parts = estimate.reference_parts(scene, angles, teeth) if not rigid else {"contact sweep": 0.0}

@@ -27,7 +27,7 @@ from solver import units
 from solver.mbs.statics import solve_static
 from study.report import results
 from study.scene import Scene
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from study.verify.fe_reference import reference
 
 MODELS = ("fe-reference", "paper", "body-torsion", "compliance")
@@ -109,12 +109,10 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
                 if log:
                     log(f"holes {n:2d}, web {web:4.1f} mm, rim {rim:4.1f} mm: " + ", ".join(
                         f"{name} p2p {f[name]['p2p']:.3f} um" for name in models))
+    dims, coords = _model_grid(models, holes=(np.asarray(holes), "1", "holes in gear 2's web"),
+                               web_thickness=(np.asarray(webs, float), "mm", "gear 2's web thickness"),
+                               rim_height=(np.asarray(rims, float), "mm", "gear 2's rim under the root circle"))
     v = results._var
-    dims = ("holes", "web_thickness", "rim_height", "model")
-    coords = {"holes": v("holes", np.asarray(holes), "1", "holes in gear 2's web"),
-              "web_thickness": v("web_thickness", np.asarray(webs, float), "mm", "gear 2's web thickness"),
-              "rim_height": v("rim_height", np.asarray(rims, float), "mm", "gear 2's rim under the root circle"),
-              "model": v("model", np.array(models), "", "model (fe-reference: LTCA with FE influence coefficients)")}
     data = {"ste_mean": v(dims, figs["mean"], "um", "mean static transmission error"),
             "ste_elastic_mean": v(dims, figs["elastic_mean"], "um", "mean STE less the backlash offset jn/2"),
             "ste_p2p": v(dims, figs["p2p"], "um", "peak-to-peak static transmission error"),
@@ -124,6 +122,15 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
              "static_torque_N_m": base.quasi_static.torque, "rotation_deg": rotation, "angle_step_deg": step,
              "base_scene": base.to_toml(), **_target_attrs(), **results.provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _model_grid(models, **axes) -> tuple[tuple, dict]:
+    """Dimensions and coordinates of a grid of figures over ``axes`` (name: (values, unit, long
+    name), in order) and the models compared, last."""
+    v = results._var
+    coords = {name: v(name, values, unit, long_name) for name, (values, unit, long_name) in axes.items()}
+    coords["model"] = v("model", np.array(models), "", "model (fe-reference: LTCA with FE influence coefficients)")
+    return tuple(coords), coords
 
 
 def relief_scene(scene: Scene, relief: float, torque: float) -> Scene:
@@ -184,12 +191,10 @@ def relief_dataset(pairs: dict, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=
             if log:
                 log(f"{name} pair, {torque:g} N m: optimum relief " + ", ".join(
                     f"{mod} {opt[a, b, m]:.2f} um" for m, mod in enumerate(models)))
+    dims, coords = _model_grid(models, pair=(np.array(names), "", "gear pair"),
+                               torque=(np.asarray(torques, float), "N m", "quasi-static torque on gear 2"),
+                               relief=(np.asarray(reliefs, float), "um", "linear tip relief at the tip, both gears"))
     v = results._var
-    dims = ("pair", "torque", "relief", "model")
-    coords = {"pair": v("pair", np.array(names), "", "gear pair"),
-              "torque": v("torque", np.asarray(torques, float), "N m", "quasi-static torque on gear 2"),
-              "relief": v("relief", np.asarray(reliefs, float), "um", "linear tip relief at the tip, both gears"),
-              "model": v("model", np.array(models), "", "model (fe-reference: LTCA with FE influence coefficients)")}
     data = {"ste_p2p": v(dims, p2p, "um", "peak-to-peak static transmission error"),
             "ste_elastic_mean": v(dims, mean, "um", "mean STE less the backlash offset jn/2"),
             "hole_amplitude": v(dims, hole, "um", "STE amplitude at the hole order of gear 2 (NaN: no holes)"),

@@ -34,12 +34,13 @@ import xarray as xr
 
 from solver import units
 from solver.mbs.dynamics import INACCURATE, simulate
-from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.implicit import simulate_implicit
+from solver.mbs.method import choose_method
 from solver.mbs.stability import linearized_system
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_scipy
 from study.report import results
-from study.setup import build_scene_model, load_table
+from study.scene_model import build_scene_model, load_table
 
 METHODS = ("explicit", "implicit alpha=0", "implicit alpha=-0.1", "LSODA")
 

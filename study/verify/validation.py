@@ -30,7 +30,7 @@ from solver import units
 from solver.fe.ltca import mesh_points
 from solver.mbs.statics import solve_static
 from study.report import results
-from study.setup import build_scene_model, coupling_fit, gear_setup, solid_scene
+from study.scene_model import build_scene_model, coupling_fit, gear_setup
 from study.verify.fe_reference import reference
 from study.verify.model_validation import order_amplitude
 
@@ -125,7 +125,7 @@ METRIC_DOC = {
 
 
 def validation_dataset(scene, angles) -> xr.Dataset:
-    pairs = {"solid": solid_scene(scene, gears=(2,)), "lightened": scene}     # the driven gear made solid
+    pairs = {"solid": scene.solid(gears=(2,)), "lightened": scene}     # the driven gear made solid
     na = angles.size
     ste = np.full((len(PAIRS), len(MODELS), na), np.nan)
     share = np.full_like(ste, np.nan)

@@ -4,7 +4,17 @@ import math
 import numpy as np
 import pytest
 
-from solver.geometry import BodySpec, GeometryError, ToothSpec, gear_geometry, involute, pair_geometry, solid_body, validate_body
+from solver.geometry import (
+    BodySpec,
+    GeometryError,
+    ToothSpec,
+    gear_geometry,
+    hole_angles,
+    involute,
+    pair_geometry,
+    solid_body,
+    validate_body,
+)
 from solver.inertia import body_inertia, hole_inertia, polygon_properties, tooth_inertia
 
 TABLE1 = ToothSpec(module=1.5e-3, teeth=67, pressure_angle=math.radians(20), addendum_coef=1.0,
@@ -142,3 +152,15 @@ def test_small_gear_with_root_inside_base_circle():
     x, y = g.outline()
     assert np.all(np.hypot(x, y) >= g.root_radius * (1 - 1e-12))
     assert involute(math.radians(20)) == pytest.approx(0.014904383867336446)
+
+
+def test_hole_angles_are_equally_spaced_from_the_phase_in_either_unit():
+    rad = hole_angles(6, 0.3)
+    assert rad.shape == (6,) and rad[0] == 0.3
+    assert np.allclose(np.diff(rad), 2 * math.pi / 6, rtol=0, atol=1e-15)
+    deg = hole_angles(6, math.degrees(0.3), 360.0)
+    assert np.allclose(np.radians(deg), rad, rtol=0, atol=1e-14)
+    # every hole the same distance from its neighbours round the full turn, the last to the first too
+    gaps = np.diff(np.concatenate([rad, [rad[0] + 2 * math.pi]]))
+    assert np.ptp(gaps) < 1e-14
+    assert hole_angles(0, 0.3).size == 0

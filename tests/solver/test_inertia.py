@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from solver.geometry import BodySpec, ToothSpec, gear_geometry, solid_body
+from solver.geometry import BodySpec, ToothSpec, gear_geometry, hole_angles, solid_body
 from solver.inertia import body_inertia, gear_inertia, gear_mass, polygon_properties
 
 RHO = 7850.0
@@ -36,8 +36,7 @@ def test_holed_web_against_a_polygon_integral_of_each_hole():
     m, i = body_inertia(g, body, RHO)
     s = np.linspace(0.0, 2 * math.pi, 4001)[:-1]
     dm = di = 0.0
-    for k in range(body.holes):
-        c = body.hole_phase + 2 * math.pi * k / body.holes
+    for c in hole_angles(body.holes, body.hole_phase):
         x = body.hole_circle_radius * math.cos(c) + body.hole_radius * np.cos(s)
         y = body.hole_circle_radius * math.sin(c) + body.hole_radius * np.sin(s)
         area, _, _, j0 = polygon_properties(x, y)
@@ -82,7 +81,7 @@ def test_gear_inertia_is_the_models_total_inertia():
     """One formula: the archive's inertia is the I_TOT the dynamics integrate (lightened gear)."""
     import study
     from study.inputs.gearsetup import gear_setups
-    from study.setup import geometry_model
+    from study.scene_model import geometry_model
     scene = study.default_scene()
     model = geometry_model(scene)
     for s, i_tot in zip(gear_setups(scene), model.inertia_total):

@@ -11,7 +11,7 @@ def test_body_dampers_join_the_joints_where_they_cannot_reach_the_mesh_ratio(pri
     from solver.mbs.kernels import layout as L
     from solver.mbs.model import body_critical_damping
     from solver.mbs.modes import joint_damping_for_ratio, modal_analysis
-    from study.setup import build_scene_model, mean_load
+    from study.scene_model import build_scene_model, mean_load
 
     scene = load_scene("small_lightened")   # joints alone: at most about 4.7 %
     assert scene.coupling_model == "compliance"

@@ -18,7 +18,7 @@ def test_cached_fe_bodies_and_influence_coefficients_are_free(private_fe_cache):
     assert labels == ["gear 2", "gear 2 solid reference"] and estimate.fe_seconds(scene) > 0
     study.stiffness(scene)
     assert estimate.fe_bodies(scene) == [] and estimate.fe_seconds(scene) == 0.0
-    from study.verify.fe_reference import static_angles
+    from study.scene_model import static_angles
     angles = static_angles(scene)
     before = estimate.reference_parts(scene, angles)
     assert before["gear 1 FE body"] > 0 and before["gear 2 FE body"] > 0

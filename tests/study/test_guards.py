@@ -13,7 +13,7 @@ STUDY = "study/scenes/example_study.toml"
 
 @pytest.fixture(scope="module")
 def small_model():
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     return build_scene_model(study.load_study(STUDY).base_scene())
 
 
@@ -85,7 +85,7 @@ def test_a_contact_too_stiff_for_its_step_is_flagged_inaccurate(paper_solid_mode
 
     from solver.mbs.dynamics import INACCURATE, simulate
     from solver.mbs.stability import stable_time_step
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     stiff = build_scene_model(solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9}))
     dt_static, _w = stable_time_step(stiff, 50.0)
     r = simulate(stiff, 100.0, 0.01, 50.0, 0.01, 0.02, dt=dt_static)
@@ -143,7 +143,7 @@ def test_a_coarse_implicit_run_of_a_rattling_150_tooth_pair_is_flagged():
     the potential energy of the mesh; flagged, not ok. (Lightly damped: the raw coefficients.)"""
     from solver.mbs.dynamics import INACCURATE
     from solver.mbs.implicit import simulate_implicit
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     sc = study.load_scene(None, ["gear1.teeth=150", "gear2.teeth=150", "gear2.body.holes=0",
                                  "gear2.body.web_thickness=17", "contact.c_con=3640",
                                  "gear1.spring.c_phi=0.062", "gear2.spring.c_phi=0.062"])
@@ -167,7 +167,7 @@ def test_a_sweep_point_whose_run_is_inaccurate_keeps_its_scalars_flagged():
     from helpers import RAW_DAMPING, solid_scene
 
     from solver.mbs.stability import stable_time_step
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     from study.sweep.engine import run_point
     from study.sweep.outputs import Outputs
     sc = solid_scene(**RAW_DAMPING, **{"contact.k_con": 5.64e9, "dynamic.duration": 0.021})

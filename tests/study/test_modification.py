@@ -4,17 +4,16 @@ import math
 import numpy as np
 import pytest
 
-from solver.geometry import gear_geometry
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import flank_deviation
 from study.scene import SceneError, default_scene, loads_scene
-from study.setup import geometry_model
+from study.scene_model import geometry_model
 
 M = "gear1.modification."
 
 
 def _geo(scene, g=1):
-    return gear_geometry(scene.tooth_spec(g))
+    return scene.geometry(g)
 
 
 def test_three_ways_to_start_a_tip_relief_give_the_same_roll():

@@ -265,7 +265,7 @@ def test_very_stiff_tooth_springs_keep_the_mesh_mode():
     MHz; the mesh mode used to be dropped as 'rigid' next to them and a 33 MHz tooth mode
     taken for it (and the dampers tuned to that)."""
     from solver.mbs.modes import modal_analysis
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     raw = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spring.c_phi": 0.062}
     f = {}
     for k in (1e12, 1e14):

@@ -14,7 +14,7 @@ import xarray as xr
 from solver.mbs.dynamics import simulate
 from study.cli import main
 from study.scene import load_scene
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 pytestmark = pytest.mark.slow      # two 1 s run-ups of the paper pair
 

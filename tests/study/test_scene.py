@@ -47,3 +47,20 @@ def test_metadata_and_toml_round_trip():
         with pytest.raises(SceneError, match="no such scene field"):
             get_dotted(paper, bad)
     assert loads_scene(paper.to_toml()) == paper
+
+
+def test_solid_variant_and_geometry_of_a_scene():
+    """`Scene.solid` makes only the named gears' bodies solid (no holes, web as thick as the
+    face) and keeps everything else; `Scene.geometry` is the SI geometry of the scene's teeth."""
+    paper = default_scene()
+    assert paper.is_lightened(2) and not paper.is_lightened(1)
+    solid = paper.solid(gears=(2,))
+    assert not solid.is_lightened(2) and solid.gear2.body.web_thickness == paper.gear2.face_width
+    assert solid.gear1 == paper.gear1 and solid.dynamic == paper.dynamic
+    assert solid.replace(**{"gear2.body.holes": paper.gear2.body.holes,
+                            "gear2.body.web_thickness": paper.gear2.body.web_thickness}) == paper
+    assert paper.solid() == solid         # the driver was solid already
+    geo = paper.geometry(2)
+    assert geo.teeth == paper.gear2.teeth
+    assert geo.pitch_radius == pytest.approx(0.5 * paper.gear2.module * paper.gear2.teeth * 1e-3, rel=1e-12)
+    assert geo.root_radius == paper.pivot_radius(2)       # the pivot defaults to the root circle

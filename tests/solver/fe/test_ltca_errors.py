@@ -10,7 +10,7 @@ from test_ltca_relief import FE_SPRINGS
 from solver.fe.ltca import error_approach, mesh_points
 from solver.mbs.kernels import layout as L
 from solver.mbs.statics import solve_static
-from study.setup import build_scene_model, geometry_model
+from study.scene_model import build_scene_model, geometry_model
 from study.verify import fe_reference as ref_mod
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")

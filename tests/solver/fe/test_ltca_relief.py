@@ -7,7 +7,7 @@ from test_ltca import small_scene
 from solver.fe.ltca import mesh_points
 from solver.mbs.kernels import layout as L
 from study.run import run_static
-from study.setup import build_scene_model, geometry_model
+from study.scene_model import build_scene_model, geometry_model
 from study.verify import fe_reference as ref_mod
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")

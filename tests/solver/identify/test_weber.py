@@ -5,14 +5,14 @@ import numpy as np
 import pytest
 
 from solver import units
-from solver.geometry import Material, gear_geometry
+from solver.geometry import Material
 from solver.identify.weber import fit_contact, weber_deflection
 from study.scene import default_scene
 
 
 def table1_fit(**kw):
     s = default_scene()
-    g1, g2 = gear_geometry(s.tooth_spec(1)), gear_geometry(s.tooth_spec(2))
+    g1, g2 = s.geometry(1), s.geometry(2)
     f = fit_contact(g1, g2, s.material_spec(), s.quasi_static.torque / g1.base_radius, **kw)
     return f, f.k_con / units.contact_stiffness_to_si(1.0, f.m1)
 
@@ -25,7 +25,7 @@ def test_fit_reproduces_the_papers_contact_law():
     # the depth of the deflection matters: to the full centreline the contact is softer
     f1, k1 = table1_fit(depth_fraction=1.0)
     s = default_scene()
-    F = s.quasi_static.torque / gear_geometry(s.tooth_spec(1)).base_radius
+    F = s.quasi_static.torque / s.geometry(1).base_radius
     d_half = (F / f.k_con) ** (1 / f.m1)
     d_full = (F / f1.k_con) ** (1 / f1.m1)
     assert d_full > d_half
@@ -47,7 +47,7 @@ def test_weber_deflection_is_logarithmic_in_depth_and_nearly_linear_in_load():
 
 def test_bad_fit_input_is_named():
     s = default_scene()
-    g = gear_geometry(s.tooth_spec(1))
+    g = s.geometry(1)
     with pytest.raises(ValueError, match="depth_fraction"):
         fit_contact(g, g, s.material_spec(), 1000.0, depth_fraction=0.0)
     with pytest.raises(ValueError, match="quasi_static.torque"):

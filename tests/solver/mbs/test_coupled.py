@@ -13,7 +13,7 @@ from solver.identify.coupling import body_torsion_fit, body_windup
 from solver.mbs.model import build_model
 from solver.mbs.statics import solve_static
 from study.scene import SceneError
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from study.verify import fe_reference as ref_mod
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
@@ -96,7 +96,7 @@ def _double_contact_errors(scene, coupling="body-torsion"):
     two pairs in the path of contact, and the single-contact errors."""
     from solver import units
     from study.inputs.coupling import plain_fe_springs
-    from study.setup import gear_setup
+    from study.scene_model import gear_setup
     angles = np.radians(np.arange(0.0, scene.quasi_static.rotation, 0.25))
     res, model, _ = ref_mod.reference(scene, angles)
     nominal = np.array([np.count_nonzero(mesh_points(model, a).kind == 1) for a in angles])
@@ -147,7 +147,8 @@ def test_scipy_peer_refuses_a_coupled_model(paper_solid_model):
 
 
 def test_implicit_integrator_refuses_and_auto_picks_explicit_for_a_coupled_model(paper_solid_model):
-    from solver.mbs.implicit import choose_method, simulate_implicit
+    from solver.mbs.implicit import simulate_implicit
+    from solver.mbs.method import choose_method
     coupled = with_body_springs(paper_solid_model, (1.5e6, 0.9e6))
     with pytest.raises(ValueError, match="dynamic.method"):
         simulate_implicit(coupled, 100.0, 0.002, 50.0, 0.002, 0.001, dt=1e-6)

@@ -9,7 +9,7 @@ from solver.mbs.dynamics import DivergenceError, simulate
 from solver.mbs.stability import stable_time_step
 from solver.mbs.statics import solve_static
 from study.run import run_static
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 UNDAMPED = {"gear1.spring.c_phi": 0.0, "gear2.spring.c_phi": 0.0, "contact.c_con": 0.0}
 

@@ -15,7 +15,7 @@ from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
 from solver.mbs.model import build_model
 from solver.mbs.statics import solve_static
 from study.errors import SceneError
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 MU = 0.05
 

@@ -16,7 +16,7 @@ from solver.mbs.stability import (
     stable_time_step,
     stiffening_exponent,
 )
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 RUN = (100.0, 0.002, 50.0, 0.002, 0.003)     # 0 -> 100 rad/s and 0 -> 50 N m in 2 ms, 3 ms
 

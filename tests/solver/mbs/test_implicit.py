@@ -8,7 +8,7 @@ import pytest
 from helpers import RAW_DAMPING, solid_scene
 
 from solver.mbs.dynamics import DivergenceError, simulate
-from solver.mbs.implicit import choose_method, simulate_implicit
+from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels.laws import (
     contact_damping_tangents,
     contact_force,
@@ -16,10 +16,11 @@ from solver.mbs.kernels.laws import (
     spring_damping_tangent,
     spring_torque,
 )
+from solver.mbs.method import choose_method
 from solver.mbs.stability import highest_frequency, linearized_system, stable_time_step
 from study.run import run_scene
 from study.scene import SceneError
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 UNDAMPED = {"gear1.spring.c_phi": 0.0, "gear2.spring.c_phi": 0.0, "contact.c_con": 0.0}
 # 100 rad/s and 50 N·m reached in 2 ms, 3 ms in all: the end of the ramps is inside the run

@@ -64,7 +64,7 @@ def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
 FIRST_RUN = r'''
 import numpy as np
 from study.scene import default_scene
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 from solver.mbs.statics import solve_static
 from solver.mbs.dynamics import simulate
 from solver.mbs.kernels import contact
@@ -75,7 +75,7 @@ from solver.mbs.kernels import mechanics
 from solver.mbs.kernels import statics
 from solver.mbs.kernels import stepping
 from solver.mbs.kernels import toothcoupling
-m = build_scene_model(default_scene().replace(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0}))
+m = build_scene_model(default_scene().solid(gears=(2,)))
 solve_static(m, np.radians([0.0, 0.1, 0.2]), 50.0)
 simulate(m, 100.0, 1e-4, 50.0, 1e-4, 1e-4)
 for mod in (contact, explicit, laws, mesh, mechanics, statics, stepping, toothcoupling):

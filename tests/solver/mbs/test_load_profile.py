@@ -42,7 +42,7 @@ def test_scene_torque_change_is_validated():
         solid_scene(**{"dynamic.torque_change_time": 0.005, "dynamic.ramp_time": 0.01})
     with pytest.raises(SceneError, match="dynamic.torque_change_time"):
         solid_scene(**{"dynamic.torque_change_time": 0.5, "dynamic.duration": 0.2})
-    from study.setup import load_table
+    from study.scene_model import load_table
     s = solid_scene(**{"dynamic.torque_change_time": 0.05, "dynamic.torque_change_duration": 0.002,
                        "dynamic.torque_after": -20.0})
     np.testing.assert_allclose(load_table(s), [[0.0, 0.0], [0.01, 50.0], [0.05, 50.0], [0.052, -20.0]])
@@ -54,7 +54,7 @@ def damped_pair():
     """The solid Table 1 pair with tooth dampers strong enough (c_phi = 2 N·mm·s/rad) that the
     impact on the coast flanks dies out within the run (with c_phi = 0.062 the 3 kHz mesh mode
     kept ringing for some 50 ms); the contact damper the scenes had before."""
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     return build_scene_model(solid_scene(**{"gear1.spring.c_phi": 2.0, "gear2.spring.c_phi": 2.0, "contact.c_con": 3640.0}))
 
 

@@ -10,7 +10,7 @@ from solver.mbs.equilibria import loaded_equilibria
 from solver.mbs.kernels import layout as L
 from solver.mbs.modes import modal_analysis
 from solver.mbs.ringdown import ring_down
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 SOLID = {"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0, "dynamic.torque": 50.0}
 

@@ -9,7 +9,7 @@ from solver.fe.ltca import mesh_points
 from solver.mbs.kernels import layout as L
 from solver.mbs.statics import solve_static
 from study.scene import load_scene
-from study.setup import geometry_model
+from study.scene_model import geometry_model
 
 PERIOD = 15.0          # deg: one mesh pitch of the 24-tooth pair
 RIGID = {"gear1.spring.k_phi": 1e9, "gear2.spring.k_phi": 1e9, "gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0,

@@ -8,7 +8,7 @@ from helpers import solid_scene
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
 from solver.mbs.statics import solve_static
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 
 def test_single_pair_matches_series_springs_in_closed_form(paper_solid_model):

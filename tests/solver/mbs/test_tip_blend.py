@@ -12,7 +12,7 @@ from solver.mbs.kernels.gearmesh import TIP_BLEND, mesh_contacts, new_contact_bu
 from solver.mbs.kernels.statics import newton_system
 from solver.mbs.statics import solve_static
 from study.scene import load_scene
-from study.setup import build_scene_model, geometry_model
+from study.scene_model import build_scene_model, geometry_model
 
 SCENES = Path(__file__).resolve().parents[3] / "study" / "scenes"
 RELIEF = {"gear1.modification.tip_relief": 9.0, "gear1.modification.tip_length": 1.5, **ELASTIC}

@@ -49,7 +49,7 @@ def with_compliance(model, c1, c2, k_body=(math.inf, math.inf), ratio=0.02):
 
 @pytest.fixture(scope="module")
 def linear_pair():
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     return build_scene_model(solid_scene(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
 
 
@@ -81,7 +81,7 @@ def test_coupling_softens_double_contact_and_leaves_single_contact():
     where one pair carries it alone the unloaded neighbours change nothing (the small pair,
     contact ratio 1.6)."""
     from study.scene import load_scene
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     small = build_scene_model(load_scene("small_pair").replace(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
     angles = np.radians(np.arange(0.0, 15.0, 0.1))
     z1, z2 = small.teeth
@@ -154,7 +154,7 @@ COUPLING = (0.12, 0.07)    # neighbours' share, about the FE fit of the lightene
 
 
 def coupled_pair(scene_overrides, coupling=COUPLING, ratio=0.02):
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     m = build_scene_model(solid_scene(**scene_overrides))
     k = float(m.k_phi[0])
     z1, z2 = m.teeth
@@ -177,7 +177,7 @@ def test_coupled_teeth_slow_transient_follows_statics():
 
 def test_diagonal_compliance_dynamics_is_the_body_torsion_model():
     from solver.mbs.dynamics import simulate
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     m = build_scene_model(solid_scene(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
     z1, z2 = m.teeth
     k1, k2 = m.k_phi[:z1], m.k_phi[z1:]

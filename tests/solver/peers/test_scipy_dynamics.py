@@ -7,7 +7,7 @@ from helpers import solid_scene
 from solver.mbs.dynamics import DivergenceError, simulate
 from solver.peers.pair_equations import PairEquations
 from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 # a short run of the paper pair: 100 rad/s and 50 N·m reached in 2 ms, 3 ms in all
 RUN = (100.0, 0.002, 50.0, 0.002, 0.003)

@@ -6,7 +6,7 @@ from helpers import solid_scene
 
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_statics import static_te_root
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,6 @@ from solver.geometry import gear_geometry
 from study.inputs.cache import BODY_SLOTS, FECache
 from study.inputs.gearsetup import gear_setup, gear_setups
 from study.scene import default_scene
-from study.setup import solid_scene
 
 
 def test_setup_holds_the_scene_in_si_and_the_shared_fe_load():
@@ -40,7 +39,7 @@ def test_cache_keys_stay_those_of_the_stored_files():
     assert keys(default_scene()) == {"c33f898505f5b9efce90", "ba94997bcf21a02e85a8"}
     g1, g2 = gear_setups(default_scene())
     # a solid body's hole sizes do not matter, whichever way the body was made solid
-    s = solid_scene(default_scene())
+    s = default_scene().solid()
     assert gear_setup(s, 2).key == g2.solid().key == g1.key != g2.key
     assert gear_setup(s.replace(**{"gear2.body.hole_radius": 2.0}), 2).key == g2.solid().key
 

@@ -13,7 +13,6 @@ from solver.peers.iso6336 import blank_factor, single_stiffness
 from study.inputs import springs
 from study.inputs.gearsetup import gear_setup
 from study.scene import default_scene, load_scene
-from study.setup import solid_scene
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
@@ -25,7 +24,7 @@ def small_scene(**kw):
 
 
 def test_solid_body_gives_the_same_stiffness_to_every_tooth():
-    s = solid_scene(small_scene())
+    s = small_scene().solid()
     k = springs.fe_stiffness(gear_setup(s, 2), teeth=[0, 5, 11, 17])
     assert np.ptp(k) / k.mean() < 2e-3
 
@@ -168,7 +167,7 @@ def test_lightened_scene_runs_with_its_fe_springs_in_the_archive():
     # the paper's model: its springs are k_phi scaled by the FE ratio (the default, the
     # compliance model, takes its tooth springs from the coupling fit instead)
     lite = small_scene(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5, "coupling.model": "paper"})
-    solid = solid_scene(lite)
+    solid = lite.solid()
     ds = run_scene(lite, static=True, dynamic=False)
     assert ds.attrs["coupling_model"] == "paper"
     k = ds["tooth_stiffness"].sel(gear=2).values

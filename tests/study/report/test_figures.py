@@ -112,8 +112,7 @@ def test_stress_render_scale_spans_zero_to_the_fillet_peak(tiny, tmp_path):
     sc = render_inputs.required_scene(ds)
     teeth = [int(np.argmax(k2)), int(np.argmin(k2))]
     fields = render_inputs.fe_fields(sc, 2, teeth)
-    from solver.geometry import gear_geometry
-    geo = gear_geometry(sc.tooth_spec(2))
+    geo = sc.geometry(2)
     peaks = [stress_render.fillet_peak(f, geo, f.tooth) / 1e6 for f in fields]
     # the loaded tooth's fillet carries far more than the body on average
     assert all(p > 5 * np.median(f.von_mises) / 1e6 for p, f in zip(peaks, fields))

@@ -14,7 +14,7 @@ def test_dynamic_factor_is_one_near_zero_speed_and_tooth_forces_carry_the_load()
     force over 2.5 mesh periods is the static one (K_v = 1 within 1 %), and at every instant
     the loaded contacts' forces times rb2 add up to the transmitted torque."""
     from study.run import run_scene
-    from study.setup import build_scene_model
+    from study.scene_model import build_scene_model
     sc = solid_scene(**{"dynamic.speed": 5.0, "dynamic.ramp_time": 0.002, "dynamic.duration": 0.05,
                         "dynamic.output_step": 5e-5})
     ds = run_scene(sc, static=False, dynamic=True)

@@ -10,7 +10,7 @@ from solver.mbs.dynamics import simulate
 from study.report.modes import critical_speeds
 from study.report.order_tracking import driver_angle, order_cut, order_map
 from study.report.spectra import amplitude_spectrum
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 
 def test_order_map_recovers_the_orders_of_a_synthetic_run_up():

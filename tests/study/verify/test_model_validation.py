@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from study.scene import SceneError, default_scene, load_scene
-from study.setup import build_scene_model, solid_scene
+from study.scene_model import build_scene_model
 from study.verify import model_validation as mv
 
 LIGHT = {"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
@@ -36,7 +36,7 @@ def test_the_relief_that_minimises_the_ste_agrees_with_the_fe_reference():
     """At a light and a heavy load: the compliance model's optimum relief within the target of
     the FE reference's, its STE within the targets without relief (the local tooth compliance
     in series with the contact is what gets the heavy load's optimum right)."""
-    scene = solid_scene(load_scene("small_pair"))
+    scene = load_scene("small_pair").solid()
     ds = mv.relief_dataset({"small": scene}, reliefs=(0.0, 2.0, 4.0, 6.0, 8.0, 10.0), torques=(25.0, 100.0),
                            rotations={"small": 15.0}, step=0.25, models=("fe-reference", "compliance"))
     for torque in (25.0, 100.0):
@@ -55,7 +55,7 @@ def test_the_paper_model_is_one_key_away_and_none_still_reads():
     assert scene.replace(**{"coupling.model": "none"}).coupling_model_name == "paper"
     assert not build_scene_model(paper).teeth_coupled
     # two solid bodies need no FE: 'auto' is the paper's model there
-    solid = solid_scene(default_scene())
+    solid = default_scene().solid()
     assert solid.coupling.model == "auto" and solid.coupling_model == "none"
     # nor do springs that ignore the lightening
     assert scene.replace(**{"gear2.spring.stiffness": "uniform"}).coupling_model == "none"
@@ -76,7 +76,7 @@ def test_a_study_over_solid_and_lightened_bodies_runs_one_model():
 
 def test_the_run_archive_names_the_model_it_ran():
     from study.run import run_scene
-    scene = solid_scene(load_scene("small_pair").replace(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5}))
+    scene = load_scene("small_pair").replace(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5}).solid()
     ds = run_scene(scene, static=True, dynamic=False)
     assert ds.attrs["coupling_model"] == "paper" and ds.attrs["coupling_model_setting"] == "auto"
     lite = small_light(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})

@@ -1,11 +1,11 @@
 """Scene fields of a gear's pitch errors and eccentricity (``gearN.errors.*``) and their
-conversion to `solver.errors.GearErrors` (SI).
+conversion to `solver.pitch_errors.GearErrors` (SI).
 
 Pitch deviations come either as a list (``pitch``, one single pitch deviation f_pt per tooth
 in um, ISO 1328-1 sign: actual minus theoretical pitch between tooth k-1 and tooth k) or as an
 ISO 1328-1:2013 flank tolerance class (``grade``, 1..11) with a ``seed``: a reproducible
 random set within that class's f_pT and F_pT for the gear's reference diameter and module
-(`solver.errors.random_pitch`). The eccentricity is the offset of the teeth's centre from the
+(`solver.pitch_errors.random_pitch`). The eccentricity is the offset of the teeth's centre from the
 bearing axis (um; radial runout F_r ~ 2 x eccentricity) at ``eccentricity_phase`` (deg, gear
 frame, from tooth 0's axis).
 """
@@ -14,8 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from solver import units
-from solver.errors import GearErrors, closure_tolerance, random_pitch
 from solver.geometry import GearGeometry
+from solver.pitch_errors import GearErrors, closure_tolerance, random_pitch
 from study.errors import SceneError
 
 

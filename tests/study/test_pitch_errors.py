@@ -5,12 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from solver.errors import iso1328_pitch_tolerances
-from solver.geometry import gear_geometry
 from solver.mbs.kernels import layout as L
+from solver.pitch_errors import iso1328_pitch_tolerances
 from study.estimate import error_period_note
 from study.scene import SceneError, default_scene, loads_scene
-from study.setup import error_period, geometry_model, static_angles, static_rotation
+from study.scene_model import error_period, geometry_model, static_angles, static_rotation
 
 E = "gear1.errors."
 E2 = "gear2.errors."
@@ -35,7 +34,7 @@ def test_perfect_gears_keep_the_plain_model_arrays():
     s = s0.replace(**{E + "pitch": [0.0, 2.0, -2.0] + [0.0] * 64, E2 + "eccentricity": 3.0,
                       E2 + "eccentricity_phase": 90.0})
     m = geometry_model(s)
-    r1 = gear_geometry(s.tooth_spec(1)).pitch_radius
+    r1 = s.geometry(1).pitch_radius
     assert m.pair_par.size == L.E_EPS + 134
     np.testing.assert_allclose(m.pair_par[L.E_EPS:L.E_EPS + 3], [0.0, 2e-6 / r1, 0.0], rtol=1e-12, atol=0)
     assert not m.pair_par[L.E_EPS + 67:].any()

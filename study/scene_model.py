@@ -24,15 +24,8 @@ from study.inputs.gearsetup import GearSetup, gear_setup, gear_setups
 from study.inputs.springs import tooth_springs
 from study.scene import MESH_DAMPING_RATIO, TOOTH_DAMPING_RATIO, Scene, SceneError
 
-__all__ = ["GearSetup", "gear_setup", "gear_setups", "solid_scene", "coupling_fit", "scene_springs",
+__all__ = ["GearSetup", "gear_setup", "gear_setups", "coupling_fit", "scene_springs",
            "build_scene_model", "kept_scene_model", "geometry_model", "static_angles", "load_table", "damping_ratios", "mean_load"]
-
-
-def solid_scene(scene: Scene, gears=(1, 2)) -> Scene:
-    """The same scene with solid bodies for ``gears``: the web as thick as the face, no holes
-    (the scene-level twin of `solver.geometry.solid_body`)."""
-    return scene.replace(**{k: v for g in gears for k, v in ((f"gear{g}.body.holes", 0),
-                                                               (f"gear{g}.body.web_thickness", scene.gear(g).face_width))})
 
 
 def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple | None = None):
@@ -254,13 +247,19 @@ def static_rotation(scene: Scene) -> float:
     return rot
 
 
-def static_angles(scene: Scene) -> np.ndarray:
-    """Driver angles [rad] of the quasi-static analysis (`static_rotation` at quasi_static.angle_step);
-    `study.errors.BudgetError` before they are built when their arrays would not fit in memory."""
+def static_angles(scene: Scene, step_deg: float | None = None, memory_factor: float = 1.0) -> np.ndarray:
+    """Driver angles [rad] of the quasi-static analysis: `static_rotation` (whole periods of the
+    pitch errors and eccentricities) at quasi_static.angle_step, or at ``step_deg`` [deg] (the
+    ``--step`` of a command). `study.errors.BudgetError` before they are built when
+    ``memory_factor`` times a static analysis's arrays would not fit in memory (the FE
+    reference holds about `study.verify.fe_reference.REFERENCE_MEMORY_FACTOR` times that)."""
     from study.estimate import check_static_memory
-    qs = scene.quasi_static
-    n = int(check_static_memory(scene))
-    return np.radians(np.arange(n) * qs.angle_step)
+    step = scene.quasi_static.angle_step if step_deg is None else step_deg
+    if not (math.isfinite(step) and step > 0):
+        raise SceneError("--step", f"the driver angle step must be a positive number of degrees, got {step}")
+    field = "quasi_static.angle_step" if step_deg is None else "--step"
+    n = int(check_static_memory(scene, step, factor=memory_factor, field=field))
+    return np.radians(np.arange(n) * step)
 
 
 def load_table(scene: Scene) -> np.ndarray | None:
