@@ -22,8 +22,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.mbs.kernels import layout as L
-
 
 @dataclass(frozen=True)
 class Relief:
@@ -72,17 +70,3 @@ class ProfileModification:
             raise ValueError(f"{name}.modification.profile_deviation: {len(self.table_deviation)} values for {r.size} positions")
         if r.size == 1 or np.any(np.diff(r) <= 0):
             raise ValueError(f"{name}.modification.profile_deviation: needs at least two positions, strictly increasing")
-
-
-def sample(mod: ProfileModification | None, u_form: float, u_tip: float, row: np.ndarray) -> None:
-    """Write the model columns DEV_* of one gear into ``row`` (a gear_par row): the deviation
-    [m] on N_DEV rolls from u_form to u_tip, the flag DEV_ON, the grid and DEV_NEG (a bound on
-    the material addition [m], which widens the rigid gap bound of the pre-search)."""
-    u = np.linspace(u_form, u_tip, L.N_DEV)
-    dev = np.zeros(L.N_DEV) if mod is None else mod.deviation(u, u_form, u_tip)
-    row[L.DEV_U0] = u_form
-    row[L.DEV_DU] = u[1] - u[0]
-    row[L.DEV0:L.DEV0 + L.N_DEV] = dev
-    row[L.DEV_ON] = 1.0 if np.any(dev != 0.0) else 0.0
-    # the cubic through the samples may undershoot them by a fraction of a step near a kink
-    row[L.DEV_NEG] = max(0.0, -float(dev.min())) + 0.25 * float(np.abs(np.diff(dev)).max())

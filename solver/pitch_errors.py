@@ -27,7 +27,7 @@ the module in mm, results in um (the standard's clauses 5.3.2 and 5.3.3; values 
 `random_pitch` draws a closed set whose |f_pt| <= f_pT and whose cumulative deviations span
 (max - min of F_p,k) at most F_pT.
 
-Model arrays (`solver.mbs.kernels.layout` E_*): when either gear has errors, ``pair_par`` is
+Model arrays (`solver.mbs.model.error_block`, columns `solver.mbs.kernels.layout` E_*): when either gear has errors, ``pair_par`` is
 extended by an errors block (a bound on the extra penetration, each gear's e and phase, and
 every tooth's eps, gear-1 teeth first); without errors it keeps its plain length and the
 kernels skip every step of this.
@@ -38,8 +38,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
-from solver.mbs.kernels import layout as L
 
 ISO_CLASSES = range(1, 12)
 
@@ -121,26 +119,3 @@ def random_pitch(teeth: int, d: float, m: float, grade: int, seed: int) -> tuple
     f = f * scale
     f -= f.mean()                                        # closed to rounding
     return tuple(float(x) for x in f)
-
-
-def error_block(errors, geometries) -> np.ndarray:
-    """The pair_par tail (`layout` E_*) of both gears' errors ((GearErrors | None) x 2), or an
-    empty array when neither has any (the kernels then skip the errors entirely)."""
-    if all(e is None or e.is_zero for e in errors):
-        return np.zeros(0)
-    z = [g.teeth for g in geometries]
-    block = np.zeros(L.E_EPS - L.N_PAIR_PAR + z[0] + z[1])
-    bound = 0.0
-    for g, (e, geo) in enumerate(zip(errors, geometries)):
-        if e is None:
-            continue
-        eps = e.cumulative(geo.teeth) / geo.pitch_radius
-        i0 = L.E_EPS - L.N_PAIR_PAR + (0 if g == 0 else z[0])
-        block[i0:i0 + geo.teeth] = eps
-        block[L.E_ECC + 2 * g - L.N_PAIR_PAR] = e.eccentricity
-        block[L.E_ECC + 2 * g + 1 - L.N_PAIR_PAR] = e.eccentricity_phase
-        # a tooth turned by eps about the centre moves its flank points at most eps*r_tip;
-        # the centre offset moves them by e
-        bound += np.max(np.abs(eps), initial=0.0) * geo.tip_radius + e.eccentricity
-    block[L.E_BOUND - L.N_PAIR_PAR] = bound
-    return block

@@ -48,9 +48,6 @@ KNOWN = {
     ("pictures", "study/report/render_inputs.py", "study.inputs.springs"),
     ("pictures", "study/report/stress_render.py", "solver.fe.body"),
     ("pictures", "study/report/stress_render.py", "study.inputs.springs"),
-    # the pitch-error and profile-modification tables are packed in the kernels' column layout
-    ("base", "solver/errors.py", "solver.mbs.kernels.layout"),
-    ("base", "solver/modification.py", "solver.mbs.kernels.layout"),
 }
 
 

@@ -27,8 +27,8 @@ from solver.geometry import (
 )
 from solver.inertia import body_inertia, hole_inertia, tooth_inertia
 from solver.mbs.kernels import layout as L
-from solver.modification import ProfileModification, sample
-from solver.pitch_errors import GearErrors, error_block
+from solver.modification import ProfileModification
+from solver.pitch_errors import GearErrors
 
 
 @dataclass(frozen=True)
@@ -209,7 +209,7 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
         gp[i, L.NZ] = g.teeth
         if gi.modification is not None:
             gi.modification.check(g.u_form, g.u_tip, ("gear1", "gear2")[i])
-        sample(gi.modification, g.u_form, g.u_tip, gp[i])
+        sample_deviation(gi.modification, g.u_form, g.u_tip, gp[i])
         if gi.contact_compliance is not None:
             sample_local_compliance(gi.contact_compliance, g.u_form, g.u_tip, gp[i], ("gear1", "gear2")[i])
         if gi.body_stiffness != math.inf:
@@ -271,3 +271,40 @@ def sample_local_compliance(table, u_form: float, u_tip: float, row: np.ndarray,
     row[L.CLOC_DU] = grid[1] - grid[0]
     row[L.CLOC0:L.CLOC0 + L.N_CLOC] = PchipInterpolator(u, c, extrapolate=False)(np.clip(grid, u[0], u[-1]))
     row[L.CLOC_ON] = 1.0 if np.any(row[L.CLOC0:L.CLOC0 + L.N_CLOC] != 0.0) else 0.0
+
+
+def sample_deviation(mod: ProfileModification | None, u_form: float, u_tip: float, row: np.ndarray) -> None:
+    """Write the model columns DEV_* of one gear into ``row`` (a gear_par row): the deviation
+    [m] on N_DEV rolls from u_form to u_tip, the flag DEV_ON, the grid and DEV_NEG (a bound on
+    the material addition [m], which widens the rigid gap bound of the pre-search)."""
+    u = np.linspace(u_form, u_tip, L.N_DEV)
+    dev = np.zeros(L.N_DEV) if mod is None else mod.deviation(u, u_form, u_tip)
+    row[L.DEV_U0] = u_form
+    row[L.DEV_DU] = u[1] - u[0]
+    row[L.DEV0:L.DEV0 + L.N_DEV] = dev
+    row[L.DEV_ON] = 1.0 if np.any(dev != 0.0) else 0.0
+    # the cubic through the samples may undershoot them by a fraction of a step near a kink
+    row[L.DEV_NEG] = max(0.0, -float(dev.min())) + 0.25 * float(np.abs(np.diff(dev)).max())
+
+
+def error_block(errors, geometries) -> np.ndarray:
+    """The pair_par tail (`layout` E_*) of both gears' errors ((GearErrors | None) x 2), or an
+    empty array when neither has any (the kernels then skip the errors entirely)."""
+    if all(e is None or e.is_zero for e in errors):
+        return np.zeros(0)
+    z = [g.teeth for g in geometries]
+    block = np.zeros(L.E_EPS - L.N_PAIR_PAR + z[0] + z[1])
+    bound = 0.0
+    for g, (e, geo) in enumerate(zip(errors, geometries)):
+        if e is None:
+            continue
+        eps = e.cumulative(geo.teeth) / geo.pitch_radius
+        i0 = L.E_EPS - L.N_PAIR_PAR + (0 if g == 0 else z[0])
+        block[i0:i0 + geo.teeth] = eps
+        block[L.E_ECC + 2 * g - L.N_PAIR_PAR] = e.eccentricity
+        block[L.E_ECC + 2 * g + 1 - L.N_PAIR_PAR] = e.eccentricity_phase
+        # a tooth turned by eps about the centre moves its flank points at most eps*r_tip;
+        # the centre offset moves them by e
+        bound += np.max(np.abs(eps), initial=0.0) * geo.tip_radius + e.eccentricity
+    block[L.E_BOUND - L.N_PAIR_PAR] = bound
+    return block
