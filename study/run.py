@@ -12,19 +12,22 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import INACCURATE, run_loads, simulate
+from solver.mbs.dynamics import run_loads, simulate
 from solver.mbs.implicit import choose_method, simulate_implicit
 from solver.mbs.kernels.layout import R_PV
+from solver.mbs.kernels.status import COMPLETED
 from solver.mbs.mesh_stiffness import mesh_states
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study import estimate
+from study.archive import run_variables as results
+from study.archive.lightening import lightening_variables
+from study.archive.mesh import dynamic_force_variables, mesh_variables
+from study.archive.modes import modal_variables
+from study.archive.netcdf import provenance
 from study.inputs.gearsetup import gear_setups
+from study.inputs.springs import root_stresses
 from study.plausibility import critical_speed_warning, report_warnings, scene_warnings
-from study.report import results
-from study.report.lightening import lightening_variables
-from study.report.mesh_outputs import dynamic_force_variables, mesh_variables
-from study.report.modes import modal_variables
 from study.scene import Scene
 from study.setup import (
     build_scene_model,
@@ -161,7 +164,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
-    c, v = lightening_variables(gear_setups(scene))      # mass, inertia; root stress from the springs' FE
+    setups = gear_setups(scene)
+    c, v = lightening_variables(setups, root_stresses(setups))    # mass, inertia; root stress from the springs' FE
     coords.update(c); data.update(v)
     z1, z2 = model.teeth
     d = scene.dynamic
@@ -183,7 +187,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         "pivot_radius_mm": model.gear_par[:, R_PV] * units.MM_PER_M,
         "teeth_coupled": int(model.teeth_coupled),
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
-        **results.provenance(),
+        **provenance(),
     }
     t0 = time.perf_counter()
     c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
@@ -234,8 +238,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
             data.update(results.efficiency_variable(dy, d.torque, d.speed, start))
         if runup:
             attrs["runup_speed_end_rad_s"] = d.speed_end
-            if dy.status in (0, INACCURATE):    # completed: the map is kept, an inaccurate one with its flag
-                from study.report.order_tracking import order_tracking_variables
+            if dy.status in COMPLETED:    # completed: the map is kept, an inaccurate one with its flag
+                from study.archive.order_tracking import order_tracking_variables
                 c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
                 if dy.status:
                     v["order_amplitude"].attrs["status"] = dy.message

@@ -30,6 +30,7 @@ from scipy import integrate
 
 from solver.mbs.dynamics import DivergenceError, DynamicResult, check_positive, run_loads, simulate
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.status import INTERRUPTED, NONFINITE, OK, PENETRATION
 from solver.mbs.model import Model
 from solver.peers.pair_equations import PairEquations, driver_motion
 
@@ -97,7 +98,7 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
     if method in STIFF_METHODS:
         kw["jac"] = eq.jac
     ys = np.full((n_out, y.size), np.nan)
-    status, msg = 0, "ok"
+    status, msg = OK, "ok"
     nfev = njev = nlu = steps = 0
     t_reached = 0.0
     cls = getattr(integrate, method)
@@ -109,13 +110,13 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
             t_old = solver.t
             err = solver.step()
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                status = 1
+                status = NONFINITE
                 msg = (f"{method} failed at t = {t_old:.6g} s (step {steps + 1}): "
                        f"{err or 'non-finite state'}")
                 break
             steps += 1
             if max_wall_time is not None and _time.perf_counter() - t0 > max_wall_time:
-                status = 5
+                status = INTERRUPTED
                 msg = (f"{method}: wall-time limit {max_wall_time:g} s reached at t = {solver.t:.6g} s "
                        f"(step {steps})")
                 solver.status = "failed"
@@ -151,8 +152,8 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
         ncon[i] = sum(1 for c in cons if c.force > 0.0)
         react[i] = eq.driver_torque(q1, acc, a1)
         ke[i], pe[i] = eq.energies(t, x, v, cons)
-        if status == 0 and max((c.delta for c in cons), default=0.0) > delta_max:
-            status, msg = 2, f"penetration beyond the bound {delta_max * 1e6:.4g} um at t = {t:.6g} s"
+        if status == OK and max((c.delta for c in cons), default=0.0) > delta_max:
+            status, msg = PENETRATION, f"penetration beyond the bound {delta_max * 1e6:.4g} um at t = {t:.6g} s"
     if status and raise_on_failure:
         raise DivergenceError(msg)
     mean_dt = t_reached / steps if steps else float("nan")

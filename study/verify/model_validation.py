@@ -25,7 +25,7 @@ import xarray as xr
 
 from solver import units
 from solver.mbs.statics import solve_static
-from study.report import results
+from study.archive.netcdf import cf_variable, provenance
 from study.scene import Scene
 from study.setup import build_scene_model
 from study.verify.fe_reference import reference
@@ -109,7 +109,7 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
                 if log:
                     log(f"holes {n:2d}, web {web:4.1f} mm, rim {rim:4.1f} mm: " + ", ".join(
                         f"{name} p2p {f[name]['p2p']:.3f} um" for name in models))
-    v = results._var
+    v = cf_variable
     dims = ("holes", "web_thickness", "rim_height", "model")
     coords = {"holes": v("holes", np.asarray(holes), "1", "holes in gear 2's web"),
               "web_thickness": v("web_thickness", np.asarray(webs, float), "mm", "gear 2's web thickness"),
@@ -122,7 +122,7 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
             "wall_time": v(dims, figs["wall"], "s", "wall time of the model's STE (its FE included unless cached)")}
     attrs = {"title": "STE of the models against the FE reference over gear 2's body",
              "static_torque_N_m": base.quasi_static.torque, "rotation_deg": rotation, "angle_step_deg": step,
-             "base_scene": base.to_toml(), **_target_attrs(), **results.provenance()}
+             "base_scene": base.to_toml(), **_target_attrs(), **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -184,7 +184,7 @@ def relief_dataset(pairs: dict, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=
             if log:
                 log(f"{name} pair, {torque:g} N m: optimum relief " + ", ".join(
                     f"{mod} {opt[a, b, m]:.2f} um" for m, mod in enumerate(models)))
-    v = results._var
+    v = cf_variable
     dims = ("pair", "torque", "relief", "model")
     coords = {"pair": v("pair", np.array(names), "", "gear pair"),
               "torque": v("torque", np.asarray(torques, float), "N m", "quasi-static torque on gear 2"),
@@ -199,7 +199,7 @@ def relief_dataset(pairs: dict, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=
     attrs = {"title": "STE against tip relief: the models against the FE reference",
              "angle_step_deg": step, "rotation_deg": str({n: (rotations or {}).get(n, 30.0) for n in names}),
              "scenes": "\n\n".join(f"# {n}\n{pairs[n].to_toml()}" for n in names), **_target_attrs(),
-             **results.provenance()}
+             **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

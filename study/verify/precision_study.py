@@ -18,9 +18,9 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import INACCURATE
+from solver.mbs.kernels.status import COMPLETED
 from solver.mbs.model import Model
-from study.report import results
+from study.archive.netcdf import provenance
 from study.scene import Scene
 from study.verify.precision_cases import (
     Spec,
@@ -98,7 +98,7 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
                 warmed.add(s.method)
             (te, nst, st, msg), best = _timed(s.run, repeats)
             steps[i] = nst
-            if st in (0, INACCURATE):       # inaccurate: completed, its error is what the study measures
+            if st in COMPLETED:       # inaccurate: completed, its error is what the study measures
                 st = 0
                 wall[i] = best
                 err[i] = te_error_norms(te[mask], ref_te[mask])
@@ -133,7 +133,7 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
             "reference": names[0],
             "cross_check": names[1],
             **{f"reference_difference_{k}_um": float(v) for k, v in zip(NORMS, e_chk)},
-            **results.provenance(),
+            **provenance(),
             "machine": machine(),
             "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             **(attrs or {}),
