@@ -69,9 +69,9 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
     [rad] and rates [rad/s] (default rtol * 1e-6, i.e. rtol times about a micrometre of flank
     motion; rates get atol scaled by the highest tooth frequency). ``delta_max`` [m]
     (default a tenth of the module) bounds the penetration.
-    A failure of the solver or a guard gives status != 0 and a message (or raises
-    `DivergenceError` with ``raise_on_failure``). ``max_wall_time`` [s] stops a run that takes
-    longer (status 5, "wall-time limit"). ``load_table``: a torque profile instead of the
+    A failure of the solver or a guard gives a status other than OK (`solver.mbs.kernels.status`)
+    and a message (or raises `DivergenceError` with ``raise_on_failure``). ``max_wall_time`` [s]
+    stops a run that takes longer (status INTERRUPTED, "wall-time limit"). ``load_table``: a torque profile instead of the
     torque ramp, as in `solver.mbs.dynamics.simulate`.
     """
     if method not in METHODS:

@@ -14,8 +14,8 @@ Each coordinate carries ``units``, ``long_name`` (from the scene's field metadat
 In the grid layout an output lies only over the swept dimensions its analysis reads
 (`outputs.ANALYSIS_FIELDS`): ``ste_p2p`` over the body fields but not over ``speed``,
 ``mass_gear2`` over the body fields only; ``status`` says which points are ok (an output is
-read with ``.where(ds.status == 1)``, which broadcasts it over every dimension). In the point
-layout every variable lies over ``point``.
+read with ``.where(ds.status == 1)``, which broadcasts it over every dimension; the flags are
+`solver.mbs.kernels.status.POINT_STATUS`). In the point layout every variable lies over ``point``.
 A sampled study (`study.sweep.sample`) has a last dimension ``sample`` (one build each), the
 drawn values of each field as variables over it (named like a grid dimension, with its
 ``distribution``), ``sample_block`` and ``sample_row`` for the Saltelli design, and every output

@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.kernels.status import COMPLETED
+from solver.mbs.kernels.status import COMPLETED, NONFINITE, OK
 from solver.mbs.model import Model
 from study.archive.netcdf import provenance
 from study.scene import Scene
@@ -99,12 +99,12 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
             (te, nst, st, msg), best = _timed(s.run, repeats)
             steps[i] = nst
             if st in COMPLETED:       # inaccurate: completed, its error is what the study measures
-                st = 0
+                st = OK
                 wall[i] = best
                 err[i] = te_error_norms(te[mask], ref_te[mask])
                 if not np.all(np.isfinite(err[i])):
-                    st, msg = 1, "output not finite or incomplete"
-            status.append("ok" if st == 0 else "failed")
+                    st, msg = NONFINITE, "output not finite or incomplete"
+            status.append("ok" if st == OK else "failed")
             message.append(msg)
         except Exception as e:            # a failed run stays in the dataset with its message
             status.append("failed")
