@@ -314,7 +314,8 @@ def render(archive, out_dir=None, renders: bool = True, limits: dict | None = No
     """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
     files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a
     path or an xarray.Dataset; ``limits`` ({output: value}, sampled studies): the probability
-    of exceeding each."""
+    of exceeding each. The renders of a lightened body draw its FE fields from the FE cache
+    (solved and cached once when missing)."""
     from pathlib import Path
 
     from study.report.figures import make_figures
