@@ -17,8 +17,8 @@ grows with the study. A task dask could not compute (its worker died more often 
 `distributed.scheduler.allowed-failures` allows) leaves its points pending, its cause in the
 archive's message. Re-running the same study after an interruption (Ctrl-C, a killed worker
 or process) computes only the missing tasks. Tasks are keyed by a hash of the scene fields
-they read, their outputs and the code (`study.archive.netcdf.code_fingerprint`), so an edited study reuses
-the tasks it shares, and a changed code computes them all again.
+they read, their outputs and the code (`study.archive.netcdf.code_fingerprint`), so an edited
+study reuses the tasks it shares, and a changed code computes them all again.
 
 Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)

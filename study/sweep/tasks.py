@@ -4,8 +4,9 @@ A point's outputs split into at most two tasks (`Outputs.parts`): the outputs th
 ``dynamic.*`` field (STE, root stress, mass properties) and the ones that do (DTE; the modal
 outputs, linearised at the dynamic run's torque). A task is keyed by a hash of the
 scene fields its widest analysis reads (`outputs.ANALYSIS_FIELDS`), its outputs and the code
-(`study.archive.netcdf.code_fingerprint`): the points of a study that differ only in ``dynamic.*`` share
-their static task, and an edited study or a resumed one reuses every task it has in common.
+(`study.archive.netcdf.code_fingerprint`): the points of a study that differ only in
+``dynamic.*`` share their static task, and an edited study or a resumed one reuses every task
+it has in common.
 
 `point_result` puts a point's tasks back together into the record `archive.study_dataset`
 reads: the worst status (`WORST_FIRST`), the messages of the tasks not ok, the scalars of both,
