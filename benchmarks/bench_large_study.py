@@ -74,7 +74,7 @@ def merge(study_args: str, out: str, how: str) -> dict:
     import xarray as xr  # noqa: F401  (imports before the baseline)
 
     import study.sweep.archive  # noqa: F401
-    from study.report.results import write_netcdf
+    from study.archive.netcdf import write_netcdf
     from study.sweep.archive import study_dataset
     from study.sweep.engine import PartStore, parts_folder, run_sweep
     from study.sweep.grid import check_points

@@ -53,6 +53,7 @@ def dynamic_rows(kind, m, rep, quick):
     from peers.exudyn_pair import simulate_exudyn
 
     from solver.mbs.dynamics import simulate
+    from solver.mbs.kernels.status import OK
     from solver.mbs.stability import stable_time_step
     from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
     win = SHORT_DYNAMIC
@@ -76,7 +77,7 @@ def dynamic_rows(kind, m, rep, quick):
         for rtol in tols:
             tim, r = best_of(lambda: simulate_scipy(m, *win, method=meth, rtol=rtol), 1)
             rows.append(dict(case=case, method=f"numpy+scipy {meth} rtol {rtol:g}", **tim,
-                             error_um=err(r.te) if r.status == 0 else float("nan"),
+                             error_um=err(r.te) if r.status == OK else float("nan"),
                              note=f"{r.steps} steps, {r.nfev} f-evals, {r.njev} Jacobians; {r.message}"))
     for solver, div in (("VelocityVerlet", 1), ("RK44", 1), ("RK44", 4)):
         tim, (t, te, _wall) = best_of(lambda: simulate_exudyn(m, *win, dt=dt / div, solver=solver), 1)

@@ -11,7 +11,7 @@
     study.render("results/holes.nc", "results/holes")          # PNG plots (and renders) of an archive
 
 Scenes are in engineering units (mm, deg, N·m, rad/s, s; see `study.scene`), archives in CF
-units (um, degree, s, Hz; see `study.report.results` and `study.sweep.archive`). An invalid
+units (um, degree, s, Hz; see `study.archive.schema` and `study.sweep.archive`). An invalid
 scene or study raises `SceneError` naming the dotted field, before any work starts.
 
 Nothing heavy is imported with this package: each function imports its module when first
@@ -176,7 +176,7 @@ def write(ds, path):
     """Write a run or study archive as NetCDF (compressed, atomically) -> its path."""
     from pathlib import Path
 
-    from study.report.results import write_netcdf
+    from study.archive.netcdf import write_netcdf
     _check(hasattr(ds, "data_vars"), "write", "ds", "an xarray.Dataset", ds)
     _check(_is_path(path), "write", "path", "a file path ending in .nc", path)
     write_netcdf(ds, path)
@@ -196,7 +196,8 @@ def summarize(ds) -> dict:
     peak-to-peak [um], DTE RMS [um], amplitudes at the mesh and hole orders [um], largest tooth
     force [N], ...). A sweep archive: {name: xarray.DataArray} of its scalars over the swept
     dimensions, NaN where a point is not ok (its status)."""
-    from study.report.summary import summarize, summarize_sweep
+    from study.archive.summary import summarize
+    from study.sweep.outputs import summarize_sweep
     _check(hasattr(ds, "data_vars"), "summarize", "ds", "a run or sweep archive (xarray.Dataset; study.read(path))", ds)
     if "status" in ds.data_vars and "study_key" in ds.attrs:
         return summarize_sweep(ds)
@@ -312,7 +313,8 @@ def render(archive, out_dir=None, renders: bool = True, limits: dict | None = No
     """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
     files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a
     path or an xarray.Dataset; ``limits`` ({output: value}, sampled studies): the probability
-    of exceeding each."""
+    of exceeding each. The renders of a lightened body draw its FE fields from the FE cache
+    (solved and cached once when missing)."""
     from pathlib import Path
 
     from study.report.figures import make_figures
@@ -325,7 +327,11 @@ def render(archive, out_dir=None, renders: bool = True, limits: dict | None = No
         archive = read(path)
     elif out_dir is None:
         raise ValueError("render: out_dir is needed for a dataset")
-    return make_figures(archive, Path(out_dir), renders=renders, limits=limits)
+    fields = None
+    if renders and "scene" in archive.attrs and "tooth_stiffness" in archive and "status" not in archive:
+        from study.inputs.springs import archive_body_fields
+        fields = archive_body_fields(archive)      # what the renders of a lightened body draw: FE cache, else solved
+    return make_figures(archive, Path(out_dir), renders=renders, limits=limits, fields=fields)
 
 
 # ---------------------------------------------------------------- the other commands

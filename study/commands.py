@@ -115,7 +115,7 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
     BASE_dynamic.nc with its plot (.png). ``progress(i, spec, errors, wall, message)`` is called
     after each run. ``model``: the model of `precision_scene` when the caller has built it
     already. The integrators compared exist for the paper's model: `precision_scene`."""
-    from study.report.results import write_netcdf
+    from study.archive.netcdf import write_netcdf
     from study.scene_model import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
     for name, value, ok, what in (("duration", duration, lambda v: v > 0, "a positive number of seconds"),

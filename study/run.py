@@ -12,20 +12,23 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import INACCURATE, run_loads, simulate
+from solver.mbs.dynamics import run_loads, simulate
 from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels.layout import R_PV
+from solver.mbs.kernels.status import COMPLETED
 from solver.mbs.mesh_stiffness import mesh_states
 from solver.mbs.method import choose_method
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
 from study import estimate
+from study.archive import run_variables
+from study.archive.lightening import lightening_variables
+from study.archive.mesh import dynamic_force_variables, mesh_variables
+from study.archive.modes import modal_variables
+from study.archive.netcdf import provenance
 from study.inputs.gearsetup import gear_setups
+from study.inputs.springs import root_stresses
 from study.plausibility import critical_speed_warning, report_warnings, scene_warnings
-from study.report import results
-from study.report.lightening import lightening_variables
-from study.report.mesh_outputs import dynamic_force_variables, mesh_variables
-from study.report.modes import modal_variables
 from study.scene import Scene
 from study.scene_model import (
     build_scene_model,
@@ -160,14 +163,15 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         est.levers[part] = estimate.dynamic_lever(scene, choice)
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
-    coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
-    c, v = lightening_variables(gear_setups(scene))      # mass, inertia; root stress from the springs' FE
+    coords, data = run_variables.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
+    setups = gear_setups(scene)
+    c, v = lightening_variables(setups, root_stresses(setups))    # mass, inertia; root stress from the springs' FE
     coords.update(c); data.update(v)
     z1, z2 = model.teeth
     d = scene.dynamic
     driven_speed = d.speed * z1 / z2
     attrs = {
-        "title": results.scene_title(scene),
+        "title": run_variables.scene_title(scene),
         "scene": scene.to_toml(),
         "backlash_offset_um": model.backlash_offset * units.UM_PER_M,
         "contact_ratio": model.pair.contact_ratio,
@@ -183,7 +187,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         "pivot_radius_mm": model.gear_par[:, R_PV] * units.MM_PER_M,
         "teeth_coupled": int(model.teeth_coupled),
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
-        **results.provenance(),
+        **provenance(),
     }
     t0 = time.perf_counter()
     c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
@@ -207,10 +211,10 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         if scene.has_errors:
             attrs["static_rotation_deg"] = static_rotation(scene)
             attrs["error_period_deg"] = error_period(scene)
-        c, v = results.static_variables(st, model.backlash_offset)
+        c, v = run_variables.static_variables(st, model.backlash_offset)
         coords.update(c); data.update(v)
-        c, v = results.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes,
-                                              revolutions=scene.has_errors)
+        c, v = run_variables.ste_spectrum_variables(c["angle"].values, v["ste"].values, z1, z2, scene.gear2.body.holes,
+                                                    revolutions=scene.has_errors)
         coords.update(c); data.update(v)
     if static and mesh_outputs:
         t0 = time.perf_counter()
@@ -225,17 +229,18 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         start = d.spectrum_start or 2 * d.ramp_time
         attrs["spectrum_start_s"] = start
         runup = d.speed_end > 0         # no spectrum over a changing speed: its order tracking instead
-        c, v, a = results.dynamic_variables(dy, d.duration if runup else start, driven_speed, scene.gear2.body.holes, z2,
-                                            (z2 / z1, 1.0) if scene.has_errors else None)
+        c, v, a = run_variables.dynamic_variables(dy, d.duration if runup else start, driven_speed,
+                                                  scene.gear2.body.holes, z2,
+                                                  (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
         c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
         coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
-            data.update(results.efficiency_variable(dy, d.torque, d.speed, start))
+            data.update(run_variables.efficiency_variable(dy, d.torque, d.speed, start))
         if runup:
             attrs["runup_speed_end_rad_s"] = d.speed_end
-            if dy.status in (0, INACCURATE):    # completed: the map is kept, an inaccurate one with its flag
-                from study.report.order_tracking import order_tracking_variables
+            if dy.status in COMPLETED:    # completed: the map is kept, an inaccurate one with its flag
+                from study.archive.order_tracking import order_tracking_variables
                 c, v = order_tracking_variables(dy.time, dy.te * units.UM_PER_M, d.speed_end, d.duration, z1, z2)
                 if dy.status:
                     v["order_amplitude"].attrs["status"] = dy.message

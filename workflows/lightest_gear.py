@@ -94,7 +94,7 @@ def candidates(ds: xr.Dataset, base: dict | None = None) -> xr.Dataset:
 
 def feasible(table: xr.Dataset, solid: dict, limits: Limits) -> xr.DataArray:
     """True where a candidate is ok and within every limit (NaN, as a root stress no FE gave, fails)."""
-    ok = table["status"] == 1
+    ok = table["status"] == study.STATUS.index("ok")
     ok &= table["ste_p2p"] <= limits.ste_factor * solid["ste_p2p"]
     ok &= table["dte_rms"] <= limits.dte_factor * solid["dte_rms"]
     ok &= table["root_stress_ratio_gear2"] <= limits.stress_ratio
@@ -239,7 +239,7 @@ def run(args) -> int:
     if order:
         text = answer(_row(table, order[0]), solid, args.speed)
     else:
-        ok = np.flatnonzero(table["status"].values == 1)
+        ok = np.flatnonzero(table["status"].values == study.STATUS.index("ok"))
         worst = np.fmax(table["ste_p2p"].values[ok] / solid["ste_p2p"] / limits.ste_factor,
                         table["dte_rms"].values[ok] / solid["dte_rms"] / limits.dte_factor)
         near = ok[int(np.nanargmin(worst))] if ok.size else None

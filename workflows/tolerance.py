@@ -138,7 +138,7 @@ def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
 def cost(ds: xr.Dataset) -> str:
     """'N of M builds ok, T s of compute (t s a build)'."""
     n = int(ds["status"].size)
-    ok = int((ds["status"] == 1).sum())
+    ok = int((ds["status"] == study.STATUS.index("ok")).sum())
     compute = float(ds["wall_time"].sum())
     return f"{ok} of {n} builds ok, {compute:.0f} s of compute ({compute / n:.2f} s a build)."
 

@@ -18,14 +18,12 @@ from solver.mbs.energy_guard import ENERGY_ERROR_RATIO, ENERGY_FLOW_RATIO, energ
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.explicit import verlet
 from solver.mbs.kernels.mechanics import driver_motion
+from solver.mbs.kernels.status import ENERGY, INACCURATE, PENETRATION, STATUS_TEXT
 from solver.mbs.kernels.stepping import work_arrays
 from solver.mbs.model import Model
 from solver.mbs.stability import IMEX_SAFETY, SAFETY, implicit_dampers_apply, load_covered, stable_time_step
 
-STATUS_TEXT = {0: "ok", 1: "non-finite state", 2: "penetration beyond the bound", 3: "energy growth",
-               4: "Newton failure", 5: "wall-time limit", 6: "inaccurate"}     # 5: the scipy peer's
 ENERGY_TOL = 0.05   # relative energy growth that stops a run (see `simulate`)
-INACCURATE = 6      # a run that completed but whose energy balance does not close (`accuracy_check`)
 # Quiet threshold of the active set [rad] (a tooth outside the mesh freezes below it): 1e-9 by
 # default; 1e-7 where every tooth-root joint is damped to at least QUIET_ZETA of critical (the
 # mesh damping ratio puts 0.7-0.9 there), since a frozen tooth there would have stopped ringing
@@ -91,9 +89,9 @@ def status_message(status: int, step: int, dt: float, delta_max: float, raise_on
     if not status:
         return "ok"
     msg = f"{STATUS_TEXT[status]} at t = {step * dt:.6g} s (step {step}, dt = {dt:.3g} s)"
-    if status == 2:
+    if status == PENETRATION:
         msg += f"; bound {delta_max * 1e6:.4g} um"
-    if status in (2, 3):
+    if status in (PENETRATION, ENERGY):
         msg += "; a step too coarse for the contact forces reached does this: try a smaller dynamic.time_step"
     if raise_on_failure:
         raise DivergenceError(msg)

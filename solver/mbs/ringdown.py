@@ -20,8 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
-from solver.mbs.dynamics import INACCURATE, DivergenceError, simulate
+from solver.mbs.dynamics import DivergenceError, simulate
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.status import COMPLETED, OK
 from solver.mbs.model import Model
 from solver.mbs.stability import IMEX_SAFETY, SAFETY, implicit_dampers_apply, stable_time_step
 
@@ -68,9 +69,9 @@ def ring_down(model: Model, torque: float, frequency: float, damping: float, cyc
     for dt in steps:
         res = simulate(model, 0.0, 1.0, load, t_ramp, t_fit + cycles * period, dt=dt, output_step=period / 40,
                        load_table=table)
-        if res.status == 0:
+        if res.status == OK:
             break
-    if res.status not in (0, INACCURATE):     # stopped by a guard (an inaccurate decay is still fitted)
+    if res.status not in COMPLETED:     # stopped by a guard (an inaccurate decay is still fitted)
         raise DivergenceError(f"free decay of the mesh mode: {res.message}")
     sel = res.time >= t_fit
     t = res.time[sel] - t_fit

@@ -30,6 +30,7 @@ from scipy import integrate
 
 from solver.mbs.dynamics import DivergenceError, DynamicResult, check_positive, run_loads, simulate
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.status import INTERRUPTED, NONFINITE, OK, PENETRATION
 from solver.mbs.model import Model
 from solver.peers.pair_equations import PairEquations, driver_motion
 
@@ -68,9 +69,9 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
     [rad] and rates [rad/s] (default rtol * 1e-6, i.e. rtol times about a micrometre of flank
     motion; rates get atol scaled by the highest tooth frequency). ``delta_max`` [m]
     (default a tenth of the module) bounds the penetration.
-    A failure of the solver or a guard gives status != 0 and a message (or raises
-    `DivergenceError` with ``raise_on_failure``). ``max_wall_time`` [s] stops a run that takes
-    longer (status 5, "wall-time limit"). ``load_table``: a torque profile instead of the
+    A failure of the solver or a guard gives a status other than OK (`solver.mbs.kernels.status`)
+    and a message (or raises `DivergenceError` with ``raise_on_failure``). ``max_wall_time`` [s]
+    stops a run that takes longer (status INTERRUPTED, "wall-time limit"). ``load_table``: a torque profile instead of the
     torque ramp, as in `solver.mbs.dynamics.simulate`.
     """
     if method not in METHODS:
@@ -97,7 +98,7 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
     if method in STIFF_METHODS:
         kw["jac"] = eq.jac
     ys = np.full((n_out, y.size), np.nan)
-    status, msg = 0, "ok"
+    status, msg = OK, "ok"
     nfev = njev = nlu = steps = 0
     t_reached = 0.0
     cls = getattr(integrate, method)
@@ -109,13 +110,13 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
             t_old = solver.t
             err = solver.step()
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                status = 1
+                status = NONFINITE
                 msg = (f"{method} failed at t = {t_old:.6g} s (step {steps + 1}): "
                        f"{err or 'non-finite state'}")
                 break
             steps += 1
             if max_wall_time is not None and _time.perf_counter() - t0 > max_wall_time:
-                status = 5
+                status = INTERRUPTED
                 msg = (f"{method}: wall-time limit {max_wall_time:g} s reached at t = {solver.t:.6g} s "
                        f"(step {steps})")
                 solver.status = "failed"
@@ -151,8 +152,8 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
         ncon[i] = sum(1 for c in cons if c.force > 0.0)
         react[i] = eq.driver_torque(q1, acc, a1)
         ke[i], pe[i] = eq.energies(t, x, v, cons)
-        if status == 0 and max((c.delta for c in cons), default=0.0) > delta_max:
-            status, msg = 2, f"penetration beyond the bound {delta_max * 1e6:.4g} um at t = {t:.6g} s"
+        if status == OK and max((c.delta for c in cons), default=0.0) > delta_max:
+            status, msg = PENETRATION, f"penetration beyond the bound {delta_max * 1e6:.4g} um at t = {t:.6g} s"
     if status and raise_on_failure:
         raise DivergenceError(msg)
     mean_dt = t_reached / steps if steps else float("nan")

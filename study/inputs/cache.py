@@ -7,7 +7,9 @@ named by `FECache.key` of everything the result depends on:
   JSON attribute) and the largest fillet stress of each tooth under the same load
   (``root_stress`` [Pa]; a file written before it was stored lacks it: the map is then
   recomputed when the stress is asked for);
-* ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.ltca.BodyCompliance`).
+* ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.ltca.BodyCompliance`);
+* ``fields-{key}.npz``: a body's FE fields under the load on a few teeth (mesh, displacement,
+  von Mises stress: `solver.fe.body.BodyField`), for the renders of an archive.
 
 In memory: the same results once read or computed, the last `BODY_SLOTS` factorised bodies (a
 reference and the coupling fits of both gears reuse them) and the coupling fits. `FE_CACHE` is
@@ -87,7 +89,7 @@ class FECache:
         """Store the map ``k`` [N·m/rad] and, when given, the fillet stresses [Pa] of the same teeth."""
         import xarray as xr
 
-        from study.report.results import write_netcdf
+        from study.archive.netcdf import write_netcdf
         self.stiffness[key] = k.copy()
         data = {"k_fe": xr.Variable("tooth", k, {"units": "N m rad-1", "long_name": "FE tooth torsion stiffness"})}
         if root_stress is not None:
@@ -116,6 +118,35 @@ class FECache:
             path.parent.mkdir(parents=True, exist_ok=True)
             tmp = path.with_name(f".{path.stem}.tmp.npz")      # readers never see a half-written file
             np.savez(tmp, u=c.u, read=c.read_teeth, load=c.load_teeth, g=c.g, symmetric=c.symmetric_body, teeth=c.teeth)
+            tmp.replace(path)
+        except OSError:
+            pass
+
+    # ---- body fields (renders)
+    def read_fields(self, key: str) -> list | None:
+        """The `BodyField` list of ``key`` from disk, or None (not held in memory: a render reads
+        them once)."""
+        def load(path):
+            from solver.fe.body import BodyField
+            with np.load(path) as d:
+                return [BodyField(d["points"], d["triangles"], d["thickness"], d["web"], d["displacement"][j],
+                                  d["von_mises"][j], int(d["tooth"][j]), float(d["load_N"][j]), d["load_point"][j],
+                                  d["load_direction"][j]) for j in range(d["tooth"].size)]
+        return self._read({}, key, f"fields-{key}.npz", load)
+
+    def write_fields(self, key: str, fields: list) -> None:
+        """Store the `BodyField` list of one body (one mesh; one load case each)."""
+        path = self.folder / f"fields-{key}.npz"
+        f0 = fields[0]
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.stem}.tmp{os.getpid()}.npz")      # readers never see a half-written file
+            np.savez_compressed(tmp, points=f0.points, triangles=f0.triangles, thickness=f0.thickness, web=f0.web,
+                                displacement=np.stack([f.displacement for f in fields]),
+                                von_mises=np.stack([f.von_mises for f in fields]),
+                                tooth=np.array([f.tooth for f in fields]), load_N=np.array([f.load_N for f in fields]),
+                                load_point=np.stack([f.load_point for f in fields]),
+                                load_direction=np.stack([f.load_direction for f in fields]))
             tmp.replace(path)
         except OSError:
             pass

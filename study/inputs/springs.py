@@ -71,6 +71,34 @@ def root_stress(setup: GearSetup, teeth=None) -> np.ndarray:
     return s
 
 
+def root_stresses(setups, stress: bool = True) -> dict:
+    """{gear: (root stress of each tooth [Pa], of the solid body's tooth 0 [Pa]) or the reason
+    it is not computed} for `study.archive.lightening.lightening_variables`: read for the gears
+    whose springs use the FE (from the cache, or the FE solve of the map); ``stress`` False:
+    for none (the caller needs no stress)."""
+    out = {}
+    for s in setups:
+        if not stress:
+            out[s.gear] = "not requested"
+        elif not uses_fe_springs(s):
+            why = "solid body" if not s.lightened else "springs 'uniform'"
+            out[s.gear] = f"{why}, its springs need no FE (none is run for this output alone)"
+        else:
+            out[s.gear] = (root_stress(s), float(root_stress(s.solid(), teeth=[0])[0]))
+    return out
+
+
+def lightening_dataset(scene: Scene, stress: bool = True):
+    """The variables of `study.archive.lightening.lightening_variables` for a scene, alone (no
+    solve: the FE runs only for a gear whose springs need it and whose map is not cached)."""
+    import xarray as xr
+
+    from study.archive.lightening import lightening_variables
+    setups = gear_setups(scene)
+    coords, data = lightening_variables(setups, root_stresses(setups, stress))
+    return xr.Dataset(data, coords=coords)
+
+
 def fe_ratio(setup: GearSetup) -> tuple[np.ndarray, np.ndarray, float]:
     """(k_fe of each tooth [N·m/rad], ratio to the solid body [1], k_fe of the solid body [N·m/rad])."""
     k = fe_stiffness(setup)
@@ -103,13 +131,46 @@ def tooth_springs(setup: GearSetup) -> tuple[np.ndarray, np.ndarray]:
     return k_si / units.spring_stiffness_to_si(1.0), ratio
 
 
-def body_fields(setup: GearSetup, teeth) -> list:
+def body_fields(setup: GearSetup, teeth, solve: bool = True) -> list | None:
     """`solver.fe.body.BodyField` (mesh, displacement, von Mises stress) of the gear's body
-    under the reference load on each of ``teeth`` (one FE solve, for renders)."""
+    under the reference load on each of ``teeth``, for renders: from the FE cache, else one FE
+    solve (stored in the cache), or None when not cached and ``solve`` is False."""
     from solver.fe import body as fe
-    _, (model, U) = fe_stiffness(setup, teeth=list(teeth), keep_fields=True)
-    return [fe.body_field(model, setup.geometry, U[:, j], int(t), setup.force, setup.pivot_radius)
-            for j, t in enumerate(teeth)]
+    teeth = [int(t) for t in teeth]
+    key = FE_CACHE.key({**setup.settings, "fields": teeth})
+    fields = FE_CACHE.read_fields(key)
+    if fields is not None or not solve:
+        return fields
+    _, (model, U) = fe_stiffness(setup, teeth=teeth, keep_fields=True)
+    fields = [fe.body_field(model, setup.geometry, U[:, j], t, setup.force, setup.pivot_radius)
+              for j, t in enumerate(teeth)]
+    FE_CACHE.write_fields(key, fields)
+    return fields
+
+
+def render_teeth(k_phi) -> list[int]:
+    """The teeth an FE stress render loads: the stiffest and the softest of ``k_phi`` (one gear's
+    tooth springs, NaN past its teeth)."""
+    k = np.asarray(k_phi, float)
+    k = k[np.isfinite(k)]
+    return [int(np.argmax(k)), int(np.argmin(k))]
+
+
+def archive_body_fields(ds, solve: bool = True) -> dict:
+    """{gear: [BodyField under the stiffest tooth's load, under the softest's]} of each
+    lightened gear of a run archive (its ``scene`` attribute and ``tooth_stiffness``), what its
+    renders draw: from the FE cache, else solved (``solve``) and cached; a gear whose fields are
+    neither cached nor solved is left out."""
+    from study.inputs.gearsetup import gear_setup
+    from study.scene import loads_scene
+    scene = loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
+    out = {}
+    for g in (1, 2):
+        if scene.is_lightened(g):
+            fields = body_fields(gear_setup(scene, g), render_teeth(ds["tooth_stiffness"].sel(gear=g).values), solve)
+            if fields is not None:
+                out[g] = fields
+    return out
 
 
 # ------------------------------------------------------------------ dataset
@@ -118,12 +179,13 @@ def stiffness_dataset(scene: Scene):
     """xarray Dataset: tooth_stiffness (N·mm/rad^n_k; CF unit N mm) and stiffness_ratio of both gears, with hole positions."""
     import xarray as xr
 
-    from study.report import results
+    from study.archive.netcdf import provenance
+    from study.archive.run_variables import stiffness_variables
     t0 = time.perf_counter()
     springs = [tooth_springs(setup) for setup in gear_setups(scene)]
-    coords, data = results.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
+    coords, data = stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
     ds = xr.Dataset(data, coords=coords, attrs={"scene": scene.to_toml(), "wall_time_springs_s": time.perf_counter() - t0,
-                                                **results.provenance()})
+                                                **provenance()})
     return ds
 
 

@@ -1,6 +1,6 @@
 """Campbell diagram of a run archive: the pair's mode frequencies [Hz] against driver speed
 [rad/s], the excitation order lines (kZ, N, 2N, kZ +- N of the driven gear's rotation) and
-the critical speeds where a line meets the mesh mode (`study.report.modes`)."""
+the critical speeds where a line meets the mesh mode (`study.archive.modes`)."""
 from __future__ import annotations
 
 import math

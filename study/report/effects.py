@@ -21,7 +21,8 @@ from itertools import combinations
 import numpy as np
 import xarray as xr
 
-STATUS_OK = 1                        # `study.sweep.outputs.STATUS`: 'ok'
+from solver.mbs.kernels.status import POINT_OK
+
 NOT_OUTPUTS = {"status", "message", "wall_time"}
 STRESS_RATIO = "root_stress_ratio_gear2"
 STRESS_LIMIT = 1.15                  # root stress relative to the solid gear, default Pareto limit
@@ -37,7 +38,7 @@ def kept(ds: xr.Dataset, var: str) -> xr.DataArray:
     """``ds[var]`` as float with NaN where the point is not ok (``status`` != 1) or not finite."""
     da = ds[var].astype(float)
     if "status" in ds:
-        da = da.where(ds["status"] == STATUS_OK)
+        da = da.where(ds["status"] == POINT_OK)
     return da.where(np.isfinite(da))
 
 

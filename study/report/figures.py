@@ -63,9 +63,13 @@ def order_map_missing(ds: xr.Dataset) -> str:
     return "not a run-up (dynamic.speed_end = 0)"
 
 
-def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True, limits: dict | None = None) -> list[Path]:
+def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True, limits: dict | None = None,
+                 fields: dict | None = None) -> list[Path]:
     """Write every plot and render ``ds`` supports into ``outdir``; return the PNG paths.
-    ``limits`` ({output: value}): the probability of exceeding each, for a sampled study."""
+    ``limits`` ({output: value}): the probability of exceeding each, for a sampled study.
+    ``fields`` ({gear: [BodyField under the stiffest tooth's load, under the softest's]},
+    `study.inputs.springs.archive_body_fields`): what the renders of a lightened gear draw;
+    without them those renders are skipped (the pictures start no FE solve)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     out: list[Path] = []
@@ -104,23 +108,24 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True,
     if "scene" not in ds.attrs or "tooth_stiffness" not in ds:
         skip("renders", "the archive has no scene attribute or no tooth_stiffness")
         return out
-    out += _renders(ds, name, skip)
+    out += _renders(ds, name, skip, fields or {})
     return out
 
 
-def _renders(ds, name, skip) -> list[Path]:
-    from study.report.render_inputs import fe_fields, tooth_stiffness
+def _renders(ds, name, skip, fields: dict) -> list[Path]:
+    from study.report.render_inputs import missing_fields
     from study.report.stiffness_render import gear_pair_render
     from study.report.stress_render import fe_stress_render
     from study.scene import loads_scene
     sc = loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
     lightened = [g for g in (1, 2) if sc.is_lightened(g)]
+    missing = missing_fields(ds, fields)
+    if missing:
+        skip("gear pair and FE stress renders", f"no FE body fields of lightened gear {', '.join(map(str, missing))} "
+             "given (the pictures start no FE solve; study.render reads them from the FE cache or solves them)")
+        return []
     t0 = time.perf_counter()
-    fields = {}
-    for g in lightened:
-        k = tooth_stiffness(ds, g)
-        fields[g] = fe_fields(sc, g, [int(np.argmax(k)), int(np.argmin(k))])
-    out = [gear_pair_render(ds, name("gear_pair"), {g: f[0] for g, f in fields.items()}).path]
+    out = [gear_pair_render(ds, name("gear_pair"), {g: fields[g][0] for g in lightened}).path]
     for g in lightened:
         out.append(fe_stress_render(ds, name(f"fe_stress_gear{g}"), g, fields=fields[g]).path)
     if not lightened:
@@ -143,8 +148,8 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
     beside the figures. They are computed here, from the points of the archive rendered, and
     not stored by ``lightgear sweep``: the archives of the parts of a split study open together
     as one (open_mfdataset), and a variance split or Pareto set of one part is wrong for the whole."""
+    from study.archive.netcdf import write_netcdf
     from study.report.effects import pareto_table, sensitivity_table, study_outputs, varies
-    from study.report.results import write_netcdf
     from study.report.study_views import main_effects_figure, sensitivity_figure, tradeoff_figure
     out, tables = [], []
     outputs = study_outputs(ds, swept)

@@ -85,11 +85,11 @@ def archive_scene(ds: xr.Dataset):
 
 def archive_title(ds: xr.Dataset) -> str:
     """The title of what the archive holds: for a run archive made from the scene it stores
-    (`study.report.results.scene_title`: the scene as run, not its free text); else its
+    (`study.archive.run_variables.scene_title`: the scene as run, not its free text); else its
     ``title`` attribute (a study's title)."""
     sc = archive_scene(ds)
     if sc is not None:
-        from study.report.results import scene_title
+        from study.archive.run_variables import scene_title
         return scene_title(sc)
     return str(ds.attrs.get("title", ""))
 

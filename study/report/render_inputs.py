@@ -1,6 +1,8 @@
-"""What the renders take from a run archive: its scene, the per-tooth spring stiffness, and
-the FE body fields of a lightened gear (`study.inputs.springs`: cached springs, one FE
-factorisation, the displacement under each loaded tooth), made into render bodies.
+"""What the renders take: the run archive's scene and per-tooth spring stiffness, and the FE
+body fields of its lightened gears, given by the caller (`study.inputs.springs.archive_body_fields`
+reads them from the FE cache or solves them; `study.render` does so before it draws). The
+pictures start no FE solve: a lightened gear without its fields is not rendered, and
+`missing_fields` says which.
 """
 from __future__ import annotations
 
@@ -24,24 +26,26 @@ def tooth_stiffness(ds: xr.Dataset, g: int) -> np.ndarray:
     return k[np.isfinite(k)]
 
 
-def fe_fields(scene, g: int, teeth) -> list:
-    """`solver.fe.body.BodyField` of gear g under the load on each of ``teeth`` (one FE solve)."""
-    from study.inputs.gearsetup import gear_setup
-    from study.inputs.springs import body_fields
-    return body_fields(gear_setup(scene, g), teeth)
+def missing_fields(ds: xr.Dataset, fields: dict | None) -> list[int]:
+    """The lightened gears of the archive's scene that have no FE body fields in ``fields``."""
+    sc = required_scene(ds)
+    return [g for g in (1, 2) if sc.is_lightened(g) and not (fields or {}).get(g)]
 
 
 def pair_bodies(ds: xr.Dataset, fields: dict | None = None) -> dict:
-    """Body2D of both gears: FE mesh for a lightened gear (from ``fields[g]`` or a new FE
-    solve), outline for a solid one."""
+    """Body2D of both gears: the FE mesh of a lightened gear (from ``fields[g]``: a BodyField,
+    or a list of them whose first is taken), the outline of a solid one. ``ValueError`` naming
+    the lightened gears without fields."""
+    missing = missing_fields(ds, fields)
+    if missing:
+        raise ValueError(f"no FE body fields of lightened gear {', '.join(map(str, missing))} "
+                         "(study.inputs.springs.archive_body_fields gives them)")
     sc = required_scene(ds)
     out = {}
     for g in (1, 2):
         if sc.is_lightened(g):
-            f = (fields or {}).get(g) or fe_fields(sc, g, [0])[0]
-            out[g] = with_teeth(fe_body(f), sc, g)
+            f = fields[g]
+            out[g] = with_teeth(fe_body(f[0] if isinstance(f, list | tuple) else f), sc, g)
         else:
             out[g] = outline_body(sc, g)
     return out
-
-

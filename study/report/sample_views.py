@@ -173,7 +173,7 @@ def sobol_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path):
 def sample_figures(ds: xr.Dataset, name, skip, limits: dict | None = None) -> list:
     """Every view of a sampled study (``name(stem)`` -> PNG path, ``skip(what, why)`` prints
     what is left out); the tables go to ``study_tables.nc`` beside them."""
-    from study.report.results import write_netcdf
+    from study.archive.netcdf import write_netcdf
     limits = dict(limits or {})
     outputs = sample_outputs(ds)
     tables = sample_tables(ds, outputs, limits)

@@ -7,8 +7,8 @@
                       the colour bar.
 
 It reads the archive (``tooth_stiffness`` and the scene TOML in ``ds.attrs['scene']``); a
-lightened body's mesh comes from `study.report.render_inputs` (cached FE), a solid gear is
-drawn from its outline without FE.
+lightened body's mesh comes from the FE body fields its caller gives (`study.report.render_inputs`),
+a solid gear is drawn from its outline without FE.
 """
 from __future__ import annotations
 
@@ -42,7 +42,8 @@ def stiffness_range(ds: xr.Dataset) -> tuple[tuple, list]:
 
 
 def gear_pair_render(ds: xr.Dataset, path, fields: dict | None = None) -> RenderResult:
-    """Both gears in mesh, teeth coloured by k_phi, holes and web thickness visible."""
+    """Both gears in mesh, teeth coloured by k_phi, holes and web thickness visible; ``fields``
+    {gear: BodyField} of each lightened gear (`study.report.render_inputs.pair_bodies`)."""
     sc = required_scene(ds)
     (lo, hi), coloured = stiffness_range(ds)
     bodies = pair_bodies(ds, fields)

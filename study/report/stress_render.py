@@ -5,7 +5,7 @@
                       scale per quantity for both.
 
 It reads the archive (``tooth_stiffness`` and the scene TOML in ``ds.attrs['scene']``); the
-body's mesh and fields come from `study.report.render_inputs` (`study.inputs.springs`, cached FE).
+body's mesh and fields are given by the caller (`study.inputs.springs.archive_body_fields`: FE cache).
 """
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from solver import units
 from study.report.plot_style import archive_title
 from study.report.render_canvas import RenderResult, fit_parallel, plotter, write_png
 from study.report.render_geometry import Body2D, extrude, fe_body, transform
-from study.report.render_inputs import fe_fields, required_scene, tooth_stiffness
+from study.report.render_inputs import required_scene, tooth_stiffness
 
 STRESS_CMAP = "turbo"
 DISPLACEMENT_CMAP = "cividis"
@@ -33,10 +33,11 @@ def fillet_peak(f, geo, tooth: int) -> float:
     return float(f.von_mises[sel].max()) if sel.any() else float("nan")
 
 
-def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) -> RenderResult:
-    """FE response of gear g's body to the tooth load on the stiffest and on the softest tooth
-    (or ``teeth``), one row each, the loaded tooth turned to point up, the view on the teeth and
-    rim around it (with the top of the hole below it):
+def fe_stress_render(ds: xr.Dataset, path, g: int, fields: list) -> RenderResult:
+    """FE response of gear g's body to the tooth loads of ``fields`` (BodyField each: the
+    stiffest and the softest tooth, `study.inputs.springs.archive_body_fields`), one row each,
+    the loaded tooth turned to point up, the view on the teeth and rim around it (with the top
+    of the hole below it):
 
     left, von Mises stress [MPa] (element means) on one linear scale for both rows (0 .. the
     larger peak fillet stress of the element means; the contact spot under the load goes
@@ -49,9 +50,6 @@ def fe_stress_render(ds: xr.Dataset, path, g: int = 2, teeth=None, fields=None) 
     geo = sc.geometry(g)
     body = sc.body_spec(g)
     k = tooth_stiffness(ds, g)
-    if teeth is None:
-        teeth = [int(np.argmax(k)), int(np.argmin(k))]
-    fields = fields or fe_fields(sc, g, teeth)
     from study.inputs.springs import hole_offset
     off = hole_offset(sc, g)
     n_holes = body.holes

@@ -1,4 +1,4 @@
-"""Summary scalars of a run archive and the one-screen summary `lightgear run` prints."""
+"""The one-screen summary `lightgear run` prints of a run archive (its scalars: `study.archive.summary`)."""
 from __future__ import annotations
 
 import sys
@@ -6,88 +6,8 @@ import sys
 import numpy as np
 import xarray as xr
 
-from study.report import results
-
-
-def summarize(ds: xr.Dataset) -> dict:
-    """Scalars a sensitivity study needs (NaN where the archive lacks the analysis)."""
-    out = {}
-    nan = float("nan")
-    off = ds.attrs.get("backlash_offset_um", 0.0)
-    if "ste" in ds:
-        ste = ds["ste"].values
-        out["ste_mean"] = float(np.nanmean(ste))
-        out["ste_elastic_mean"] = float(np.nanmean(ste) - flank_side(ds) * off)
-        out["ste_p2p"] = float(np.nanmax(ste) - np.nanmin(ste))
-    for name in ("mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
-                 "c_gamma_alpha_iso6336", "loaded_contact_ratio", "dynamic_factor"):
-        if name in ds:
-            out[name] = float(ds[name])
-    if "dte" in ds:
-        t = ds["time"].values
-        sel = t >= ds.attrs.get("spectrum_start_s", 0.0)
-        dte = ds["dte"].values[sel]
-        out["dte_mean"] = float(np.mean(dte)) if dte.size else nan
-        out["dte_rms"] = float(np.sqrt(np.mean((dte - dte.mean()) ** 2))) if dte.size else nan
-        out["dte_p2p"] = float(np.ptp(dte)) if dte.size else nan
-        out["tooth_force_max"] = float(np.max(ds["contact_force_max"].values[sel])) if dte.size else nan
-        out["mesh_efficiency"] = float(ds["mesh_efficiency"]) if "mesh_efficiency" in ds else nan
-    if "dte_amplitude" in ds:
-        z = ds.attrs["mesh_order"]
-        named = named_amplitudes(ds)
-        for name, label, order in (("mesh", "Z", z), ("mesh2", "2Z", 2 * z), ("mesh3", "3Z", 3 * z),
-                                   ("hole", "N", ds.attrs["hole_order"])):
-            if not order > 0:
-                out[f"amp_{name}_order"] = nan
-            elif label in named:    # the value the summary prints (`spectra.named_peaks`)
-                out[f"amp_{name}_order"] = named[label]
-            else:
-                out[f"amp_{name}_order"] = amplitude_at_order(ds, order)
-    if "mode_frequency" in ds:
-        out["mesh_mode_frequency"] = float(ds.attrs["mesh_mode_frequency_hz"])
-        out["mesh_mode_damping"] = float(ds.attrs["mesh_mode_damping"])
-        out["mesh_mode_damping_decay"] = float(ds.attrs.get("mesh_mode_damping_decay", nan))
-        for k in (1, 2, 3):
-            out[f"critical_speed_{k if k > 1 else ''}z"] = float(ds["critical_speed"].sel(excitation=f"{k}Z", mode=0))
-    if "mass" in ds:
-        from study.sweep.outputs import GEAR_VARIABLES
-        for g in (1, 2):
-            for name in GEAR_VARIABLES:
-                out[f"{name}_gear{g}"] = float(ds[name].sel(gear=g)) if name in ds else nan
-    for k in ("wall_time_springs_s", "wall_time_static_s", "wall_time_dynamic_s"):
-        if k in ds.attrs:
-            out[k] = float(ds.attrs[k])
-    return out
-
-
-def summarize_sweep(ds: xr.Dataset) -> dict:
-    """The scalars of a sweep archive: {name: DataArray over the swept dimensions}, NaN where
-    the point's status is not ok (an output not over every swept dimension is broadcast)."""
-    from study.sweep.outputs import SCALARS, STATUS
-    ok = ds["status"] == STATUS.index("ok")
-    return {k: ds[k].where(ok) for k in SCALARS if k in ds.data_vars}
-
-
-def flank_side(ds: xr.Dataset) -> float:
-    """+1 when the static load drives on the drive flanks, -1 on the coast flanks (a negative
-    torque): the side of the backlash offset the elastic TE is measured from."""
-    return -1.0 if ds.attrs.get("static_torque_N_m", 1.0) < 0 else 1.0
-
-
-def named_amplitudes(ds: xr.Dataset) -> dict:
-    """DTE amplitude [um] of each named order of the archive's peak table (NaN where no peak
-    is resolved), by name ('Z', '2Z', 'N', ...); {} without the table."""
-    if "dte_peak_amplitude" not in ds:
-        return {}
-    return {str(n): float(a) for n, a in zip(ds["dte_peak"].values, ds["dte_peak_amplitude"].values)}
-
-
-def amplitude_at_order(ds: xr.Dataset, order: float, half_width: float = 0.5) -> float:
-    """Largest DTE amplitude [um] within +-half_width orders of ``order``."""
-    o = ds["order"].values
-    sel = np.abs(o - order) <= half_width
-    return float(ds["dte_amplitude"].values[sel].max()) if sel.any() else float("nan")
-
+from study.archive.run_variables import largest_peaks
+from study.archive.summary import summarize
 
 NAMED_SHOWN = 0.01      # named peaks printed: those above this fraction of the largest
 
@@ -123,7 +43,7 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         if np.isfinite(s["mesh_efficiency"]):
             w(f"  mesh efficiency after the ramp {s['mesh_efficiency'] * 100:.3f} % (flank friction and dampers)\n")
-        for f, o, a in results.largest_peaks(ds):
+        for f, o, a in largest_peaks(ds):
             w(f"    peak {a:8.4f} um at {f:8.1f} Hz = order {o:6.2f}\n")
     if "dynamic_factor" in s:
         fm = ds["dte_tooth_force_max"]

@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
+from study.archive.spectra import HANN_MAIN_LOBE_BINS, sideband_orders
 from study.report.plot_style import (
     C_HOLE,
     C_LIGHT,
@@ -30,7 +31,6 @@ from study.report.plot_style import (
     need,
     save_figure,
 )
-from study.report.spectra import HANN_MAIN_LOBE_BINS, sideband_orders
 
 
 def _runs(mask: np.ndarray):

@@ -1,4 +1,4 @@
-"""The archive of a study: one labelled xarray.Dataset (written as NetCDF by results.write_netcdf).
+"""The archive of a study: one labelled xarray.Dataset (written as NetCDF by `study.archive.netcdf.write_netcdf`).
 
 Layout
   grid layout:  one dimension per swept field (``n_holes``, ``hole_radius``, ``rim_thickness``,
@@ -14,8 +14,8 @@ Each coordinate carries ``units``, ``long_name`` (from the scene's field metadat
 In the grid layout an output lies only over the swept dimensions its analysis reads
 (`outputs.ANALYSIS_FIELDS`): ``ste_p2p`` over the body fields but not over ``speed``,
 ``mass_gear2`` over the body fields only; ``status`` says which points are ok (an output is
-read with ``.where(ds.status == 1)``, which broadcasts it over every dimension). In the point
-layout every variable lies over ``point``.
+read with ``.where(ds.status == 1)``, which broadcasts it over every dimension; the flags are
+`solver.mbs.kernels.status.POINT_STATUS`). In the point layout every variable lies over ``point``.
 A sampled study (`study.sweep.sample`) has a last dimension ``sample`` (one build each), the
 drawn values of each field as variables over it (named like a grid dimension, with its
 ``distribution``), ``sample_block`` and ``sample_row`` for the Saltelli design, and every output
@@ -23,7 +23,7 @@ over (the swept dimensions its analysis reads..., ``sample``). Archives of a spl
 ``xr.open_mfdataset(paths, combine="by_coords", data_vars="minimal", compat="no_conflicts")`` (outputs that do not lie
 over the split dimension are then taken once, checked equal).
 Global attributes: title, the study TOML, the base scene TOML, the study key (a hash of all
-its points), software versions, machine and date (`results.provenance`).
+its points), software versions, machine and date (`study.archive.netcdf.provenance`).
 """
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ import json
 import numpy as np
 import xarray as xr
 
-from study.report.results import provenance
+from study.archive.netcdf import provenance
 from study.scene import field_doc, field_unit
 from study.sweep.grid import Point, Study, coupling_models, dim_name
 from study.sweep.outputs import CURVES, SCALARS, STATUS, analysis_of, reads

@@ -17,8 +17,8 @@ grows with the study. A task dask could not compute (its worker died more often 
 `distributed.scheduler.allowed-failures` allows) leaves its points pending, its cause in the
 archive's message. Re-running the same study after an interruption (Ctrl-C, a killed worker
 or process) computes only the missing tasks. Tasks are keyed by a hash of the scene fields
-they read, their outputs and the code (`results.code_fingerprint`), so an edited study reuses
-the tasks it shares, and a changed code computes them all again.
+they read, their outputs and the code (`study.archive.netcdf.code_fingerprint`), so an edited
+study reuses the tasks it shares, and a changed code computes them all again.
 
 Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)
@@ -72,7 +72,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
     "curves": {name: (axis name, axis values, axis attrs, values, attrs)}}``; scalars of an
     analysis that failed are NaN.
     """
-    from study.report.summary import summarize
+    from study.archive.summary import summarize
     from study.run import run_scene
     from study.scene import loads_scene, scene_from_dict
 
@@ -90,7 +90,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
                            mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)),
                            warn=False, keep_model=True)   # the sweep warns once; a body's points share its model
         else:   # geometry (and root stress) only: no model, no solve
-            from study.report.lightening import lightening_dataset
+            from study.inputs.springs import lightening_dataset
             ds = lightening_dataset(scene, stress=outputs.fe)
         s = summarize(ds)
         bad = set()          # analyses whose numbers are not to be trusted
@@ -396,7 +396,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     from tqdm import tqdm
 
     from study import estimate
-    from study.report.results import write_netcdf
+    from study.archive.netcdf import write_netcdf
 
     t0 = time.perf_counter()
     estimate.check_study_size(study, max_time)

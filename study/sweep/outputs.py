@@ -1,14 +1,14 @@
 """What a study point can compute and archive, declared once: scalar and curve outputs, the
 selection a study makes (`Outputs`), and the status flags of a point.
 
-A scalar is one number per point (the names of `study.report.summary.summarize`), with its
+A scalar is one number per point (the names of `study.archive.summary.summarize`), with its
 units and long name; a curve is a run-archive variable over its own axis, archived with the
-units and long name the run archive gives it (`study.report.results`). Each output needs one
+units and long name the run archive gives it (`study.archive.schema`). Each output needs one
 analysis: 'static' (quasi-static STE), 'dynamic' (DTE run), 'modes' (the pair linearised at the mean
 load: a few static solves, no time integration), 'geometry' (mass properties, no solve) or 'fe' (the
 FE body of the springs: root stress, NaN for a gear whose springs need no FE).
 
-The per-gear outputs of the run archive (`study.report.lightening`) are scalars named
+The per-gear outputs of the run archive (`study.archive.lightening`) are scalars named
 ``{variable}_gear{g}``: ``mass_gear2`` is ``mass.sel(gear=2)``.
 
 `ANALYSIS_FIELDS` says which scene fields (dotted paths) each analysis reads; it is the one
@@ -20,6 +20,7 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass
 
+from solver.mbs.kernels.status import POINT_STATUS
 from study.scene import SceneError
 
 
@@ -81,7 +82,7 @@ for _g, _which in ((1, "driver"), (2, "driven gear")):
 # a study that asks for none of them skips that part
 MESH_SCALARS = ("mesh_stiffness", "mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
                 "c_gamma_alpha_iso6336", "loaded_contact_ratio", "dynamic_factor")
-GEAR_VARIABLES = ("mass", "mass_saving", "inertia", "root_stress_max", "root_stress_ratio")   # scalars *_gear{g}
+# GEAR_VARIABLES (`study.archive.schema`): the per-gear archive variables a study archives as *_gear{g}
 
 CURVES = {
     "ste": Curve("angle", "static"),
@@ -132,9 +133,9 @@ def reads_dynamic(analysis: str) -> bool:
     return reads(analysis, "dynamic.torque")
 
 
-# CF flag meanings, values 0..5; inaccurate: the dynamic run completed but its energy balance
-# does not close (`solver.mbs.dynamics.accuracy_check`): its scalars are kept, flagged
-STATUS = ("pending", "ok", "diverged", "invalid", "failed", "inaccurate")
+# CF flag meanings, values 0..5 (`solver.mbs.kernels.status.POINT_STATUS`); inaccurate: the
+# dynamic run completed but its energy balance does not close: its scalars are kept, flagged
+STATUS = POINT_STATUS
 
 
 def analysis_of(output: str) -> str:
@@ -212,3 +213,10 @@ def outputs_from_table(table) -> Outputs:
     if not scalars and not curves:
         raise SceneError("outputs", "asks for nothing")
     return Outputs(tuple(dict.fromkeys(scalars)), tuple(dict.fromkeys(curves)))
+
+
+def summarize_sweep(ds) -> dict:
+    """The scalars of a sweep archive: {name: DataArray over the swept dimensions}, NaN where
+    the point's status is not ok (an output not over every swept dimension is broadcast)."""
+    ok = ds["status"] == STATUS.index("ok")
+    return {k: ds[k].where(ok) for k in SCALARS if k in ds.data_vars}

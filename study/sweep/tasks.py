@@ -4,8 +4,9 @@ A point's outputs split into at most two tasks (`Outputs.parts`): the outputs th
 ``dynamic.*`` field (STE, root stress, mass properties) and the ones that do (DTE; the modal
 outputs, linearised at the dynamic run's torque). A task is keyed by a hash of the
 scene fields its widest analysis reads (`outputs.ANALYSIS_FIELDS`), its outputs and the code
-(`results.code_fingerprint`): the points of a study that differ only in ``dynamic.*`` share
-their static task, and an edited study or a resumed one reuses every task it has in common.
+(`study.archive.netcdf.code_fingerprint`): the points of a study that differ only in
+``dynamic.*`` share their static task, and an edited study or a resumed one reuses every task
+it has in common.
 
 `point_result` puts a point's tasks back together into the record `archive.study_dataset`
 reads: the worst status (`WORST_FIRST`), the messages of the tasks not ok, the scalars of both,
@@ -47,7 +48,7 @@ def flat_fields(data: dict, prefix: str = "") -> dict:
 
 def task_key(scene: Scene, outputs: Outputs) -> str:
     """Content hash of a task: the scene fields its outputs read, the outputs, the code."""
-    from study.report.results import code_fingerprint
+    from study.archive.netcdf import code_fingerprint
     analysis = outputs.widest
     fields = {k: v for k, v in flat_fields(dataclasses.asdict(scene)).items() if reads(analysis, k)}
     blob = json.dumps([fields, list(outputs.scalars), list(outputs.curves), code_fingerprint()],
@@ -58,7 +59,7 @@ def task_key(scene: Scene, outputs: Outputs) -> str:
 def point_task_keys(point: Point, outputs: Outputs) -> tuple[str, ...]:
     """The keys of the tasks a valid point needs (none for an invalid one), in the order of
     ``outputs.parts()``; computed once per outputs and code (a sweep asks several times)."""
-    from study.report.results import code_fingerprint
+    from study.archive.netcdf import code_fingerprint
     if point.scene is None:
         return ()
     code = code_fingerprint()

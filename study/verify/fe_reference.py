@@ -102,20 +102,20 @@ def _reference(scene, angles, rigid, n_u, model, parts, bar, teeth=None):
 def reference_dataset(scene: Scene, angles=None, progress: bool = False) -> xr.Dataset:
     """FE reference archive: ste, load sharing and contacts over the driver angle (``progress``:
     see `reference`)."""
-    from study.report import results
+    from study.archive.netcdf import cf_variable, provenance
 
     t0 = time.perf_counter()
     res, model, info = reference(scene, angles, progress=progress)
     wall = time.perf_counter() - t0
-    coords = {"angle": results._var("angle", np.degrees(res.angle), "degree", "driver rotation from the nominal position"),
-              "driver_tooth": results._var("driver_tooth", np.arange(model.teeth[0]), "1", "driver tooth index")}
+    coords = {"angle": cf_variable("angle", np.degrees(res.angle), "degree", "driver rotation from the nominal position"),
+              "driver_tooth": cf_variable("driver_tooth", np.arange(model.teeth[0]), "1", "driver tooth index")}
     off = res.backlash_offset
     data = {
-        "ste": results._var("angle", res.te * units.UM_PER_M, "um", "FE reference static transmission error rb1*theta1 + rb2*theta2",
+        "ste": cf_variable("angle", res.te * units.UM_PER_M, "um", "FE reference static transmission error rb1*theta1 + rb2*theta2",
                             comment=f"LTCA with FE influence coefficients; rigid teeth in drive contact read +{off * 1e6:.4f} um"),
-        "ste_contacts": results._var("angle", res.n_contacts.astype("int16"), "1", "loaded tooth contacts"),
-        "ste_tooth_force": results._var(("angle", "driver_tooth"), res.tooth_force, "N", "normal contact force on each driver tooth"),
-        "extended_contact_force": results._var("angle", res.extended, "N", "force carried by tip-corner contacts outside the path of contact"),
+        "ste_contacts": cf_variable("angle", res.n_contacts.astype("int16"), "1", "loaded tooth contacts"),
+        "ste_tooth_force": cf_variable(("angle", "driver_tooth"), res.tooth_force, "N", "normal contact force on each driver tooth"),
+        "extended_contact_force": cf_variable("angle", res.extended, "N", "force carried by tip-corner contacts outside the path of contact"),
     }
     attrs = {"title": f"FE reference (LTCA): {scene.title}", "scene": scene.to_toml(),
              "backlash_offset_um": off * units.UM_PER_M, "contact_ratio": model.pair.contact_ratio,
@@ -127,5 +127,5 @@ def reference_dataset(scene: Scene, angles=None, progress: bool = False) -> xr.D
              "method": "loaded-tooth-contact analysis: bulk FE compliance read at the tooth centreline (both bodies, "
                        "clamped at the bore, all loaded teeth coupled) + contact law k_con*delta^m1 in series",
              "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
-             **results.provenance()}
+             **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)

@@ -25,7 +25,7 @@ import xarray as xr
 
 from solver import units
 from solver.mbs.statics import solve_static
-from study.report import results
+from study.archive.netcdf import cf_variable, provenance
 from study.scene import Scene
 from study.scene_model import build_scene_model
 from study.verify.fe_reference import reference
@@ -112,7 +112,7 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
     dims, coords = _model_grid(models, holes=(np.asarray(holes), "1", "holes in gear 2's web"),
                                web_thickness=(np.asarray(webs, float), "mm", "gear 2's web thickness"),
                                rim_height=(np.asarray(rims, float), "mm", "gear 2's rim under the root circle"))
-    v = results._var
+    v = cf_variable
     data = {"ste_mean": v(dims, figs["mean"], "um", "mean static transmission error"),
             "ste_elastic_mean": v(dims, figs["elastic_mean"], "um", "mean STE less the backlash offset jn/2"),
             "ste_p2p": v(dims, figs["p2p"], "um", "peak-to-peak static transmission error"),
@@ -120,14 +120,14 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
             "wall_time": v(dims, figs["wall"], "s", "wall time of the model's STE (its FE included unless cached)")}
     attrs = {"title": "STE of the models against the FE reference over gear 2's body",
              "static_torque_N_m": base.quasi_static.torque, "rotation_deg": rotation, "angle_step_deg": step,
-             "base_scene": base.to_toml(), **_target_attrs(), **results.provenance()}
+             "base_scene": base.to_toml(), **_target_attrs(), **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 def _model_grid(models, **axes) -> tuple[tuple, dict]:
     """Dimensions and coordinates of a grid of figures over ``axes`` (name: (values, unit, long
     name), in order) and the models compared, last."""
-    v = results._var
+    v = cf_variable
     coords = {name: v(name, values, unit, long_name) for name, (values, unit, long_name) in axes.items()}
     coords["model"] = v("model", np.array(models), "", "model (fe-reference: LTCA with FE influence coefficients)")
     return tuple(coords), coords
@@ -194,7 +194,7 @@ def relief_dataset(pairs: dict, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=
     dims, coords = _model_grid(models, pair=(np.array(names), "", "gear pair"),
                                torque=(np.asarray(torques, float), "N m", "quasi-static torque on gear 2"),
                                relief=(np.asarray(reliefs, float), "um", "linear tip relief at the tip, both gears"))
-    v = results._var
+    v = cf_variable
     data = {"ste_p2p": v(dims, p2p, "um", "peak-to-peak static transmission error"),
             "ste_elastic_mean": v(dims, mean, "um", "mean STE less the backlash offset jn/2"),
             "hole_amplitude": v(dims, hole, "um", "STE amplitude at the hole order of gear 2 (NaN: no holes)"),
@@ -204,7 +204,7 @@ def relief_dataset(pairs: dict, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=
     attrs = {"title": "STE against tip relief: the models against the FE reference",
              "angle_step_deg": step, "rotation_deg": str({n: (rotations or {}).get(n, 30.0) for n in names}),
              "scenes": "\n\n".join(f"# {n}\n{pairs[n].to_toml()}" for n in names), **_target_attrs(),
-             **results.provenance()}
+             **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -18,9 +18,9 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import INACCURATE
+from solver.mbs.kernels.status import COMPLETED, NONFINITE, OK
 from solver.mbs.model import Model
-from study.report import results
+from study.archive.netcdf import provenance
 from study.scene import Scene
 from study.verify.precision_cases import (
     Spec,
@@ -98,13 +98,13 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
                 warmed.add(s.method)
             (te, nst, st, msg), best = _timed(s.run, repeats)
             steps[i] = nst
-            if st in (0, INACCURATE):       # inaccurate: completed, its error is what the study measures
-                st = 0
+            if st in COMPLETED:       # inaccurate: completed, its error is what the study measures
+                st = OK
                 wall[i] = best
                 err[i] = te_error_norms(te[mask], ref_te[mask])
                 if not np.all(np.isfinite(err[i])):
-                    st, msg = 1, "output not finite or incomplete"
-            status.append("ok" if st == 0 else "failed")
+                    st, msg = NONFINITE, "output not finite or incomplete"
+            status.append("ok" if st == OK else "failed")
             message.append(msg)
         except Exception as e:            # a failed run stays in the dataset with its message
             status.append("failed")
@@ -133,7 +133,7 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
             "reference": names[0],
             "cross_check": names[1],
             **{f"reference_difference_{k}_um": float(v) for k, v in zip(NORMS, e_chk)},
-            **results.provenance(),
+            **provenance(),
             "machine": machine(),
             "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             **(attrs or {}),

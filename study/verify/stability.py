@@ -33,13 +33,14 @@ import scipy.linalg
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import INACCURATE, simulate
+from solver.mbs.dynamics import simulate
 from solver.mbs.implicit import simulate_implicit
+from solver.mbs.kernels.status import INACCURATE
 from solver.mbs.method import choose_method
 from solver.mbs.stability import linearized_system
 from solver.mbs.statics import solve_static
 from solver.peers.scipy_dynamics import simulate_scipy
-from study.report import results
+from study.archive.netcdf import provenance
 from study.scene_model import build_scene_model, load_table
 
 METHODS = ("explicit", "implicit alpha=0", "implicit alpha=-0.1", "LSODA")
@@ -195,5 +196,5 @@ def run_suite(scene, duration: float = 0.002, methods=METHODS, scipy_wall: float
         coords={"scene": [n for n, _ in scenes], "method": list(methods)},
         attrs={"title": "stability suite", "duration_s": duration, "ramp_time_s": duration / 2,
                "fe_mesh_size_mm": mesh_size, "scipy_wall_time_limit_s": scipy_wall,
-               "scene_base": scene.to_toml(), **results.provenance()},
+               "scene_base": scene.to_toml(), **provenance()},
     )

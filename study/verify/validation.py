@@ -29,7 +29,7 @@ import xarray as xr
 from solver import units
 from solver.fe.ltca import mesh_points
 from solver.mbs.statics import solve_static
-from study.report import results
+from study.archive.netcdf import cf_variable, provenance
 from study.scene_model import build_scene_model, coupling_fit, gear_setup
 from study.verify.fe_reference import reference
 from study.verify.model_validation import order_amplitude
@@ -151,7 +151,7 @@ def validation_dataset(scene, angles) -> xr.Dataset:
             wall[p, i] = w[mod]
             for k in METRIC_DOC:
                 tab[k][p, i] = m[mod][k]
-    v = results._var
+    v = cf_variable
     coords = {"pair": v("pair", np.array(PAIRS), "", "gear pair (driven gear solid or lightened)"),
               "model": v("model", np.array(MODELS), "", "model (fe-reference: LTCA with FE influence coefficients)"),
               "angle": v("angle", np.degrees(angles), "degree", "driver rotation from the nominal position")}
@@ -169,5 +169,5 @@ def validation_dataset(scene, angles) -> xr.Dataset:
     attrs = {"title": "STE of the pseudo-rigid models against the FE reference", "scene": scene.to_toml(),
              "backlash_offset_um": offsets[0], "static_torque_N_m": scene.quasi_static.torque,
              "hole_order": float(scene.gear2.body.holes), "mesh_order": float(scene.gear2.teeth),
-             **results.provenance()}
+             **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)

@@ -135,7 +135,7 @@ def test_the_coast_flanks_elastic_mean_mirrors_the_drive_side():
     image of its drive-flank equilibrium, so the elastic part of the mean STE (measured from
     the backlash offset of the loaded side) changes sign and keeps its size. (Over one whole
     mesh period, 18 deg for 20 teeth: the mirror image runs through the period backwards.)"""
-    from study.report.summary import summarize
+    from study.archive.summary import summarize
     from study.run import run_scene
     period = {"quasi_static.rotation": 18.0 - 0.25, "quasi_static.angle_step": 0.25}
     drive = summarize(run_scene(small_scene(**period), static=True, dynamic=False))
@@ -148,7 +148,7 @@ def test_the_coast_flanks_elastic_mean_mirrors_the_drive_side():
 def test_the_transient_ste_holds_no_unloaded_sample():
     """The slow-ramp transient samples only angles the driver reaches under the whole load: its
     STE ripple is that of the equilibria (the first sample used to be the unloaded start)."""
-    from study.report.summary import summarize
+    from study.archive.summary import summarize
     from study.run import run_scene
     static = run_scene(small_scene(), static=True, dynamic=False)
     transient = run_scene(small_scene(**{"quasi_static.method": "transient"}), static=True, dynamic=False)
@@ -160,7 +160,7 @@ def test_the_transient_ste_holds_no_unloaded_sample():
 def test_the_sweep_scalar_of_the_mesh_order_is_the_value_the_summary_prints():
     """A short run resolves orders coarsely: the scalar comes from the same named-peak table as
     the printed summary, not from a window narrower than a bin (NaN at status ok)."""
-    from study.report.summary import summarize
+    from study.archive.summary import summarize
     from study.run import run_scene
     ds = run_scene(small_scene(**{"dynamic.speed": 100.0}), static=False, dynamic=True)
     s = summarize(ds)

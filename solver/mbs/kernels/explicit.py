@@ -45,7 +45,8 @@ from solver.mbs.kernels.mechanics import (
     load_torque,
     mesh_energies,
 )
-from solver.mbs.kernels.stepping import OK, activate, end_step, initial_set, record_output
+from solver.mbs.kernels.status import OK
+from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_output
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)

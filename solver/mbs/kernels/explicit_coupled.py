@@ -47,7 +47,8 @@ from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 from solver.mbs.kernels.mechanics import dissipation_power, driver_acc_left, driver_motion, load_torque, mesh_energies
-from solver.mbs.kernels.stepping import OK, activate, end_step, initial_set, record_output
+from solver.mbs.kernels.status import OK
+from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_output
 from solver.mbs.kernels.toothcoupling import coupled_set, set_differs, set_energy, set_springs, update_set
 
 

@@ -51,7 +51,8 @@ from solver.mbs.kernels.mechanics import (
     mesh_energies,
 )
 from solver.mbs.kernels.statics import solve_dense
-from solver.mbs.kernels.stepping import NEWTON, NONFINITE, OK, activate, end_step, initial_set, record_output
+from solver.mbs.kernels.status import NEWTON, NONFINITE, OK
+from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_output
 
 # coefficients of the scheme: nw[0]
 K_BETA = 0          # Newmark beta [-]

@@ -2,8 +2,7 @@
 status codes, work arrays, the active-tooth set, and the end of a step (guards, energy
 bookkeeping, output records).
 
-Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy growth,
-4 Newton failure (implicit), 5 interrupted (par[ABORT] set from another thread, checked at
+Status codes: `solver.mbs.kernels.status` (par[ABORT], set from another thread, is checked at
 the end of every step: `solver.mbs.interrupt`).
 
 Teeth away from the mesh are left out of the integration, rigid to their hub; a tooth joins
@@ -23,13 +22,7 @@ import numpy as np
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
-
-OK = 0
-NONFINITE = 1
-PENETRATION = 2
-ENERGY = 3
-NEWTON = 4
-INTERRUPTED = 5
+from solver.mbs.kernels.status import ENERGY, INTERRUPTED, NONFINITE, OK, PENETRATION
 
 
 def work_arrays(ntooth):

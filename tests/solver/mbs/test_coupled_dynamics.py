@@ -12,7 +12,7 @@ from solver.mbs.dynamics import energy_error_limit, simulate
 from solver.mbs.kernels import layout as L
 from solver.mbs.modes import modal_analysis
 from solver.mbs.ringdown import ring_down
-from study.report.order_tracking import order_cut, order_map
+from study.archive.order_tracking import order_cut, order_map
 from study.scene_model import build_scene_model
 
 MODELS = ("none", "body-torsion", "compliance")

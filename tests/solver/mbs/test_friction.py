@@ -144,7 +144,7 @@ def test_scene_rejects_bad_friction(key, value, words):
 def test_archive_carries_the_mesh_efficiency():
     """A run with friction archives mesh_efficiency [1]: its loss is the friction's mu*H_V (the
     dampers add little at a steady 100 rad/s) within 15 %; a frictionless archive has none."""
-    from study.report.summary import summarize
+    from study.archive.summary import summarize
     from study.run import run_scene
     over = {"dynamic.duration": 0.012, "dynamic.ramp_time": 0.002, "dynamic.spectrum_start": 0.004}
     ds = run_scene(solid_scene(**over, **{"contact.friction": MU}), static=False, dynamic=True)

@@ -68,7 +68,7 @@ def test_loaded_contact_ratio_falls_to_the_geometric_one_as_the_load_vanishes(pa
     """Deflection brings teeth into contact before and after the geometric path (tip corners
     included): the mean number of loaded pairs over whole mesh periods grows with the torque
     and tends to the geometric transverse contact ratio as the load vanishes."""
-    from study.report.mesh_outputs import whole_periods
+    from study.archive.mesh import whole_periods
     m = paper_solid_model
     ang = np.radians(np.arange(0.0, 360.0 / 67 * 2, 0.02))
     sel = whole_periods(np.degrees(ang), 67)

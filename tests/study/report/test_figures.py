@@ -9,6 +9,7 @@ import pytest
 import xarray as xr
 from matplotlib.image import imread
 
+from study.inputs.springs import archive_body_fields
 from study.report import render_inputs, stiffness_render, stress_render
 from study.report.figures import make_figures
 from study.report.render_geometry import extrude
@@ -33,8 +34,14 @@ def tiny(tmp_path_factory):
     scene = load_scene("small_lightened").replace(**TINY_LIGHTENED)
     ds = run_scene(scene)
     out = tmp_path_factory.mktemp("figs")
-    paths = make_figures(ds, out)
+    paths = make_figures(ds, out, fields=archive_body_fields(ds))
     return ds, out, paths
+
+
+@pytest.fixture(scope="module")
+def fields(tiny):
+    """The lightened driven gear's FE body fields the renders draw (from the FE cache now)."""
+    return archive_body_fields(tiny[0], solve=False)
 
 
 def _png(path):
@@ -65,12 +72,34 @@ def test_archive_without_dynamics_skips_what_it_cannot_draw(tiny, tmp_path, caps
     assert "skip DTE plot" in said and "skip renders" in said
 
 
-def test_stiffness_map_colour_range_and_pixels_match_the_tooth_stiffness(tiny, tmp_path):
+def test_renders_read_the_fe_cache_and_skip_without_fields(tiny, fields, tmp_path, capsys, monkeypatch):
+    """The pictures start no FE solve: the fields come from the FE cache (bit for bit what the
+    solve gave), and without them the renders are skipped with the reason."""
+    ds, _, _ = tiny
+    k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
+    assert list(fields) == [2] and [f.tooth for f in fields[2]] == [int(np.argmax(k2)), int(np.argmin(k2))]
+    from study.inputs.gearsetup import gear_setup
+    from study.inputs.springs import body_fields
+    fresh = body_fields(gear_setup(render_inputs.required_scene(ds), 2), [f.tooth for f in fields[2]], solve=True)
+    for a, b in zip(fields[2], fresh):
+        assert np.array_equal(a.points, b.points) and np.array_equal(a.triangles, b.triangles)
+        assert np.array_equal(a.displacement, b.displacement) and np.array_equal(a.von_mises, b.von_mises)
+    paths = make_figures(ds, tmp_path)
+    said = capsys.readouterr().out
+    assert "skip gear pair and FE stress renders: no FE body fields of lightened gear 2" in said
+    assert not {"gear_pair.png", "fe_stress_gear2.png"} & {p.name for p in paths}
+    with pytest.raises(ValueError, match="lightened gear 2"):
+        render_inputs.pair_bodies(ds)
+    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "empty"))
+    assert archive_body_fields(ds, solve=False) == {}              # nothing cached there, nothing solved
+
+
+def test_stiffness_map_colour_range_and_pixels_match_the_tooth_stiffness(tiny, fields, tmp_path):
     ds, _, _ = tiny
     k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
     k1 = ds["tooth_stiffness"].sel(gear=1).values[:24]
     assert np.ptp(k2) > 0.005 * k2.mean()            # the holes make the driven teeth differ
-    res = stiffness_render.gear_pair_render(ds, tmp_path / "pair.png")
+    res = stiffness_render.gear_pair_render(ds, tmp_path / "pair.png", fields)
     # the colour bar spans exactly the lightened gear's stiffness; the solid driver (stiffer,
     # one value) lies outside and is drawn grey
     assert res.clim == pytest.approx((k2.min(), k2.max()), rel=1e-12)
@@ -88,14 +117,14 @@ def test_stiffness_map_colour_range_and_pixels_match_the_tooth_stiffness(tiny, t
     far = cmap(1.0)[:3], cmap(0.0)[:3]
     assert np.abs(np.array(far[0]) - np.array(far[1])).max() > 0.5
     # every tooth of both bodies got its own index (FE mesh and outline alike)
-    bodies = render_inputs.pair_bodies(ds)
+    bodies = render_inputs.pair_bodies(ds, fields)
     for g in (1, 2):
         assert set(np.unique(bodies[g].tooth)) == set(range(-1, 24))
 
 
-def test_extruded_body_keeps_web_thinner_and_scalars_per_tooth(tiny):
+def test_extruded_body_keeps_web_thinner_and_scalars_per_tooth(tiny, fields):
     ds, _, _ = tiny
-    b = render_inputs.pair_bodies(ds)[2]
+    b = render_inputs.pair_bodies(ds, fields)[2]
     k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
     val = np.where(b.tooth >= 0, k2[np.clip(b.tooth, 0, None)], np.nan)
     mesh = extrude(b, 0.0, (0.0, 0.0), val, "k_phi")
@@ -106,17 +135,15 @@ def test_extruded_body_keeps_web_thinner_and_scalars_per_tooth(tiny):
     assert np.nanmin(kk) == pytest.approx(k2.min()) and np.nanmax(kk) == pytest.approx(k2.max())
 
 
-def test_stress_render_scale_spans_zero_to_the_fillet_peak(tiny, tmp_path):
+def test_stress_render_scale_spans_zero_to_the_fillet_peak(tiny, fields, tmp_path):
     ds, _, _ = tiny
-    k2 = ds["tooth_stiffness"].sel(gear=2).values[:24]
     sc = render_inputs.required_scene(ds)
-    teeth = [int(np.argmax(k2)), int(np.argmin(k2))]
-    fields = render_inputs.fe_fields(sc, 2, teeth)
+    fields = fields[2]
     geo = sc.geometry(2)
     peaks = [stress_render.fillet_peak(f, geo, f.tooth) / 1e6 for f in fields]
     # the loaded tooth's fillet carries far more than the body on average
     assert all(p > 5 * np.median(f.von_mises) / 1e6 for p, f in zip(peaks, fields))
-    res = stress_render.fe_stress_render(ds, tmp_path / "stress.png", fields=fields)
+    res = stress_render.fe_stress_render(ds, tmp_path / "stress.png", 2, fields)
     assert res.clim == pytest.approx((0.0, max(peaks)))
     img = _png(res.path)[:, : _png(res.path).shape[1] // 2]          # left column: stress
     cmap = matplotlib.colormaps[stress_render.STRESS_CMAP]
@@ -150,8 +177,8 @@ def test_sweep_view_facets_the_other_dimensions():
 
 
 def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
+    from study.archive.netcdf import write_netcdf
     from study.cli import main
-    from study.report.results import write_netcdf
     ds, _, _ = tiny
     path = tmp_path / "run.nc"
     write_netcdf(ds, path)

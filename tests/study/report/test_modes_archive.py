@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from helpers import solid_scene
 
+from study.archive.summary import summarize
 from study.report.campbell import campbell_plot
-from study.report.summary import summarize
 from study.run import run_scene
 from study.sweep import engine
 from study.sweep.outputs import outputs_from_table

@@ -8,7 +8,7 @@ import xarray as xr
 from sweep_cases import BASE, count_points, ctrl_c_after_stored, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
 
 import study.sweep.engine as sweep
-from study.report.summary import summarize
+from study.archive.summary import summarize
 from study.run import run_scene
 from study.scene import default_scene
 from study.sweep.engine import parts_folder, run_sweep
@@ -69,10 +69,10 @@ def test_rerunning_a_complete_study_computes_nothing(swept, monkeypatch):
 def test_changed_code_recomputes_every_point(swept, tmp_path, monkeypatch):
     """Finished points of another version of the code are never reused, neither from the
     part files nor from a complete archive."""
-    from study.report import results
+    from study.archive import netcdf
     res, out = swept
     keys = set(plan(tiny_study(), tiny_study().points())[0])
-    monkeypatch.setattr(results, "code_fingerprint", lambda: "another-version")
+    monkeypatch.setattr(netcdf, "code_fingerprint", lambda: "another-version")
     assert not keys & set(plan(tiny_study(), tiny_study().points())[0])
     calls = []
     monkeypatch.setattr(sweep, "run_point", lambda s, o: calls.append(s) or {"status": "failed", "message": "new code",

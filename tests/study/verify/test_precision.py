@@ -79,14 +79,14 @@ def test_static_study_and_failed_run_kept(paper_solid_scene, paper_solid_model, 
     assert "ZeroDivisionError" in ds2["message"].values[0] and "penetration" in ds2["message"].values[1]
     plot(ds, tmp_path / "wp.png")
     assert (tmp_path / "wp.png").stat().st_size > 10_000
-    from study.report import results
-    results.write_netcdf(ds2, tmp_path / "wp.nc")
+    from study.archive.netcdf import write_netcdf
+    write_netcdf(ds2, tmp_path / "wp.nc")
     import xarray as xr
     back = xr.open_dataset(tmp_path / "wp.nc")
     assert list(back["message"].values) == list(ds2["message"].values)
     if importlib.util.find_spec("compliance_checker"):
         from cf_check import cf_errors
-        results.write_netcdf(ds, tmp_path / "wp_static.nc")
+        write_netcdf(ds, tmp_path / "wp_static.nc")
         assert cf_errors(tmp_path / "wp.nc") == [] and cf_errors(tmp_path / "wp_static.nc") == []
 
 

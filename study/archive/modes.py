@@ -15,15 +15,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import xarray as xr
 
 from solver import units
 from solver.mbs.kernels import layout as L
 from solver.mbs.model import Model
-
-
-def _var(dims, data, unit, long_name):
-    return xr.Variable(dims, data, {"units": unit, "long_name": long_name})
+from study.archive.schema import MODAL_SOURCE, variable
 
 
 def excitation_orders(z2: int, holes: int) -> list[tuple[str, float]]:
@@ -48,22 +44,18 @@ def modal_variables(model: Model, torque: float, holes: int, decay: bool = True)
     z1, z2 = model.teeth
     exc = excitation_orders(z2, holes)
     coords = {
-        "mode": _var("mode", np.arange(md.frequency.shape[0]), "1", "mode number: 0 the mesh mode, then the tooth modes by frequency"),
-        "mode_kind": _var("mode", np.array(md.kind, dtype=object), "1",
-                          "what the mode is: the mesh mode (largest share of kinetic energy on the driven hub) or a tooth "
-                          "mode of the gear whose teeth carry most of its energy"),
-        "mesh_position": _var("mesh_position", np.degrees(md.position), "degree", "driver angle over one mesh period"),
-        "excitation": _var("excitation", np.array([e[0] for e in exc], dtype=object), "1",
-                           "excitation: kZ mesh orders, N hole order, kZ+-N sidebands"),
-        "excitation_order": _var("excitation", np.array([e[1] for e in exc]), "1", "order of the driven gear's rotation"),
+        "mode": variable("mode", np.arange(md.frequency.shape[0])),
+        "mode_kind": variable("mode_kind", np.array(md.kind, dtype=object)),
+        "mesh_position": variable("mesh_position", np.degrees(md.position)),
+        "excitation": variable("excitation", np.array([e[0] for e in exc], dtype=object)),
+        "excitation_order": variable("excitation_order", np.array([e[1] for e in exc])),
     }
-    src = f"pair linearised at static equilibrium under {torque:g} N·m; state-space eigenvalues lambda: f = |lambda|/2pi, zeta = -Re(lambda)/|lambda|"
+    src = MODAL_SOURCE.format(torque=torque)
     fmean = np.nanmean(md.frequency, axis=1)
     data = {
-        "mode_frequency": xr.Variable(("mode", "mesh_position"), md.frequency, {"units": "Hz", "long_name": "natural frequency", "source": src}),
-        "mode_damping": xr.Variable(("mode", "mesh_position"), md.damping, {"units": "1", "long_name": "damping ratio (of critical)", "source": src}),
-        "critical_speed": xr.Variable(("excitation", "mode"), critical_speeds(fmean, coords["excitation_order"].values, z1, z2),
-                                      {"units": "rad/s", "long_name": "driver speed at which the excitation order meets the mode's mean frequency"}),
+        "mode_frequency": variable("mode_frequency", md.frequency, source=src),
+        "mode_damping": variable("mode_damping", md.damping, source=src),
+        "critical_speed": variable("critical_speed", critical_speeds(fmean, coords["excitation_order"].values, z1, z2)),
     }
     attrs = {
         "mesh_mode_frequency_hz": float(fmean[0]),

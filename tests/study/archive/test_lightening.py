@@ -7,7 +7,7 @@ import pytest
 from solver.inertia import gear_mass
 from study.inputs import springs
 from study.inputs.gearsetup import gear_setups
-from study.report.lightening import lightening_dataset
+from study.inputs.springs import lightening_dataset
 from study.scene import load_scene
 
 
@@ -69,7 +69,8 @@ def test_run_archive_summary_and_sweep_scalars_carry_the_gear_outputs(capsys, mo
     the per-gear variables; `summarize` gives them as the sweep scalars of the same names and
     `print_summary` prints them; a study that asks for geometry outputs only runs no solve."""
     import study.run
-    from study.report.summary import print_summary, summarize
+    from study.archive.summary import summarize
+    from study.report.summary import print_summary
     from study.sweep import engine
     from study.sweep.outputs import SCALARS, outputs_from_table
     scene = small_scene(**{"gear2.spring.stiffness": "uniform", "quasi_static.rotation": 2.0,

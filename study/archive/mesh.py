@@ -10,14 +10,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import xarray as xr
 
 from solver import units
 from solver.peers import iso6336
-
-
-def _var(dims, data, unit, long_name, **attrs):
-    return xr.Variable(dims, data, {"units": unit, "long_name": long_name, **attrs})
+from study.archive.schema import variable
 
 
 def iso_stiffness(scene, contact_ratio: float) -> tuple[float, float, float]:
@@ -60,38 +56,35 @@ def mesh_variables(states, model, scene, torque: float) -> tuple[dict, dict]:
     eps = model.pair.contact_ratio
     c1_iso, cga_iso, c_r = iso_stiffness(scene, eps)
     load_note = f"at static equilibrium under {torque:g} N·m"
-    coords = {"driven_tooth": _var("driven_tooth", np.arange(z2), "1", "driven tooth index (counter-clockwise from tooth 0)")}
+    coords = {"driven_tooth": variable("driven_tooth", np.arange(z2))}
     data = {
-        "mesh_stiffness": _var("angle", k, "N um-1", "tangent mesh stiffness along the line of action",
-                               comment=f"dF/dTE {load_note}, the pair linearised as for the modes "
+        "mesh_stiffness": variable("mesh_stiffness", k,
+                                   comment=f"dF/dTE {load_note}, the pair linearised as for the modes "
                                        "(solver.mbs.mesh_stiffness): the driver hub prescribed, every tooth at its "
                                        "static response; F = driven torque / rb2"),
-        "mesh_stiffness_mean": _var((), mean, "N um-1", "mean tangent mesh stiffness over whole mesh periods of the STE"),
-        "mesh_stiffness_p2p": _var((), p2p, "N um-1", "peak-to-peak of the tangent mesh stiffness over the STE"),
-        "c_prime": _var((), c1, "N mm-1 um-1", "single stiffness c' of a tooth pair per face width (largest over the STE)",
-                        comment="each loaded pair's share of the tangent mesh stiffness (the pair as if alone in mesh), "
+        "mesh_stiffness_mean": variable("mesh_stiffness_mean", mean),
+        "mesh_stiffness_p2p": variable("mesh_stiffness_p2p", p2p),
+        "c_prime": variable("c_prime", c1,
+                            comment="each loaded pair's share of the tangent mesh stiffness (the pair as if alone in mesh), "
                                 f"its largest value over the STE angles, over the face width {width * 1e3:g} mm"),
-        "c_gamma_alpha": _var((), cga, "N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width (mean over the STE)"),
-        "c_prime_iso6336": _var((), c1_iso, "N mm-1 um-1", "single stiffness c' by ISO 6336-1 Method B",
-                                comment=f"C_M 0.8, C_R {c_r:.4f} (mean of the two webs; holes are not in the standard), "
+        "c_gamma_alpha": variable("c_gamma_alpha", cga),
+        "c_prime_iso6336": variable("c_prime_iso6336", c1_iso,
+                                    comment=f"C_M 0.8, C_R {c_r:.4f} (mean of the two webs; holes are not in the standard), "
                                         "C_B of the basic rack, no profile shift; the standard states a spread of about 20 %"),
-        "c_gamma_alpha_iso6336": _var((), cga_iso, "N mm-1 um-1", "mesh stiffness c_gamma_alpha by ISO 6336-1 Method B",
-                                      comment=f"c' (0.75 eps_alpha + 0.25), eps_alpha = {eps:.4f} (geometric)"),
-        "loaded_contact_ratio": _var((), eps_loaded, "1", "loaded contact ratio: mean number of loaded tooth pairs",
-                                     comment=f"{load_note}, over whole mesh periods of the STE, tip-corner contacts "
+        "c_gamma_alpha_iso6336": variable("c_gamma_alpha_iso6336", cga_iso,
+                                          comment=f"c' (0.75 eps_alpha + 0.25), eps_alpha = {eps:.4f} (geometric)"),
+        "loaded_contact_ratio": variable("loaded_contact_ratio", eps_loaded,
+                                         comment=f"{load_note}, over whole mesh periods of the STE, tip-corner contacts "
                                              f"included; the geometric transverse contact ratio is {eps:.4f}"),
-        "ste_tooth_force_gear2": _var(("angle", "driven_tooth"), states.tooth_force[:, z1:], "N",
-                                      "normal contact force on each driven tooth", comment=load_note),
-        "ste_mate_tooth": _var("driver_tooth", _mates(states.mate, z1), "1",
-                               "driven tooth that each driver tooth meets in the STE (-1: none)"),
+        "ste_tooth_force_gear2": variable("ste_tooth_force_gear2", states.tooth_force[:, z1:], comment=load_note),
+        "ste_mate_tooth": variable("ste_mate_tooth", _mates(states.mate, z1)),
     }
     kt = units.stiffness_n_per_um(pitch_point_stiffness(model, torque / model.base_radii[1]))
     zmax = max(z1, z2)
     K = np.full((2, zmax), np.nan)
     K[0, :z1], K[1, :z2] = kt[:z1], kt[z1:]
-    data["tooth_stiffness_pitch"] = _var(("gear", "tooth"), K, "N um-1",
-                                         "tooth stiffness at the pitch point along the line of action",
-                                         comment=f"tangent of the tooth's spring under the whole load {torque:g} N·m / rb "
+    data["tooth_stiffness_pitch"] = variable("tooth_stiffness_pitch", K,
+                                             comment=f"tangent of the tooth's spring under the whole load {torque:g} N·m / rb "
                                                  "at the pitch point, n_k k_phi phi^(n_k-1) / h^2, h the lever arm of "
                                                  "the line of action about the pivot (solver.mbs.mesh_stiffness)")
     return coords, data
@@ -120,12 +113,11 @@ def dynamic_force_variables(res, start: float, z1: int, z2: int, static_force_ma
     t1 = c[:, :, L.OC_TOOTH1].astype(np.int32)
     t2 = c[:, :, L.OC_TOOTH2].astype(np.int32)
     f = c[:, :, L.OC_FORCE]
-    coords = {"contact_slot": _var("contact_slot", np.arange(c.shape[1]), "1", "slot of a loaded contact at an instant")}
+    coords = {"contact_slot": variable("contact_slot", np.arange(c.shape[1]))}
     data = {
-        "dte_contact_tooth1": _var(("time", "contact_slot"), t1, "1", "driver tooth of each loaded contact (-1: empty slot)"),
-        "dte_contact_tooth2": _var(("time", "contact_slot"), t2, "1", "driven tooth of each loaded contact (-1: empty slot)"),
-        "dte_contact_force": _var(("time", "contact_slot"), f, "N", "normal force of each loaded contact",
-                                  comment="at the output instant; a tooth's force is the sum over the slots naming it"),
+        "dte_contact_tooth1": variable("dte_contact_tooth1", t1),
+        "dte_contact_tooth2": variable("dte_contact_tooth2", t2),
+        "dte_contact_force": variable("dte_contact_force", f),
     }
     sel = res.time >= start
     fmax = np.full((2, max(z1, z2)), np.nan)
@@ -136,11 +128,11 @@ def dynamic_force_variables(res, start: float, z1: int, z2: int, static_force_ma
             ok = t[rows, s] >= 0
             np.add.at(per, (np.nonzero(ok)[0], t[rows, s][ok]), f[rows, s][ok])
         fmax[g, :z] = per.max(axis=0) if per.shape[0] else np.nan
-    data["dte_tooth_force_max"] = _var(("gear", "tooth"), fmax, "N", "largest dynamic force on each tooth",
-                                       comment=f"over the steady part from {start:g} s (output instants)", start_s=float(start))
+    data["dte_tooth_force_max"] = variable("dte_tooth_force_max", fmax,
+                                           comment=f"over the steady part from {start:g} s (output instants)", start_s=float(start))
     fdyn = float(np.nanmax(fmax)) if np.isfinite(fmax).any() else float("nan")
     kv = fdyn / static_force_max if static_force_max > 0 else float("nan")
-    data["dynamic_factor"] = _var((), kv, "1", "dynamic factor K_v: largest dynamic over largest static tooth force",
-                                  comment=f"largest dynamic tooth force {fdyn:.1f} N after {start:g} s, largest static "
+    data["dynamic_factor"] = variable("dynamic_factor", kv,
+                                      comment=f"largest dynamic tooth force {fdyn:.1f} N after {start:g} s, largest static "
                                           f"{static_force_max:.1f} N (static, the same torque, over a whole revolution)")
     return coords, data

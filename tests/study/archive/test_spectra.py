@@ -4,8 +4,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from study.report import results
-from study.report.spectra import (
+from study.archive import run_variables
+from study.archive.spectra import (
     HANN_MAIN_LOBE_BINS,
     amplitude_spectrum,
     named_orders,
@@ -107,7 +107,7 @@ def test_dte_spectrum_in_the_archive_has_orders_and_named_peaks():
                           driver_torque=np.zeros_like(t), energy_error=np.zeros_like(t), potential=np.zeros_like(t),
                           dissipated=np.zeros_like(t), status=0, dt=dt,
                           steps=t.size, omega_max=1.0, message="ok", max_active_teeth=4)
-    coords, data, _ = results.dynamic_variables(res, 0.02, speed, n_holes, z)
+    coords, data, _ = run_variables.dynamic_variables(res, 0.02, speed, n_holes, z)
     order = coords["order"].values
     np.testing.assert_allclose(order, coords["frequency"].values / f_rot)
     names = list(coords["dte_peak"].values)
@@ -130,12 +130,12 @@ def test_once_per_revolution_orders_of_gears_with_errors_are_named():
     step = 0.25
     theta = np.radians(np.arange(0.0, 12 * 360.0, step))
     ste = 1.0 * np.cos(theta + 0.2) + 0.4 * np.cos(theta * 20 / 30 - 0.5) + 0.1 * np.cos(20 * theta)
-    c, d = results.ste_spectrum_variables(np.degrees(theta), ste, 20, 30, 0.0, revolutions=True)
+    c, d = run_variables.ste_spectrum_variables(np.degrees(theta), ste, 20, 30, 0.0, revolutions=True)
     names = list(c["ste_peak"].values)
     assert names[:2] == ["R1", "R2"]
     np.testing.assert_allclose(d["ste_peak_nominal_order"].values[:2], [1.5, 1.0])
     np.testing.assert_allclose(d["ste_peak_amplitude"].values[:2], [1.0, 0.4], rtol=0.02)
-    c0, d0 = results.ste_spectrum_variables(np.degrees(theta), ste, 20, 30, 0.0)
+    c0, d0 = run_variables.ste_spectrum_variables(np.degrees(theta), ste, 20, 30, 0.0)
     assert "R1" not in list(c0["ste_peak"].values)
     assert list(c0["ste_peak"].values) == names[2:]
     others = d0["ste_peak_order"].values[[n.startswith("other") for n in c0["ste_peak"].values]]

@@ -9,7 +9,7 @@ import xarray as xr
 from cf_check import cf_errors
 
 import study
-from study.report.results import clean_stale_temporaries, write_netcdf
+from study.archive.netcdf import clean_stale_temporaries, write_netcdf
 
 pytest.importorskip("compliance_checker")
 
@@ -54,7 +54,7 @@ def test_a_killed_writers_temporary_is_removed_on_the_next_write(tmp_path):
     out = tmp_path / "out.nc"
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
     dead_pid = int(dead.stdout)                                  # that process has exited
-    from study.report.results import host_tag
+    from study.archive.netcdf import host_tag
     stale = tmp_path / f".out.nc.tmp{dead_pid}.{host_tag()}-0123abcd"
     legacy = tmp_path / f".out.nc.tmp{dead_pid}.89abcdef"       # the older name, without host tag
     live = tmp_path / f".out.nc.tmp{os.getppid()}.{host_tag()}-00000000"   # a running writer

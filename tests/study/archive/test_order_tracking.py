@@ -7,9 +7,9 @@ import pytest
 from helpers import solid_scene
 
 from solver.mbs.dynamics import simulate
-from study.report.modes import critical_speeds
-from study.report.order_tracking import driver_angle, order_cut, order_map
-from study.report.spectra import amplitude_spectrum
+from study.archive.modes import critical_speeds
+from study.archive.order_tracking import driver_angle, order_cut, order_map
+from study.archive.spectra import amplitude_spectrum
 from study.scene_model import build_scene_model
 
 
@@ -34,7 +34,7 @@ def test_run_up_tracks_the_steady_mesh_order_and_peaks_at_the_critical_speed():
     """The solid paper pair (5 % mesh damping) sped up 0 -> 400 rad/s in 0.5 s: the mesh
     order's amplitude matches steady runs within 10 % away from its resonance, and peaks
     within 3 % of the modal critical speed of the mesh order (1Z on the mesh mode)."""
-    from study.report.modes import modal_variables
+    from study.archive.modes import modal_variables
     m = build_scene_model(solid_scene())
     run = simulate(m, 400.0, 0.5, 50.0, 0.01, 0.5)
     assert run.status == 0

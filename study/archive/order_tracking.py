@@ -13,9 +13,9 @@ so the low speeds, where a revolution takes long, are coarse.
 from __future__ import annotations
 
 import numpy as np
-import xarray as xr
 
-from study.report.spectra import WINDOW, amplitude_spectrum
+from study.archive.schema import variable
+from study.archive.spectra import amplitude_spectrum
 
 
 def driver_angle(t, speed_end: float, ramp: float):
@@ -59,10 +59,6 @@ def order_tracking_variables(time, dte_um, speed_end: float, ramp: float, z1: in
     (default 5 Z2 + 10)."""
     speed, order, amp = order_map(time, dte_um, speed_end, ramp, z1, z2, revs, speed_min=0.05 * speed_end)
     keep = order <= (max_order or 5 * z2 + 10)
-    coords = {"runup_speed": xr.Variable("runup_speed", speed, {"units": "rad/s", "long_name": "driver speed (mean over the block)"}),
-              "tracked_order": xr.Variable("tracked_order", order[keep], {"units": "1", "long_name": "order of the driven gear's rotation"})}
-    data = {"order_amplitude": xr.Variable(("runup_speed", "tracked_order"), amp[:, keep], {
-        "units": "um", "long_name": "DTE amplitude by order over the run-up (computed order tracking)",
-        "window": WINDOW, "revolutions_per_block": revs,
-        "comment": "DTE resampled to the driven gear's angle; one spectrum per block of whole driven revolutions"})}
+    coords = {"runup_speed": variable("runup_speed", speed), "tracked_order": variable("tracked_order", order[keep])}
+    data = {"order_amplitude": variable("order_amplitude", amp[:, keep], revolutions_per_block=revs)}
     return coords, data
