@@ -366,3 +366,24 @@ def gear_outline(g: GearGeometry, **kw):
         xs.append(c * x - s * y)
         ys.append(s * x + c * y)
     return np.concatenate(xs), np.concatenate(ys)
+
+
+def fillet_band(centroids: np.ndarray, g: GearGeometry, tooth: int) -> np.ndarray:
+    """Mask of the elements (by their centroids (m, 2) [m]) in the root/fillet band of ``tooth``:
+    radius within one module of the root circle, within one pitch of the tooth axis (both fillets
+    of the tooth, clear of the pitch-point load patch 1.25 modules above the root)."""
+    r = np.hypot(centroids[:, 0], centroids[:, 1])
+    a = np.arctan2(centroids[:, 1], centroids[:, 0]) - tooth * g.pitch_angle
+    a = (a + math.pi) % (2 * math.pi) - math.pi
+    return (np.abs(r - g.root_radius) < g.spec.module) & (np.abs(a) < g.pitch_angle)
+
+
+def hole_offset(teeth: int, holes: int, hole_phase_deg: float) -> np.ndarray:
+    """Angular distance [tooth pitches] of each of ``teeth`` tooth axes to the nearest of ``holes``
+    hole centres (the first at ``hole_phase_deg`` [deg]); NaN without holes."""
+    if holes == 0:
+        return np.full(teeth, np.nan)
+    tooth = np.arange(teeth) * 360.0 / teeth
+    centres = hole_angles(holes, hole_phase_deg, 360.0)
+    d = (tooth[:, None] - centres[None, :] + 180.0) % 360.0 - 180.0
+    return d[np.arange(teeth), np.argmin(np.abs(d), axis=1)] / (360.0 / teeth)

@@ -12,6 +12,8 @@ import sys
 import time
 from pathlib import Path
 
+from study.errors import UsageError  # noqa: F401  (raised here and by the option parsers)
+
 EXIT_CODES = """exit codes:
   0    done
   1    an unexpected error (one line on stderr; LIGHTGEAR_DEBUG=1 shows the traceback),
@@ -23,12 +25,6 @@ EXIT_CODES = """exit codes:
        did not converge (archive written, cause and count on stderr)
   130  interrupted by Ctrl-C or SIGTERM (a sweep keeps its finished points)"""
 
-
-class UsageError(Exception):
-    """Bad command-line input (an option, an output path, an archive): exit 2."""
-
-    def __init__(self, option: str, reason: str):
-        super().__init__(f"{option}: {reason}")
 
 
 def writable_folder(folder: Path, option: str = "-o") -> None:
@@ -179,7 +175,7 @@ def stiffness_command(args) -> int:
     import numpy as np
 
     import study
-    from study.inputs.springs import hole_offset
+    from solver.geometry import hole_offset
     scene = args_scene(args)
     checked_output(args.output)
     ds = study.stiffness(scene, max_time=checked_max_time(args), progress=True)
@@ -191,7 +187,7 @@ def stiffness_command(args) -> int:
         lo, hi = int(np.argmin(k)), int(np.argmax(k))
         print(f"  gear {g}: k_phi {k.min():.4g} .. {k.max():.4g} N mm/rad^n (ratio {r.min():.4f} .. {r.max():.4f})")
         if scene.gear(g).body.holes:
-            off = hole_offset(scene, g)
+            off = hole_offset(scene.gear(g).teeth, scene.gear(g).body.holes, scene.gear(g).body.hole_phase)
             print(f"    stiffest tooth {hi} ({off[hi]:+.2f} pitches from a hole centre), "
                   f"softest tooth {lo} ({off[lo]:+.2f} pitches from a hole centre)")
         if args.identify:

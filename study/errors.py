@@ -24,3 +24,10 @@ class BudgetError(Exception):
         self.field = field
         self.reason = reason
         super().__init__(f"{field}: {reason}")
+
+
+class UsageError(Exception):
+    """Bad command-line input (an option, an output path, an archive): exit 2."""
+
+    def __init__(self, option: str, reason: str):
+        super().__init__(f"{option}: {reason}")

@@ -31,7 +31,7 @@ import numpy as np
 
 from solver.fe.factor import blas1_solver, factorise
 from solver.fe.mesh import REGION_WEB, BodyMesh
-from solver.geometry import GearGeometry, Material
+from solver.geometry import GearGeometry, Material, fillet_band
 
 
 @dataclass(frozen=True)
@@ -291,16 +291,6 @@ def body_field(model: BodyModel, g: GearGeometry, u: np.ndarray, tooth: int, for
     case = load_case(g, tooth, pivot_radius)
     return BodyField(model.mesh.points, model.mesh.triangles, model.thickness, model.mesh.region == REGION_WEB,
                      disp, von_mises(model, u), tooth, force, case.point, case.direction)
-
-
-def fillet_band(centroids: np.ndarray, g: GearGeometry, tooth: int) -> np.ndarray:
-    """Mask of the elements (by their centroids (m, 2) [m]) in the root/fillet band of ``tooth``:
-    radius within one module of the root circle, within one pitch of the tooth axis (both fillets
-    of the tooth, clear of the pitch-point load patch 1.25 modules above the root)."""
-    r = np.hypot(centroids[:, 0], centroids[:, 1])
-    a = np.arctan2(centroids[:, 1], centroids[:, 0]) - tooth * g.pitch_angle
-    a = (a + math.pi) % (2 * math.pi) - math.pi
-    return (np.abs(r - g.root_radius) < g.spec.module) & (np.abs(a) < g.pitch_angle)
 
 
 def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind: str = "von_mises") -> np.ndarray:

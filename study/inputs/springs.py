@@ -25,7 +25,6 @@ import time
 import numpy as np
 
 from solver import units
-from solver.geometry import hole_angles
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup, gear_setups
 from study.scene import Scene
@@ -187,18 +186,6 @@ def stiffness_dataset(scene: Scene):
     ds = xr.Dataset(data, coords=coords, attrs={"scene": scene.to_toml(), "wall_time_springs_s": time.perf_counter() - t0,
                                                 **provenance()})
     return ds
-
-
-def hole_offset(scene: Scene, g: int) -> np.ndarray:
-    """Angular distance [tooth pitches] of each tooth's axis to the nearest hole centre."""
-    b = scene.gear(g).body
-    z = scene.gear(g).teeth
-    if b.holes == 0:
-        return np.full(z, np.nan)
-    tooth = np.arange(z) * 360.0 / z
-    holes = hole_angles(b.holes, b.hole_phase, 360.0)
-    d = (tooth[:, None] - holes[None, :] + 180.0) % 360.0 - 180.0
-    return d[np.arange(z), np.argmin(np.abs(d), axis=1)] / (360.0 / z)
 
 
 def identify_spring(setup: GearSetup, radii: int = 7, levels=(0.25, 0.5, 1.0)):

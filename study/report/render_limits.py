@@ -6,10 +6,10 @@ from pathlib import Path
 
 
 def checked_limits(path: Path, items: list[str]) -> dict[str, float]:
-    """{output: limit} from ``OUTPUT=VALUE`` items; `study.cli.UsageError` (exit 2) for a malformed
+    """{output: limit} from ``OUTPUT=VALUE`` items; `study.errors.UsageError` (exit 2) for a malformed
     item, a value that is no finite number, an archive with no sample dimension or an output
     that is not one of its sampled outputs."""
-    from study.cli import UsageError
+    from study.errors import UsageError
     if not items:
         return {}
     out = {}

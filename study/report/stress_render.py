@@ -26,9 +26,9 @@ DISPLACEMENT_CMAP = "cividis"
 
 def fillet_peak(f, geo, tooth: int) -> float:
     """Largest element von Mises stress [Pa] in the root/fillet band of the loaded tooth
-    (`solver.fe.body.fillet_band`: radius within one module of the root circle, within one pitch
+    (`solver.geometry.fillet_band`: radius within one module of the root circle, within one pitch
     of the tooth axis)."""
-    from solver.fe.body import fillet_band
+    from solver.geometry import fillet_band
     sel = fillet_band(f.points[f.triangles].mean(axis=1), geo, tooth)
     return float(f.von_mises[sel].max()) if sel.any() else float("nan")
 
@@ -50,8 +50,9 @@ def fe_stress_render(ds: xr.Dataset, path, g: int, fields: list) -> RenderResult
     geo = sc.geometry(g)
     body = sc.body_spec(g)
     k = tooth_stiffness(ds, g)
-    from study.inputs.springs import hole_offset
-    off = hole_offset(sc, g)
+    from solver.geometry import hole_offset
+    b = sc.gear(g).body
+    off = hole_offset(sc.gear(g).teeth, b.holes, b.hole_phase)
     n_holes = body.holes
     r_tip = geo.tip_radius / units.MM
     # view: from just above the hole circle's outer edge (or mid-web) to the tip, +-3.5 pitches
