@@ -8,6 +8,13 @@ work of a first, uncached run). The Python wrapper stays, so every kernel can be
 tested from Python. The stepping loops also release the GIL (``nogil=True``), so that a
 progress bar can follow them from another thread. Column indices of the arrays are in `layout`.
 
+The stepping loops (`explicit`, `explicit_coupled`, `implicit`) and the static sweep (`statics`)
+all find the contacts with `gearmesh.mesh_contacts`, which reads the flanks' profile deviations
+(gear_par DEV_*, `solver.modification`), the local compliances in series with the contact
+(CLOC_*) and the pitch errors and eccentricities (pair_par E_*, `solver.pitch_errors`) from the model
+arrays: each kernel runs modified, compliant and erroneous pairs alike. `layout` also holds a
+glossary of the kernels' short names and the named work tuples they carry.
+
 The disk cache sits in a folder named after a hash of every kernel source,
 ``$NUMBA_CACHE_DIR/kernels-<KERNELS_FINGERPRINT>`` (without ``NUMBA_CACHE_DIR``: this package's
 ``__pycache__``): numba checks only the time stamp of a kernel's own file, not those of the

@@ -25,9 +25,6 @@ Energy bookkeeping (trapezoidal in time): work in (driver + load torque), kineti
 potential energy, dissipated energy; the balance closes to O(dt^2).
 
 Status codes: 0 ok, 1 non-finite state, 2 penetration beyond the bound, 3 energy balance.
-
-The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
-the gear_par columns DEV_* (`solver.modification`).
 """
 import math
 
@@ -39,10 +36,10 @@ from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 from solver.mbs.kernels.mechanics import (
     arrowhead_accelerations,
     dissipation_power,
+    drive,
     driver_acc_left,
-    driver_motion,
     driver_speed,
-    load_torque,
+    kick_gear_par,
     mesh_energies,
 )
 from solver.mbs.kernels.status import OK
@@ -59,27 +56,22 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     (n x 2; 0 rows: the torque ramp, see `load_torque`); hub[:, H_TH2] and teeth (rows
     angle, rate, acceleration) the initial state, advanced in place. The run stops on the
     guards of `stepping` (energy growth beyond par[ENERGY_TOL], checked at the output
-    instants). ws: the work arrays (`stepping.work_arrays`). Returns (status, step reached,
-    max active teeth, 0).
+    instants). ws: the work arrays (`layout.StepWork`, from `stepping.work_arrays`). Returns
+    (status, step reached, max active teeth, 0).
     """
     gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, table = ctl
     phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
+    rec, pairs, q, vpred, book = ws.rec, ws.pairs, ws.q, ws.vpred, ws.book
+    act = ws.tset[L.T_ACT]
     tz2 = int(gp[1, L.TOOTH0])
     dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
-    rec, pairs, q, vpred, tset, book = ws
-    act = tset[L.T_ACT]
     imex = par[L.IMEX] != 0.0
-    # the arrowhead of the kicks: the tooth inertia I_P + dt/4*c_phi with implicit dampers
-    gpk = gp.copy()
-    if imex:
-        for g in range(2):
-            gpk[g, L.I_P] += 0.25 * dt * gp[g, L.C_PHI]
+    gpk = kick_gear_par(gp, dt, imex)
     theta2, w2 = hub[L.POS, L.H_TH2], hub[L.RATE, L.H_TH2]
-    th1, w1, acc1 = driver_motion(0.0, speed, ramp)
-    tl = load_torque(0.0, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+    th1, w1, acc1, tl = drive(0.0, par, table)
     nc, npair = mesh_contacts((th1, theta2, w1, w2), phi, dphi, (gp, pp, lp), (rec, pairs))
-    nact = initial_set(tset, teeth, pairs, npair, tz2)
+    nact = initial_set(ws.tset, teeth, pairs, npair, tz2)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     a2, s1, r1 = arrowhead_accelerations(q, act, nact, gpk, acc)
     react = s1 * acc1 + r1
@@ -107,8 +99,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
                 dphi[i] -= cr1 * dw_a
             phi[i] += dt * dphi[i]
         theta2 += dt * w2h
-        th1, w1, acc1 = driver_motion(t, speed, ramp)
-        tl = load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+        th1, w1, acc1, tl = drive(t, par, table)
         # predicted velocities for the damping terms
         w2p = w2h + 0.5 * dt * a2
         for a in range(nact):
@@ -119,7 +110,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
         # contacts; activate the teeth the pre-search finds
         nc, npair = mesh_contacts((th1, theta2, w1, w2p), phi, vpred, (gp, pp, lp), (rec, pairs))
         n_old = nact
-        nact = activate(tset, nact, pairs, npair, tz2)
+        nact = activate(ws.tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):
             acc[act[a]] = 0.0
             vpred[act[a]] = 0.0

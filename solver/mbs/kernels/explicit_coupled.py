@@ -35,9 +35,6 @@ Linear tooth-root dampers (par[IMEX] = 1) are taken implicitly in the kicks exac
 each kick starts with, and the next first kick's accelerations again with the new rates):
 the step is then bound by the stiffness alone. Body and contact dampers stay explicit
 (predicted velocity).
-
-The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
-the gear_par columns DEV_* (`solver.modification`).
 """
 import math
 
@@ -46,7 +43,7 @@ import numpy as np
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
-from solver.mbs.kernels.mechanics import dissipation_power, driver_acc_left, driver_motion, load_torque, mesh_energies
+from solver.mbs.kernels.mechanics import dissipation_power, drive, driver_acc_left, kick_gear_par, mesh_energies
 from solver.mbs.kernels.status import OK
 from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_output
 from solver.mbs.kernels.toothcoupling import coupled_set, set_differs, set_energy, set_springs, update_set
@@ -100,7 +97,7 @@ def body_dissipation(p, gp, w1, v):
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
-    """Forces and accelerations for the contacts ws[0][:nc], the tooth rotations teeth[0] and
+    """Forces and accelerations for the contacts ws.rec[:nc], the tooth rotations teeth[0] and
     the rates teeth[1] of their root dampers, the body angles hub[POS] and rates v (columns
     H_*): fills q, the teeth's and the bodies' accelerations (row ACC of hub, and of the teeth
     through ``acc``); drv = (theta1 [rad], theta1' [rad/s], theta1'' [rad/s²], load torque
@@ -108,16 +105,16 @@ def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
     tooth inertia I_P + dt/4 c_phi, `explicit.py`). Returns (driver torque [N m], body-spring
     moment on the driver rim [N m])."""
     gp, _pp, _lp, kphi, _ct = mdl
-    rec, _pairs, q, _vel, tset, _book = ws
+    q, act = ws.q, ws.tset[L.T_ACT]
     th1, w1, acc1, tl, acc = drv
     phi = teeth[0]
     q[:] = 0.0
-    generalized_forces(rec, nc, phi, teeth[1], tset[L.T_ACT], nact, kphi, gp, 0.0, q)
+    generalized_forces(ws.rec, nc, phi, teeth[1], act, nact, kphi, gp, 0.0, q)
     set_springs(cset, ns, kphi, phi, q)
     mb1, mb2 = body_moments(gp, th1, w1, hub[L.POS], v)
     q[0] += mb1
     q[1] += mb2
-    rim_accelerations(q, tset[L.T_ACT], nact, gpk, acc, hub[L.ACC])
+    rim_accelerations(q, act, nact, gpk, acc, hub[L.ACC])
     hub[L.ACC, L.H_H2] = (tl - mb2) / gp[1, L.I_HUB]
     return gp[0, L.I_HUB] * acc1 + mb1, mb1
 
@@ -128,18 +125,17 @@ def coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth):
     the teeth on the rims, and the coupled set's springs through K_S instead of their own.
     Arguments as `coupled_forces` (drv: its first two, theta1 [rad] and theta1' [rad/s])."""
     gp, _pp, _lp, kphi, _ct = mdl
-    rec, tset = ws[0], ws[4]
     th1, w1 = drv[0], drv[1]
     x = hub[L.POS]
     v = hub[L.RATE]
     ke = 0.5 * gp[0, L.I_HUB] * w1 * w1 + 0.5 * (gp[0, L.I_TOT] - gp[0, L.I_HUB]) * v[L.H_R1] * v[L.H_R1]
     ke += 0.5 * gp[1, L.I_HUB] * v[L.H_H2] * v[L.H_H2] + 0.5 * (gp[1, L.I_TOT] - gp[1, L.I_HUB]) * v[L.H_TH2] * v[L.H_TH2]
     pe = 0.5 * gp[0, L.K_BODY] * (th1 - x[L.H_R1]) ** 2 + 0.5 * gp[1, L.K_BODY] * (x[L.H_H2] - x[L.H_TH2]) ** 2
-    ke, pe = mesh_energies(ke, pe, v[L.H_R1], v[L.H_TH2], teeth, tset[L.T_ACT], nact, mdl, rec, nc)
+    ke, pe = mesh_energies(ke, pe, v[L.H_R1], v[L.H_TH2], teeth, ws.tset[L.T_ACT], nact, mdl, ws.rec, nc)
     if ns > 0:
-        pe += set_energy(cset[1], cset[2], ns, teeth[L.POS])
+        pe += set_energy(cset.ks, cset.lst, ns, teeth[L.POS])
         for a in range(ns):
-            i = cset[2][a]
+            i = cset.lst[a]
             pe -= 0.5 * kphi[i] * teeth[L.POS, i] * teeth[L.POS, i]
     return ke, pe
 
@@ -170,32 +166,29 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     gp, pp, lp, kphi, ctooth = mdl
     par, ipar, table = ctl
     phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
+    rec, pairs, q, vpred, tset, book = ws.rec, ws.pairs, ws.q, ws.vpred, ws.tset, ws.book
+    act = tset[L.T_ACT]
     tz2 = int(gp[1, L.TOOTH0])
     dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
-    rec, pairs, q, vpred, tset, book = ws
-    act = tset[L.T_ACT]
     x, v, ha = hub[L.POS], hub[L.RATE], hub[L.ACC]
     vh = np.zeros(L.N_HUB)
     vp = np.zeros(L.N_HUB)
     imex = par[L.IMEX] != 0.0
-    # the arrowhead of the kicks: the tooth inertia I_P + dt/4*c_phi with implicit dampers
-    gpk = gp.copy()
+    gpk = kick_gear_par(gp, dt, imex)
     # the dissipation power integrated by the trapezoidal rule: without the implicit tooth-root
     # dampers, whose work each kick books exactly (below)
     gpd = gp.copy()
     if imex:
         for g in range(2):
-            gpk[g, L.I_P] += 0.25 * dt * gp[g, L.C_PHI]
             gpd[g, L.C_PHI] = 0.0
     mdl_d = (gpd, pp, lp, kphi, ctooth)
     cset = coupled_set(ctooth)
     coupled = ctooth.shape[0] > 0
-    th1, w1, acc1 = driver_motion(0.0, speed, ramp)
-    tl = load_torque(0.0, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+    th1, w1, acc1, tl = drive(0.0, par, table)
     nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
     ns = np.int64(0)
     if coupled:
-        nn = new_candidates(cset[3], tset[L.T_INCAND], pairs, npair, tz2)
+        nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2)
         ns = update_set(cset, ns, nn, phi, dphi, dphi)
         tset[L.T_INCAND, :] = 0
     nact = initial_set(tset, teeth, pairs, npair, tz2)
@@ -226,13 +219,12 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         for k in range(L.N_HUB):
             x[k] += dt * vh[k]
             vp[k] = vh[k] + 0.5 * dt * ha[k]    # predicted velocities for the damping terms
-        th1, w1, acc1 = driver_motion(t, speed, ramp)
-        tl = load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+        th1, w1, acc1, tl = drive(t, par, table)
         for a in range(nact):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
         nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, (gp, pp, lp), (rec, pairs))
-        nn = new_candidates(cset[3], tset[L.T_INCAND], pairs, npair, tz2) if coupled else 0
+        nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2) if coupled else 0
         n_old = nact
         nact = activate(tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):

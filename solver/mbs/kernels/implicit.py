@@ -26,13 +26,10 @@ forces are then re-evaluated at the converged state (they start the next step).
 
 Status codes: those of the explicit kernel, plus 4 Newton failure.
 
-Newton work arrays ``nw`` = (coef, q_old, pred, hpred, A, r, dx, loc, cl) (`newton_arrays`):
-the scheme's coefficients (K_* columns below), the forces of the last step, the Newmark
-predictors of the teeth and of theta2 (rows POS, RATE), the system, residual, correction,
-and the condensation's index maps.
-
-The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
-the gear_par columns DEV_* (`solver.modification`).
+Newton work arrays ``nw`` (`layout.NewtonWork`, from `newton_arrays`): the scheme's
+coefficients (K_* columns below), the forces of the last step, the Newmark predictors of the
+teeth and of theta2 (rows POS, RATE), the system, residual, correction, and the
+condensation's index maps.
 """
 import math
 
@@ -45,7 +42,7 @@ from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tan
 from solver.mbs.kernels.mechanics import (
     arrowhead_accelerations,
     dissipation_power,
-    driver_motion,
+    drive,
     driver_speed,
     load_torque,
     mesh_energies,
@@ -54,7 +51,7 @@ from solver.mbs.kernels.statics import solve_dense
 from solver.mbs.kernels.status import NEWTON, NONFINITE, OK
 from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_output
 
-# coefficients of the scheme: nw[0]
+# coefficients of the scheme: nw.coef
 K_BETA = 0          # Newmark beta [-]
 K_GAMMA = 1         # Newmark gamma [-]
 K_CM = 2            # mass factor of the tangent 1/(beta dt^2) [1/s^2]
@@ -70,8 +67,9 @@ def newton_arrays(ntooth, alpha, dt):
     gamma = 0.5 - alpha
     coef = np.array([beta, gamma, 1.0 / (beta * dt * dt), 1.0 + alpha, (1.0 + alpha) * gamma / (beta * dt), alpha])
     m = 2 * L.MAX_CONTACTS
-    return (coef, np.zeros(ntooth + 2), np.zeros((2, ntooth)), np.zeros(2), np.zeros((m + 1, m + 1)),
-            np.zeros(ntooth + 1), np.zeros(ntooth + 1), np.zeros(ntooth, dtype=np.int64), np.zeros(m, dtype=np.int64))
+    return L.NewtonWork(coef, np.zeros(ntooth + 2), np.zeros((2, ntooth)), np.zeros(2), np.zeros((m + 1, m + 1)),
+                        np.zeros(ntooth + 1), np.zeros(ntooth + 1), np.zeros(ntooth, dtype=np.int64),
+                        np.zeros(m, dtype=np.int64))
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -130,7 +128,7 @@ def newton_correction(mdl, rec, nc, teeth, act, nact, nw):
     and is condensed out first; the dense solve runs over theta2 and the teeth in contact.
     """
     gp = mdl[0]
-    coef, _q_old, _pred, _hpred, A, r, dx, loc, cl = nw
+    coef, A, r, dx, loc, cl = nw.coef, nw.A, nw.r, nw.dx, nw.loc, nw.cl
     tz2 = int(gp[1, L.TOOTH0])
     m = 0
     for c in range(nc):
@@ -203,7 +201,7 @@ def hht_residual(mdl, q, nw, hub, acc, act, nact, a1m):
     """r = -(M a - (1+alpha) Q_{n+1} + alpha Q_n) into nw's r, over (theta2, active teeth);
     a1m [rad/s²]: the driver acceleration over the step (inertia on the gear-1 teeth)."""
     gp = mdl[0]
-    coef, q_old, _pred, _hpred, _A, r, _dx, _loc, _cl = nw
+    coef, q_old, r = nw.coef, nw.q_old, nw.r
     tz2 = int(gp[1, L.TOOTH0])
     alpha = coef[K_ALPHA]
     a2 = hub[L.ACC, L.H_TH2]
@@ -229,8 +227,8 @@ def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
     Returns (status, iterations, contacts, candidate pairs, active teeth)."""
     gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
     par, ipar, _table = ctl
-    rec, pairs, q, _vpred, tset, _book = ws
-    coef, q_old, pred, hpred, _A, _r, dx, _loc, _cl = nw
+    rec, pairs, q, tset = ws.rec, ws.pairs, ws.q, ws.tset
+    coef, q_old, pred, hpred, dx = nw.coef, nw.q_old, nw.pred, nw.hpred, nw.dx
     th1, w1, tl, a1m = drv
     act = tset[L.T_ACT]
     phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
@@ -302,14 +300,13 @@ def hht(mdl, ctl, hub, teeth, out, ws):
     phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
     tz2 = int(gp[1, L.TOOTH0])
     dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
-    rec, pairs, q, _vpred, tset, book = ws
+    rec, pairs, q, tset, book = ws.rec, ws.pairs, ws.q, ws.tset, ws.book
     nw = newton_arrays(phi.shape[0], par[L.HHT_ALPHA], dt)
     act = tset[L.T_ACT]
     nact = initial_set(tset, teeth, pairs, np.int64(0), tz2)     # the teeth already moving
-    th1, w1, acc1 = driver_motion(0.0, speed, ramp)
+    th1, w1, acc1, tl = drive(0.0, par, table)
     nc, npair = mesh_contacts((th1, hub[L.POS, L.H_TH2], w1, hub[L.RATE, L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
     nact = activate(tset, nact, pairs, npair, tz2)
-    tl = load_torque(0.0, par[L.TORQUE], par[L.TORQUE_RAMP], table)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     # initial accelerations: the explicit arrowhead solve, plus the driver coupling
     hub[L.ACC, L.H_TH2], _s1, _r1 = arrowhead_accelerations(q, act, nact, gp, acc)
@@ -332,7 +329,7 @@ def hht(mdl, ctl, hub, teeth, out, ws):
     for step in range(1, ipar[L.N_STEPS] + 1):
         t_old = (step - 1) * dt
         t = step * dt
-        nw[1][:] = q
+        nw.q_old[:] = q
         # driver acceleration over the step (constant when the ramp end lies on the grid)
         a1m = (driver_speed(t, speed, ramp) - driver_speed(t_old, speed, ramp)) / dt
         if a1m != a1_prev:
@@ -342,8 +339,7 @@ def hht(mdl, ctl, hub, teeth, out, ws):
             tl_old = load_torque(t_old, par[L.TORQUE], par[L.TORQUE_RAMP], table)
             book[L.B_P_IN] = react * driver_speed(t_old, speed, ramp) + tl_old * hub[L.RATE, L.H_TH2]
             a1_prev = a1m
-        th1, w1, _a1 = driver_motion(t, speed, ramp)
-        tl = load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+        th1, w1, _a1, tl = drive(t, par, table)
         status, it, nc, npair, nact = newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, (th1, w1, tl, a1m))
         total_it += it
         itmax = max(itmax, it)

@@ -1,8 +1,67 @@
-"""Indices into the flat parameter arrays that the kernels take (see `solver.mbs.model`).
+"""What the kernels' arrays and tuples hold: column indices of the flat parameter arrays (see
+`solver.mbs.model`), the state, output and work arrays, the named work tuples, and the short
+names the kernels use for them.
 
 ``gear_par[g, :]`` holds per-gear scalars (g = 0 driver, 1 driven), SI units.
 ``law_par`` holds the contact law; ``pair_par`` the pair data.
+
+Glossary of the kernels' short names (SI units throughout):
+
+    gp, pp, lp    gear_par (2 x N_GEAR_PAR), pair_par, law_par: the columns below
+    kphi          tooth spring stiffness k_phi of each tooth [N m/rad^n_k]
+    ctooth        tooth compliance matrix of teeth coupled through the body [rad/(N m)] (0 x 0 or
+                  None: plain springs)
+    mdl           (gp, pp, lp, kphi) or (gp, pp, lp, kphi, ctooth): the model
+    ctl           (par, ipar[, load table]): the control scalars and integers (columns below)
+    g             gear: 0 driver, 1 driven; s, side: flank side, +1 drive, -1 coast
+    i, tz2        tooth index over both gears (gear 1 first); tz2 = gp[1, TOOTH0], the index of
+                  the first gear-2 tooth (i >= tz2: a gear-2 tooth)
+    k, j          tooth number within gear 1 (k) and gear 2 (j); ia, ib: their indices i
+    phi, dphi     tooth rotations relative to their hub (or rim) [rad] and rates [rad/s]
+    acc           tooth angular accelerations [rad/s^2]
+    theta1, th1   driver hub angle [rad]; w1 its rate [rad/s], acc1 its acceleration [rad/s^2]
+    theta2, w2    driven angle (hub, or rim in the coupled model) [rad] and rate [rad/s]; a2 its
+                  acceleration [rad/s^2]
+    w2h, w2p      theta2' at the half step of the Verlet kick [rad/s], and predicted at the step's
+                  end for the damping terms (w2h + dt/2*a2)
+    vpred         predicted tooth rates for the damping terms [rad/s]
+    x, v, ha      body angles [rad], rates [rad/s], accelerations [rad/s^2] (hub rows POS, RATE,
+                  ACC, columns H_*); vh, vp: their half-step and predicted rates
+    tl            resisting (load) torque on gear 2 [N m]
+    te            transmission error rb1*theta1 + rb2*theta2 [m]
+    ke, pe        kinetic and potential energy [J]
+    react         torque the driver applies [N m]
+    s1, r1        driver torque = s1*theta1'' + r1 from the arrowhead solve [kg m^2], [N m]
+    cr1           I_CPL/I_P of gear 1 (of gpk): a gear-1 tooth's rate relative to its hub drops by
+                  cr1 times each driver speed increment (the inertial coupling) [-]
+    gpk           gear_par of the kicks' arrowhead solve (I_P + dt/4*c_phi with implicit dampers)
+    imex          the tooth-root dampers taken implicitly in the Verlet kicks (par[IMEX])
+    q             generalised forces: q[0] on theta1, q[1] on theta2, q[2 + i] on tooth i [N m]
+    rec           contact records, one row per contact (C_* columns), nc of them
+    nc            number of contacts in rec (loaded or not); nload: those with a force > 0
+    pairs, npair  candidate tooth pairs of the pre-search (gear-1 tooth, gear-2 tooth, side)
+    tset          active-tooth set (T_* rows); act = tset[T_ACT], the first nact valid
+    act, nact     active tooth indices and their number
+    book          running sums of a run (B_* columns)
+    out, o        output records (O_* or S_* columns) and the record index
+    cset, ns, nn  the coupled set of teeth (`CoupledSet`), its size, the size of the next one
+    ks            stiffness K_S = C[S, S]^-1 of the coupled set [N m/rad]
+    nt, lst, pos  the statics' unknown teeth: their number, their indices, and each tooth's
+                  unknown number (0: theta2, -1: not an unknown)
+    r, rn         Newton residual [N m] and its max-norm
+    nw            the HHT Newton's work arrays (`NewtonWork`); coef its scheme coefficients
+    kt            tangent stiffness dF/d delta of a contact [N/m]
+    drv           the driver and the load at an instant: (theta1, theta1', [theta1'',] load
+                  torque, ...) as each kernel's docstring lists
+    A, B          the gear-1 and the gear-2 tooth of a candidate pair (the contact search)
+    ua, ub        roll parameters of the contact point on the flanks of tooth A and B [-]
+    pose, frame   where a pair's teeth stand: base-circle centres, axis sines and cosines,
+                  eccentric offsets; the bearing axes and tooth pivots (`gearmesh._tooth_poses`)
+    dg, ser       a contact's gradient share of the flank deviations [m]; its series local
+                  compliance and that compliance's gradient [m/N]
 """
+from collections import namedtuple
+
 # gear_par columns
 RB = 0          # base radius [m]
 PSI_B = 1       # half tooth angle on the base circle [rad]
@@ -59,7 +118,7 @@ JN_HALF = 0     # half the normal backlash [m]
 ALPHA = 1       # pressure angle [rad]
 MARGIN = 2      # pre-search margin on the roll parameter [rad]
 N_PAIR_PAR = 3
-# pitch errors and eccentricity (`solver.errors`): a block after N_PAIR_PAR, present only when
+# pitch errors and eccentricity (`solver.pitch_errors`): a block after N_PAIR_PAR, present only when
 # either gear has errors (the kernels test the length of pair_par)
 E_BOUND = 3     # bound on the penetration the errors can add [m]
 E_ECC = 4       # gear g: eccentricity [m] at E_ECC + 2g, its phase from tooth 0's axis [rad] at E_ECC + 2g + 1
@@ -192,3 +251,23 @@ S_NC = 2            # loaded contacts [-]
 S_ITER = 3          # Newton iterations (negative: not converged) [-]
 S_T1 = 4            # torque the contacts take from the driver (its rim) [N m]
 N_S_OUT = 5
+
+# ---- named work tuples: the scratch arrays a kernel carries (numba types them like tuples, and
+# ``ws.rec`` compiles to the same code as ``ws[0]``)
+StepWork = namedtuple("StepWork", "rec pairs q vpred tset book")
+StepWork.__doc__ = """Work arrays of a time-stepping loop (`stepping.work_arrays`): contact records
+(C_* columns), candidate pairs, generalised forces q [N m], predicted tooth rates [rad/s], the
+active-tooth set (T_* rows), the running sums (B_* columns)."""
+StaticWork = namedtuple("StaticWork", "rec pairs q zero_rates pos lst r")
+StaticWork.__doc__ = """Work arrays of the static Newton (`statics`): contact records, candidate
+pairs, generalised forces q [N m], tooth rates held at zero [rad/s], each tooth's unknown number
+(0: theta2, -1: none), the unknown teeth's indices, the residual [N m] over theta2 and them."""
+NewtonWork = namedtuple("NewtonWork", "coef q_old pred hpred A r dx loc cl")
+NewtonWork.__doc__ = """Work arrays of the HHT-alpha Newton (`implicit.newton_arrays`): the scheme's
+coefficients (`implicit` K_* columns), the forces of the last step [N m], the Newmark predictors
+of the teeth and of theta2 (rows POS, RATE), the Newton matrix, residual and correction, and the
+condensation's index maps (each tooth's row in A, 0: condensed; the teeth of the rows)."""
+CoupledSet = namedtuple("CoupledSet", "C ks lst newl inset innew mo dmo")
+CoupledSet.__doc__ = """The coupled set S of teeth (`toothcoupling.coupled_set`): the compliance C
+[rad/(N m)], the set's stiffness K_S [N m/rad] (with as many scratch columns), its teeth, the
+next set's teeth, per-tooth 0/1 flags of the current and the next set, scratch moments [N m]."""

@@ -51,6 +51,27 @@ def load_torque(t, torque, ramp, table):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
+def drive(t, par, table):
+    """The loads at t [s] of the controls par (`layout` SPEED, SPEED_RAMP, TORQUE, TORQUE_RAMP)
+    and the load profile ``table`` (`load_torque`): driver angle [rad], speed [rad/s] and
+    acceleration [rad/s²], and the resisting torque on gear 2 [N m]."""
+    th1, w1, acc1 = driver_motion(t, par[L.SPEED], par[L.SPEED_RAMP])
+    return th1, w1, acc1, load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def kick_gear_par(gp, dt, imex):
+    """The gear_par of the Verlet kicks' arrowhead solve: a copy of gp, with the tooth inertia
+    I_P + dt/4*c_phi [kg m²] where the tooth-root dampers are taken implicitly (imex; step dt
+    [s], `explicit`)."""
+    gpk = gp.copy()
+    if imex:
+        for g in range(2):
+            gpk[g, L.I_P] += 0.25 * dt * gp[g, L.C_PHI]
+    return gpk
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
 def arrowhead_accelerations(q, act, nact, gp, acc):
     """Solve the arrowhead systems of the plain pair for the force part of the accelerations.
 

@@ -14,10 +14,6 @@ teeth at rest on their hubs): the sliding direction of a pair whose driver turns
 positive sense, regularised as in dynamics at that speed. The caller zeroes the contact
 damping (it would see the kinematic penetration rate). The tangent carries the friction's
 change through the normal force (H (F_t/F) k_t G^T, nonsymmetric).
-
-The contact search it calls (`gearmesh.mesh_contacts`) takes the flanks' profile deviations from
-the gear_par columns DEV_* (`solver.modification`) and the pitch errors and eccentricities
-from the pair_par block E_* (`solver.errors`).
 """
 
 import numpy as np
@@ -25,6 +21,7 @@ import numpy as np
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
 from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, tooth_spring_tangent
+from solver.mbs.kernels.layout import StaticWork
 from solver.mbs.kernels.toothcoupling import set_moment, set_stiffness
 
 
@@ -63,18 +60,18 @@ def solve_dense(a, b):
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def _workspace(ntooth):
-    """Work arrays ``ws`` of the Newton for ntooth teeth: (contact records, candidate pairs,
-    generalised forces, zero tooth rates, the unknowns' positions and list, residual)."""
-    return (np.zeros((L.MAX_CONTACTS, L.N_C_COLS)), np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64),
-            np.zeros(ntooth + 2), np.zeros(ntooth), np.zeros(ntooth, dtype=np.int64),
-            np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth + 1))
+    """Work arrays ``sw`` of the Newton for ntooth teeth (`layout.StaticWork`)."""
+    return StaticWork(np.zeros((L.MAX_CONTACTS, L.N_C_COLS)), np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64),
+                      np.zeros(ntooth + 2), np.zeros(ntooth), np.zeros(ntooth, dtype=np.int64),
+                      np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth + 1))
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _unknown_set(ws, npair, gp, phi):
-    """Number the teeth of the npair candidate pairs 1.. in ws's pos (0 is theta2; -1: not an
-    unknown) and list them in lst; the other teeth are unloaded (phi = 0). Returns their number."""
-    _rec, pairs, _q, _zeros, pos, lst, _r = ws
+def _unknown_set(sw, npair, gp, phi):
+    """Number the teeth of the npair candidate pairs 1.. in sw.pos (0 is theta2; -1: not an
+    unknown) and list them in sw.lst; the other teeth are unloaded (phi = 0). Returns their
+    number."""
+    pairs, pos, lst = sw.pairs, sw.pos, sw.lst
     for i in range(pos.shape[0]):
         pos[i] = -1
     nt = np.int64(0)
@@ -92,13 +89,13 @@ def _unknown_set(ws, npair, gp, phi):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _unknown_forces(mdl, ks, ws, nc, nt, phi, torque):
-    """Residual ws's r [N m] on theta2 and the nt unknown teeth from the contacts rec[:nc]
+def _unknown_forces(mdl, ks, sw, nc, nt, phi, torque):
+    """Residual sw.r [N m] on theta2 and the nt unknown teeth from the contacts sw.rec[:nc]
     under the resisting torque [N m]; returns its max-norm. A coupled model's tooth springs
     act through the set stiffness ks (its per-tooth kphi are zero; ks is None otherwise)."""
     gp, _pp, _lp, kphi = mdl
-    rec, _pairs, q, zeros, _pos, lst, r = ws
-    generalized_forces(rec, nc, phi, zeros, lst, nt, kphi, gp, torque, q)
+    q, lst, r = sw.q, sw.lst, sw.r
+    generalized_forces(sw.rec, nc, phi, sw.zero_rates, lst, nt, kphi, gp, torque, q)
     r[0] = q[1]
     for a in range(nt):
         r[1 + a] = q[2 + lst[a]]
@@ -111,12 +108,12 @@ def _unknown_forces(mdl, ks, ws, nc, nt, phi, torque):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _tangent(mdl, ks, ws, nc, nt, phi):
-    """Newton tangent [N m/rad] over theta2 and the nt unknown teeth: the contacts rec[:nc]
+def _tangent(mdl, ks, sw, nc, nt, phi):
+    """Newton tangent [N m/rad] over theta2 and the nt unknown teeth: the contacts sw.rec[:nc]
     plus the tooth springs (the set stiffness ks of a coupled model, else each tooth's own
     tangent, regularised where it vanishes at phi = 0)."""
     gp, _pp, lp, kphi = mdl
-    rec, _pairs, _q, _zeros, pos, lst, _r = ws
+    rec, pos, lst = sw.rec, sw.pos, sw.lst
     friction = lp[L.MU] > 0.0
     n = nt + 1
     K = np.zeros((n, n))
@@ -165,13 +162,71 @@ def newton_system(mdl, theta1, theta2, phi, torque):
     residual [N m], the unknown teeth), the unknowns being theta2 and those teeth, as the
     sweep below builds them (for checks against finite differences)."""
     gp, pp, lp, _kphi = mdl
-    ws = _workspace(phi.shape[0])
-    rec, pairs, zeros = ws[0], ws[1], ws[3]
+    sw = _workspace(phi.shape[0])
     ph = phi.copy()
-    nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), ph, zeros, (gp, pp, lp), (rec, pairs))
-    nt = _unknown_set(ws, npair, gp, ph)
-    _unknown_forces(mdl, None, ws, nc, nt, ph, torque)
-    return _tangent(mdl, None, ws, nc, nt, ph), ws[6][:nt + 1].copy(), ws[5][:nt].copy()
+    nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), ph, sw.zero_rates, (gp, pp, lp), (sw.rec, sw.pairs))
+    nt = _unknown_set(sw, npair, gp, ph)
+    _unknown_forces(mdl, None, sw, nc, nt, ph, torque)
+    return _tangent(mdl, None, sw, nc, nt, ph), sw.r[:nt + 1].copy(), sw.lst[:nt].copy()
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _open_gap(gp, pp):
+    """How far an open mesh may be from its first touch beyond the rigid gap [m]: both flanks'
+    largest deviations, the pitch errors and eccentricities (a loop, not .max(): numpy's max
+    and take would compile too)."""
+    open_gap = 0.0
+    for g in range(2):
+        dev_max = 0.0
+        if gp[g, L.DEV_ON] > 0.0:
+            for k in range(L.DEV0, L.DEV0 + L.N_DEV):
+                dev_max = max(dev_max, gp[g, k])
+        open_gap += dev_max
+    if pp.shape[0] > L.N_PAIR_PAR:
+        open_gap += pp[L.E_BOUND]
+    return open_gap
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _loaded(rec, nc):
+    """Number of the contacts rec[:nc] that carry a force."""
+    n = 0
+    for c in range(nc):
+        if rec[c, L.C_FORCE] > 0.0:
+            n += 1
+    return n
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _closing_angle(theta1, torque, open_steps, open_gap, gp, pp, lp):
+    """Driven angle [rad] at driver angle theta1 [rad] of a mesh not yet in contact: the rigid
+    gap closed plus the contact-only penetration under the torque [N m], and, as modified
+    flanks or errors may leave the gap up to open_gap [m] more, open_steps 16ths of that (one
+    more at each iteration without contact, near the first touch)."""
+    rb1 = gp[0, L.RB]
+    rb2 = gp[1, L.RB]
+    dpen = (abs(torque) / rb2 / lp[L.K_CON]) ** (1.0 / lp[L.M1])
+    dpen += open_steps / 16.0 * open_gap
+    return ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _unknown_rotations(phi, lst, nt):
+    """A copy of the rotations [rad] of the nt unknown teeth lst[:nt]."""
+    ph = np.empty(nt)
+    for m in range(nt):
+        ph[m] = phi[lst[m]]
+    return ph
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _line_step(theta2, ph, dx, step, phi, lst, nt):
+    """Move the unknowns from (theta2 [rad], the rotations ph [rad] of the teeth lst[:nt]) by
+    step times the Newton correction dx (theta2 first): the teeth in phi; returns the new
+    theta2 [rad]."""
+    for m in range(nt):
+        phi[lst[m]] = ph[m] + step * dx[m + 1]
+    return theta2 + step * dx[0]
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -180,7 +235,6 @@ def _store(out, force1, a, rec, nc, row):
     from the contacts rec[:nc], the loaded ones, the force on each gear-1 tooth [N] and the
     driver torque [N m] (their moments about O1, friction included)."""
     out[a, L.S_TE], out[a, L.S_TH2], out[a, L.S_ITER] = row
-    nload = 0
     t1 = 0.0
     for k in range(force1.shape[1]):
         force1[a, k] = 0.0
@@ -188,9 +242,8 @@ def _store(out, force1, a, rec, nc, row):
         f = rec[c, L.C_FORCE]
         t1 += f * rec[c, L.C_G1] + rec[c, L.C_FT] * rec[c, L.C_H1]
         if f > 0.0:
-            nload += 1
             force1[a, int(rec[c, L.C_TOOTH1])] += f
-    out[a, L.S_NC] = nload
+    out[a, L.S_NC] = _loaded(rec, nc)
     out[a, L.S_T1] = t1
 
 
@@ -210,13 +263,16 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     force on each gear-1 tooth [N] force1[a, k]. Returns the number of angles that did not
     converge. Stops before the next angle once par[S_ABORT] is set (from another thread:
     `solver.mbs.interrupt`); the angles not reached keep their zero rows.
+
+    The Newton of each angle is written out here, not in a helper kernel: a kernel around
+    mesh_contacts costs its own optimisation of the whole contact search at compile time.
     """
     gp, pp, lp, _kphi = mdl
     par, ipar = ctl
     torque = par[L.S_TORQUE]
     ntooth = phi.shape[0]
-    ws = _workspace(ntooth)
-    rec, pairs, zeros, lst, r = ws[0], ws[1], ws[3], ws[5], ws[6]
+    sw = _workspace(ntooth)
+    rec, pairs, zeros, lst = sw.rec, sw.pairs, sw.zero_rates, sw.lst
     if ctooth is None:
         ks = None
     else:
@@ -227,18 +283,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     theta2 = par[L.S_THETA2]
     w1 = par[L.S_W1]
     w2 = -rb1 / rb2 * w1 if w1 != 0.0 else 0.0
-    # how far an open mesh may be from its first touch beyond the rigid gap: both flanks'
-    # largest deviations, the pitch errors and eccentricities (a loop, not .max(): numpy's max
-    # and take would compile too)
-    open_gap = 0.0
-    for g in range(2):
-        dev_max = 0.0
-        if gp[g, L.DEV_ON] > 0.0:
-            for k in range(L.DEV0, L.DEV0 + L.N_DEV):
-                dev_max = max(dev_max, gp[g, k])
-        open_gap += dev_max
-    if pp.shape[0] > L.N_PAIR_PAR:
-        open_gap += pp[L.E_BOUND]
+    open_gap = _open_gap(gp, pp)
     failures = 0
     nc = np.int64(0)        # not a literal 0: numba would compile the callees once more for it
     npair = np.int64(0)
@@ -249,7 +294,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
         if a > 0:
             theta2 -= rb1 / rb2 * (theta1s[a] - theta1s[a - 1])
         it = 0
-        open_steps = 0      # iterations at this angle without contact
+        open_steps = np.int64(0)    # iterations at this angle without contact
         converged = False
         fresh = False       # rec and pairs already hold the search at this very state
         while it < ipar[L.S_MAX_ITER]:
@@ -258,45 +303,30 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                 nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
             fresh = False
             # the unknowns: the teeth the pre-search finds at the current iterate
-            nt = _unknown_set(ws, npair, gp, phi)
+            nt = _unknown_set(sw, npair, gp, phi)
             if ctooth is not None:
                 set_stiffness(ctooth, lst, nt, ks)
-            nload = 0
-            for c in range(nc):
-                if rec[c, L.C_FORCE] > 0.0:
-                    nload += 1
-            if nload == 0:
+            if _loaded(rec, nc) == 0:
                 if torque == 0.0:
                     converged = True
                     break
-                # no contact yet: close the gap rigidly, plus the contact-only penetration
-                dpen = (abs(torque) / rb2 / lp[L.K_CON]) ** (1.0 / lp[L.M1])
-                # modified flanks or errors: the gap may be up to open_gap more; closed in 16ths
-                # of it, one more at each iteration without contact (near the first touch)
-                dpen += open_steps / 16.0 * open_gap
+                theta2 = _closing_angle(theta1, torque, open_steps, open_gap, gp, pp, lp)
                 open_steps += 1
-                theta2 = ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
                 continue
             # residual from the contacts just found (same state: no second search)
-            rn = _unknown_forces(mdl, ks, ws, nc, nt, phi, torque)
+            rn = _unknown_forces(mdl, ks, sw, nc, nt, phi, torque)
             if rn < tol_abs:
                 converged = True
                 break
-            dx = solve_dense(_tangent(mdl, ks, ws, nc, nt, phi), r[:nt + 1].copy())
+            dx = solve_dense(_tangent(mdl, ks, sw, nc, nt, phi), sw.r[:nt + 1].copy())
             # backtracking on the max-norm of the residual
             th_old = theta2
-            ph_old = np.empty(nt)
-            for m in range(nt):
-                ph_old[m] = phi[lst[m]]
+            ph_old = _unknown_rotations(phi, lst, nt)
             step = 1.0
             for _ in range(30):
-                theta2 = th_old + step * dx[0]
-                for m in range(nt):
-                    phi[lst[m]] = ph_old[m] + step * dx[m + 1]
-                # (written out, not a helper kernel: a kernel around mesh_contacts costs its own
-                # optimisation of the whole contact search at compile time)
+                theta2 = _line_step(th_old, ph_old, dx, step, phi, lst, nt)
                 nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
-                rn2 = _unknown_forces(mdl, ks, ws, nc, nt, phi, torque)
+                rn2 = _unknown_forces(mdl, ks, sw, nc, nt, phi, torque)
                 if rn2 < rn or rn2 < tol_abs:
                     break
                 step *= 0.5

@@ -26,17 +26,16 @@ from solver.mbs.kernels.status import ENERGY, INTERRUPTED, NONFINITE, OK, PENETR
 
 
 def work_arrays(ntooth):
-    """(rec, pairs, q, vpred, tset, book), the work arrays ``ws`` of a loop over ntooth teeth:
-    contact records, candidate pairs, generalised forces, predicted tooth rates, active set,
-    running sums. Plain Python (the caller allocates them: one numba function less to
-    compile)."""
+    """The work arrays ``ws`` of a loop over ntooth teeth (`layout.StepWork`: contact records,
+    candidate pairs, generalised forces, predicted tooth rates, active set, running sums).
+    Plain Python (the caller allocates them: one numba function less to compile)."""
     rec = np.zeros((L.MAX_CONTACTS, L.N_C_COLS))
     pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
     q = np.zeros(ntooth + 2)
     vpred = np.zeros(ntooth)
     tset = np.zeros((L.N_TSET, ntooth), dtype=np.int64)
     book = np.zeros(L.N_BOOK)
-    return rec, pairs, q, vpred, tset, book
+    return L.StepWork(rec, pairs, q, vpred, tset, book)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -80,7 +79,7 @@ def activate(tset, nact, pairs, npair, tz2):
 def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     """The end of a step: guards, energy bookkeeping, and the active set.
 
-    Records the largest contact force of ws's contacts rec[:nc] and checks the penetration
+    Records the largest contact force of the contacts ws.rec[:nc] and checks the penetration
     bound (status PENETRATION); integrates the work [J] and the dissipated energy [J] by the
     trapezoidal rule from the last step's powers to these, powers = (p_in_left, p_in, p_d):
     input power p_in [W] (p_in_left its left limit at this instant, where the driver
@@ -90,7 +89,7 @@ def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     candidate flags of the npair pre-search pairs (gear-2 teeth offset by tz2); status
     INTERRUPTED once par[ABORT] is set. Returns (status, new number of active teeth).
     """
-    rec, pairs, q, tset, book = ws[0], ws[1], ws[2], ws[4], ws[5]
+    rec, pairs, q, tset, book = ws.rec, ws.pairs, ws.q, ws.tset, ws.book
     p_in_left, p_in, p_d = powers
     if par[L.ABORT] != 0.0:
         status = INTERRUPTED

@@ -12,14 +12,14 @@ exactly, whatever the rotations of the unloaded teeth. The kernels keep S small 
 candidates of the contact pre-search), so K_S is a few teeth square and is rebuilt only when
 S changes. ``lst[:n]`` holds the tooth indices of S; ``ks[:n, :n]`` its stiffness.
 
-The stepping loop keeps S in ``cset`` = (C, ks, lst, newl, inset, innew, mo, dmo)
-(`coupled_set`): C the compliance, ``newl`` the next set's teeth, ``inset``/``innew``
+The stepping loop keeps S in ``cset`` (`layout.CoupledSet`, from `coupled_set`): C the
+compliance, ``ks`` and ``lst`` as above, ``newl`` the next set's teeth, ``inset``/``innew``
 per-tooth 0/1 flags of the current and the next set, ``mo``/``dmo`` scratch moments.
 """
 import numpy as np
 
 from solver.mbs.kernels import njit
-from solver.mbs.kernels.layout import MAX_CONTACTS
+from solver.mbs.kernels.layout import MAX_CONTACTS, CoupledSet
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -71,14 +71,14 @@ def coupled_set(ctooth):
     candidate pair."""
     ntooth = ctooth.shape[0]
     ms = 2 * MAX_CONTACTS if ntooth > 0 else 0
-    return (ctooth, np.zeros((ms, 2 * ms)), np.zeros(ms, dtype=np.int64), np.zeros(ms, dtype=np.int64),
-            np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth, dtype=np.int64), np.zeros(ms), np.zeros(ms))
+    return CoupledSet(ctooth, np.zeros((ms, 2 * ms)), np.zeros(ms, dtype=np.int64), np.zeros(ms, dtype=np.int64),
+                      np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth, dtype=np.int64), np.zeros(ms), np.zeros(ms))
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def set_differs(cset, ns, nn):
     """Whether newl[:nn] differs from the current set (ns teeth)."""
-    _ct, _ks, slst, newl, inset, _innew, _mo, _dmo = cset
+    newl, inset = cset.newl, cset.inset
     if nn != ns:
         return True
     for a in range(nn):
@@ -137,7 +137,7 @@ def update_set(cset, ns, nn, phi, dphi, vpred):
 @njit(cache=True, no_cfunc_wrapper=True)
 def set_springs(cset, ns, kphi, phi, q):
     """Replace the own elastic spring torque of the set's teeth in q[2 + i] by the coupled one."""
-    ks, slst = cset[1], cset[2]
+    ks, slst = cset.ks, cset.lst
     for a in range(ns):
         i = slst[a]
         q[2 + i] += kphi[i] * phi[i] - set_moment(ks, slst, ns, phi, a)
