@@ -142,6 +142,7 @@ class RimBlock:
             self.S = 0.5 * (S + S.T)
         self.split = dict(order=order, n=n, L11=L[:n, :n].tocsc(), Ut11=U[:n, :n].T.tocsc(), L21=L[n:, :n].tocsr(),
                           U12=U[:n, n:].tocsr(), pr=pr, pc=pc)
+        self.blocks = ()                                  # not needed again
 
     def rim_solve(self, f: np.ndarray) -> np.ndarray:
         """K_rr^-1 f [m] for loads f (n_interior, k) [N]; the last `SOLVES_KEPT` results are

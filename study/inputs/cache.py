@@ -155,17 +155,20 @@ class FECache:
         path = self.folder / f"{name}.npz"
         if not path.exists():
             return None
+        import zipfile
         try:
             with np.load(path) as d:
                 return {k: d[k] for k in d.files}
-        except (OSError, KeyError, ValueError):
+        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
             return None
 
     def write_arrays(self, name: str, **arrays) -> None:
+        """Store ``arrays`` as ``{name}.npz`` (two workers may write the same file at once:
+        each writes its own temporary file, the last rename wins)."""
         path = self.folder / f"{name}.npz"
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_name(f".{path.stem}.tmp.npz")      # readers never see a half-written file
+            tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp.npz")   # readers never see a half-written file
             np.savez(tmp, **arrays)
             tmp.replace(path)
         except OSError:
