@@ -127,7 +127,8 @@ def influence(model, R, F, block: int = 48) -> np.ndarray:
     S = np.flatnonzero(reach)
     y = _lower_solve(L[S][:, S], b_f[S].toarray(), block)
     z = _lower_solve(Ut[S][:, S], b_r[S].toarray(), block)
-    return z.T @ y
+    with one_blas_thread():          # the same bits whatever the process's BLAS threads
+        return z.T @ y
 
 
 def _reach(T, sources: np.ndarray) -> np.ndarray:

@@ -179,6 +179,14 @@ def flank_load_vector(model: BodyModel, g: GearGeometry, case: LoadCase, u: floa
     return f
 
 
+def products_key(u: np.ndarray, load_teeth, read_teeth, patch: float) -> str:
+    """Name of a compliance load set (roll grid, loaded and read teeth, patch [m]) among a
+    condensed rim's products (`solver.fe.condense.RimBlock.products`)."""
+    import json
+    return "compliance:" + json.dumps({"u": [float(x) for x in u], "load": [int(t) for t in load_teeth],
+                                       "read": [int(t) for t in read_teeth], "patch": float(patch)})
+
+
 def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth, read_teeth,
                     patch: float, symmetric_body: bool = False, block: int = 48,
                     timings: dict | None = None) -> BodyCompliance:
@@ -198,9 +206,19 @@ def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth
     load_teeth = np.asarray(load_teeth, dtype=int)
     read_teeth = np.asarray(read_teeth, dtype=int)
     z = g.teeth
+    condensed = model.condensed
+    if condensed is not None:
+        # a body solved through its condensed rim: the rim's products of this load set serve
+        # every web of the rim, and the loads and reads are built (in the rim's numbering) once
+        key = products_key(u, load_teeth, read_teeth, patch)
+        if key in condensed.rim.products:
+            with clock("solve"):
+                G = condensed.influence(None, None, key)
+            return _compliance(G, u, read_teeth, load_teeth, symmetric_body, z)
+    target = condensed.rim.model if condensed is not None else model
     with clock("loads"):
         read_cases = [load_case(g, int(a) % z, 0.0, ui) for a in read_teeth for ui in u]
-        P = model.basis.probes(np.column_stack([c.centre_point for c in read_cases])).tocsr()   # (2 m, N)
+        P = target.basis.probes(np.column_stack([c.centre_point for c in read_cases])).tocsr()   # (2 m, N)
         m = len(read_cases)
         dx = np.array([c.direction[0] for c in read_cases])
         dy = np.array([c.direction[1] for c in read_cases])
@@ -208,13 +226,18 @@ def body_compliance(model: BodyModel, g: GearGeometry, u: np.ndarray, load_teeth
         cols = []
         for b in load_teeth:
             for ui in u:
-                f = flank_load_vector(model, g, load_case(g, int(b) % z, 0.0, ui), ui, 1.0, patch)
+                f = flank_load_vector(target, g, load_case(g, int(b) % z, 0.0, ui), ui, 1.0, patch)
                 nz = np.flatnonzero(f)
                 cols.append((nz, f[nz]))
         F = sp.csc_matrix((np.concatenate([c[1] for c in cols]), np.concatenate([c[0] for c in cols]),
-                           np.cumsum([0] + [c[0].size for c in cols])), shape=(model.basis.N, len(cols)))
+                           np.cumsum([0] + [c[0].size for c in cols])), shape=(target.basis.N, len(cols)))
     with clock("solve"):
-        G = influence(model, R, F, block)
+        G = condensed.influence(R, F, key) if condensed is not None else influence(model, R, F, block)
+    return _compliance(G, u, read_teeth, load_teeth, symmetric_body, z)
+
+
+def _compliance(G, u, read_teeth, load_teeth, symmetric_body, z) -> BodyCompliance:
+    u = np.asarray(u, float)
     n_u = u.size
     G = G.reshape(read_teeth.size, n_u, load_teeth.size, n_u)
     return BodyCompliance(np.asarray(u, float), read_teeth, load_teeth, G, symmetric_body, z)

@@ -98,9 +98,13 @@ def _rotate(p: np.ndarray, a: float) -> np.ndarray:
 
 
 def mesh_body(g: GearGeometry, body: BodySpec, size: float | None = None, prefix: str = "gear.body",
-              grading: str = "fine") -> BodyMesh:
+              grading: str = "fine", rim: bool = True) -> BodyMesh:
     """Mesh the gear body. ``size`` = element size at the outline [m] (default from the module);
-    ``grading``: one of `GRADINGS` (how fast the elements grow away from the outline)."""
+    ``grading``: one of `GRADINGS` (how fast the elements grow away from the outline).
+    ``rim=False``: only the web and hub (a body with neither: an error), meshed exactly as in
+    the whole body (gmsh meshes each region from its own boundary, whose nodes are placed by
+    the same size field): the part that differs between bodies of one rim height, to be joined
+    to their common teeth and rim (`solver.fe.condense.join_rim`)."""
     validate_body(g, body, prefix)
     if grading not in GRADINGS:
         raise ValueError(f"fe.mesh_grading: one of {', '.join(GRADINGS)}, got {grading!r}")
@@ -115,12 +119,12 @@ def mesh_body(g: GearGeometry, body: BodySpec, size: float | None = None, prefix
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("gear_body")
-        return _build(gmsh, g, body, h, grading)
+        return _build(gmsh, g, body, h, grading, rim)
     finally:
         gmsh.finalize()
 
 
-def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str) -> BodyMesh:
+def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str, rim: bool = True) -> BodyMesh:
     geo = gmsh.model.geo
     h_body = 5.0 * h
     pieces = tooth_pieces(g)
@@ -163,8 +167,11 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str) -> Bod
     rim_in = circle(0.0, 0.0, r_rim, min(2 * h, h_body)) if (has_web or has_hub) else None
     hub_out = circle(0.0, 0.0, r_hub, h_body) if (has_web and has_hub) else None
     bore = circle(0.0, 0.0, r_bore, h_body)
-    # rim (with the teeth)
-    surfaces[REGION_RIM] = geo.addPlaneSurface([outline, rim_in if rim_in is not None else bore])
+    if not (rim or has_web or has_hub):
+        raise ValueError("mesh_body: a body without web and hub has nothing below its rim to mesh")
+    # rim (with the teeth); the outline is defined either way: the size field measures from it
+    if rim:
+        surfaces[REGION_RIM] = geo.addPlaneSurface([outline, rim_in if rim_in is not None else bore])
     if has_web:
         holes = []
         h_hole = min(h_body, 2 * math.pi * body.hole_radius / 24) if body.holes else h_body

@@ -10,9 +10,13 @@ named by `FECache.key` of everything the result depends on:
 * ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.ltca.BodyCompliance`);
 * ``fields-{key}.npz``: a body's FE fields under the load on a few teeth (mesh, displacement,
   von Mises stress: `solver.fe.body.BodyField`), for the renders of an archive.
+* ``rim-{key}.npz``: the teeth and rim of one rim height condensed onto the web
+  (`solver.fe.condense`: the condensed stiffness and the DOF positions it belongs to), and
+  ``rim-{key}-{load set}.npz`` its products of a compliance load set.
 
 In memory: the same results once read or computed, the last `BODY_SLOTS` factorised bodies (a
-reference and the coupling fits of both gears reuse them) and the coupling fits. `FE_CACHE` is
+reference and the coupling fits of both gears reuse them), the last `RIM_SLOTS` condensed rims
+(every body of one rim height reuses one) and the coupling fits. `FE_CACHE` is
 the process-wide instance; `FECache.clear` forgets everything held in memory (the disk stays).
 A missing or unreadable file is recomputed; a read-only folder only costs recomputation.
 """
@@ -26,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 BODY_SLOTS = 2      # factorised bodies kept: one per gear (each up to ~0.5 GB)
+RIM_SLOTS = 2       # condensed teeth-and-rim blocks kept (each up to ~0.4 GB with its factors)
 FIT_SLOTS = 16      # coupling fits kept (small: a few arrays of the tooth count)
 
 
@@ -38,6 +43,7 @@ class FECache:
         self.compliance: dict = {}                   # key -> BodyCompliance
         self.bodies: dict = {}                       # body key -> factorised BodyModel (least recently used first)
         self.fits: dict = {}                         # fit key -> coupling fit (least recently used first)
+        self.rims: dict = {}                         # rim key -> condensed teeth and rim (`solver.fe.condense.RimBlock`)
 
     @property
     def folder(self) -> Path:
@@ -51,7 +57,7 @@ class FECache:
 
     def clear(self) -> None:
         """Forget every result held in memory (maps, compliances, factorised bodies, fits)."""
-        for held in (self.stiffness, self.root_stress, self.compliance, self.bodies, self.fits):
+        for held in (self.stiffness, self.root_stress, self.compliance, self.bodies, self.fits, self.rims):
             held.clear()
 
     def _read(self, held: dict, key: str, name: str, load):
@@ -162,6 +168,42 @@ class FECache:
             model = build()
         self.bodies[key] = model                      # most recently used last
         return model
+
+    def rim(self, key: str, build):
+        """The condensed teeth and rim of ``key``, made by ``build()`` when it is not among the
+        last `RIM_SLOTS` used."""
+        rim = self.rims.pop(key, None)
+        if rim is None:
+            while len(self.rims) >= RIM_SLOTS:
+                self.rims.pop(next(iter(self.rims)))
+            rim = build()
+        self.rims[key] = rim
+        return rim
+
+    # ---- arrays of a condensed rim (its condensed stiffness, the products of a load set)
+    def read_arrays(self, name: str) -> dict | None:
+        """The arrays of ``{name}.npz`` on disk, or None when missing or unreadable."""
+        path = self.folder / f"{name}.npz"
+        if not path.exists():
+            return None
+        import zipfile
+        try:
+            with np.load(path) as d:
+                return {k: d[k] for k in d.files}
+        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
+            return None
+
+    def write_arrays(self, name: str, **arrays) -> None:
+        """Store ``arrays`` as ``{name}.npz`` (two workers may write the same file at once:
+        each writes its own temporary file, the last rename wins)."""
+        path = self.folder / f"{name}.npz"
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp.npz")   # readers never see a half-written file
+            np.savez(tmp, **arrays)
+            tmp.replace(path)
+        except OSError:
+            pass
 
     def fit(self, key, build):
         """The coupling fit of ``key`` (any hashable), made by ``build()`` when not held."""

@@ -59,11 +59,35 @@ def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFI
     t0, c0 = time.perf_counter(), time.process_time()
     stages = {}              # wall and CPU seconds of each stage (CPU: all threads of the process)
     model = factorised_body(setup, stages)
+    rim, pkey = _rim_products(model, u, load, read, setup.patch)
     c = body_compliance(model, geo, u, load, read, setup.patch, symmetric_body=symmetric, timings=stages)
+    if rim is not None and pkey in rim.products and not (FE_CACHE.folder / f"{_products_file(rim, pkey)}.npz").exists():
+        G0, A, B = rim.products[pkey]
+        FE_CACHE.write_arrays(_products_file(rim, pkey), G0=G0, A=A, B=B)
     info.update(cached=False, wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0,
                 dofs=int(model.n_dofs), stages=stages)
     FE_CACHE.write_compliance(key, c)
     return c, info
+
+
+def _products_file(rim, pkey: str) -> str:
+    return f"rim-{rim.key}-{FE_CACHE.key({'products': pkey})}"
+
+
+def _rim_products(model, u, load, read, patch) -> tuple:
+    """(rim, load-set key) of a condensed body, the rim's products of the load set read from
+    disk into it when stored there; (None, None) for a body factorised whole."""
+    from solver.fe.ltca import products_key
+    cb = model.condensed
+    if cb is None or not cb.rim.key:
+        return None, None
+    pkey = products_key(u, load, read, patch)
+    if pkey not in cb.rim.products:
+        stored = FE_CACHE.read_arrays(_products_file(cb.rim, pkey))
+        n_i, m, k = cb.rim.n_interface, len(read) * len(u), len(load) * len(u)
+        if stored is not None and stored["G0"].shape == (m, k) and stored["A"].shape == (m, n_i) and stored["B"].shape == (n_i, k):
+            cb.rim.products[pkey] = (stored["G0"], stored["A"], stored["B"])
+    return cb.rim, pkey
 
 
 def factorised_body(setup: GearSetup, stages: dict | None = None):
@@ -71,20 +95,84 @@ def factorised_body(setup: GearSetup, stages: dict | None = None):
     in memory by `FE_CACHE` for every FE result of the same body: the spring map, its fillet
     stress and the influence coefficients share one factorisation (the body depends on the
     geometry, material and mesh only, not on the load or the pivot). ``stages``: if given and
-    the body is built, the wall and CPU seconds of meshing, assembly and factorisation."""
+    the body is built, the wall and CPU seconds of meshing, assembly and factorisation.
+
+    A body with a web or hub is solved through its teeth and rim condensed once per rim height
+    (`condensed_rim`, `solver.fe.condense`): it factors only its web, with the same results as
+    the whole-body factorisation to rounding. Should its rim's mesh ever differ from the
+    condensed one, the whole body is factorised instead."""
     from solver.fe import body as fe
+    from solver.fe.condense import RimMismatch, assemble_condensed, join_rim
     from solver.fe.mesh import mesh_body
 
     def build():
         t0, c0 = time.perf_counter(), time.process_time()
-        mesh = mesh_body(setup.geometry, setup.body, setup.mesh_size, prefix=f"{setup.prefix}.body",
-                         grading=setup.mesh_grading)
-        model = fe.assemble(mesh, setup.geometry.spec.face_width, setup.body.web_thickness, setup.material)
+        geo, body = setup.geometry, setup.body
+
+        def mesh(rim=True):
+            return mesh_body(geo, body, setup.mesh_size, prefix=f"{setup.prefix}.body", grading=setup.mesh_grading, rim=rim)
+        whole, model = None, None
+        has_web = body.web_height > 0 or body.hub_height > 0
+        if CONDENSE and has_web:
+            rim = FE_CACHE.rims.get(rim_key(setup))
+            try:
+                if rim is not None:        # only the web is meshed, and joined to the kept rim
+                    whole = join_rim(rim, mesh(rim=False))
+                else:
+                    whole = mesh()
+                    rim = condensed_rim(setup, whole)
+                    whole = join_rim(rim, whole)      # numbered as any later body of this rim
+                t1, c1 = time.perf_counter(), time.process_time()    # a rim's own cost is not the body's
+                model = assemble_condensed(whole, geo.spec.face_width, body.web_thickness, setup.material, rim)
+            except RimMismatch:
+                whole, model = None, None
+        if model is None:
+            whole = whole or mesh()
+            t1, c1 = time.perf_counter(), time.process_time()
+            model = fe.assemble(whole, geo.spec.face_width, body.web_thickness, setup.material)
         if stages is not None:
-            stages.update(mesh_wall_s=time.perf_counter() - t0 - model.assembly_time - model.factor_time,
-                          mesh_cpu_s=time.process_time() - c0 - model.assembly_cpu - model.factor_cpu,
+            stages.update(mesh_wall_s=t1 - t0, mesh_cpu_s=c1 - c0,    # with the rim's, when condensed here
                           assembly_wall_s=model.assembly_time, assembly_cpu_s=model.assembly_cpu,
                           factor_wall_s=model.factor_time, factor_cpu_s=model.factor_cpu)
         return model
     key = json.dumps({k: v for k, v in setup.settings.items() if k not in ("force", "pivot")}, sort_keys=True, default=float)
     return FE_CACHE.body(key, build)
+
+
+CONDENSE = True         # solve bodies with a web or hub through their condensed teeth and rim
+RIM_VERSION = "1"       # bump when the condensation changes (it is in every rim key)
+
+
+def rim_key(setup: GearSetup) -> str:
+    """Cache key of the gear's teeth and rim: everything they depend on (tooth, rim height,
+    material, mesh size and grading, code versions), not the web, hub or holes."""
+    st = setup.settings
+    return FE_CACHE.key({"tooth": st["tooth"], "rim_height": setup.body.rim_height, "material": st["material"],
+                         "size": st["size"], "grading": setup.mesh_grading, "version": st["version"], "rim": RIM_VERSION})
+
+
+def condensed_rim(setup: GearSetup, mesh):
+    """The gear's teeth and rim condensed onto the web (`solver.fe.condense.RimBlock`), from
+    the teeth-and-rim elements of ``mesh`` (a body mesh of the gear), kept by `FE_CACHE` in
+    memory and, its condensed stiffness, on disk (``rim-{key}.npz``)."""
+    from solver.fe.condense import RimMismatch, rim_block
+
+    key = rim_key(setup)
+
+    def build():
+        geo = setup.geometry
+        r_if = geo.root_radius - setup.body.rim_height
+        stored = FE_CACHE.read_arrays(f"rim-{key}")
+        if stored is not None:
+            try:
+                rim = rim_block(mesh, geo.spec.face_width, setup.material, r_if, S=stored["S"])
+                if rim.keys.shape == stored["keys"].shape and np.allclose(rim.keys, stored["keys"], rtol=0, atol=1e-9):
+                    rim.key = key
+                    return rim
+            except (RimMismatch, KeyError):
+                pass
+        rim = rim_block(mesh, geo.spec.face_width, setup.material, r_if)
+        rim.key = key
+        FE_CACHE.write_arrays(f"rim-{key}", S=rim.S, keys=rim.keys)
+        return rim
+    return FE_CACHE.rim(key, build)

@@ -1,0 +1,75 @@
+"""The FE inputs of a study through the condensed teeth and rim: the spring map, its root stress
+and the bulk compliance equal those of the whole-body factorisation, one rim serves every web
+of its rim height (in memory and from the disk cache), and another rim height gets its own."""
+import numpy as np
+import pytest
+from conftest import SMALL_PAIR
+
+from study.inputs import compliance, springs
+from study.inputs.cache import FE_CACHE
+from study.inputs.gearsetup import gear_setup
+from study.scene import default_scene
+
+pytestmark = pytest.mark.usefixtures("private_fe_cache")
+
+
+def small_scene(**kw):
+    """The small 24-tooth pair of conftest, the driven gear with a web of 8 mm and 4 holes."""
+    return default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+                                      "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
+
+
+def _inputs(setup):
+    """(spring map [N m/rad], root stress [Pa], compliance [m/N]) of a gear, from empty memory."""
+    for held in (FE_CACHE.stiffness, FE_CACHE.root_stress, FE_CACHE.compliance, FE_CACHE.bodies):
+        held.clear()
+    teeth = list(range(setup.teeth))
+    k = springs.fe_stiffness(setup)
+    s = springs.root_stress(setup)
+    c, _ = compliance.gear_compliance(setup, teeth, 0, n_u=4, u=None)
+    return k, s, c.g
+
+
+def test_condensed_inputs_equal_the_whole_body(monkeypatch, tmp_path):
+    bodies = [small_scene(), small_scene(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 5.0})]
+    got = []
+    for scene in bodies:
+        got.append(_inputs(gear_setup(scene, 2)))
+        assert FE_CACHE.bodies and list(FE_CACHE.bodies.values())[-1].condensed is not None
+    assert len(FE_CACHE.rims) == 1                          # both webs on one rim
+    assert len(list((tmp_path / "cache" / "fe").glob("rim-*.npz"))) == 2   # its S_R and one load set
+    monkeypatch.setattr(compliance, "CONDENSE", False)
+    for scene, (k, s, g) in zip(bodies, got):
+        for f in (tmp_path / "cache" / "fe").glob("*"):
+            if not f.name.startswith("rim-"):
+                f.unlink()
+        k0, s0, g0 = _inputs(gear_setup(scene, 2))
+        assert list(FE_CACHE.bodies.values())[-1].condensed is None
+        assert np.abs(k / k0 - 1).max() < 1e-9
+        assert np.abs(s / s0 - 1).max() < 1e-9
+        assert np.abs(g - g0).max() < 1e-9 * np.abs(g0).max()
+
+
+def test_a_rim_read_from_disk_gives_the_same_inputs_and_another_rim_height_its_own(tmp_path):
+    setup = gear_setup(small_scene(), 2)
+    first = _inputs(setup)
+    # the same body again, its web now meshed alone and joined to the kept rim: the same bits
+    for f in (tmp_path / "cache" / "fe").glob("*"):
+        if not f.name.startswith("rim-"):
+            f.unlink()
+    for a, b in zip(first, _inputs(setup)):
+        assert np.array_equal(a, b)
+    FE_CACHE.clear()                                        # a new process: the rim from disk
+    for f in (tmp_path / "cache" / "fe").glob("*"):
+        if not f.name.startswith("rim-"):
+            f.unlink()
+    again = _inputs(setup)
+    rim = next(iter(FE_CACHE.rims.values()))
+    assert rim.split is None                                # S_R and the products came from disk
+    for a, b in zip(first, again):
+        assert np.array_equal(a, b)
+    deeper = gear_setup(small_scene(**{"gear2.body.rim_height": 5.0}), 2)
+    assert compliance.rim_key(deeper) != compliance.rim_key(setup)
+    assert compliance.rim_key(gear_setup(small_scene(**{"gear2.body.holes": 6}), 2)) == compliance.rim_key(setup)
+    k = springs.fe_stiffness(deeper)
+    assert len(FE_CACHE.rims) == 2 and k.shape == (setup.teeth,)
