@@ -2,7 +2,8 @@
 
 - `solver` never imports `study` (nor the workflows): the solver runs without the study layer;
 - the numba kernels (`solver/mbs/kernels`) import only numpy, math, numba and each other
-  (their package also hashes its own sources with hashlib, os and pathlib for the disk cache);
+  (their package also hashes its own sources with hashlib, os and pathlib for the disk cache, and
+  the layout names the work tuples with collections.namedtuple);
 - the base solver modules (solver/*.py, solver/fe, solver/identify) import no `solver.mbs`: the
   multibody model is built from them, not the other way round. The FE reference
   (`solver/fe/ltca.py`) and the peers (`solver/peers`) stand above the model they check;
@@ -86,6 +87,8 @@ def _is_base(module: str) -> bool:
 def _kernels_refuse(name: str, module: str) -> bool:
     if module == "solver.mbs.kernels" and name in ("hashlib", "os", "pathlib"):
         return False        # the package hashes the kernel sources for its disk-cache folder
+    if module == "solver.mbs.kernels.layout" and name == "collections":
+        return False        # the named work tuples are namedtuples, which numba passes as tuples
     return not _under(name, "numpy", "math", "numba", "solver.mbs.kernels")
 
 
