@@ -34,9 +34,9 @@ RAW_DAMPING = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spri
 
 
 def solid_scene(**overrides):
-    """The paper pair with a solid driven gear (no FE needed), plus overrides."""
+    """The paper pair with a solid driven gear on the paper's plain model (no FE needed), plus overrides."""
     from study import setup
-    return setup.solid_scene(default_scene(), gears=(2,)).replace(**overrides)
+    return setup.solid_scene(default_scene(), gears=(2,)).replace(**{"coupling.model": "paper", **overrides})
 
 
 @pytest.fixture

@@ -24,7 +24,7 @@ RELIEF = {"gear1.modification.tip_relief": 10.0, "gear1.modification.tip_length"
 
 def small(**kw):
     """The 24-tooth pair of conftest (m = 3 mm, contact ratio 1.6), solid, uniform springs."""
-    return default_scene().replace(**{**SMALL_PAIR, "gear2.spring.stiffness": "uniform", **kw})
+    return default_scene().replace(**{**SMALL_PAIR, "gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform", **kw})
 
 
 def modified_flanks(scene, model, g, theta, n=1500):
