@@ -352,7 +352,7 @@ def dynamic_lever(scene, choice) -> str:
              "tooth springs) over the tooth inertia (material.density, the tooth size)")
     if scene.contact.friction > 0:
         cause += ", and the friction's regularisation (contact.friction_velocity: a smaller one stiffens it)"
-    if choice.method == "explicit" and d.method == "auto":
+    if choice.method == "explicit" and d.method == "auto" and scene.coupling_model == "none":
         cause += "; dynamic.method = 'implicit' takes larger steps at a higher cost per step"
     return text + f"; its step {choice.dt:.3g} s is {cause}"
 

@@ -170,13 +170,15 @@ CRITICAL_SPEED_FACTOR = 3.0
 def scene_warnings(scene) -> list[str]:
     """Values that pass the checks but are almost certainly a unit slip, each as one line naming
     the field: a lightening hole smaller than the FE mesh size (metres typed for millimetres), a
-    pitch-line velocity above PITCH_LINE_VELOCITY_MAX (rpm typed for rad/s)."""
+    pitch-line velocity above PITCH_LINE_VELOCITY_MAX (rpm typed for rad/s), a spring field the
+    coupled model does not read (`unread_spring_warnings`)."""
     out = []
     for g in (1, 2):
         b, h = scene.gear(g).body, mesh_size_mm(scene, g)
         if b.holes and b.hole_radius < h:
             out.append(f"gear{g}.body.hole_radius: {b.hole_radius:.4g} mm is smaller than the FE mesh size "
                        f"({h:.4g} mm): the hole is no lightening the model can see (millimetres meant?)")
+    out += unread_spring_warnings(scene)
     d = scene.dynamic
     if d.enabled:
         field, speed = ("dynamic.speed_end", d.speed_end) if d.speed_end > 0 else ("dynamic.speed", d.speed)
@@ -184,6 +186,32 @@ def scene_warnings(scene) -> list[str]:
         if v > PITCH_LINE_VELOCITY_MAX:
             out.append(f"{field}: {speed:.4g} rad/s turns the pitch line at {v:.3g} m/s, above "
                        f"{PITCH_LINE_VELOCITY_MAX:g} m/s (rpm meant? {speed:.4g} rpm = {speed * 0.10471975511965977:.4g} rad/s)")
+    return out
+
+
+def unread_spring_warnings(scene) -> list[str]:
+    """A line for each tooth-spring field a scene sets that its model does not read: a coupled
+    model ('body-torsion', 'compliance', and 'auto' unless both gears' springs are 'uniform')
+    takes its tooth springs, their linear law and the tooth pivot from the FE body, so
+    gearN.spring.k_phi, gearN.spring.n_k and gearN.pivot_radius away from their defaults have
+    no effect, nor does gearN.spring.stiffness = 'uniform' on a lightened body."""
+    if scene.coupling_model == "none":
+        return []
+    how = (f"coupling.model = 'auto' runs {scene.coupling_model!r} here" if scene.coupling.model == "auto"
+           else f"coupling.model = {scene.coupling.model!r}")
+    out = []
+    for g in (1, 2):
+        gs = scene.gear(g)
+        sp, sp0, gs0 = gs.spring, type(gs.spring)(), type(gs)()
+        for field, value, default, unit in (("spring.k_phi", sp.k_phi, sp0.k_phi, " N*mm/rad^n_k"),
+                                            ("spring.n_k", sp.n_k, sp0.n_k, ""),
+                                            ("pivot_radius", gs.pivot_radius, gs0.pivot_radius, " mm")):
+            if value != default:
+                out.append(f"gear{g}.{field}: {value:.4g}{unit} has no effect: {how}, whose tooth springs and pivots "
+                           f"come from the FE body (the paper's per-tooth law is read by coupling.model = 'paper' only)")
+        if sp.stiffness == "uniform" and scene.is_lightened(g):
+            out.append(f"gear{g}.spring.stiffness: 'uniform' has no effect: {how}, which takes gear {g}'s lightened "
+                       "body from its FE (springs that ignore the lightening: coupling.model = 'paper')")
     return out
 
 

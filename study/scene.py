@@ -180,10 +180,11 @@ class FESection:
 
 @dataclass(frozen=True)
 class CouplingSection:
-    model: str = _f("auto", "", "foundation coupling between the teeth: 'auto' (the default: 'compliance' when either "
-                    "gear has FE springs, a lightened body that needs its FE anyway, else 'paper': solid bodies, or "
-                    "spring.stiffness 'uniform', need none), 'paper' (the paper's MUBOCO-PR: per-tooth springs that each hold the body's wind-up; 'none' is "
-                    "the same), 'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and "
+    model: str = _f("auto", "", "foundation coupling between the teeth: 'auto' (the default: 'compliance', the model "
+                    "that agrees with the FE reference, for solid and lightened bodies alike; 'paper' only when both "
+                    "gears' spring.stiffness is 'uniform', springs that ignore the body and ask for no FE), 'paper' (the "
+                    "paper's MUBOCO-PR: per-tooth springs that each hold the body's wind-up; 'none' is "
+                    "the same; the only model of dynamic.method 'implicit'), 'body-torsion' (hub -> body torsion spring -> rigid rim -> tooth springs, all linear and "
                     "identified from the FE body, tooth pivot included; the gears' pivot_radius, k_phi and n_k are then not "
                     "used) or 'compliance' (the same, with the tooth springs coupled through the FE compliance between the "
                     "teeth: neighbours and hole positions; the model that agrees with the FE reference, see docs/models.md)",
@@ -238,13 +239,15 @@ class Scene:
     @property
     def coupling_model(self) -> str:
         """The coupling model the scene runs: 'none' (the paper's plain model, also named
-        'paper'), 'body-torsion' or 'compliance'; 'auto' resolves to 'compliance' when either
-        gear has FE springs (a lightened body whose spring.stiffness is not 'uniform') and to
-        'none' otherwise (solid bodies, or springs that ignore the lightening: no FE wanted)."""
+        'paper'), 'body-torsion' or 'compliance'. 'auto' resolves to 'compliance' (the model that
+        agrees with the FE reference, for a solid pair as for a lightened one: the plain model's
+        springs hold the body's wind-up in every tooth and miss half the STE ripple of a solid
+        pair) unless both gears' spring.stiffness is 'uniform': springs that ignore the body
+        ask for no FE, and only the plain model reads them (k_phi, n_k)."""
         m = self.coupling.model
         if m == "auto":
-            fe = any(self.is_lightened(g) and self.gear(g).spring.stiffness != "uniform" for g in (1, 2))
-            return "compliance" if fe else "none"
+            uniform = all(self.gear(g).spring.stiffness == "uniform" for g in (1, 2))
+            return "none" if uniform else "compliance"
         return "none" if m == "paper" else m
 
     @property
@@ -394,8 +397,25 @@ def check_scene(scene: Scene) -> None:
                          f"of the run ({d.duration} s), got {d.torque_change_time} s")
     if d.spectrum_start >= d.duration:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
+    check_integrator_model(scene)
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
+
+
+def check_integrator_model(scene: Scene) -> None:
+    """The implicit integrator (HHT-alpha) carries the paper's plain model only: with a coupled
+    model (coupling.model named, or 'auto' resolved to it) dynamic.method = 'implicit' is refused
+    before any work, naming both fields and the two ways out. The choice of an integrator never
+    changes the physics silently; 'auto' picks the explicit integrator for a coupled model."""
+    d = scene.dynamic
+    if not (d.enabled and d.method == "implicit") or scene.coupling_model == "none":
+        return
+    how = ("coupling.model = 'auto' runs the compliance model here (the default unless both gears' "
+           "spring.stiffness is 'uniform')" if scene.coupling.model == "auto"
+           else f"coupling.model = {scene.coupling.model!r} is a coupled model")
+    raise SceneError("dynamic.method", f"'implicit' (HHT-alpha) integrates the paper's plain model only, and {how}: "
+                                       "set coupling.model = 'paper' to integrate the paper's model implicitly, or "
+                                       "dynamic.method = 'explicit' (or 'auto') to keep the coupled model")
 
 
 def check_jamming(scene: Scene, pair) -> None:

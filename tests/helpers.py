@@ -8,8 +8,9 @@ RAW_DAMPING = {"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.062, "gear2.spri
 
 
 def solid_scene(**overrides):
-    """The paper pair with a solid driven gear (no FE needed; the embedded scene paper_solid), plus overrides."""
-    return load_scene("paper_solid").replace(**overrides)
+    """The paper pair with a solid driven gear (the embedded scene paper_solid) on the paper's plain
+    model (no FE needed), plus overrides."""
+    return load_scene("paper_solid").replace(**{"coupling.model": "paper", **overrides})
 
 
 def scene_overrides(name: str) -> dict:

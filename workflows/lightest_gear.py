@@ -156,9 +156,9 @@ def base_scene(path, overrides, speed: float, duration: float | None, angle_step
 
 
 def solid_of(scene):
-    """The reference: the driven gear solid, run by the model the lightened bodies run (the
-    default 'auto' would put a solid pair on the paper's model, and a factor between two
-    models' STE would measure the models, not the lightening)."""
+    """The reference: the driven gear solid, run by the model the lightened bodies run, named
+    (whatever 'auto' makes of a solid pair, a factor between two models' STE would measure the
+    models, not the lightening)."""
     lightened = scene.replace(**{"gear2.body.holes": max(scene.gear2.body.holes, 1)})
     return study.solid_scene(scene, gears=(2,)).replace(**{"coupling.model": lightened.coupling_model_name})
 

@@ -30,7 +30,10 @@ through rim and web, and by how much depends on where the holes are. The body sp
 the tooth springs become one compliance matrix C over the teeth (tooth rotation per tooth
 moment), fitted with c_body and the pivot to the FE influence coefficients at the points where
 the mesh loads the teeth together (a tooth's own contact point; neighbours at their
-simultaneous contact points). The kernels use it through `kernels.toothcoupling`.
+simultaneous contact points). Where a local compliance in series with the contact completes
+each tooth's own compliance along the profile (`local_compliance`), the pivot and c_body come
+from the samples between different teeth alone (``own_completed``). The kernels use it through
+`kernels.toothcoupling`.
 Units: SI.
 """
 from __future__ import annotations
@@ -100,26 +103,29 @@ class ToothComplianceFit:
         return 1.0 / np.diag(self.compliance)
 
 
-def _linear_fit(sample_pair, n_pairs, LL, value, weight):
+def _linear_fit(sample_pair, n_pairs, LL, value, weight, shared):
     """For levers fixed (LL = lever_read*lever_load [m^2]): the weighted least-squares c_body
     [m/N] and C of every pair [rad/(N·m)] (the model is linear in them), and the weighted sum
-    of squared relative residuals. C_p = A_p - c_body*B_p eliminates the pairs; c_body is then one linear fit,
-    held at or below the smallest coefficient (the objective is convex in it, so the bound is
-    the constrained optimum): the body part is what every loaded pair shares, and the local
-    part never pulls a neighbour back."""
+    of squared relative residuals. C_p = A_p - c_body*B_p eliminates the pairs (each pair's C
+    from its own samples); c_body is then one linear fit to the ``shared`` samples (bool mask,
+    which also make the returned residual), held at or below the smallest coefficient (the
+    objective is convex in it, so the bound is the constrained optimum): the body part is what
+    every loaded pair shares, and the local part never pulls a neighbour back."""
     w = weight / value**2
     den = np.bincount(sample_pair, w * LL * LL, n_pairs)
     A = np.bincount(sample_pair, w * value * LL, n_pairs) / den
     B = np.bincount(sample_pair, w * LL, n_pairs) / den
     e = 1.0 - B[sample_pair] * LL                  # d residual / d c_body
     f = A[sample_pair] * LL - value                # residual at c_body = 0
-    c_body = min(-np.sum(w * e * f) / np.sum(w * e * e), float(value.min()))
+    ws = np.where(shared, w, 0.0)
+    c_body = min(-np.sum(ws * e * f) / np.sum(ws * e * e), float(value.min()))
     r = c_body * e + f
-    return c_body, A - c_body * B, float(np.sum(w * r * r))
+    return c_body, A - c_body * B, float(np.sum(ws * r * r))
 
 
 def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, base_radius: float,
-                         psi_base: float, pivot_bounds: tuple, weight=None) -> ToothComplianceFit:
+                         psi_base: float, pivot_bounds: tuple, weight=None,
+                         own_completed: bool = False) -> ToothComplianceFit:
     """The full foundation coupling, identified from FE influence coefficients.
 
     Samples k = 0..N-1: ``value[k]`` [m/N], the displacement along the line of action at roll
@@ -137,7 +143,16 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
     times its ``weight`` [1], default 1: how much load the mesh puts there); r_Q minimises
     that residual within ``pivot_bounds`` [m] (the rim under the tooth; a bounded scalar
     search). ``rms_rel_error`` is the weighted RMS relative residual. Pairs not
-    listed are not coupled (C = 0): the mesh never loads them together. Raises ValueError
+    listed are not coupled (C = 0): the mesh never loads them together.
+
+    ``own_completed``: each tooth's own compliance along the profile is completed by a local
+    compliance in series with the contact (`local_compliance`), which makes the own samples
+    (read tooth = load tooth) exact whatever the fit. They then set only their C[a, a], and the
+    shared pivot and c_body are fitted to the samples between different teeth, the coupling
+    through rim and web that nothing else corrects (with no such samples, to all). Fitted to
+    all samples instead, the pivot follows the own compliance's bending shape (near the root
+    circle), and the coupling's levers grow towards the tip where the FE's neighbour
+    coupling stays nearly flat: the model is too stiff in double contact. Raises ValueError
     when the fit is not a valid stiffness (a window of reach + 2 neighbouring teeth not
     positive definite).
     """
@@ -163,10 +178,14 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
         raise ValueError(f"pivot_bounds: need 0 < lower < upper, got {pivot_bounds}")
     P = len(pairs)
     cos_r, cos_l = np.cos(psi_base - u_read), np.cos(psi_base - u_load)
+    own = (pairs[:, 0] - pairs[:, 1]) % teeth == 0
+    shared = ~own[sample_pair] if own_completed else np.ones(n, bool)
+    if not np.any(shared & (weight > 0)):
+        shared = np.ones(n, bool)
 
     def fit(r_q):       # levers about the pivot (identify.lever), r_q [m]
         LL = np.abs(base_radius - r_q * cos_r) * np.abs(base_radius - r_q * cos_l)
-        return _linear_fit(sample_pair, P, LL, value, weight)
+        return _linear_fit(sample_pair, P, LL, value, weight, shared)
 
     res = minimize_scalar(lambda x: fit(x * 1e-3)[2], bounds=(lo * 1e3, hi * 1e3), method="bounded",
                           options=dict(xatol=1e-6))
@@ -189,7 +208,7 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
         except np.linalg.LinAlgError:
             raise ValueError(f"value: the fitted compliance of teeth {a}..{a + w - 1} is not positive "
                              "definite (not a valid stiffness)") from None
-    return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / weight.sum())))
+    return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / weight[shared].sum())))
 
 
 def local_compliance(fit: ToothComplianceFit, u, own, base_radius: float, psi_base: float) -> np.ndarray:

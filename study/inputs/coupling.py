@@ -134,7 +134,7 @@ def tooth_compliance(setup: GearSetup, samples: dict[int, np.ndarray]) -> ToothC
     bounds = (geo.root_radius - setup.body.rim_height, geo.root_radius)
     cat = np.concatenate
     fit = tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z,
-                               geo.base_radius, geo.psi_base, bounds, cat(wt))
+                               geo.base_radius, geo.psi_base, bounds, cat(wt), own_completed=True)
     n = c.u.size
     own = np.array([[block(a, 0)[i, i] for i in range(n)] for a in range(z if setup.lightened else 1)])
     return replace(fit, local_u=np.array(c.u), local_compliance=local_compliance(fit, c.u, own, geo.base_radius, geo.psi_base))

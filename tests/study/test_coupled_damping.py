@@ -13,15 +13,16 @@ def test_body_dampers_join_the_joints_where_they_cannot_reach_the_mesh_ratio(pri
     from solver.mbs.modes import joint_damping_for_ratio, modal_analysis
     from study.scene_model import build_scene_model, mean_load
 
-    scene = load_scene("small_lightened")   # joints alone: at most about 4.7 %
+    # joints alone: at most about 5.3 % of critical on the mesh mode
+    scene = load_scene("small_lightened").replace(**{"contact.damping_ratio": 0.08})
     assert scene.coupling_model == "compliance"
     raw = build_scene_model(scene, convert_damping=False)
     eqs = loaded_equilibria(raw, mean_load(scene))
     with pytest.raises(ValueError, match="cannot damp the mesh mode"):
-        joint_damping_for_ratio(raw, eqs, 0.05)
+        joint_damping_for_ratio(raw, eqs, 0.08)
     model = build_scene_model(scene)
     modes = modal_analysis(model, mean_load(scene))
-    assert float(np.nanmean(modes.damping[0])) == pytest.approx(0.05, rel=1e-6)
+    assert float(np.nanmean(modes.damping[0])) == pytest.approx(0.08, rel=1e-6)
     # joints and bodies at one ratio of their own modes, above the 2 % the bodies had
     gp = model.gear_par
     ratio = [gp[i, L.C_BODY] / body_critical_damping(gp, i) for i in (0, 1)]

@@ -81,6 +81,26 @@ def test_unit_slips_that_give_numbers_are_warned_about():
         **{"dynamic.speed": 3000.0, "dynamic.enabled": False})) == []
 
 
+def test_spring_fields_the_coupled_model_does_not_read_are_warned_about():
+    """The coupled models take tooth springs and pivots from the FE body: a k_phi, n_k or
+    pivot radius the scene sets (away from its default) has no effect there, and the warning
+    names the field and the model that ignores it; the paper's model reads them: no warning."""
+    scene = study.default_scene()
+    assert scene.coupling_model == "compliance"
+    w = study.plausibility_warnings(scene.replace(**{"gear1.spring.k_phi": 2.0e6}))
+    assert len(w) == 1 and w[0].startswith("gear1.spring.k_phi: 2e+06") and "has no effect" in w[0]
+    assert "coupling.model = 'auto' runs 'compliance'" in w[0] and "coupling.model = 'paper'" in w[0]
+    w = study.plausibility_warnings(scene.replace(**{"gear2.spring.n_k": 1.0, "gear2.pivot_radius": 45.0,
+                                                     "coupling.model": "body-torsion"}))
+    assert [x.split(":")[0] for x in w] == ["gear2.spring.n_k", "gear2.pivot_radius"]
+    assert all("coupling.model = 'body-torsion'" in x for x in w)
+    # springs that ignore the lightening, under a model that reads the lightened body's FE
+    w = study.plausibility_warnings(scene.replace(**{"gear2.spring.stiffness": "uniform"}))
+    assert len(w) == 1 and w[0].startswith("gear2.spring.stiffness: 'uniform' has no effect")
+    paper = scene.replace(**{"coupling.model": "paper", "gear1.spring.k_phi": 2.0e6, "gear2.spring.n_k": 1.0})
+    assert study.plausibility_warnings(paper) == []
+
+
 def test_a_speed_far_above_the_critical_speeds_is_warned_about_on_stderr_and_in_the_archive(tmp_path, capsys):
     scene = small(**{"quasi_static.enabled": False, "dynamic.duration": 0.006, "dynamic.ramp_time": 0.001,
                      "gear2.body.holes": 4})

@@ -146,7 +146,7 @@ def test_a_coarse_implicit_run_of_a_rattling_150_tooth_pair_is_flagged():
     from study.scene_model import build_scene_model
     sc = study.load_scene(None, ["gear1.teeth=150", "gear2.teeth=150", "gear2.body.holes=0",
                                  "gear2.body.web_thickness=17", "contact.c_con=3640",
-                                 "gear1.spring.c_phi=0.062", "gear2.spring.c_phi=0.062"])
+                                 "gear1.spring.c_phi=0.062", "gear2.spring.c_phi=0.062", "coupling.model=paper"])
     m = build_scene_model(sc)
     r = simulate_implicit(m, 100.0, 0.01, 50.0, 0.01, 0.025, dt=2.5e-6)
     assert r.status == INACCURATE and np.max(r.force_max) > 10 * 50.0 / m.base_radii[1]

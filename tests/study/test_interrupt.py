@@ -21,6 +21,7 @@ SMALL = """
 "gear2.teeth" = 20
 "gear1.body" = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0}
 "gear2.body" = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0, holes = 0}
+"gear1.spring.stiffness" = "uniform"
 "gear2.spring.stiffness" = "uniform"
 "quasi_static" = {rotation = 6.0, angle_step = 0.5}
 """

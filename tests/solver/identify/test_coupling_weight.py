@@ -54,3 +54,30 @@ def test_bad_weights_are_refused():
     for w in (np.ones(val.size - 1), -np.ones(val.size), np.where(sp == 0, 0.0, 1.0)):
         with pytest.raises(ValueError, match="weight"):
             tooth_compliance_fit(pairs, sp, ur, ul, val, Z, RB, PSI_B, (0.044, 0.048), weight=w)
+
+
+def test_own_samples_completed_in_series_leave_the_pivot_to_the_coupling():
+    """Own compliance of a bending shape no rigid tooth follows (every own sample reshaped
+    along the profile): with ``own_completed`` (a local compliance in series makes the own
+    samples exact) the pivot, c_body and the neighbour coupling are recovered exactly from the
+    samples between different teeth, and the own samples set only C[a, a]; fitted to all
+    samples, the own shape drags the pivot and spoils the coupling."""
+    pairs, sp, ur, ul, val, C, _ = samples(1.0)
+    own = (pairs[sp, 0] == pairs[sp, 1])
+    bent = val * np.where(own, 1.0 + 2.0 * (ur - 0.25) ** 2, 1.0)       # softer towards the tip
+    fit = lambda **k: tooth_compliance_fit(pairs, sp, ur, ul, bent, Z, RB, PSI_B, (0.044, 0.048), **k)  # noqa: E731
+    done = fit(own_completed=True)
+    assert done.pivot_radius == pytest.approx(R_Q, rel=1e-5)
+    assert done.c_body == pytest.approx(C_BODY, rel=1e-6)
+    off = ~np.eye(Z, dtype=bool)
+    assert done.compliance[off] == pytest.approx(C[off], rel=1e-5, abs=1e-12)
+    assert done.rms_rel_error < 1e-6                     # the residual is the coupling's: none
+    # each C[a, a]: the least-squares fit of its own (bent) samples at that pivot
+    L = lever(RB, PSI_B - ur, R_Q) ** 2
+    s0 = sp == next(i for i, (a, b) in enumerate(pairs) if a == b == 0)
+    w = 1.0 / bent[s0] ** 2
+    c00 = np.sum(w * L[s0] * (bent[s0] - C_BODY)) / np.sum(w * L[s0] ** 2)
+    assert done.compliance[0, 0] == pytest.approx(c00, rel=1e-6)
+    plain = fit()
+    assert abs(plain.pivot_radius - R_Q) > 1e-5
+    assert np.max(np.abs(plain.compliance[off] - C[off])) > 1e-3 * C[0, 1]

@@ -12,7 +12,7 @@ from solver.mbs.modes import modal_analysis
 from solver.mbs.ringdown import ring_down
 from study.scene_model import build_scene_model
 
-SOLID = {"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0, "dynamic.torque": 50.0}
+SOLID = {"gear2.body.holes": 0, "gear2.body.web_thickness": 17.0, "dynamic.torque": 50.0, "coupling.model": "paper"}
 
 
 def _model(**over):

@@ -22,8 +22,9 @@ RELIEF = {"gear1.modification.tip_relief": 10.0, "gear1.modification.tip_length"
 
 
 def small(**kw):
-    """The 24-tooth pair of the small_pair scene (m = 3 mm, contact ratio 1.6), solid, uniform springs."""
-    return load_scene("small_pair").replace(**{"gear2.spring.stiffness": "uniform", **kw})
+    """The 24-tooth pair of the small_pair scene (m = 3 mm, contact ratio 1.6), solid, uniform springs
+    on both gears (the paper's model: no FE)."""
+    return load_scene("small_pair").replace(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform", **kw})
 
 
 def modified_flanks(scene, model, g, theta, n=1500):

@@ -56,7 +56,7 @@ def test_lightened_gear_root_stress_from_the_spring_fe_cached_with_the_map(priva
 
 def test_no_fe_is_started_for_the_root_stress_alone(monkeypatch, private_fe_cache):
     _no_fe(monkeypatch)
-    ds = lightening_dataset(small_scene(**{"gear2.spring.stiffness": "uniform"}))
+    ds = lightening_dataset(small_scene(**{"gear2.spring.stiffness": "uniform", "gear1.spring.stiffness": "uniform"}))
     assert np.isnan(ds["root_stress_max"]).all()
     assert "gear 2: springs 'uniform'" in ds["root_stress_max"].attrs["not_computed"]
     # a lightened gear is not its own reference: without the FE its ratio is unknown
@@ -73,7 +73,7 @@ def test_run_archive_summary_and_sweep_scalars_carry_the_gear_outputs(capsys, mo
     from study.report.summary import print_summary
     from study.sweep import engine
     from study.sweep.outputs import SCALARS, outputs_from_table
-    scene = small_scene(**{"gear2.spring.stiffness": "uniform", "quasi_static.rotation": 2.0,
+    scene = small_scene(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform", "quasi_static.rotation": 2.0,
                            "quasi_static.angle_step": 0.5})
     ds = study.run.run_scene(scene, static=True, dynamic=False)
     s = summarize(ds)

@@ -3,19 +3,18 @@ and the bulk compliance equal those of the whole-body factorisation, one rim ser
 of its rim height (in memory and from the disk cache), and another rim height gets its own."""
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR
 
 from study.inputs import compliance, springs
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import gear_setup
-from study.scene import default_scene
+from study.scene import load_scene
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
 
 def small_scene(**kw):
-    """The small 24-tooth pair of conftest, the driven gear with a web of 8 mm and 4 holes."""
-    return default_scene().replace(**{**SMALL_PAIR, "gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+    """The small 24-tooth pair (the small_pair scene), the driven gear with a web of 8 mm and 4 holes."""
+    return load_scene("small_pair").replace(**{"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
                                       "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5, **kw})
 
 

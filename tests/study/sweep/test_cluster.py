@@ -33,6 +33,7 @@ STUDY = """title = "cluster"
 "gear2.teeth" = 20
 "gear1.body" = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0}
 "gear2.body" = {rim_height = 3.0, web_height = 4.0, hub_height = 3.0, hole_radius = 1.5, hole_circle_radius = 8.1, web_thickness = 12.0}
+"gear1.spring.stiffness" = "uniform"
 "gear2.spring.stiffness" = "uniform"
 "quasi_static" = {rotation = 6.0, angle_step = 0.5}
 "dynamic" = {duration = 0.05, ramp_time = 0.002}

@@ -14,7 +14,7 @@ from study.sweep.outputs import STATUS
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
 
-SCENE = "\n".join(f'"{k}" = {v!r}' for k, v in {**scene_overrides("small_pair"), "quasi_static.rotation": 6.0,
+SCENE = "\n".join(f'"{k}" = {v!r}' for k, v in {**scene_overrides("small_pair"), "coupling.model": "paper", "quasi_static.rotation": 6.0,
                                                  "quasi_static.angle_step": 1.0, "dynamic.duration": 0.004,
                                                  "dynamic.ramp_time": 0.001}.items())
 STUDY = f"""title = "pilot"

@@ -54,11 +54,15 @@ def test_the_paper_model_is_one_key_away_and_none_still_reads():
     assert paper.coupling_model == "none" and paper.coupling_model_name == "paper"
     assert scene.replace(**{"coupling.model": "none"}).coupling_model_name == "paper"
     assert not build_scene_model(paper).teeth_coupled
-    # two solid bodies need no FE: 'auto' is the paper's model there
+    # a pair of solid bodies runs the compliance model too: the plain model misses its STE ripple
     solid = default_scene().solid()
-    assert solid.coupling.model == "auto" and solid.coupling_model == "none"
-    # nor do springs that ignore the lightening
-    assert scene.replace(**{"gear2.spring.stiffness": "uniform"}).coupling_model == "none"
+    assert solid.coupling.model == "auto" and solid.coupling_model == "compliance"
+    # springs that ignore the body on both gears ask for no FE: the paper's model
+    uniform = {"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform"}
+    assert solid.replace(**uniform).coupling_model == "none"
+    assert scene.replace(**uniform).coupling_model == "none"
+    # one gear's FE springs are enough for the coupled model
+    assert scene.replace(**{"gear2.spring.stiffness": "uniform"}).coupling_model == "compliance"
     with pytest.raises(SceneError, match="coupling.model"):
         scene.replace(**{"coupling.model": "plain-ish"})
 
@@ -69,6 +73,10 @@ def test_a_study_over_solid_and_lightened_bodies_runs_one_model():
     pts = make_study(base, {"gear2.body.holes": [0, 6]}, outputs={"scalars": ["ste_p2p"]}).points()
     assert [p.scene.coupling_model for p in pts] == ["compliance", "compliance"]
     assert coupling_models(pts) == "compliance"
+    # a grid that switches the FE springs off on some points still runs one model
+    uni = base.replace(**{"gear1.spring.stiffness": "uniform"})
+    pts = make_study(uni, {"gear2.spring.stiffness": ["uniform", "fe-ratio"]}, outputs={"scalars": ["ste_p2p"]}).points()
+    assert [p.scene.coupling_model for p in pts] == ["compliance", "compliance"]
     pts = make_study(base.replace(**{"coupling.model": "paper"}), {"gear2.body.holes": [0, 6]},
                      outputs={"scalars": ["ste_p2p"]}).points()
     assert coupling_models(pts) == "paper"
@@ -76,10 +84,28 @@ def test_a_study_over_solid_and_lightened_bodies_runs_one_model():
 
 def test_the_run_archive_names_the_model_it_ran():
     from study.run import run_scene
-    scene = load_scene("small_pair").replace(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5}).solid()
+    scene = load_scene("small_pair").replace(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5,
+                                                "gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform"}).solid()
     ds = run_scene(scene, static=True, dynamic=False)
     assert ds.attrs["coupling_model"] == "paper" and ds.attrs["coupling_model_setting"] == "auto"
     lite = small_light(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})
     ds = run_scene(lite, static=True, dynamic=False)
     assert ds.attrs["coupling_model"] == "compliance" and ds.attrs["coupling_model_setting"] == "auto"
     assert ds.attrs["teeth_coupled"] == 1
+
+
+def test_the_implicit_integrator_with_a_coupled_model_is_refused_before_any_work():
+    """HHT-alpha carries the paper's model only: the default resolved to the compliance model
+    with dynamic.method = 'implicit' is a SceneError naming both fields and the ways out; the
+    paper's model named, the scene is valid; 'auto' picks the explicit integrator."""
+    solid = default_scene().solid()
+    with pytest.raises(SceneError, match=r"dynamic.method.*coupling.model = 'auto' runs the compliance model.*"
+                                         r"coupling.model = 'paper'.*dynamic.method = 'explicit'"):
+        solid.replace(**{"dynamic.method": "implicit"})
+    with pytest.raises(SceneError, match=r"dynamic.method.*'body-torsion' is a coupled model"):
+        solid.replace(**{"dynamic.method": "implicit", "coupling.model": "body-torsion"})
+    ok = solid.replace(**{"dynamic.method": "implicit", "coupling.model": "paper"})
+    assert ok.coupling_model == "none"
+    # no dynamic run, no integrator: nothing to refuse
+    assert solid.replace(**{"dynamic.method": "implicit", "dynamic.enabled": False}).coupling_model == "compliance"
+    assert solid.replace(**{"dynamic.method": "auto"}).coupling_model == "compliance"
