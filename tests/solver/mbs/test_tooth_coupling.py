@@ -82,7 +82,7 @@ def test_coupling_softens_double_contact_and_leaves_single_contact():
     contact ratio 1.6)."""
     from study.scene import load_scene
     from study.scene_model import build_scene_model
-    small = build_scene_model(load_scene("small_pair").replace(**{"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
+    small = build_scene_model(load_scene("small_pair").replace(**{"coupling.model": "paper", "gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0}))
     angles = np.radians(np.arange(0.0, 15.0, 0.1))
     z1, z2 = small.teeth
     k = float(small.k_phi[0])
