@@ -412,6 +412,37 @@ def estimate_model(scene):
     return build_scene_model(plain)
 
 
+# A study's task, costed without a model (for the order and batching of the tasks on dask, not
+# for a budget): the dynamic run at a typical step (the paper pair's 1.1 us, the small 20-tooth
+# pair's 1.4 us), the fixed part of a task (its run archive, summary and record: 0.015-0.02 s
+# measured on the small pair) and the part of the first point of a model (its build, damping
+# conversion, modes and step bound), paid once per worker and model and left out here.
+TASK_S = 0.02
+TYPICAL_STEP_S = 1.2e-6
+
+
+def task_seconds(scene, outputs) -> float:
+    """Estimated compute seconds of one study task (`study.sweep.tasks.Task`: its scene and
+    outputs) on a quiet core, from the scene alone: the statics by their angles, the mesh
+    outputs, the dynamic run by its duration at TYPICAL_STEP_S (a run-up's teeth all active and
+    its run repeated). A relative figure: the order in which a study's tasks start and how
+    many share a dask task (`study.sweep.tasks.batches`)."""
+    from study.sweep.outputs import MESH_SCALARS
+    teeth = scene.gear1.teeth + scene.gear2.teeth
+    s = TASK_S
+    if outputs.static and scene.quasi_static.method == "static":
+        angles = static_angle_count(scene)
+        s += angles * STATIC_S_PER_ANGLE_TOOTH * teeth
+        if set(outputs.scalars + outputs.curves) & set(MESH_SCALARS):
+            s += angles * MESH_S_PER_ANGLE
+    if outputs.dynamic:
+        runup = scene.dynamic.speed_end > 0
+        active = teeth if runup else min(teeth, 2 * ACTIVE_TEETH_PER_GEAR)
+        steps = scene.dynamic.duration / (scene.dynamic.time_step or TYPICAL_STEP_S)
+        s += steps * (EXPLICIT_S_PER_STEP + EXPLICIT_S_PER_STEP_TOOTH * active) * (RUNUP_RUNS if runup else 1.0)
+    return s
+
+
 def sweep_estimate(tasks) -> Estimate:
     """Estimated seconds of a study's tasks (`study.sweep.tasks.Task`), summed: FE bodies (each
     distinct body the cache lacks), statics (per static task, by its angles) and dynamics

@@ -129,7 +129,16 @@ class Modes:
 
 def modal_analysis(model: Model, torque: float, positions: int = 12, equilibria=None) -> Modes:
     """Modes of the pair linearised at static equilibrium under ``torque`` [N·m] at
-    ``positions`` driver angles across one mesh period (see the module docstring)."""
+    ``positions`` driver angles across one mesh period (see the module docstring). Without
+    given ``equilibria``, solved once per model and load (`solver.mbs.memo`)."""
+    if equilibria is None:
+        from solver.mbs.memo import kept
+        return kept("modal_analysis", model, (float(torque), int(positions)),
+                    lambda: _modal_analysis(model, torque, positions, None))
+    return _modal_analysis(model, torque, positions, equilibria)
+
+
+def _modal_analysis(model: Model, torque: float, positions: int, equilibria) -> Modes:
     eqs = equilibria or loaded_equilibria(model, torque, positions)
     rows = []
     tz2 = int(model.gear_par[1, L.TOOTH0])

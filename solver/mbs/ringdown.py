@@ -51,7 +51,15 @@ def ring_down(model: Model, torque: float, frequency: float, damping: float, cyc
     """Simulated free decay of the mesh mode under ``torque`` [N·m] with the driver held at
     ``driver_angle`` [rad]; ``frequency`` [Hz] and ``damping`` [1] (from the modal analysis
     there) set the time scales and start the fit. ``cycles``: periods fitted (default: until
-    the amplitude falls to ~5 %, 6 to 40 periods)."""
+    the amplitude falls to ~5 %, 6 to 40 periods). Solved once per model and arguments
+    (`solver.mbs.memo`): a study's points of one body share it."""
+    from solver.mbs.memo import kept
+    args = (float(torque), float(frequency), float(damping), cycles, float(driver_angle))
+    return kept("ring_down", model, args, lambda: _ring_down(model, *args))
+
+
+def _ring_down(model: Model, torque: float, frequency: float, damping: float, cycles: float | None,
+               driver_angle: float) -> RingDown:
     load = torque if abs(torque) > 1e-9 else 1.0
     # the default step of a run, from the model's own loaded equilibria (kept: the turned
     # pair has the same bound and needs no statics of its own); where a guard or the energy

@@ -61,8 +61,16 @@ def stability_limit(model: Model, torque: float, positions: int = 12,
     with continuation (tooth rotations carried from angle to angle); positions where it does
     not converge are left out. ``implicit_dampers``: the tooth-root dampers are taken implicitly
     (IMEX kicks, `implicit_dampers_apply`), which are stable at any damping: only the contact
-    and body dampers count then.
+    and body dampers count then. Solved once per model and arguments (`solver.mbs.memo`: a
+    run asks for it in its method choice and again in `simulate`; a study's points of one body
+    share it).
     """
+    from solver.mbs.memo import kept
+    args = (float(torque), int(positions), bool(implicit_dampers))
+    return kept("stability_limit", model, args, lambda: _stability_limit(model, *args))
+
+
+def _stability_limit(model: Model, torque: float, positions: int, implicit_dampers: bool) -> tuple[float, float]:
     wmax = 0.0
     dt_crit = math.inf
     for sy in linearizations(model, torque, positions):

@@ -48,16 +48,24 @@ def summarize(ds: xr.Dataset) -> dict:
         out["mesh_mode_damping"] = float(ds.attrs["mesh_mode_damping"])
         out["mesh_mode_damping_decay"] = float(ds.attrs.get("mesh_mode_damping_decay", nan))
         for k in (1, 2, 3):
-            out[f"critical_speed_{k if k > 1 else ''}z"] = float(ds["critical_speed"].sel(excitation=f"{k}Z", mode=0))
+            out[f"critical_speed_{k if k > 1 else ''}z"] = float(_at(ds, "critical_speed", excitation=f"{k}Z", mode=0))
     if "mass" in ds:
         for g in (1, 2):
             for name in GEAR_VARIABLES:
-                out[f"{name}_gear{g}"] = float(ds[name].sel(gear=g)) if name in ds else nan
+                out[f"{name}_gear{g}"] = float(_at(ds, name, gear=g)) if name in ds else nan
     for k in ("wall_time_springs_s", "wall_time_static_s", "wall_time_dynamic_s"):
         if k in ds.attrs:
             out[k] = float(ds.attrs[k])
     return out
 
+
+
+def _at(ds: xr.Dataset, name: str, **where):
+    """``ds[name].sel(**where)`` by position in the plain arrays (a study's task summarises
+    every point: xarray's label lookup cost more than the rest of the summary)."""
+    var = ds.variables[name]
+    index = tuple(list(ds.variables[d].values).index(where[d]) if d in where else slice(None) for d in var.dims)
+    return var.values[index]
 
 def flank_side(ds: xr.Dataset) -> float:
     """+1 when the static load drives on the drive flanks, -1 on the coast flanks (a negative

@@ -28,7 +28,10 @@ can import this package. On dask the FE spring maps the tasks read go first, eac
 and no task holds a worker up with a map in the middle of the study. On a local cluster whose
 numba cache lacks the kernels, one task (the pilot) runs first and compiles them into the disk
 cache; the other tasks wait for it and load them, so the machine compiles once, not once per
-worker (the other workers compute the FE meanwhile).
+worker (the other workers compute the FE meanwhile). The tasks go to dask dearest first
+(`study.estimate.task_seconds`), the cheap ones of one model in batches
+(`study.sweep.tasks.batches`: a 10 ms dynamic run costs dask about as much as its physics);
+an interrupted batch loses only its own unfinished tasks.
 """
 from __future__ import annotations
 
@@ -297,9 +300,11 @@ def _in_process(todo: dict, outputs: dict):
         yield key, run_point(scene, outputs[key])
 
 
-def run_after(scene: Scene, outputs: Outputs, *maps) -> dict:
-    """`run_point`, once the FE maps it reads (``maps``: their futures' results) are cached."""
-    return run_point(scene, outputs)
+def run_after(batch: tuple, *maps) -> list:
+    """[(key, `run_point` result)] of a batch of tasks ((key, scene, outputs) each,
+    `study.sweep.tasks.batches`), once the FE maps they read (``maps``: their futures'
+    results) are cached."""
+    return [(key, run_point(scene, outputs)) for key, scene, outputs in batch]
 
 
 def kernel_cache_folder() -> Path:
@@ -326,6 +331,7 @@ def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | 
     from distributed import as_completed
 
     from study.sweep.bodies import compute_body, fe_jobs
+    from study.sweep.tasks import Task, batches
     with dask_client(scheduler, workers) as client:
         # each FE map or body once, ahead of the tasks (higher priority; the bodies, dearest,
         # first), and each task after the FE it reads
@@ -339,24 +345,31 @@ def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | 
                 after.setdefault(key, []).append(maps[fe_key])
         futures = {}
         if pilot is not None:       # compiles the kernels into the disk cache; the other tasks load them
-            first = client.submit(run_after, todo[pilot], outputs[pilot], *after.get(pilot, ()),
+            first = client.submit(run_after, ((pilot, todo[pilot], outputs[pilot]),), *after.get(pilot, ()),
                                   key=f"lightgear-task-{pilot}", pure=False, priority=3)
-            futures[first] = pilot
+            futures[first] = (pilot,)
             for key in todo:
                 after.setdefault(key, []).append(first)
-        futures.update({client.submit(run_after, scene, outputs[key], *after.get(key, ()), key=f"lightgear-task-{key}",
-                                      pure=False): key
-                        for key, scene in todo.items() if key != pilot})
+        # the rest in batches of one model, dearest first (dask starts ready tasks in the order
+        # they were submitted)
+        n_workers = len(client.scheduler_info().get("workers", ())) or workers or os.cpu_count() or 1
+        for batch in batches([Task(k, todo[k], outputs[k]) for k in todo if k != pilot], n_workers):
+            keys = tuple(t.key for t in batch)
+            waits = list(dict.fromkeys(f for k in keys for f in after.get(k, ())))
+            name = f"lightgear-task-{keys[0]}" if len(keys) == 1 else f"lightgear-tasks-{keys[0]}-{len(keys)}"
+            fut = client.submit(run_after, tuple((t.key, t.scene, t.outputs) for t in batch), *waits, key=name,
+                                pure=False)
+            futures[fut] = keys
         del maps, after     # the tasks hold the maps' futures now; dask forgets each map once its tasks ran
         try:
             for fut in as_completed(futures):
-                key = futures.pop(fut)
+                keys = futures.pop(fut)
                 try:
-                    res = fut.result()
+                    done = fut.result()
                 except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001 - lost task (killed worker...): stays pending
-                    res = {"lost": lost_cause(e)}
+                    done = [(key, {"lost": lost_cause(e)}) for key in keys]
                 fut.release()       # the worker drops the result: its memory does not grow with the study
-                yield key, res
+                yield from done
         finally:
             client.cancel(list(futures))
 

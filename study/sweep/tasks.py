@@ -83,6 +83,49 @@ def plan(study: Study, points: list[Point]) -> tuple[dict[str, Task], dict[tuple
     return tasks, of_point
 
 
+# Tasks per dask task: a cheap task (a 10 ms dynamic run of a small pair) costs dask and the
+# client about as much as its physics (submit, schedule, transfer, its part file), so on dask
+# the tasks of one model (`model_group`) are run in batches of about BATCH_S estimated
+# compute seconds (`study.estimate.task_seconds`): under 1 % of overhead, and a worker's
+# kept model and its model-only analyses (`study.setup.kept_scene_model`, `solver.mbs.memo`)
+# serve the whole batch. At least BATCHES_PER_WORKER batches per worker are kept, so that the
+# end of a study still spreads over the workers; a study with fewer tasks is not batched.
+BATCH_S = 2.0
+BATCHES_PER_WORKER = 4
+
+
+def model_group(scene: Scene) -> tuple:
+    """What a task's model depends on: every scene field but ``dynamic.*`` (the points of one
+    group share the model a worker keeps)."""
+    return tuple(getattr(scene, f.name) for f in dataclasses.fields(scene) if f.name != "dynamic")
+
+
+def batches(tasks: list[Task], workers: int) -> list[tuple[Task, ...]]:
+    """The tasks grouped into dask tasks, dearest first: tasks of one `model_group`, dearest
+    first, up to BATCH_S estimated seconds and at most len(tasks) / (BATCHES_PER_WORKER x
+    workers) tasks a batch (one task a batch for a small study)."""
+    from study.estimate import task_seconds
+    cost = {t.key: task_seconds(t.scene, t.outputs) for t in tasks}
+    cap = max(1, len(tasks) // (BATCHES_PER_WORKER * max(workers, 1)))
+    groups: dict[tuple, list[Task]] = {}
+    for t in tasks:
+        groups.setdefault(model_group(t.scene), []).append(t)
+    out = []
+    for members in groups.values():
+        members.sort(key=lambda t: cost[t.key], reverse=True)
+        batch, seconds = [], 0.0
+        for t in members:
+            if batch and (seconds + cost[t.key] > BATCH_S or len(batch) >= cap):
+                out.append(tuple(batch))
+                batch, seconds = [], 0.0
+            batch.append(t)
+            seconds += cost[t.key]
+        if batch:
+            out.append(tuple(batch))
+    out.sort(key=lambda b: sum(cost[t.key] for t in b), reverse=True)     # stable: the study's order among equals
+    return out
+
+
 def point_result(keys: tuple[str, ...], results: dict, shared: Counter) -> dict | None:
     """A point's record from its tasks' results (None while one is missing: the point is pending).
     ``shared``: how many points use each task (its compute time is split over them). A task's

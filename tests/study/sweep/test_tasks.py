@@ -157,3 +157,28 @@ def test_the_merge_reads_each_task_part_once_per_position_of_its_curves(swept, t
     xr.testing.assert_identical(again.dataset.drop_vars(drop).load().assign_attrs(created="", history=""),
                                 res.dataset.drop_vars(drop).load().assign_attrs(created="", history=""))
     assert again.dataset["ste"].dims == ("n_holes", "web_thickness", "angle")
+
+
+def test_cheap_tasks_go_to_dask_in_batches_of_one_model_dearest_first():
+    from study.estimate import task_seconds
+    from study.sweep.grid import check_points
+    from study.sweep.tasks import BATCH_S, batches, model_group
+    st = tiny_study(grid='[grid]\ngear2.body.holes = [0, 4]\n"dynamic.speed" = {start = 50.0, stop = 100.0, num = 40}\n'
+                         '"dynamic.duration" = [0.01, 0.05]\n[outputs]\nscalars = ["ste_p2p", "dte_rms"]\n')
+    tasks, _ = plan(st, check_points(st))
+    assert len(tasks) == 2 + 160
+    out = batches(list(tasks.values()), workers=2)
+    # every task once; a batch holds tasks of one model only, within BATCH_S unless alone, at most
+    # len / (4 x workers) tasks; the longer runs cost more and go first
+    assert Counter(t.key for b in out for t in b) == Counter(tasks.keys())
+    assert all(len({model_group(t.scene) for t in b}) == 1 for b in out)
+    cost = [[task_seconds(t.scene, t.outputs) for t in b] for b in out]
+    assert all(len(c) == 1 or sum(c) <= BATCH_S for c in cost)
+    assert max(len(b) for b in out) <= len(tasks) // 8 and len(out) >= 8
+    assert [sum(c) for c in cost] == sorted((sum(c) for c in cost), reverse=True)
+    assert task_seconds(*max(((t.scene, t.outputs) for t in tasks.values()), key=lambda so: so[0].dynamic.duration)) > \
+        3 * task_seconds(*min(((t.scene, t.outputs) for t in tasks.values() if t.outputs.dynamic),
+                              key=lambda so: so[0].dynamic.duration))
+    # a small study: one task a batch (its tasks spread over the workers as before)
+    small, _ = plan(tiny_study(), check_points(tiny_study()))
+    assert all(len(b) == 1 for b in batches(list(small.values()), workers=2))
