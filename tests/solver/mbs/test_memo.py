@@ -10,7 +10,7 @@ from solver.mbs import memo
 from solver.mbs.kernels import layout as L
 from solver.mbs.modes import modal_analysis
 from solver.mbs.stability import stability_limit, stable_time_step
-from study.setup import build_scene_model
+from study.scene_model import build_scene_model
 
 
 @pytest.fixture(scope="module")
