@@ -87,7 +87,7 @@ def plan(study: Study, points: list[Point]) -> tuple[dict[str, Task], dict[tuple
 # client about as much as its physics (submit, schedule, transfer, its part file), so on dask
 # the tasks of one model (`model_group`) are run in batches of about BATCH_S estimated
 # compute seconds (`study.estimate.task_seconds`): under 1 % of overhead, and a worker's
-# kept model and its model-only analyses (`study.setup.kept_scene_model`, `solver.mbs.memo`)
+# kept model and its model-only analyses (`study.scene_model.kept_scene_model`, `solver.mbs.memo`)
 # serve the whole batch. At least BATCHES_PER_WORKER batches per worker are kept, so that the
 # end of a study still spreads over the workers; a study with fewer tasks is not batched.
 BATCH_S = 2.0

@@ -4,18 +4,18 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import SMALL_PAIR, solid_scene
 
 from solver.mbs import memo
 from solver.mbs.kernels import layout as L
 from solver.mbs.modes import modal_analysis
 from solver.mbs.stability import stability_limit, stable_time_step
+from study.scene import load_scene
 from study.scene_model import build_scene_model
 
 
 @pytest.fixture(scope="module")
 def model():
-    return build_scene_model(solid_scene(**SMALL_PAIR))
+    return build_scene_model(load_scene("small_pair").replace(**{"coupling.model": "paper"}))
 
 
 def test_a_kept_step_bound_and_modes_are_those_solved_afresh(model):
@@ -33,7 +33,7 @@ def test_a_kept_step_bound_and_modes_are_those_solved_afresh(model):
 
 
 def test_a_model_changed_in_place_is_solved_again(model):
-    m = build_scene_model(solid_scene(**SMALL_PAIR))
+    m = build_scene_model(load_scene("small_pair").replace(**{"coupling.model": "paper"}))
     dt, w = stable_time_step(m, 40.0)
     m.law_par[L.K_CON] *= 4.0            # a stiffer contact: a higher top frequency, a shorter step
     dt4, w4 = stable_time_step(m, 40.0)
