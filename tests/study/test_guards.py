@@ -103,7 +103,7 @@ def test_a_contact_too_stiff_for_its_step_is_flagged_inaccurate(paper_solid_mode
 
 
 def test_auto_takes_the_explicit_integrator(small_model):
-    from solver.mbs.implicit import choose_method
+    from solver.mbs.method import choose_method
     # 10 s of the small pair: millions of steps, still explicit (an implicit step costs ~20)
     ch = choose_method(small_model, 50.0, 10.0, "auto")
     assert ch.method == "explicit" and 10.0 / ch.dt > 2e6 and "auto: explicit" in ch.reason

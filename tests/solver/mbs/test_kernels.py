@@ -75,7 +75,7 @@ from solver.mbs.kernels import mechanics
 from solver.mbs.kernels import statics
 from solver.mbs.kernels import stepping
 from solver.mbs.kernels import toothcoupling
-m = build_scene_model(default_scene().solid(gears=(2,)))
+m = build_scene_model(default_scene().solid(gears=(2,)).replace(**{'coupling.model': 'paper'}))
 solve_static(m, np.radians([0.0, 0.1, 0.2]), 50.0)
 simulate(m, 100.0, 1e-4, 50.0, 1e-4, 1e-4)
 for mod in (contact, explicit, laws, mesh, mechanics, statics, stepping, toothcoupling):
