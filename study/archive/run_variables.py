@@ -46,8 +46,7 @@ def scene_title(scene) -> str:
     if d.enabled:
         load += f", {d.speed:g} rad/s" if d.speed_end <= 0 else f", run-up 0-{d.speed_end:g} rad/s"
     parts.append(load)
-    if scene.coupling.model != "none":
-        parts.append(f"coupling {scene.coupling.model}")
+    parts.append(f"{scene.coupling_model_name} model")     # the model run, 'auto' resolved
     return "; ".join(parts)
 
 

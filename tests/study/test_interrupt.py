@@ -29,10 +29,10 @@ STEP = "1e-10"
 STOP_WITHIN_S = 5.0
 
 
-def slow_study(folder: Path, step: str = STEP) -> Path:
+def slow_study(folder: Path, step: str = STEP, speeds: str = "50.0, 60.0, 70.0") -> Path:
     path = folder / "slow.toml"
     path.write_text(f'title = "slow"\n[scene]\n{SMALL}"dynamic" = {{duration = 0.01, ramp_time = 0.002, time_step = {step}}}\n'
-                    '[grid]\n"dynamic.speed" = [50.0, 60.0, 70.0]\n[outputs]\nscalars = ["ste_p2p", "dte_rms"]\n')
+                    f'[grid]\n"dynamic.speed" = [{speeds}]\n[outputs]\nscalars = ["ste_p2p", "dte_rms"]\n')
     return path
 
 
@@ -127,15 +127,17 @@ def test_run_stops_on_a_signal(tmp_path, sig):
 
 @pytest.mark.parametrize("workers", [0, 2])
 def test_sweep_stops_on_sigint_and_sigterm_and_resumes(tmp_path, workers):
-    study = slow_study(tmp_path)
+    # one speed: on two workers the dearest tasks go first, so the static task (milliseconds)
+    # starts at once beside the dynamic one only while a worker is free for it
+    study = slow_study(tmp_path, speeds="50.0")
     fast = tmp_path / "fast"
     fast.mkdir()
-    fast = slow_study(fast, "0.0")
+    fast = slow_study(fast, "0.0", speeds="50.0")
     for sig in (signal.SIGINT, signal.SIGTERM):
         out = tmp_path / f"{sig.name}.nc"
         parts = tmp_path / f".{sig.name}.nc.parts"
         proc = cli(["sweep", study, "-o", out, "--workers", workers, "--no-progress"], tmp_path)
-        # the static task (shared by the three speeds) is stored first; the dynamic ones then run
+        # the static task is stored first; the dynamic one runs (minutes at this step)
         code, took = stop_after(proc, lambda: parts.is_dir() and any(parts.glob("*.pkl")), sig)
         err = (tmp_path / "err.txt").read_text()
         assert code == 130 and took < STOP_WITHIN_S, err
@@ -145,4 +147,4 @@ def test_sweep_stops_on_sigint_and_sigterm_and_resumes(tmp_path, workers):
         done = cli(["sweep", fast, "-o", out, "--workers", 0, "--no-progress"], tmp_path)
         assert done.wait(timeout=600) == 0, (tmp_path / "err.txt").read_text()
         text = (tmp_path / "out.txt").read_text()
-        assert "computed 3, reused 1" in text and "ok 3" in text
+        assert "computed 1, reused 1" in text and "ok 1" in text
