@@ -161,24 +161,12 @@ class FECache:
     def body(self, key: str, build):
         """The factorised body of ``key``, made by ``build()`` when it is not among the last
         `BODY_SLOTS` used."""
-        model = self.bodies.pop(key, None)
-        if model is None:
-            while len(self.bodies) >= BODY_SLOTS:     # drop the least recently used first
-                self.bodies.pop(next(iter(self.bodies)))
-            model = build()
-        self.bodies[key] = model                      # most recently used last
-        return model
+        return _held(self.bodies, BODY_SLOTS, key, build)
 
     def rim(self, key: str, build):
         """The condensed teeth and rim of ``key``, made by ``build()`` when it is not among the
         last `RIM_SLOTS` used."""
-        rim = self.rims.pop(key, None)
-        if rim is None:
-            while len(self.rims) >= RIM_SLOTS:
-                self.rims.pop(next(iter(self.rims)))
-            rim = build()
-        self.rims[key] = rim
-        return rim
+        return _held(self.rims, RIM_SLOTS, key, build)
 
     # ---- arrays of a condensed rim (its condensed stiffness, the products of a load set)
     def read_arrays(self, name: str) -> dict | None:
@@ -207,13 +195,19 @@ class FECache:
 
     def fit(self, key, build):
         """The coupling fit of ``key`` (any hashable), made by ``build()`` when not held."""
-        fit = self.fits.pop(key, None)
-        if fit is None:
-            while len(self.fits) >= FIT_SLOTS:
-                self.fits.pop(next(iter(self.fits)))
-            fit = build()
-        self.fits[key] = fit
-        return fit
+        return _held(self.fits, FIT_SLOTS, key, build)
+
+
+def _held(store: dict, slots: int, key, build):
+    """``store[key]``, made by ``build()`` when it is not among the last ``slots`` used: the
+    least recently used goes first (a dict keeps its insertion order: most recently used last)."""
+    value = store.pop(key, None)
+    if value is None:
+        while len(store) >= slots:
+            store.pop(next(iter(store)))
+        value = build()
+    store[key] = value
+    return value
 
 
 FE_CACHE = FECache()
