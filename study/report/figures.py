@@ -113,11 +113,10 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True,
 
 
 def _renders(ds, name, skip, fields: dict) -> list[Path]:
-    from study.report.render_inputs import missing_fields
+    from study.report.render_inputs import missing_fields, required_scene
     from study.report.stiffness_render import gear_pair_render
     from study.report.stress_render import fe_stress_render
-    from study.scene import loads_scene
-    sc = loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
+    sc = required_scene(ds)
     lightened = [g for g in (1, 2) if sc.is_lightened(g)]
     missing = missing_fields(ds, fields)
     if missing:

@@ -9,15 +9,16 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from study.report.plot_style import archive_scene
 from study.report.render_geometry import fe_body, outline_body, with_teeth
 
 
 def required_scene(ds: xr.Dataset):
     """The scene stored in the archive's ``scene`` attribute; ``KeyError`` without one."""
-    if "scene" not in ds.attrs:
+    sc = archive_scene(ds)
+    if sc is None:
         raise KeyError("archive has no 'scene' attribute: renders need the scene")
-    from study.scene import loads_scene
-    return loads_scene(ds.attrs["scene"], "archive attribute 'scene'")
+    return sc
 
 
 def tooth_stiffness(ds: xr.Dataset, g: int) -> np.ndarray:
