@@ -312,6 +312,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
                     break
                 theta2 = _closing_angle(theta1, torque, open_steps, open_gap, gp, pp, lp)
                 open_steps += 1
+                for m in range(nt):
+                    phi[lst[m]] = 0.0
                 continue
             # residual from the contacts just found (same state: no second search)
             rn = _unknown_forces(mdl, ks, sw, nc, nt, phi, torque)
