@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from solver.fe.body import BodyModel, plane_stress_lame, plane_stress_p2_stiffness
-from solver.fe.factor import blas1_solver, factorise, influence, one_blas_thread
+from solver.fe.factor import blas1_solver, congruence, factorise, influence, one_blas_thread
 from solver.fe.mesh import REGION_RIM, REGION_WEB, BodyMesh
 from solver.geometry import Material
 
@@ -476,9 +476,13 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     if web_free.size:
         lu_w = factorise(K_ww)
         web_solve = blas1_solver(lu_w)
-        # K_iw K_ww^-1 K_wi by triangular solves restricted to the web DOFs the interface reaches
-        web = BodyModel(mesh, _Size(web_free.size), None, np.arange(web_free.size), web_solve, material, factor=lu_w)
-        S -= influence(web, K_wi.T.tocsr(), K_wi)
+        # K_iw K_ww^-1 K_wi by a triangular solve restricted to the web DOFs the interface
+        # reaches and a symmetric product (two solves and a general product if not symmetric)
+        W = congruence(lu_w, K_wi)
+        if W is None:
+            web = BodyModel(mesh, _Size(web_free.size), None, np.arange(web_free.size), web_solve, material, factor=lu_w)
+            W = influence(web, K_wi.T.tocsr(), K_wi)
+        S -= W
     with one_blas_thread():
         schur = cho_factor(0.5 * (S + S.T), lower=True, check_finite=False)
     cb = CondensedBody(rim, pos_r, pos_i, pos_w, web_solve, K_wi if web_free.size else sp.csr_matrix((0, body_i.size)),

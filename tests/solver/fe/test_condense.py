@@ -169,3 +169,18 @@ def test_column_reads_equal_the_whole_body_solve(ring):
     u2 = whole.solve(f2)
     got2 = cond.condensed.column_reads(f2, reads)
     assert np.abs(got2[0] - u2[reads[0], 0]).max() < 1e-9 * np.abs(u2).max()
+
+
+def test_congruence_equals_the_solves(ring):
+    """C^T K^-1 C by one restricted solve and a symmetric product (`factor.congruence`, the
+    web's condensation onto the interface) equals C^T times the full solves of C, and is
+    symmetric."""
+    from solver.fe.factor import congruence
+    mesh, _ = ring
+    whole = fe.assemble(mesh, T_RIM, 0.008, STEEL)
+    C = sp.random(whole.free.size, 30, density=0.002, random_state=np.random.default_rng(4), format="csc")
+    C = C + sp.csc_matrix(([1.0], ([5], [0])), shape=C.shape)        # no empty column
+    W = congruence(whole.factor, C)
+    ref = C.T @ whole.solve(C.toarray())
+    assert W is not None and np.array_equal(W, W.T)
+    assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
