@@ -152,14 +152,15 @@ class RimBlock:
                           U12=U[:n, n:].tocsr(), pr=pr, pc=pc)
         self.blocks = ()                                  # not needed again
 
-    def read_set(self, F: np.ndarray, reads: list) -> ReadSet:
+    def read_set(self, F, reads: list) -> ReadSet:
         """The rim's part of `CondensedBody.column_reads` for the loads F (n_interior, k) [N]
-        and the reads ``reads`` (k arrays of rim interior indices, column j's reads), made by
-        restricted triangular solves of the interface-last factorisation; the last
-        `SOLVES_KEPT` are kept by the loads' and reads' bytes (every web of the rim reads the
-        same teeth under the same loads)."""
+        (CSC, indices sorted) and the reads ``reads`` (k arrays of rim interior indices, column
+        j's reads), made by restricted triangular solves of the interface-last factorisation;
+        the last `SOLVES_KEPT` are kept by the loads' and reads' bytes (every web of the rim
+        reads the same teeth under the same loads)."""
         import hashlib
-        h = hashlib.sha1(np.ascontiguousarray(F).tobytes())
+        h = hashlib.sha1(F.data.tobytes() + b"|" + F.indices.astype(np.int64).tobytes() + b"|"
+                         + F.indptr.astype(np.int64).tobytes())
         for r in reads:
             h.update(np.asarray(r, np.int64).tobytes() + b"|")
         key = h.hexdigest() + str(F.shape)
@@ -209,8 +210,8 @@ def _closed_block(T, rows: np.ndarray):
     return sp.csc_matrix((sub.data, inv[sub.indices], sub.indptr), shape=(rows.size, rows.size))
 
 
-def _read_set(rim: RimBlock, F: np.ndarray, reads: list) -> ReadSet:
-    """`ReadSet` of the loads F (n_interior, k) and reads (k arrays of rim interior indices)."""
+def _read_set(rim: RimBlock, F, reads: list) -> ReadSet:
+    """`ReadSet` of the loads F (n_interior, k; CSC) and reads (k arrays of rim interior indices)."""
     from solver.fe.factor import _lower_solve, _reach
     if rim.split is None:           # a rim whose S_R was read from a cache
         rim.make_split()
@@ -228,10 +229,10 @@ def _read_set(rim: RimBlock, F: np.ndarray, reads: list) -> ReadSet:
     B = np.zeros((rim.n_interface, F.shape[1]))
     rows, s, at = [], [], []
     for j in range(F.shape[1]):
-        loaded = np.flatnonzero(F[:, j])
+        loaded = F.indices[F.indptr[j]:F.indptr[j + 1]]
         fwd = np.flatnonzero(_reach(L11, to_row[loaded]))
         b = np.zeros(n)
-        b[to_row[loaded]] = F[loaded, j]
+        b[to_row[loaded]] = F.data[F.indptr[j]:F.indptr[j + 1]]
         y = _lower_solve(_closed_block(L11, fwd), b[fwd, None], 1)[:, 0]
         B[:, j] = (L21[:, fwd] @ y)[prb]
         read = to_col[np.asarray(reads[j], np.int64)]
@@ -334,15 +335,17 @@ class CondensedBody:
             to_rim = np.full(self.n_free, -1, np.int64)
             to_rim[self.pos_r] = np.arange(self.pos_r.size)
             self._to_rim = to_rim
-        in_rim = all(np.all(self._to_rim[r] >= 0) for r in reads)
-        elsewhere = np.ones(self.n_free, bool)
-        elsewhere[self.pos_r] = False
-        if not in_rim or np.any(f[elsewhere] != 0):
-            u = self.solve(f)
-            return [u[r, j] for j, r in enumerate(reads)]
+        import scipy.sparse as sp
         from scipy.sparse.linalg import spsolve_triangular
 
-        rs = rim.read_set(np.ascontiguousarray(f[self.pos_r]), [self._to_rim[r] for r in reads])
+        fs = sp.csc_matrix(f)
+        in_rim = all(np.all(self._to_rim[r] >= 0) for r in reads) and np.all(self._to_rim[fs.indices] >= 0)
+        if not in_rim:
+            u = self.solve(f)
+            return [u[r, j] for j, r in enumerate(reads)]
+        F_r = sp.csc_matrix((fs.data, self._to_rim[fs.indices], fs.indptr), shape=(self.pos_r.size, f.shape[1]))
+        F_r.sort_indices()
+        rs = rim.read_set(F_r, [self._to_rim[r] for r in reads])
         n = rim.split["n"]
         u_i = -self.schur_solve(rs.B)                        # interface displacement [m], rim interface order
         w2 = np.empty_like(u_i)
