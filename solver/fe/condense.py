@@ -328,6 +328,9 @@ class CondensedBody:
         [m], for each j: the full solve's numbers (to rounding) at a fraction of its cost where
         the loads lie in the teeth and rim and each column reads a few DOFs there (see the
         module doc). Loads or reads elsewhere (web, interface loads): the full solve."""
+        import scipy.sparse as sp
+        from scipy.sparse.linalg import spsolve_triangular
+
         f = np.asarray(f, float).reshape(f.shape[0], -1)
         reads = [np.asarray(r, np.int64) for r in reads]
         rim = self.rim
@@ -335,9 +338,6 @@ class CondensedBody:
             to_rim = np.full(self.n_free, -1, np.int64)
             to_rim[self.pos_r] = np.arange(self.pos_r.size)
             self._to_rim = to_rim
-        import scipy.sparse as sp
-        from scipy.sparse.linalg import spsolve_triangular
-
         fs = sp.csc_matrix(f)
         in_rim = all(np.all(self._to_rim[r] >= 0) for r in reads) and np.all(self._to_rim[fs.indices] >= 0)
         if not in_rim:
