@@ -231,6 +231,15 @@ def point_displacement(model: BodyModel, u: np.ndarray, x: np.ndarray) -> np.nda
     return np.asarray(P @ u).ravel()
 
 
+def _map_loads(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth: list, force: float, patch: float):
+    """(load cases, their nodal forces F (N_dofs, n) [N], the probes P (2n, N_dofs) of their
+    tooth-centreline points: rows x of all points, then y) of the spring map."""
+    cases = [load_case(g, i, pivot_radius) for i in teeth]
+    F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
+    P = model.basis.probes(np.column_stack([c.centre_point for c in cases])).tocsr()
+    return cases, F, P
+
+
 def tooth_stiffness(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, force: float,
                     patch: float) -> tuple[np.ndarray, np.ndarray]:
     """Torsion stiffness k_phi [N·m/rad] of the listed teeth and their displacement fields.
@@ -239,11 +248,48 @@ def tooth_stiffness(model: BodyModel, g: GearGeometry, pivot_radius: float, teet
     Returns (k (n,), u (N_dofs, n)).
     """
     teeth = [int(i) for i in teeth]
-    cases = [load_case(g, i, pivot_radius) for i in teeth]
-    F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
+    cases, F, P = _map_loads(model, g, pivot_radius, teeth, force, patch)
     U = np.zeros((model.basis.N, len(teeth)))
     U[model.free] = model.solve(np.ascontiguousarray(F[model.free]))
-    P = model.basis.probes(np.column_stack([c.centre_point for c in cases]))  # rows: x of all points, then y
+    return _stiffness(teeth, cases, P, U, force), U
+
+
+def tooth_map(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, force: float,
+              patch: float) -> tuple[np.ndarray, np.ndarray]:
+    """(k_phi [N·m/rad], largest von Mises fillet stress [Pa]) of the listed teeth: the numbers
+    of `tooth_stiffness` and `fillet_stress` (to rounding), from only the displacements they
+    read, each load case's at its own tooth's centreline probe and fillet-band DOFs. A body
+    solved through a condensed rim reads them by restricted solves
+    (`solver.fe.condense.CondensedBody.column_reads`) instead of back-substituting the whole
+    rim for every load case; any other body is solved in full."""
+    teeth = [int(i) for i in teeth]
+    if model.condensed is None:
+        k, U = tooth_stiffness(model, g, pivot_radius, teeth, force, patch)
+        return k, fillet_stress(model, g, U, teeth)
+    cases, F, P = _map_loads(model, g, pivot_radius, teeth, force, patch)
+    bands = _fillet_bands(model, g, teeth)
+    n, ed = len(teeth), model.basis.element_dofs
+    pos = np.full(model.basis.N, -1, np.int64)
+    pos[model.free] = np.arange(model.free.size)
+    reads = []
+    for j, band in enumerate(bands):
+        dofs = np.unique(np.concatenate([ed[:, band].ravel(), P[j].indices, P[n + j].indices]))
+        reads.append(dofs[pos[dofs] >= 0])                  # a clamped DOF reads 0
+    cols = model.condensed.column_reads(np.ascontiguousarray(F[model.free]), [pos[r] for r in reads])
+    U = np.full((model.basis.N, n), np.nan)                 # NaN: not read (would show in k or stress)
+    U[pos < 0] = 0.0
+    for j, (r, c) in enumerate(zip(reads, cols)):
+        U[r, j] = c
+    k = _stiffness(teeth, cases, P, U, force)
+    stress = fillet_stress(model, g, U, teeth, bands=bands)
+    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(stress) | np.array([not b.any() for b in bands]))):
+        raise RuntimeError("tooth_map: a load case read a displacement it did not solve for")
+    return k, stress
+
+
+def _stiffness(teeth: list, cases: list, P, U: np.ndarray, force: float) -> np.ndarray:
+    """k_phi [N·m/rad] of each tooth from its load case's displacement U[:, j] [m] read by the
+    probes P at its centreline point."""
     n = len(teeth)
     uc = np.asarray(P @ U)
     k = np.empty(n)
@@ -252,7 +298,7 @@ def tooth_stiffness(model: BodyModel, g: GearGeometry, pivot_radius: float, teet
         if not delta > 0:
             raise RuntimeError(f"tooth {teeth[j]}: non-positive deflection {delta:.3g} m at the tooth centreline")
         k[j] = force * c.lever**2 / delta
-    return k, U
+    return k
 
 
 def von_mises(model: BodyModel, u: np.ndarray) -> np.ndarray:
@@ -298,7 +344,15 @@ def body_field(model: BodyModel, g: GearGeometry, u: np.ndarray, tooth: int, for
                      disp, von_mises(model, u), tooth, force, case.point, case.direction)
 
 
-def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind: str = "von_mises") -> np.ndarray:
+def _fillet_bands(model: BodyModel, g: GearGeometry, teeth) -> list:
+    """Boolean element mask of each listed tooth's `fillet_band`."""
+    mesh = model.mesh
+    centroids = mesh.points[mesh.triangles].mean(axis=1)
+    return [fillet_band(centroids, g, int(t)) for t in teeth]
+
+
+def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind: str = "von_mises",
+                  bands: list | None = None) -> np.ndarray:
     """Largest fillet stress [Pa] of each listed tooth under its own load case (column j of the
     displacements U (N_dofs, n) belongs to ``teeth[j]``).
 
@@ -307,7 +361,7 @@ def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind:
     surface stress; element means read some 15 % low and vary from tooth to tooth with the
     mesh). ``kind``: 'von_mises' (plane stress; both fillets, the compression side usually
     carries the peak) or 'max_principal' (the largest tensile principal stress: the loaded
-    flank's fillet, what ISO 6336-3 rates).
+    flank's fillet, what ISO 6336-3 rates). ``bands``: the teeth's `_fillet_bands`, if at hand.
     """
     import skfem
     from skfem.element import DiscreteField
@@ -315,11 +369,9 @@ def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind:
 
     if kind not in ("von_mises", "max_principal"):
         raise ValueError(f"kind: 'von_mises' or 'max_principal', got {kind!r}")
-    mesh = model.mesh
-    centroids = mesh.points[mesh.triangles].mean(axis=1)
     lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
     vertices = (np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), np.full(3, 1.0 / 6.0))   # reference vertices
-    bands = [fillet_band(centroids, g, int(t)) for t in teeth]
+    bands = _fillet_bands(model, g, teeth) if bands is None else bands
     union = np.flatnonzero(np.logical_or.reduce(bands)) if bands else np.empty(0, np.int64)
     # one basis over the bands of all teeth (a basis per tooth cost more than the rest of the
     # stress); each tooth sums its displacement times the basis gradients on its own band only,

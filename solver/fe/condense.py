@@ -21,6 +21,13 @@ B = K_ir K_rr^-1 F, made once per rim and load set (`RimBlock.products`):
 
     R K^-1 F = G0 + A S^-1 B     (the interface, free, moves by u_i = -S^-1 B).
 
+Where each load case reads its own few DOFs (the spring map: load case j at its tooth's probe
+and fillet band), the reads are made per column instead (`CondensedBody.column_reads`): with
+the interface-last factorisation, the forward solve s = L11^-1 Pr1 f_j and B are the rim's
+(made once per load set), and per body only u_i = -S^-1 B and, per column, the back-substitution
+U11 w = s - U12 u_i restricted to the rows the column's reads depend on (their ancestors in
+U11's graph: some 2,000 of the rim's 71,000 interior DOFs on a gear), not the whole rim.
+
 Units: SI (m, N, N/m).
 """
 from __future__ import annotations
@@ -30,12 +37,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from solver.fe.body import BodyModel, plane_stress_lame, plane_stress_p2_stiffness
-from solver.fe.factor import blas1_solver, factorise, influence, one_blas_thread
+from solver.fe.factor import blas1_solver, congruence, factorise, influence, one_blas_thread
 from solver.fe.mesh import REGION_RIM, REGION_WEB, BodyMesh
 from solver.geometry import Material
 
 MATCH_TOL = 1e-9        # m: two DOF locations closer than this are the same node
-SOLVES_KEPT = 2         # rim solves kept for reuse (`RimBlock.rim_solve`)
+SOLVES_KEPT = 2         # rim solves and column-read sets kept for reuse (`RimBlock.rim_solve`, `RimBlock.read_set`)
 
 
 class _Size:
@@ -113,6 +120,7 @@ class RimBlock:
     split: dict | None = field(default=None, repr=False)   # factors of the interface-last factorisation
     key: str = ""                                          # the cache's name for this rim, if any
     solves: dict = field(default_factory=dict, repr=False)  # kept K_rr^-1 f (`rim_solve`)
+    read_sets: dict = field(default_factory=dict, repr=False)  # kept `ReadSet`s (`read_set`)
 
     @property
     def n_interface(self) -> int:
@@ -144,6 +152,26 @@ class RimBlock:
                           U12=U[:n, n:].tocsr(), pr=pr, pc=pc)
         self.blocks = ()                                  # not needed again
 
+    def read_set(self, F, reads: list) -> ReadSet:
+        """The rim's part of `CondensedBody.column_reads` for the loads F (n_interior, k) [N]
+        (CSC, indices sorted) and the reads ``reads`` (k arrays of rim interior indices, column
+        j's reads), made by restricted triangular solves of the interface-last factorisation;
+        the last `SOLVES_KEPT` are kept by the loads' and reads' bytes (every web of the rim
+        reads the same teeth under the same loads)."""
+        import hashlib
+        h = hashlib.sha1(F.data.tobytes() + b"|" + F.indices.astype(np.int64).tobytes() + b"|"
+                         + F.indptr.astype(np.int64).tobytes())
+        for r in reads:
+            h.update(np.asarray(r, np.int64).tobytes() + b"|")
+        key = h.hexdigest() + str(F.shape)
+        rs = self.read_sets.pop(key, None)
+        if rs is None:
+            rs = _read_set(self, F, reads)
+            while len(self.read_sets) >= SOLVES_KEPT:
+                self.read_sets.pop(next(iter(self.read_sets)))
+        self.read_sets[key] = rs
+        return rs
+
     def rim_solve(self, f: np.ndarray) -> np.ndarray:
         """K_rr^-1 f [m] for loads f (n_interior, k) [N]; the last `SOLVES_KEPT` results are
         kept by the loads' bytes (every web of the rim solves its teeth's reference loads)."""
@@ -156,6 +184,65 @@ class RimBlock:
                 self.solves.pop(next(iter(self.solves)))
         self.solves[key] = y
         return y
+
+
+@dataclass
+class ReadSet:
+    """The rim's part of per-column reads (`RimBlock.read_set`): for each load column j, the
+    rows ``rows[j]`` of the interface-last factorisation's U11 that its reads depend on (sorted,
+    closed under U11's graph), the forward solution s_j = L11^-1 Pr1 f_j on them, and where in
+    them each read lies; and B = K_ir K_rr^-1 F of the module doc."""
+
+    rows: list            # k arrays: U11 positions of column j's restricted back-substitution
+    s: list               # k arrays: L11^-1 Pr1 f_j on ``rows[j]`` (U11 w = s gives w in m)
+    at: list              # k arrays: position in ``rows[j]`` of each of column j's reads
+    B: np.ndarray         # (n_i, k) K_ir K_rr^-1 F [N]
+
+
+def _closed_block(T, rows: np.ndarray):
+    """T[rows][:, rows] (CSC) of a lower-triangular T (CSC) whose ``rows`` (sorted) are closed
+    under its graph (every entry of those columns lies in those rows): a column slice and a
+    renumbering, not a row search through all of T."""
+    import scipy.sparse as sp
+    sub = T[:, rows]
+    inv = np.full(T.shape[0], -1, np.int64)
+    inv[rows] = np.arange(rows.size)
+    return sp.csc_matrix((sub.data, inv[sub.indices], sub.indptr), shape=(rows.size, rows.size))
+
+
+def _read_set(rim: RimBlock, F, reads: list) -> ReadSet:
+    """`ReadSet` of the loads F (n_interior, k; CSC) and reads (k arrays of rim interior indices)."""
+    from solver.fe.factor import _lower_solve, _reach
+    if rim.split is None:           # a rim whose S_R was read from a cache
+        rim.make_split()
+    sp_ = rim.split
+    n = sp_["n"]
+    if "L21c" not in sp_:
+        sp_["L21c"] = sp_["L21"].tocsc()
+    L11, Ut11, L21 = sp_["L11"], sp_["Ut11"], sp_["L21c"]
+    pr1, pc1 = sp_["pr"][:n], sp_["pc"][:n]
+    inv_order = np.empty(n, np.int64)
+    inv_order[sp_["order"]] = np.arange(n)
+    to_row = pr1[inv_order]                   # rim interior index -> row of Pr1 f
+    to_col = pc1[inv_order]                   # rim interior index -> U11 position of its unknown
+    prb = sp_["pr"][n:] - n
+    B = np.zeros((rim.n_interface, F.shape[1]))
+    rows, s, at = [], [], []
+    for j in range(F.shape[1]):
+        loaded = F.indices[F.indptr[j]:F.indptr[j + 1]]
+        fwd = np.flatnonzero(_reach(L11, to_row[loaded]))
+        b = np.zeros(n)
+        b[to_row[loaded]] = F.data[F.indptr[j]:F.indptr[j + 1]]
+        y = _lower_solve(_closed_block(L11, fwd), b[fwd, None], 1)[:, 0]
+        B[:, j] = (L21[:, fwd] @ y)[prb]
+        read = to_col[np.asarray(reads[j], np.int64)]
+        back = np.flatnonzero(_reach(Ut11, read))
+        full = np.zeros(n)
+        full[fwd] = y
+        rows.append(back)
+        s.append(full[back])
+        at.append(np.searchsorted(back, read))
+    return ReadSet(rows, s, at, B)
 
 
 def rim_block(mesh: BodyMesh, face_width: float, material: Material, r_interface: float,
@@ -211,6 +298,7 @@ class CondensedBody:
     K_wi: object              # (n_w, n_i) CSR [N/m]
     schur: tuple              # Cholesky factor of S (scipy.linalg.cho_factor)
     n_free: int
+    _to_rim: np.ndarray | None = field(default=None, repr=False)   # body free position -> rim interior index (-1: not in the rim)
 
     def schur_solve(self, b: np.ndarray) -> np.ndarray:
         """S^-1 b in single-threaded BLAS (the same bits in a study's workers and in one process)."""
@@ -234,6 +322,49 @@ class CondensedBody:
             u[self.pos_w] = t - self.web_solve(np.ascontiguousarray(self.K_wi @ u_i))
         u[self.pos_r] = y - rim.model.solve(np.ascontiguousarray(rim.K_ri @ u_i))
         return u[:, 0] if vec else u
+
+    def column_reads(self, f: np.ndarray, reads: list) -> list:
+        """Column j of K_ff^-1 f (f (n_free, k) [N]) at the body free positions ``reads[j]``
+        [m], for each j: the full solve's numbers (to rounding) at a fraction of its cost where
+        the loads lie in the teeth and rim and each column reads a few DOFs there (see the
+        module doc). Loads or reads elsewhere (web, interface loads): the full solve."""
+        import scipy.sparse as sp
+        from scipy.sparse.linalg import spsolve_triangular
+
+        f = np.asarray(f, float).reshape(f.shape[0], -1)
+        reads = [np.asarray(r, np.int64) for r in reads]
+        rim = self.rim
+        if self._to_rim is None:
+            to_rim = np.full(self.n_free, -1, np.int64)
+            to_rim[self.pos_r] = np.arange(self.pos_r.size)
+            self._to_rim = to_rim
+        fs = sp.csc_matrix(f)
+        in_rim = all(np.all(self._to_rim[r] >= 0) for r in reads) and np.all(self._to_rim[fs.indices] >= 0)
+        if not in_rim:
+            u = self.solve(f)
+            return [u[r, j] for j, r in enumerate(reads)]
+        F_r = sp.csc_matrix((fs.data, self._to_rim[fs.indices], fs.indptr), shape=(self.pos_r.size, f.shape[1]))
+        F_r.sort_indices()
+        rs = rim.read_set(F_r, [self._to_rim[r] for r in reads])
+        n = rim.split["n"]
+        u_i = -self.schur_solve(rs.B)                        # interface displacement [m], rim interface order
+        w2 = np.empty_like(u_i)
+        w2[rim.split["pc"][n:] - n] = u_i                    # in the factorisation's interface order
+        U12, Ut11 = rim.split["U12"], rim.split["Ut11"]
+        if "inv_diag" not in rim.split:
+            rim.split["inv_diag"] = 1.0 / Ut11.diagonal()
+        inv_d = rim.split["inv_diag"]
+        out = []
+        for j in range(f.shape[1]):
+            rows = rs.rows[j]
+            c = (rs.s[j] - U12[rows] @ w2[:, j]) * inv_d[rows]
+            # U11[rows][:, rows] w = c' with the rows scaled to a unit diagonal (scipy's own
+            # scaling would copy the block twice more)
+            Ut = _closed_block(Ut11, rows)                   # U11[rows][:, rows]^T, lower, CSC
+            Ut.data *= np.repeat(inv_d[rows], np.diff(Ut.indptr))
+            w = spsolve_triangular(Ut.T, c, lower=False, unit_diagonal=True, overwrite_A=True, overwrite_b=True)
+            out.append(w[rs.at[j]])
+        return out
 
     def influence(self, R_rim, F_rim, key) -> np.ndarray:
         """R K^-1 F [m/N for unit loads] of reads R (m, N_R) and loads F (N_R, k) on the rim's
@@ -348,9 +479,13 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     if web_free.size:
         lu_w = factorise(K_ww)
         web_solve = blas1_solver(lu_w)
-        # K_iw K_ww^-1 K_wi by triangular solves restricted to the web DOFs the interface reaches
-        web = BodyModel(mesh, _Size(web_free.size), None, np.arange(web_free.size), web_solve, material, factor=lu_w)
-        S -= influence(web, K_wi.T.tocsr(), K_wi)
+        # K_iw K_ww^-1 K_wi by a triangular solve restricted to the web DOFs the interface
+        # reaches and a symmetric product (two solves and a general product if not symmetric)
+        W = congruence(lu_w, K_wi)
+        if W is None:
+            web = BodyModel(mesh, _Size(web_free.size), None, np.arange(web_free.size), web_solve, material, factor=lu_w)
+            W = influence(web, K_wi.T.tocsr(), K_wi)
+        S -= W
     with one_blas_thread():
         schur = cho_factor(0.5 * (S + S.T), lower=True, check_finite=False)
     cb = CondensedBody(rim, pos_r, pos_i, pos_w, web_solve, K_wi if web_free.size else sp.csr_matrix((0, body_i.size)),

@@ -48,10 +48,14 @@ def fe_stiffness(setup: GearSetup, teeth=None, keep_fields: bool = False):
             return k
     geo = setup.geometry
     model = factorised_body(setup)      # shared with the influence coefficients of the same body
+    if not keep_fields:                 # only the reads of k and the stress: no full fields
+        k, stress = fe.tooth_map(model, geo, setup.pivot_radius, tooth_list, setup.force, setup.patch)
+        FE_CACHE.write_stiffness(key, k, settings, stress)
+        return k
     k, U = fe.tooth_stiffness(model, geo, setup.pivot_radius, tooth_list, setup.force, setup.patch)
     stress = fe.fillet_stress(model, geo, U, tooth_list)
     FE_CACHE.write_stiffness(key, k, settings, stress)
-    return (k, (model, U)) if keep_fields else k
+    return k, (model, U)
 
 
 def _teeth(setup: GearSetup, teeth) -> list[int]:

@@ -133,3 +133,54 @@ def test_rim_mesh_numbering_does_not_depend_on_the_body(ring):
     assert np.array_equal(a.points, b.points) and np.array_equal(a.triangles, b.triangles)
     assert a.n_elements == int(np.sum(mesh.region == REGION_RIM))
     assert math.isclose(np.hypot(*a.points.T).min(), C, rel_tol=1e-9)
+
+
+def _column_reads(model, n_cols, seed):
+    """Per load column, a different handful of free DOFs in the rim (r > 22 mm), as body free
+    positions of ``model`` (picked by DOF location: the same DOFs in any numbering)."""
+    rng = np.random.default_rng(seed)
+    keys = cd._dof_keys(model.basis)[model.free]
+    outer = np.flatnonzero(np.hypot(keys[:, 0], keys[:, 1]) > 0.022)
+    outer = outer[np.lexsort((keys[outer, 2], keys[outer, 1], keys[outer, 0]))]
+    return [np.sort(rng.choice(outer, 25, replace=False)) for _ in range(n_cols)]
+
+
+def test_column_reads_equal_the_whole_body_solve(ring):
+    """Each load column read at its own DOFs through the rim's restricted back-substitutions
+    equals the whole body's full solve there, for two webs on one rim (the rim's read set made
+    once); loads off the rim fall back to the full solve, with the same numbers."""
+    mesh, rim = ring
+    for t_web in (0.006, 0.012):
+        whole = fe.assemble(mesh, T_RIM, t_web, STEEL)
+        cond = cd.assemble_condensed(mesh, T_RIM, t_web, STEEL, rim)
+        _, F = _loads_and_reads(whole)
+        f = np.ascontiguousarray(F.toarray()[whole.free])
+        reads = _column_reads(whole, f.shape[1], seed=7)
+        u = whole.solve(f)
+        got = cond.condensed.column_reads(f, reads)
+        scale = np.abs(u).max()
+        for j, r in enumerate(reads):
+            assert np.abs(got[j] - u[r, j]).max() < 1e-9 * scale
+    assert len(rim.read_sets) == 1
+    # a load in the web (r < C): the full solve, the same numbers
+    web_dof = np.flatnonzero(np.hypot(*cd._dof_keys(whole.basis)[whole.free, :2].T) < 0.015)[0]
+    f2 = f.copy()
+    f2[web_dof, 0] = 1.0
+    u2 = whole.solve(f2)
+    got2 = cond.condensed.column_reads(f2, reads)
+    assert np.abs(got2[0] - u2[reads[0], 0]).max() < 1e-9 * np.abs(u2).max()
+
+
+def test_congruence_equals_the_solves(ring):
+    """C^T K^-1 C by one restricted solve and a symmetric product (`factor.congruence`, the
+    web's condensation onto the interface) equals C^T times the full solves of C, and is
+    symmetric."""
+    from solver.fe.factor import congruence
+    mesh, _ = ring
+    whole = fe.assemble(mesh, T_RIM, 0.008, STEEL)
+    C = sp.random(whole.free.size, 30, density=0.002, random_state=np.random.default_rng(4), format="csc")
+    C = C + sp.csc_matrix(([1.0], ([5], [0])), shape=C.shape)        # no empty column
+    W = congruence(whole.factor, C)
+    ref = C.T @ whole.solve(C.toarray())
+    assert W is not None and np.array_equal(W, W.T)
+    assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
