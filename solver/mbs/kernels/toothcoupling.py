@@ -12,9 +12,10 @@ exactly, whatever the rotations of the unloaded teeth. The kernels keep S small 
 candidates of the contact pre-search), so K_S is a few teeth square and is rebuilt only when
 S changes. ``lst[:n]`` holds the tooth indices of S; ``ks[:n, :n]`` its stiffness.
 
-The stepping loop keeps S in ``cset`` (`layout.CoupledSet`, from `coupled_set`, in the loop's work arrays): C the
-compliance, ``ks`` and ``lst`` as above, ``newl`` the next set's teeth, ``inset``/``innew``
-per-tooth 0/1 flags of the current and the next set, ``mo``/``dmo`` scratch moments.
+The stepping loop keeps S in ``cset`` (`layout.CoupledSet`, from `coupled_set`, in the loop's
+work arrays): C the compliance, ``ks`` and ``lst`` as above, ``newl`` the next set's teeth,
+``inset``/``innew`` per-tooth 0/1 flags of the current and the next set, ``mo``/``dmo``
+scratch moments.
 """
 import numpy as np
 
