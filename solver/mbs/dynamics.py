@@ -237,7 +237,8 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
         teeth[L.POS] = 1e-300
     out = np.zeros((n_out, L.N_OUT + L.CONTACT_SLOTS * L.O_CONTACT_COLS))
     mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance)
-    args = (mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out, work_arrays(model.n_teeth))
+    args = (mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out,
+            work_arrays(model.n_teeth, model.tooth_compliance))
     poll = None if progress is None else (lambda: progress(float(out[last_record(out), L.O_TIME])))
     ret = interrupt.call(kernel, args, p, L.ABORT, poll, PROGRESS_PERIOD_S)
     return ret, out[:min(n_out, ret[1] // out_every + 1)]

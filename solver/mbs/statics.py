@@ -25,7 +25,7 @@ import numpy as np
 
 from solver.mbs import interrupt
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.statics import static_sweep
+from solver.mbs.kernels.statics import static_sweep, static_work
 from solver.mbs.model import Model
 
 # Largest elastic approach of the flanks along the line of action at an equilibrium, as a
@@ -96,7 +96,8 @@ def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_it
     mdl = (model.gear_par, model.pair_par, lp, kphi)
     ctl = (np.array([float(torque), theta2, tol, w1, 0.0]), np.array([max_iter], dtype=np.int64))
     # stoppable by Ctrl-C / SIGTERM before the next angle (KeyboardInterrupt raised here)
-    interrupt.call(static_sweep, (mdl, ctooth, ctl, rim_angles, phi, out, f1), ctl[0], L.S_ABORT)
+    sw = static_work(model.n_teeth, ctooth is not None)
+    interrupt.call(static_sweep, (mdl, ctooth, ctl, rim_angles, phi, out, f1, sw), ctl[0], L.S_ABORT)
     te, th2 = out[:, L.S_TE].copy(), out[:, L.S_TH2].copy()
     nc, it = out[:, L.S_NC].astype(np.int64), out[:, L.S_ITER].astype(np.int64)
     if model.coupled:

@@ -46,7 +46,7 @@ from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
 from solver.mbs.kernels.mechanics import dissipation_power, drive, driver_acc_left, kick_gear_par, mesh_energies
 from solver.mbs.kernels.status import OK
 from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_output
-from solver.mbs.kernels.toothcoupling import coupled_set, set_differs, set_energy, set_springs, update_set
+from solver.mbs.kernels.toothcoupling import set_differs, set_energy, set_springs, update_set
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -123,7 +123,8 @@ def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
 def coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth):
     """(kinetic, potential) energy [J]: hubs, rims, body springs, then `mesh_energies` with
     the teeth on the rims, and the coupled set's springs through K_S instead of their own.
-    Arguments as `coupled_forces` (drv: its first two, theta1 [rad] and theta1' [rad/s])."""
+    Arguments as `coupled_forces` but drv = (theta1 [rad], theta1' [rad/s]) (always this
+    pair: another tuple type would compile the function once more)."""
     gp, _pp, _lp, kphi, _ct = mdl
     th1, w1 = drv[0], drv[1]
     x = hub[L.POS]
@@ -166,7 +167,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     gp, pp, lp, kphi, ctooth = mdl
     par, ipar, table = ctl
     phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
-    rec, pairs, q, vpred, tset, book = ws.rec, ws.pairs, ws.q, ws.vpred, ws.tset, ws.book
+    rec, pairs, q, vpred, tset, book, cset = ws.rec, ws.pairs, ws.q, ws.vpred, ws.tset, ws.book, ws.cset
     act = tset[L.T_ACT]
     tz2 = int(gp[1, L.TOOTH0])
     dt, speed, ramp = par[L.DT], par[L.SPEED], par[L.SPEED_RAMP]
@@ -182,7 +183,6 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         for g in range(2):
             gpd[g, L.C_PHI] = 0.0
     mdl_d = (gpd, pp, lp, kphi, ctooth)
-    cset = coupled_set(ctooth)
     coupled = ctooth.shape[0] > 0
     th1, w1, acc1, tl = drive(0.0, par, table)
     nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
@@ -192,10 +192,11 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         ns = update_set(cset, ns, nn, phi, dphi, dphi)
         tset[L.T_INCAND, :] = 0
     nact = initial_set(tset, teeth, pairs, npair, tz2)
-    vpred[:] = dphi
+    for i in range(dphi.shape[0]):     # (a loop: an array copied into a slice compiles numba's shape-error message)
+        vpred[i] = dphi[i]
     drv = (th1, w1, acc1, tl, acc)
     react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, (phi, dphi), gpk)
-    ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth)
+    ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, (th1, w1), hub, teeth)
     book[L.B_E0] = ke + pe
     book[L.B_P_IN] = react * w1 + tl * v[L.H_H2]
     book[L.B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl_d, rec, nc), gp, w1, v)
@@ -264,7 +265,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         max_act = max(max_act, nact)
         if step % ipar[L.OUT_EVERY] == 0:
             o += 1
-            ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth)
+            ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, (th1, w1), hub, teeth)
             te = gp[0, L.RB] * th1 + gp[1, L.RB] * x[L.H_H2]
             finite = math.isfinite(x[L.H_TH2]) and math.isfinite(x[L.H_H2])
             status = record_output(out, o, (t, te, x[L.H_H2], react, ke, pe), book, rec, nc, finite, par, status)

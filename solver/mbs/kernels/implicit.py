@@ -329,7 +329,8 @@ def hht(mdl, ctl, hub, teeth, out, ws):
     for step in range(1, ipar[L.N_STEPS] + 1):
         t_old = (step - 1) * dt
         t = step * dt
-        nw.q_old[:] = q
+        for i in range(q.shape[0]):     # (a loop: see `explicit_coupled`)
+            nw.q_old[i] = q[i]
         # driver acceleration over the step (constant when the ramp end lies on the grid)
         a1m = (driver_speed(t, speed, ramp) - driver_speed(t_old, speed, ramp)) / dt
         if a1m != a1_prev:

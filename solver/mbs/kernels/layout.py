@@ -254,14 +254,16 @@ N_S_OUT = 5
 
 # ---- named work tuples: the scratch arrays a kernel carries (numba types them like tuples, and
 # ``ws.rec`` compiles to the same code as ``ws[0]``)
-StepWork = namedtuple("StepWork", "rec pairs q vpred tset book")
+StepWork = namedtuple("StepWork", "rec pairs q vpred tset book cset")
 StepWork.__doc__ = """Work arrays of a time-stepping loop (`stepping.work_arrays`): contact records
 (C_* columns), candidate pairs, generalised forces q [N m], predicted tooth rates [rad/s], the
-active-tooth set (T_* rows), the running sums (B_* columns)."""
-StaticWork = namedtuple("StaticWork", "rec pairs q zero_rates pos lst r")
+active-tooth set (T_* rows), the running sums (B_* columns), the coupled set of teeth
+(`CoupledSet`; empty arrays without a tooth compliance)."""
+StaticWork = namedtuple("StaticWork", "rec pairs q zero_rates pos lst r ks")
 StaticWork.__doc__ = """Work arrays of the static Newton (`statics`): contact records, candidate
 pairs, generalised forces q [N m], tooth rates held at zero [rad/s], each tooth's unknown number
-(0: theta2, -1: none), the unknown teeth's indices, the residual [N m] over theta2 and them."""
+(0: theta2, -1: none), the unknown teeth's indices, the residual [N m] over theta2 and them,
+the coupled set's stiffness [N m/rad] (teeth coupled through the body; None otherwise)."""
 NewtonWork = namedtuple("NewtonWork", "coef q_old pred hpred A r dx loc cl")
 NewtonWork.__doc__ = """Work arrays of the HHT-alpha Newton (`implicit.newton_arrays`): the scheme's
 coefficients (`implicit` K_* columns), the forces of the last step [N m], the Newmark predictors

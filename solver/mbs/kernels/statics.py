@@ -58,12 +58,15 @@ def solve_dense(a, b):
     return x
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
-def _workspace(ntooth):
-    """Work arrays ``sw`` of the Newton for ntooth teeth (`layout.StaticWork`)."""
+def static_work(ntooth, coupled=False):
+    """Work arrays ``sw`` of the Newton for ntooth teeth (`layout.StaticWork`); ``ks``, the set
+    stiffness of teeth coupled through the body (ntooth x 2 ntooth, `toothcoupling`), only when
+    ``coupled`` (else None, which prunes the coupled code from the compiled kernel). Plain
+    Python (the caller allocates them: np.zeros of integers is then not compiled)."""
     return StaticWork(np.zeros((L.MAX_CONTACTS, L.N_C_COLS)), np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64),
                       np.zeros(ntooth + 2), np.zeros(ntooth), np.zeros(ntooth, dtype=np.int64),
-                      np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth + 1))
+                      np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth + 1),
+                      np.zeros((ntooth, 2 * ntooth)) if coupled else None)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -156,13 +159,12 @@ def _tangent(mdl, ks, sw, nc, nt, phi):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def newton_system(mdl, theta1, theta2, phi, torque):
+def newton_system(mdl, theta1, theta2, phi, torque, sw):
     """The plain model's Newton system at driver angle theta1 and driven angle theta2 [rad] with
     the tooth rotations phi [rad] under the resisting torque [N m]: (tangent [N m/rad],
     residual [N m], the unknown teeth), the unknowns being theta2 and those teeth, as the
-    sweep below builds them (for checks against finite differences)."""
+    sweep below builds them (for checks against finite differences); sw: `static_work`."""
     gp, pp, lp, _kphi = mdl
-    sw = _workspace(phi.shape[0])
     ph = phi.copy()
     nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), ph, sw.zero_rates, (gp, pp, lp), (sw.rec, sw.pairs))
     nt = _unknown_set(sw, npair, gp, ph)
@@ -248,7 +250,7 @@ def _store(out, force1, a, rec, nc, row):
 
 
 @njit(cache=True, nogil=True, no_cfunc_wrapper=True)
-def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
+def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1, sw):
     """Equilibrium at each driver angle theta1s[a] [rad].
 
     mdl: (gear_par, pair_par, law_par, k_phi); ctl: (par, ipar) with the `layout` S_*
@@ -257,6 +259,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     are coupled through the body (`toothcoupling`; its k_phi are then zero), or None. The
     coupled code sits under ``if ctooth is not None`` (and ``ks``) so that numba prunes it
     from the plain model's compiled version (a switch inside a tuple would not be pruned).
+    sw: the work arrays (`static_work`, its ``ks`` given exactly when ctooth is: an argument's
+    None prunes, a None set inside the kernel would make ks an optional array).
 
     phi (Z1+Z2) is the start guess and is updated in place. Writes out[a, S_*] (TE [m],
     theta2 [rad], loaded contacts, Newton iterations, negative when not converged) and the
@@ -270,13 +274,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1):
     gp, pp, lp, _kphi = mdl
     par, ipar = ctl
     torque = par[L.S_TORQUE]
-    ntooth = phi.shape[0]
-    sw = _workspace(ntooth)
-    rec, pairs, zeros, lst = sw.rec, sw.pairs, sw.zero_rates, sw.lst
-    if ctooth is None:
-        ks = None
-    else:
-        ks = np.zeros((ntooth, 2 * ntooth))
+    rec, pairs, zeros, lst, ks = sw.rec, sw.pairs, sw.zero_rates, sw.lst, sw.ks
     rb1 = gp[0, L.RB]
     rb2 = gp[1, L.RB]
     tol_abs = par[L.S_TOL] * max(abs(torque), 1e-3)

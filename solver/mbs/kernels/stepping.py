@@ -23,19 +23,23 @@ import numpy as np
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
 from solver.mbs.kernels.status import ENERGY, INTERRUPTED, NONFINITE, OK, PENETRATION
+from solver.mbs.kernels.toothcoupling import coupled_set
 
 
-def work_arrays(ntooth):
+def work_arrays(ntooth, ctooth=None):
     """The work arrays ``ws`` of a loop over ntooth teeth (`layout.StepWork`: contact records,
-    candidate pairs, generalised forces, predicted tooth rates, active set, running sums).
-    Plain Python (the caller allocates them: one numba function less to compile)."""
+    candidate pairs, generalised forces, predicted tooth rates, active set, running sums, and
+    the coupled set of the tooth compliance ctooth [rad/(N m)], `toothcoupling.coupled_set`;
+    None or 0 x 0: none). Plain Python (the caller allocates them: fewer numba functions,
+    and no np.zeros of integers, to compile)."""
     rec = np.zeros((L.MAX_CONTACTS, L.N_C_COLS))
     pairs = np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)
     q = np.zeros(ntooth + 2)
     vpred = np.zeros(ntooth)
     tset = np.zeros((L.N_TSET, ntooth), dtype=np.int64)
     book = np.zeros(L.N_BOOK)
-    return L.StepWork(rec, pairs, q, vpred, tset, book)
+    cset = coupled_set(np.zeros((0, 0)) if ctooth is None else np.ascontiguousarray(ctooth, dtype=float))
+    return L.StepWork(rec, pairs, q, vpred, tset, book, cset)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)

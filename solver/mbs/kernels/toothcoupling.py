@@ -12,9 +12,10 @@ exactly, whatever the rotations of the unloaded teeth. The kernels keep S small 
 candidates of the contact pre-search), so K_S is a few teeth square and is rebuilt only when
 S changes. ``lst[:n]`` holds the tooth indices of S; ``ks[:n, :n]`` its stiffness.
 
-The stepping loop keeps S in ``cset`` (`layout.CoupledSet`, from `coupled_set`): C the
-compliance, ``ks`` and ``lst`` as above, ``newl`` the next set's teeth, ``inset``/``innew``
-per-tooth 0/1 flags of the current and the next set, ``mo``/``dmo`` scratch moments.
+The stepping loop keeps S in ``cset`` (`layout.CoupledSet`, from `coupled_set`, in the loop's
+work arrays): C the compliance, ``ks`` and ``lst`` as above, ``newl`` the next set's teeth,
+``inset``/``innew`` per-tooth 0/1 flags of the current and the next set, ``mo``/``dmo``
+scratch moments.
 """
 import numpy as np
 
@@ -64,11 +65,10 @@ def set_energy(ks, lst, n, phi):
     return e
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
 def coupled_set(ctooth):
     """Work arrays ``cset`` of the coupled set for the compliance ctooth (teeth x teeth, or
     0 x 0: no coupled teeth, empty arrays). The set holds at most both teeth of every
-    candidate pair."""
+    candidate pair. Plain Python (`stepping.work_arrays` allocates it for the loop)."""
     ntooth = ctooth.shape[0]
     ms = 2 * MAX_CONTACTS if ntooth > 0 else 0
     return CoupledSet(ctooth, np.zeros((ms, 2 * ms)), np.zeros(ms, dtype=np.int64), np.zeros(ms, dtype=np.int64),

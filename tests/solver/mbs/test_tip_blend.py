@@ -9,7 +9,7 @@ from test_relief import ELASTIC, small
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.gearmesh import TIP_BLEND, mesh_contacts, new_contact_buffer
-from solver.mbs.kernels.statics import newton_system
+from solver.mbs.kernels.statics import newton_system, static_work
 from solver.mbs.statics import solve_static
 from study.scene import load_scene
 from study.scene_model import build_scene_model, geometry_model
@@ -95,12 +95,12 @@ def test_statics_tangent_matches_the_finite_difference_jacobian_in_the_blend():
     rec, pairs = new_contact_buffer()
     nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (model.gear_par, model.pair_par, model.law_par), (rec, pairs))
     assert any(rec[c, L.C_KGEO] != 0.0 for c in range(nc))
-    K, _r, teeth = newton_system(mdl, th1, th2, phi, 0.0)
+    K, _r, teeth = newton_system(mdl, th1, th2, phi, 0.0, static_work(model.n_teeth))
 
     def residual(x):
         ph = phi.copy()
         ph[teeth] = x[1:]
-        r = newton_system(mdl, th1, x[0], ph, 0.0)[1]
+        r = newton_system(mdl, th1, x[0], ph, 0.0, static_work(model.n_teeth))[1]
         assert r.size == x.size                      # the same unknowns
         return r
 

@@ -214,7 +214,7 @@ def test_coupled_kernel_matches_its_plain_python_run(imex):
         hub[L.RATE, L.H_TH2] = hub[L.RATE, L.H_H2] = -300.0
         teeth = np.zeros((3, m.n_teeth))
         mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance)
-        res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out, work_arrays(m.n_teeth))
+        res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out, work_arrays(m.n_teeth, m.tooth_compliance))
         runs.append((res, out, teeth[L.POS]))
     (r1, o1, p1), (r2, o2, p2) = runs
     assert r1 == r2 and r1[0] == 0
@@ -235,7 +235,7 @@ def test_set_changes_keep_the_spring_moments(jit):
     phi = RNG.normal(size=z) * 1e-4
     dphi = RNG.normal(size=z) * 1e-2
     vpred = dphi.copy()
-    cset = coupled_set.py_func(C)
+    cset = coupled_set(C)
     _C, ks, slst, newl, inset, innew, _mo, _dmo = cset
 
     def joining(teeth):
