@@ -5,6 +5,7 @@ example when no scene is given, writes the archive and prints a summary.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -116,6 +117,24 @@ def static_force_max(scene: Scene, model: Model) -> float:
     return float(np.max(f)) if f.size and st.converged.all() else float("nan")
 
 
+# the springs and model of the last scene run with keep_model: (what they depend on, springs, model)
+_LAST_MODEL: list = [None, None, None]
+
+
+def kept_springs_and_model(scene: Scene):
+    """(springs, model) of a scene, the springs and the `kept_scene_model` of the last scene
+    that differs from this one only in ``dynamic.*`` fields that leave the model as it is (the
+    mean load its damping ratios are converted at: `study.scene_model.model_key`). A study's
+    worker runs the points of one model in a row: their springs and model key (both read the
+    whole scene) are then made once, not once per point. The objects are shared: not to be
+    changed in place."""
+    key = (tuple(getattr(scene, f.name) for f in dataclasses.fields(scene) if f.name != "dynamic"), mean_load(scene))
+    if _LAST_MODEL[0] != key:
+        springs = scene_springs(scene)
+        _LAST_MODEL[:] = [key, springs, kept_scene_model(scene, springs)]
+    return _LAST_MODEL[1], _LAST_MODEL[2]
+
+
 class RunFields:
     """A run's variables and global attributes before they become its archive (`dataset`),
     read the way `study.archive.summary.summarize` and a study's task read an archive:
@@ -157,7 +176,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
 def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
                max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True,
                warn: bool = True, keep_model: bool = False, archive: bool = True,
-               gear_variables: bool = True) -> RunFields:
+               gear_variables: bool = True, modal: bool = True) -> RunFields:
     """Run the analyses a scene asks for (or those forced by static/dynamic) -> the run
     archive's variables and attributes (`RunFields`; `run_scene` makes the archive of them).
 
@@ -171,9 +190,12 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     Plausibility warnings (`study.plausibility.scene_warnings`, and a speed far above the
     critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr.
     ``keep_model``: take the model from `study.scene_model.kept_scene_model` (a study's worker: the
-    points of one body share it). A study's task reads a few scalars and curves of the run:
-    ``archive=False`` leaves out the attributes that only document an archive (the scene's
-    TOML, the provenance), ``gear_variables=False`` the per-gear mass, inertia and root stress."""
+    points of one body share it; with the springs of the last scene when this one differs from
+    it only in its dynamic run: `kept_springs_and_model`). A study's task reads a few scalars
+    and curves of the run: ``archive=False`` leaves out the attributes that only document an
+    archive (the scene's TOML, the provenance), ``gear_variables=False`` the per-gear mass,
+    inertia and root stress, ``modal=False`` the modal variables (mesh mode, critical speeds,
+    free decay) and the critical-speed warning they give."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
     warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
@@ -188,9 +210,13 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     t0 = time.perf_counter()
     if springs is None:
         estimate.run_fe_bodies(scene, progress)
-    springs = springs or scene_springs(scene)
-    t_springs = time.perf_counter() - t0
-    model = (kept_scene_model if keep_model else build_scene_model)(scene, springs)
+    if keep_model and springs is None:
+        springs, model = kept_springs_and_model(scene)
+        t_springs = time.perf_counter() - t0
+    else:
+        springs = springs or scene_springs(scene)
+        t_springs = time.perf_counter() - t0
+        model = (kept_scene_model if keep_model else build_scene_model)(scene, springs)
     if not damping_ratios(scene):    # (with ratios the damping conversion has checked it)
         from study.plausibility import carrying_equilibria
         carrying_equilibria(scene, model, mean_load(scene), positions=2)     # SceneError: teeth too soft for the load
@@ -234,11 +260,12 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
         **(provenance() if archive else {}),
     }
-    t0 = time.perf_counter()
-    c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
-    coords.update(c); data.update(v); attrs.update(a)
-    attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
-    attrs["wall_time_modes_s"] = time.perf_counter() - t0
+    if modal:
+        t0 = time.perf_counter()
+        c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
+        coords.update(c); data.update(v); attrs.update(a)
+        attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
+        attrs["wall_time_modes_s"] = time.perf_counter() - t0
     if dynamic and "critical_speed" in data:
         cs = data["critical_speed"]
         line = critical_speed_warning(scene, float(cs.values[list(coords["excitation"].values).index("1Z"), 0]))

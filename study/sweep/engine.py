@@ -94,7 +94,8 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
             run = run_fields(scene, static=outputs.static, dynamic=outputs.dynamic,
                              mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)),
                              warn=False, keep_model=True,    # the sweep warns once; a body's points share its model
-                             archive=False, gear_variables=outputs.needs("geometry") or outputs.needs("fe"))
+                             archive=False, gear_variables=outputs.needs("geometry") or outputs.needs("fe"),
+                             modal=outputs.modes or "mesh_mode_damping_decay" in outputs.scalars)
         else:   # geometry (and root stress) only: no model, no solve
             from study.inputs.springs import lightening_dataset
             run = lightening_dataset(scene, stress=outputs.fe)

@@ -135,3 +135,18 @@ def test_a_dimension_without_coordinate_reads_as_its_positions():
     assert float(run["angle"][1]) == 0.5 and run["force"].attrs == ds["force"].attrs == {"units": "N"}
     with pytest.raises(KeyError):
         run["no_such_variable"]
+
+
+def test_points_of_one_model_share_its_springs_and_model_only():
+    """A study's worker keeps the springs and model of the last scene: reused for a scene that
+    differs only in its run's speed, made again when the mean load (the damping conversion's)
+    or the body changes."""
+    from study.run import kept_springs_and_model
+    base = scene_of()
+    springs, model = kept_springs_and_model(base)
+    faster = kept_springs_and_model(scene_of(dynamic={"speed": 180.0, "duration": 0.02}))
+    assert faster[0] is springs and faster[1] is model
+    loaded = kept_springs_and_model(scene_of(dynamic={"torque": 80.0}))
+    assert loaded[1] is not model
+    other = kept_springs_and_model(base.replace(**{"gear2.body.holes": 0}))
+    assert other[1] is not model and other[1].body_inertia[1] > model.body_inertia[1]     # no holes: heavier
