@@ -193,7 +193,8 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     points of one body share it; with the springs of the last scene when this one differs from
     it only in its dynamic run: `kept_springs_and_model`). A study's task reads a few scalars
     and curves of the run: ``archive=False`` leaves out the attributes that only document an
-    archive (the scene's TOML, the provenance), ``gear_variables=False`` the per-gear mass,
+    archive (the scene's TOML, the provenance) and, without ``mesh_outputs``, the loaded
+    contacts of the dynamic run and each tooth's largest force, ``gear_variables=False`` the per-gear mass,
     inertia and root stress, ``modal=False`` the modal variables (mesh mode, critical speeds,
     free decay) and the critical-speed warning they give."""
     static = scene.quasi_static.enabled if static is None else static
@@ -305,8 +306,9 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
                                                   scene.gear2.body.holes, z2,
                                                   (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
-        c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
-        coords.update(c); data.update(v)
+        if archive or mesh_outputs:     # (read by no study output but the dynamic factor, a mesh output)
+            c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
+            coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(run_variables.efficiency_variable(dy, d.torque, d.speed, start))
         if runup:

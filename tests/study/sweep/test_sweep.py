@@ -155,9 +155,9 @@ def test_only_the_asked_analyses_run(monkeypatch):
     monkeypatch.setattr(study.run, "run_fields", lambda s, **kw: seen.append(kw) or real(s, **kw))
     st = tiny_study("[grid]\ndynamic.speed = [50.0]\n[outputs]\nscalars = ['ste_p2p']")
     r = sweep.run_point(st.points()[0].scene, st.outputs)
-    # the sweep warns once; keeps the model; reads the run without its archive's documentation
-    # and per-gear variables
-    lean = {"warn": False, "keep_model": True, "archive": False, "gear_variables": False}
+    # the sweep warns once; keeps the model; reads the run without its archive's documentation,
+    # per-gear and modal variables
+    lean = {"warn": False, "keep_model": True, "archive": False, "gear_variables": False, "modal": False}
     assert r["status"] == "ok" and seen == [{"static": True, "dynamic": False, "mesh_outputs": False, **lean}]
     assert set(r["scalars"]) == {"ste_p2p"} and r["curves"] == {}
     # a mesh scalar asks for the linearised mesh over the STE
