@@ -4,7 +4,8 @@
              DTE), hole count {0, 4} x 1000 speeds, four scalars and the `dte` and
              `dte_amplitude` curves, on a LocalCluster of 2 single-threaded workers: wall time,
              points/s, peak RSS of the client process (this one: the sweep loop, the dask
-             client and the LocalCluster's scheduler).
+             client and the LocalCluster's scheduler), CPU a point of this process and of the
+             workers (the whole run_sweep: the plan, the workers' start and imports, the merge).
   merge      the same parts merged into the archive again in a fresh process, as `run_sweep`
              does (curves read from the part files in blocks of `MERGE_BLOCK_BYTES`) and, for
              comparison, with every record held in memory first (as before): wall time, peak
@@ -121,8 +122,12 @@ def main(argv=None) -> int:
     out = tmp / "large.nc"
     base = rss_mib()[0]
     t0 = time.perf_counter()
+    cpu0 = os.times()
     res = run_sweep(large_study(*study_args), out, workers=2, progress=False, keep_parts=True)
     wall = time.perf_counter() - t0
+    cpu1 = os.times()      # the workers' CPU reaches children_* once the cluster has closed
+    own = cpu1.user - cpu0.user + cpu1.system - cpu0.system
+    workers_cpu = cpu1.children_user - cpu0.children_user + cpu1.children_system - cpu0.children_system
     client_peak = peak_rss_mib()
     n = res.points
     ds = res.dataset
@@ -133,6 +138,9 @@ def main(argv=None) -> int:
           f"point compute {compute / n:.3f} s on average; curves {curve_mib:.1f} MiB; {load()}")
     print(f"client (sweep loop + dask client + LocalCluster scheduler): peak RSS {client_peak:.0f} MiB "
           f"({base:.0f} MiB after imports)")
+    print(f"CPU: {own + workers_cpu:.1f} s = {(own + workers_cpu) / n * 1e3:.1f} ms a point: this process (plan, "
+          f"client, scheduler, part files, merge) {own / n * 1e3:.1f} ms, the workers and their nannies (start, "
+          f"imports, tasks) {workers_cpu / n * 1e3:.1f} ms; {load()}")
     part_mib = sum(f.stat().st_size for f in parts_folder(out).glob("*.pkl")) / 2**20
     for how in ("blocks", "memory"):
         r = subprocess.run([sys.executable, __file__, "--merge", json.dumps(study_args), str(out), how],

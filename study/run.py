@@ -5,6 +5,7 @@ example when no scene is given, writes the archive and prints a summary.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -116,10 +117,72 @@ def static_force_max(scene: Scene, model: Model) -> float:
     return float(np.max(f)) if f.size and st.converged.all() else float("nan")
 
 
+# the springs and model of the last scene run with keep_model: (what they depend on, springs, model)
+_LAST_MODEL: list = [None, None, None]
+
+
+def kept_springs_and_model(scene: Scene):
+    """(springs, model) of a scene, the springs and the `kept_scene_model` of the last scene
+    that differs from this one only in ``dynamic.*`` fields that leave the model as it is (the
+    mean load its damping ratios are converted at: `study.scene_model.model_key`). A study's
+    worker runs the points of one model in a row: their springs and model key (both read the
+    whole scene) are then made once, not once per point. The objects are shared: not to be
+    changed in place."""
+    from study.inputs.cache import FE_CACHE
+    # the FE cache's folder and generation: springs read from another cache, or from one
+    # cleared since, are made again
+    key = (tuple(getattr(scene, f.name) for f in dataclasses.fields(scene) if f.name != "dynamic"), mean_load(scene),
+           str(FE_CACHE.folder), FE_CACHE.generation)
+    if _LAST_MODEL[0] != key:
+        springs = scene_springs(scene)
+        _LAST_MODEL[:] = [key, springs, kept_scene_model(scene, springs)]
+    return _LAST_MODEL[1], _LAST_MODEL[2]
+
+
+class RunFields:
+    """A run's variables and global attributes before they become its archive (`dataset`),
+    read the way `study.archive.summary.summarize` and a study's task read an archive:
+    ``name in run``, ``run[name]`` (an xarray.Variable: ``.values``, ``.dims``, ``.attrs``,
+    ``float()``), ``run.variables``, ``run.attrs``. A study's task reads a few numbers of a
+    run: assembling the run's xarray.Dataset (indexes, alignment, merge) cost it more than any
+    other step but the dynamic run itself."""
+
+    def __init__(self, coords: dict, data: dict, attrs: dict):
+        self.coords, self.data, self.attrs = coords, data, attrs
+        self.variables = {**coords, **data}
+
+    def __contains__(self, name) -> bool:
+        return name in self.variables
+
+    def __getitem__(self, name: str) -> xr.Variable:
+        var = self.variables.get(name)
+        if var is None:
+            # a dimension without a coordinate reads as its positions, as in a Dataset
+            size = next((v.sizes[name] for v in self.variables.values() if name in v.dims), None)
+            if size is None:
+                raise KeyError(name)
+            return xr.Variable((name,), np.arange(size))
+        return var
+
+    def dataset(self) -> xr.Dataset:
+        """The run archive."""
+        return xr.Dataset(self.data, coords=self.coords, attrs=self.attrs)
+
+
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
               max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True,
               warn: bool = True, keep_model: bool = False) -> xr.Dataset:
-    """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive.
+    """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive
+    (`run_fields`, assembled into its xarray.Dataset)."""
+    return run_fields(scene, static, dynamic, springs, max_time, progress, mesh_outputs, warn, keep_model).dataset()
+
+
+def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
+               max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True,
+               warn: bool = True, keep_model: bool = False, archive: bool = True,
+               gear_variables: bool = True, modal: bool = True) -> RunFields:
+    """Run the analyses a scene asks for (or those forced by static/dynamic) -> the run
+    archive's variables and attributes (`RunFields`; `run_scene` makes the archive of them).
 
     Before any work: a dynamic run whose output arrays do not fit in memory is refused
     (`study.errors.BudgetError`), and, with ``max_time`` [s], so is a run whose estimated
@@ -131,7 +194,13 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     Plausibility warnings (`study.plausibility.scene_warnings`, and a speed far above the
     critical speeds) go to the archive's ``plausibility_warnings`` and, with ``warn``, to stderr.
     ``keep_model``: take the model from `study.scene_model.kept_scene_model` (a study's worker: the
-    points of one body share it)."""
+    points of one body share it; with the springs of the last scene when this one differs from
+    it only in its dynamic run: `kept_springs_and_model`). A study's task reads a few scalars
+    and curves of the run: ``archive=False`` leaves out the attributes that only document an
+    archive (the scene's TOML, the provenance) and, without ``mesh_outputs``, the loaded
+    contacts of the dynamic run and each tooth's largest force, ``gear_variables=False`` the per-gear mass,
+    inertia and root stress, ``modal=False`` the modal variables (mesh mode, critical speeds,
+    free decay) and the critical-speed warning they give."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
     warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
@@ -139,40 +208,47 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     if dynamic:
         estimate.check_dynamic_memory(scene)
     est = estimate.Estimate()
-    if springs is None:
+    bounded = max_time is not None      # the estimates serve only the bound
+    if springs is None and bounded:
         est.seconds["FE bodies"] = estimate.fe_seconds(scene)
         estimate.check_time(est, max_time)
     t0 = time.perf_counter()
     if springs is None:
         estimate.run_fe_bodies(scene, progress)
-    springs = springs or scene_springs(scene)
-    t_springs = time.perf_counter() - t0
-    model = (kept_scene_model if keep_model else build_scene_model)(scene, springs)
+    if keep_model and springs is None:
+        springs, model = kept_springs_and_model(scene)
+        t_springs = time.perf_counter() - t0
+    else:
+        springs = springs or scene_springs(scene)
+        t_springs = time.perf_counter() - t0
+        model = (kept_scene_model if keep_model else build_scene_model)(scene, springs)
     if not damping_ratios(scene):    # (with ratios the damping conversion has checked it)
         from study.plausibility import carrying_equilibria
         carrying_equilibria(scene, model, mean_load(scene), positions=2)     # SceneError: teeth too soft for the load
     choice = None
-    if static:
+    if static and bounded:
         est.seconds["statics"] = estimate.static_seconds(scene, model)
         if mesh_outputs:
             est.seconds["mesh stiffness"] = estimate.mesh_seconds(scene)
     if dynamic:
         choice = dynamic_choice(scene, model)
-        part = f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"
-        est.seconds[part] = estimate.dynamic_seconds(model, choice, scene.dynamic.duration, scene)
-        est.levers[part] = estimate.dynamic_lever(scene, choice)
+        if bounded:
+            part = f"dynamics ({choice.method}, dt {choice.dt:.3g} s)"
+            est.seconds[part] = estimate.dynamic_seconds(model, choice, scene.dynamic.duration, scene)
+            est.levers[part] = estimate.dynamic_lever(scene, choice)
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = run_variables.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
-    setups = gear_setups(scene)
-    c, v = lightening_variables(setups, root_stresses(setups))    # mass, inertia; root stress from the springs' FE
-    coords.update(c); data.update(v)
+    if gear_variables:
+        setups = gear_setups(scene)
+        c, v = lightening_variables(setups, root_stresses(setups))    # mass, inertia; root stress from the springs' FE
+        coords.update(c); data.update(v)
     z1, z2 = model.teeth
     d = scene.dynamic
     driven_speed = d.speed * z1 / z2
     attrs = {
         "title": run_variables.scene_title(scene),
-        "scene": scene.to_toml(),
+        **({"scene": scene.to_toml()} if archive else {}),
         "backlash_offset_um": model.backlash_offset * units.UM_PER_M,
         "contact_ratio": model.pair.contact_ratio,
         "mesh_order": float(z2),
@@ -187,13 +263,14 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         "pivot_radius_mm": model.gear_par[:, R_PV] * units.MM_PER_M,
         "teeth_coupled": int(model.teeth_coupled),
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
-        **provenance(),
+        **(provenance() if archive else {}),
     }
-    t0 = time.perf_counter()
-    c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
-    coords.update(c); data.update(v); attrs.update(a)
-    attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
-    attrs["wall_time_modes_s"] = time.perf_counter() - t0
+    if modal:
+        t0 = time.perf_counter()
+        c, v, a = modal_variables(model, mean_load(scene), scene.gear2.body.holes, decay=dynamic)
+        coords.update(c); data.update(v); attrs.update(a)
+        attrs["mesh_damping_ratio_requested"] = damping_ratios(scene).get("contact", float("nan"))
+        attrs["wall_time_modes_s"] = time.perf_counter() - t0
     if dynamic and "critical_speed" in data:
         cs = data["critical_speed"]
         line = critical_speed_warning(scene, float(cs.values[list(coords["excitation"].values).index("1Z"), 0]))
@@ -233,8 +310,9 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
                                                   scene.gear2.body.holes, z2,
                                                   (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
-        c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
-        coords.update(c); data.update(v)
+        if archive or mesh_outputs:     # (read by no study output but the dynamic factor, a mesh output)
+            c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
+            coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(run_variables.efficiency_variable(dy, d.torque, d.speed, start))
         if runup:
@@ -250,4 +328,4 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
         attrs["dynamic_method"] = choice.method
         attrs["dynamic_method_reason"] = choice.reason
         attrs["hht_alpha"] = d.alpha if choice.method == "implicit" else float("nan")
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return RunFields(coords, data, attrs)

@@ -44,6 +44,7 @@ class FECache:
         self.bodies: dict = {}                       # body key -> factorised BodyModel (least recently used first)
         self.fits: dict = {}                         # fit key -> coupling fit (least recently used first)
         self.rims: dict = {}                         # rim key -> condensed teeth and rim (`solver.fe.condense.RimBlock`)
+        self.generation = 0                          # counts `clear`: what was made from the held results is stale
 
     @property
     def folder(self) -> Path:
@@ -59,6 +60,7 @@ class FECache:
         """Forget every result held in memory (maps, compliances, factorised bodies, fits)."""
         for held in (self.stiffness, self.root_stress, self.compliance, self.bodies, self.fits, self.rims):
             held.clear()
+        self.generation += 1
 
     def _read(self, held: dict, key: str, name: str, load):
         """The result of ``key`` from ``held``, else loaded from the file ``name`` (None when

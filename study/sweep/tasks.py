@@ -16,6 +16,7 @@ point's share of the compute time (a shared task's time split equally over its p
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 from collections import Counter
@@ -46,11 +47,38 @@ def flat_fields(data: dict, prefix: str = "") -> dict:
     return out
 
 
+def scene_fields(obj, prefix: str = "") -> dict:
+    """A scene (or one of its sections) -> {dotted path: value}: ``flat_fields(dataclasses.asdict(obj))``
+    without asdict's deep copy of every value (a study keys thousands of scenes)."""
+    out = {}
+    for f in dataclasses.fields(obj):
+        v = getattr(obj, f.name)
+        path = prefix + f.name
+        if dataclasses.is_dataclass(v):
+            out.update(scene_fields(v, path + "."))
+        elif isinstance(v, dict | list | tuple):     # containers: as asdict makes them
+            v = dataclasses.asdict(_Box(v)).get("v")
+            out.update(flat_fields(v, path) if isinstance(v, dict) else {path: v})
+        else:
+            out[path] = v
+    return out
+
+
+@dataclasses.dataclass
+class _Box:
+    v: object
+
+
+@functools.lru_cache(maxsize=4096)
+def _reads(analysis: str, path: str) -> bool:
+    return reads(analysis, path)
+
+
 def task_key(scene: Scene, outputs: Outputs) -> str:
     """Content hash of a task: the scene fields its outputs read, the outputs, the code."""
     from study.archive.netcdf import code_fingerprint
     analysis = outputs.widest
-    fields = {k: v for k, v in flat_fields(dataclasses.asdict(scene)).items() if reads(analysis, k)}
+    fields = {k: v for k, v in scene_fields(scene).items() if _reads(analysis, k)}
     blob = json.dumps([fields, list(outputs.scalars), list(outputs.curves), code_fingerprint()],
                       sort_keys=True, default=str)
     return hashlib.sha256(blob.encode()).hexdigest()[:24]

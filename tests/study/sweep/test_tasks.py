@@ -11,7 +11,7 @@ from sweep_cases import swept, tiny_study  # noqa: F401  (swept: the sweep, run 
 from study.scene import default_scene
 from study.sweep.engine import run_point, run_sweep
 from study.sweep.outputs import ANALYSES, SCALARS, STATUS, analysis_of, outputs_from_table, reads
-from study.sweep.tasks import WORST_FIRST, flat_fields, plan, point_result, task_key
+from study.sweep.tasks import WORST_FIRST, flat_fields, plan, point_result, scene_fields, task_key
 
 FIELDS = list(flat_fields(dataclasses.asdict(default_scene())))
 
@@ -27,6 +27,20 @@ def test_the_analyses_read_nested_sets_of_scene_fields():
     assert not {"gear2.spring.k_phi", "material.youngs_modulus", "quasi_static.torque"} & read["geometry"]
     assert {"quasi_static.torque", "fe.mesh_size", "gear2.spring.stiffness"} <= read["fe"]
     assert not {"contact.k_con", "quasi_static.rotation", "dynamic.speed"} & read["fe"]
+
+
+def test_scene_fields_are_the_flattened_scene():
+    """The task key's flattening (no deep copy) gives the paths and values of the flattened
+    dataclasses.asdict, containers (pitch deviations, profile tables) included."""
+    sc = default_scene()
+    changed = sc.replace(**{"gear1.errors.pitch": (1.0, -2.0, 0.5) * 22 + (11.0,), "gear2.modification.tip_relief": 5.0,
+                            "gear2.modification.tip_length": 1.0, "dynamic.speed": 120.0})
+    for scene in (sc, changed):
+        flat = scene_fields(scene)
+        ref = flat_fields(dataclasses.asdict(scene))
+        assert list(flat) == list(ref) and flat == ref
+    assert scene_fields(changed)["gear1.errors.pitch"] == (1.0, -2.0, 0.5) * 22 + (11.0,)
+    assert scene_fields(changed)["dynamic.speed"] == 120.0 and scene_fields(sc)["dynamic.speed"] != 120.0
 
 
 def test_a_task_key_changes_with_the_fields_its_outputs_read_only():
