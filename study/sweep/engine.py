@@ -25,10 +25,13 @@ Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a da
 that is always closed, or an existing scheduler (``scheduler="tcp://host:8786"``) whose workers
 can import this package. On dask the FE spring maps the tasks read go first, each once
 (`study.sweep.bodies`), and each task waits for its maps: no two workers compute the same map,
-and no task holds a worker up with a map in the middle of the study. On a local cluster whose
-numba cache lacks the kernels, one task (the pilot) runs first and compiles them into the disk
-cache; the other tasks wait for it and load them, so the machine compiles once, not once per
-worker (the other workers compute the FE meanwhile). The tasks go to dask dearest first
+and no task holds a worker up with a map in the middle of the study. The first FE job of each
+condensed rim (`bodies.job_rim`) goes first, the rim's other jobs after it: they read the rim
+from the disk instead of condensing it again on each worker (`rims_first`). On a local cluster
+whose numba cache lacks the kernels, the pilot (a static and a dynamic task of the first body,
+`pilot_tasks`) runs first and compiles them into the disk cache; the other tasks wait for it and
+load them, so the machine compiles once, not once per worker (the other workers compute the FE
+meanwhile). The tasks go to dask dearest first
 (`study.estimate.task_seconds`), the cheap ones of one model in batches
 (`study.sweep.tasks.batches`: a 10 ms dynamic run costs dask about as much as its physics);
 on a local cluster a batch's worker stores each of its tasks as it finishes, so that an
