@@ -317,11 +317,16 @@ def run_after(batch: tuple, *maps, parts: str | None = None) -> list:
     ``parts``: the study's part folder, on a disk the client shares (a local cluster): each
     task's result is stored there as soon as it is finished (`PartStore`; the result comes back
     marked ``stored``), so that a batch cut short (Ctrl-C, its worker lost) keeps its finished
-    tasks for the resume. A task that ends while the worker is closing is not stored: its kernel
+    tasks for the resume, and dask's retry of a batch whose worker died computes only the tasks
+    it had not finished. A task that ends while the worker is closing is not stored: its kernel
     was stopped (`solver.mbs.interrupt`), its record says so, not what the point gives."""
     store = PartStore(parts) if parts is not None else None
     out = []
     for key, scene, outputs in batch:
+        result = store.get(key) if store is not None else None     # (stored by a first try of the batch)
+        if result is not None:
+            out.append((key, {**result, "stored": True}))
+            continue
         result = run_point(scene, outputs)
         if store is not None and not _CLOSING:
             store.put(key, result)

@@ -36,9 +36,15 @@ def test_a_batch_cut_short_keeps_its_finished_tasks_and_the_resume_computes_the_
             part = pickle.load(f)
         assert part["status"] == "ok" and "stored" not in part
     monkeypatch.undo()
+    # the batch tried again (dask's retry when its worker died) runs only its unfinished task
     calls = count_points(monkeypatch)
+    retried = run_after(batch, parts=str(parts_folder(out)))
+    assert len(calls) == 1 and [k for k, _ in retried] == [k for k, _, _ in batch]
+    assert all(r["stored"] and r["status"] == "ok" for _, r in retried)
+    # the resume of the study computes the tasks no batch finished
+    calls.clear()
     again = run_sweep(st, out, workers=0, progress=False)
-    assert again.reused == 2 and again.computed == len(tasks) - 2 == len(calls)
+    assert again.reused == 3 and again.computed == len(tasks) - 3 == len(calls)
     same_archive(again.dataset, res.dataset)
 
 
