@@ -15,6 +15,12 @@ loaded along its profile: the dearest FE of a study). `fe_jobs` lists, per gear,
 `compute_body` job that computes the gear's spring map and its compliance in one process, so
 that both come from one factorisation of the body, and the solid reference's map as above.
 Scenes with the body-torsion model list no job: their tasks compute what they need.
+
+A body with a web or hub is solved through its teeth and rim condensed once per rim height
+(`study.inputs.compliance.condensed_rim`: the dearest part of a study's first body, kept on
+disk as ``rim-*.npz`` with its products). `job_rim` names the rim a job builds or reads, so
+that the engine runs one job per rim first and the rim's other jobs after it: they read the
+condensed rim from the disk instead of each worker condensing it again.
 """
 from __future__ import annotations
 
@@ -101,10 +107,24 @@ def fe_jobs(scene: Scene) -> list[tuple[str, object, tuple]]:
         return []
 
 
-def compute_body(scene: Scene, g: int) -> None:
+def job_rim(func, args: tuple) -> str | None:
+    """Cache key (`study.inputs.compliance.rim_key`) of the condensed teeth and rim that an FE
+    job of `fe_jobs` builds or reads; None for a body factorised whole or a job that cannot
+    say (its own error comes later, from the job)."""
+    from study.inputs.compliance import CONDENSE, rim_key
+    from study.inputs.gearsetup import gear_setups
+    try:
+        setup = gear_setups(args[0])[args[1] - 1] if func is compute_body else args[0]
+        body = setup.body
+        return rim_key(setup) if CONDENSE and (body.web_height > 0 or body.hub_height > 0) else None
+    except Exception:  # noqa: BLE001 - see above
+        return None
+
+
+def compute_body(scene: Scene, g: int, *after) -> None:
     """Compute gear g's FE spring map (when its springs read one) and the compliance its
     coupling fit reads into the cache, one factorisation for both; never raises (see
-    `compute_map`)."""
+    `compute_map`). ``after``: the results of the jobs it waits for (its rim's first job)."""
     from study.inputs.gearsetup import gear_setups
     from study.inputs.springs import fe_stiffness, uses_fe_springs
     from study.scene_model import coupling_fit
@@ -118,9 +138,9 @@ def compute_body(scene: Scene, g: int) -> None:
         pass
 
 
-def compute_map(setup, teeth) -> None:
+def compute_map(setup, teeth, *after) -> None:
     """Compute one FE map into the cache; never raises (a task that reads a map that failed
-    computes it again and reports the error as its own)."""
+    computes it again and reports the error as its own). ``after``: as for `compute_body`."""
     from study.inputs.springs import fe_stiffness
     try:
         fe_stiffness(setup, teeth)

@@ -25,13 +25,17 @@ Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a da
 that is always closed, or an existing scheduler (``scheduler="tcp://host:8786"``) whose workers
 can import this package. On dask the FE spring maps the tasks read go first, each once
 (`study.sweep.bodies`), and each task waits for its maps: no two workers compute the same map,
-and no task holds a worker up with a map in the middle of the study. On a local cluster whose
-numba cache lacks the kernels, one task (the pilot) runs first and compiles them into the disk
-cache; the other tasks wait for it and load them, so the machine compiles once, not once per
-worker (the other workers compute the FE meanwhile). The tasks go to dask dearest first
+and no task holds a worker up with a map in the middle of the study. The first FE job of each
+condensed rim (`bodies.job_rim`) goes first, the rim's other jobs after it: they read the rim
+from the disk instead of condensing it again on each worker (`rims_first`). On a local cluster
+whose numba cache lacks the kernels, the pilot (a static and a dynamic task of the first body,
+`pilot_tasks`) runs first and compiles them into the disk cache; the other tasks wait for it and
+load them, so the machine compiles once, not once per worker (the other workers compute the FE
+meanwhile). The tasks go to dask dearest first
 (`study.estimate.task_seconds`), the cheap ones of one model in batches
 (`study.sweep.tasks.batches`: a 10 ms dynamic run costs dask about as much as its physics);
-an interrupted batch loses only its own unfinished tasks.
+on a local cluster a batch's worker stores each of its tasks as it finishes, so that an
+interrupted batch loses only its unfinished tasks.
 """
 from __future__ import annotations
 
@@ -282,7 +286,9 @@ def stop_kernels_plugin():
         def teardown(self, worker):
             import gc
 
+            import study.sweep.engine as engine
             from solver.mbs import interrupt
+            engine._CLOSING = True      # before the kernels stop: a stopped point is not a result to store
             interrupt.stop_all()
             gc.freeze()     # the process ends: no final collection of every object (seconds)
     return StopKernels()
@@ -314,11 +320,33 @@ def _in_process(todo: dict, outputs: dict):
         yield key, run_point(scene, outputs[key])
 
 
-def run_after(batch: tuple, *maps) -> list:
+_CLOSING = False     # set in a worker whose cluster closes (`stop_kernels_plugin`): its results are not stored
+
+
+def run_after(batch: tuple, *maps, parts: str | None = None) -> list:
     """[(key, `run_point` result)] of a batch of tasks ((key, scene, outputs) each,
     `study.sweep.tasks.batches`), once the FE maps they read (``maps``: their futures'
-    results) are cached."""
-    return [(key, run_point(scene, outputs)) for key, scene, outputs in batch]
+    results) are cached.
+
+    ``parts``: the study's part folder, on a disk the client shares (a local cluster): each
+    task's result is stored there as soon as it is finished (`PartStore`; the result comes back
+    marked ``stored``), so that a batch cut short (Ctrl-C, its worker lost) keeps its finished
+    tasks for the resume, and dask's retry of a batch whose worker died computes only the tasks
+    it had not finished. A task that ends while the worker is closing is not stored: its kernel
+    was stopped (`solver.mbs.interrupt`), its record says so, not what the point gives."""
+    store = PartStore(parts) if parts is not None else None
+    out = []
+    for key, scene, outputs in batch:
+        result = store.get(key) if store is not None else None     # (stored by a first try of the batch)
+        if result is not None:
+            out.append((key, {**result, "stored": True}))
+            continue
+        result = run_point(scene, outputs)
+        if store is not None and not _CLOSING:
+            store.put(key, result)
+            result = {**result, "stored": True}
+        out.append((key, result))
+    return out
 
 
 def kernel_cache_folder() -> Path:
@@ -341,38 +369,83 @@ def kernels_cached() -> bool:
     return folder.is_dir() and any(folder.glob("*.nbi"))
 
 
-def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None):
+def pilot_tasks(todo: dict, outputs: dict) -> tuple:
+    """The keys of the tasks that compile the kernels on a machine whose numba cache lacks
+    them, run first by one worker: the study's first task and, when it runs no dynamics, the
+    first dynamic task of the same body (a dynamic run compiles the time stepping, and the
+    statics for its damping), so that no kernel is left for two workers to compile at once."""
+    if not todo:
+        return ()
+    first = next(iter(todo))
+    if outputs[first].dynamic:
+        return (first,)
+    group = body_group(todo[first])
+    dynamic = [k for k in todo if outputs[k].dynamic]
+    same = [k for k in dynamic if body_group(todo[k]) == group]
+    return (first, *(same or dynamic)[:1])
+
+
+def rims_first(jobs: dict, rim_of) -> tuple[list, list]:
+    """The FE jobs ({key: (function, arguments, priority)}, `study.sweep.bodies.fe_jobs`) in
+    the order to submit them, as (job key, function, arguments, priority, leader): the first
+    job of each condensed rim (``rim_of(function, arguments)``, `bodies.job_rim`; leader
+    None), and the others, each with the key of its rim's first job as leader (None for a job
+    without a rim): it runs after that job and reads the rim it left on disk, so that no two
+    workers condense the same rim at once (each worker reads it once)."""
+    first, rest = [], []
+    leaders: dict = {}
+    for key, (func, args, priority) in jobs.items():
+        rim = rim_of(func, args)
+        if rim is not None and rim not in leaders:
+            leaders[rim] = key
+            first.append((key, func, args, priority, None))
+        else:
+            rest.append((key, func, args, priority, leaders.get(rim) if rim is not None else None))
+    return first, rest
+
+
+def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None, parts: Path | None = None):
     from distributed import as_completed
 
-    from study.sweep.bodies import compute_body, fe_jobs
+    from study.sweep.bodies import compute_body, fe_jobs, job_rim
     from study.sweep.tasks import Task, batches
     with dask_client(scheduler, workers) as client:
         # each FE map or body once, ahead of the tasks (higher priority; the bodies, dearest,
         # first), and each task after the FE it reads
-        pilot = next(iter(todo), None) if scheduler is None and not kernels_cached() else None
-        maps, after = {}, {}
-        for key, scene in todo.items():
-            for fe_key, func, args in fe_jobs(scene):
-                if fe_key not in maps:
-                    maps[fe_key] = client.submit(func, *args, key=f"lightgear-fe-{fe_key}", pure=False,
-                                                 priority=3 if key == pilot else 2 if func is compute_body else 1)
-                after.setdefault(key, []).append(maps[fe_key])
+        pilot = pilot_tasks(todo, outputs) if scheduler is None and not kernels_cached() else ()
+        jobs, reads = {}, {}            # FE job key -> (function, arguments, priority); task key -> its jobs
+        for key in sorted(todo, key=lambda k: k not in pilot):      # the pilot's jobs first
+            for fe_key, func, args in fe_jobs(todo[key]):
+                if fe_key not in jobs:
+                    jobs[fe_key] = (func, args, 3 if key in pilot else 2 if func is compute_body else 1)
+                reads.setdefault(key, []).append(fe_key)
+        maps = {}
+        firsts, rest = rims_first(jobs, job_rim)
+        for fe_key, func, args, priority, leader in [*((*j[:3], max(j[3], 3), j[4]) for j in firsts), *rest]:
+            # (each rim's first job goes with the pilot's FE: the rim's other jobs wait for it)
+            maps[fe_key] = client.submit(func, *args, *([maps[leader]] if leader else ()), key=f"lightgear-fe-{fe_key}",
+                                         pure=False, priority=priority)
+        after = {key: [maps[k] for k in fe_keys] for key, fe_keys in reads.items()}
         futures = {}
-        if pilot is not None:       # compiles the kernels into the disk cache; the other tasks load them
-            first = client.submit(run_after, ((pilot, todo[pilot], outputs[pilot]),), *after.get(pilot, ()),
-                                  key=f"lightgear-task-{pilot}", pure=False, priority=3)
-            futures[first] = (pilot,)
+
+        def stored_here(keys):      # a local cluster's workers store a batch's tasks as each finishes (`run_after`)
+            return str(parts) if parts is not None and scheduler is None and len(keys) > 1 else None
+        if pilot:       # compiles the kernels into the disk cache; the other tasks load them
+            waits = list(dict.fromkeys(f for k in pilot for f in after.get(k, ())))
+            first = client.submit(run_after, tuple((k, todo[k], outputs[k]) for k in pilot), *waits,
+                                  key=f"lightgear-pilot-{pilot[0]}", pure=False, priority=3, parts=stored_here(pilot))
+            futures[first] = pilot
             for key in todo:
                 after.setdefault(key, []).append(first)
         # the rest in batches of one model, dearest first (dask starts ready tasks in the order
         # they were submitted)
         n_workers = len(client.scheduler_info().get("workers", ())) or workers or os.cpu_count() or 1
-        for batch in batches([Task(k, todo[k], outputs[k]) for k in todo if k != pilot], n_workers):
+        for batch in batches([Task(k, todo[k], outputs[k]) for k in todo if k not in pilot], n_workers):
             keys = tuple(t.key for t in batch)
             waits = list(dict.fromkeys(f for k in keys for f in after.get(k, ())))
             name = f"lightgear-task-{keys[0]}" if len(keys) == 1 else f"lightgear-tasks-{keys[0]}-{len(keys)}"
             fut = client.submit(run_after, tuple((t.key, t.scene, t.outputs) for t in batch), *waits, key=name,
-                                pure=False)
+                                pure=False, parts=stored_here(keys))
             futures[fut] = keys
         del maps, after     # the tasks hold the maps' futures now; dask forgets each map once its tasks ran
         try:
@@ -449,7 +522,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     todo = interleave(todo)
     if todo:
         outs = {k: tasks[k].outputs for k in todo}
-        run = _in_process(todo, outs) if workers == 0 and not scheduler else _with_dask(todo, outs, scheduler, workers)
+        run = _in_process(todo, outs) if workers == 0 and not scheduler else _with_dask(todo, outs, scheduler, workers, store.folder)
         # the bar counts points (a point is done when all its tasks are); a task may serve many points
         waiting = {idx: {k for k in keys if k in todo} for idx, keys in of_point.items()}
         waiting = {idx: w for idx, w in waiting.items() if w}
@@ -463,7 +536,8 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
                 if "lost" in res:
                     lost[key] = res["lost"]
                 else:
-                    store.put(key, res)
+                    if not res.pop("stored", False):      # (a batch's worker stored it as it finished)
+                        store.put(key, res)
                     results[key] = without_curves(res)
                 finished = 0
                 for idx in users.get(key, ()):

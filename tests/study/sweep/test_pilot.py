@@ -48,19 +48,23 @@ def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_this_checkout(tmp_
 def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, monkeypatch):
     import distributed
     st = loads_study(STUDY)
-    submitted = []
+    submitted, batches = [], []
     real = distributed.Client.submit
 
     def submit(self, func, *args, **kw):
         future = real(self, func, *args, **kw)
         submitted.append((future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
+        batches.append(args[0])
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
     monkeypatch.setattr(engine, "kernels_cached", lambda: False)
     res = run_sweep(st, tmp_path / "cold.nc", workers=2, progress=False)
     (pilot, before), *rest = submitted
-    assert before == [] and len(rest) == len(submitted) - 1 >= 3
+    assert before == [] and len(rest) == len(submitted) - 1 >= 2
     assert all(after == [pilot] for _, after in rest)
+    # the pilot runs the statics and a dynamic run of one body: every kernel compiled before the fan-out
+    assert sorted(outputs.dynamic for _, _, outputs in batches[0]) == [False, True]
+    assert len({scene.dynamic.speed for _, scene, _ in batches[0]}) == 1
     assert (res.dataset["status"] == STATUS.index("ok")).all()
     # a warm cache: no pilot, no waiting, the same numbers
     submitted.clear()
