@@ -154,8 +154,14 @@ def rim_key(setup: GearSetup) -> str:
 def condensed_rim(setup: GearSetup, mesh):
     """The gear's teeth and rim condensed onto the web (`solver.fe.condense.RimBlock`), from
     the teeth-and-rim elements of ``mesh`` (a body mesh of the gear), kept by `FE_CACHE` in
-    memory and, its condensed stiffness, on disk (``rim-{key}.npz``)."""
+    memory and, its condensed stiffness and its mesh, on disk (``rim-{key}.npz``).
+
+    A rim read from disk keeps the stored mesh, not the rim elements of ``mesh``: two bodies'
+    meshes hold the same rim elements, but gmsh places their nodes a few 1e-15 m apart, which
+    moves the solves in the 13th digit; with the stored nodes every body of the rim gets the
+    same bits whichever body condensed it and whether in this process or another."""
     from solver.fe.condense import RimMismatch, rim_block
+    from solver.fe.mesh import BodyMesh
 
     key = rim_key(setup)
 
@@ -165,7 +171,10 @@ def condensed_rim(setup: GearSetup, mesh):
         stored = FE_CACHE.read_arrays(f"rim-{key}")
         if stored is not None:
             try:
-                rim = rim_block(mesh, geo.spec.face_width, setup.material, r_if, S=stored["S"])
+                own = mesh
+                if "points" in stored:      # the rim's own nodes, not this body's (see above)
+                    own = BodyMesh(stored["points"], stored["triangles"], stored["region"], mesh.bore_radius, mesh.size)
+                rim = rim_block(own, geo.spec.face_width, setup.material, r_if, S=stored["S"])
                 if rim.keys.shape == stored["keys"].shape and np.allclose(rim.keys, stored["keys"], rtol=0, atol=1e-9):
                     rim.key = key
                     return rim
@@ -173,6 +182,7 @@ def condensed_rim(setup: GearSetup, mesh):
                 pass
         rim = rim_block(mesh, geo.spec.face_width, setup.material, r_if)
         rim.key = key
-        FE_CACHE.write_arrays(f"rim-{key}", S=rim.S, keys=rim.keys)
+        rm = rim.model.mesh
+        FE_CACHE.write_arrays(f"rim-{key}", S=rim.S, keys=rim.keys, points=rm.points, triangles=rm.triangles, region=rm.region)
         return rim
     return FE_CACHE.rim(key, build)
