@@ -66,7 +66,7 @@ def main(argv=None) -> int:
     from solver.mbs.kernels.gearmesh import new_contact_buffer
     from solver.mbs.stability import stable_time_step
     from solver.mbs.statics import solve_static
-    m = common.model("solid")
+    m = common.model("solid", "paper")     # the plain contact search and forces
     gp, pp, lp = m.gear_par, m.pair_par, m.law_par
     mdl = (gp, pp, lp, m.k_phi, m.tooth_compliance)
     tz2 = int(gp[1, L.TOOTH0])

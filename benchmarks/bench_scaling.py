@@ -31,7 +31,7 @@ COLUMNS = ("series", "value", "wall_min_s", "wall_median_s", "cpu_min_s", "cost_
 
 def z_model(z: int):
     from study.scene_model import build_scene_model
-    s = common.scene("solid")
+    s = common.scene("solid", "paper")
     f = (1.5 * z / 2 - 1.25 * 1.5) / (1.5 * 67 / 2 - 1.25 * 1.5)
     over = {}
     for g in (1, 2):
@@ -71,11 +71,11 @@ def main(argv=None) -> int:
     zs = (20, 67, 200) if args.quick else (20, 30, 50, 67, 100, 150, 200)
     for z in zs:
         rows.append(point("teeth Z", z, z_model(z), speed=100.0 * 67 / z, note=f"driver {100.0 * 67 / z:.4g} rad/s"))
-    base = common.model("solid")
+    base = common.model("solid", "paper")      # the all-teeth reference integrates the paper's springs
     pitch = base.geometry[0].pitch_angle
     margins = (0.5, 2.0, 4.0) if args.quick else (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
     for frac in margins:
-        m = common.model("solid")
+        m = common.model("solid", "paper")
         m.pair_par[L.MARGIN] = frac * pitch
         rows.append(point("presearch margin [pitch]", frac, m, note="default 0.5"))
     for pq in ((1e-9, 1e-6) if args.quick else (1e-10, 1e-9, 1e-8, 1e-7, 1e-6)):

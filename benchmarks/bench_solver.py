@@ -87,8 +87,8 @@ def main(argv=None) -> int:
     kinds = ["solid"] if args.quick else ["solid", "lightened"]
     full_cpu = {}
     for kind in kinds:
-        m = common.model(kind)
-        sc = common.scene(kind)
+        m = common.model(kind, "paper")      # the solver's speed on the paper's model (the peers' equations)
+        sc = common.scene(kind, "paper")
         # --- warm STE, 120 deg at 0.1 deg
         ang = static_angles(sc)
         torque = sc.quasi_static.torque
@@ -126,7 +126,7 @@ def main(argv=None) -> int:
                          note="as `lightgear run` calls it (dt from the eigenvalues at 12 positions)"))
 
     # --- plain numpy + scipy LSODA on a short window, against lightgear on the same window
-    m = common.model("solid")
+    m = common.model("solid", "paper")     # scipy integrates the paper's per-tooth springs
     dt, _w = stable_time_step(m, 50.0)
     win = SHORT_DYNAMIC
     ref = simulate(m, *win, dt=dt / 8)
