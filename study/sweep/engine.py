@@ -363,10 +363,21 @@ def kernel_cache_folder() -> Path:
     return top / f"{source.name}_{hashlib.sha1(str(source).encode()).hexdigest()}"
 
 
-def kernels_cached() -> bool:
-    """True when this machine's numba disk cache holds compiled kernels of the current sources."""
+def kernels_cached(coupled: bool | None = None) -> bool:
+    """True when this machine's numba disk cache holds compiled kernels of the current sources
+    and, for ``coupled`` True or False (the study's model couples the teeth through the bodies
+    or not), the explicit time stepping of that model: a cache filled by runs of the other
+    model lacks it, and every worker would then compile it at the same time."""
     folder = kernel_cache_folder()
-    return folder.is_dir() and any(folder.glob("*.nbi"))
+    if not (folder.is_dir() and any(folder.glob("*.nbi"))):
+        return False
+    if coupled is None:
+        return True
+    if coupled:
+        from solver.mbs.kernels.explicit_coupled import verlet_coupled as stepping
+    else:
+        from solver.mbs.kernels.explicit import verlet as stepping
+    return (folder / stepping._cache._cache_file._index_name).exists()
 
 
 def pilot_tasks(todo: dict, outputs: dict) -> tuple:
@@ -412,7 +423,9 @@ def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | 
     with dask_client(scheduler, workers) as client:
         # each FE map or body once, ahead of the tasks (higher priority; the bodies, dearest,
         # first), and each task after the FE it reads
-        pilot = pilot_tasks(todo, outputs) if scheduler is None and not kernels_cached() else ()
+        dynamic = [todo[k] for k in todo if outputs[k].dynamic]
+        coupled = any(sc.coupling_model != "none" for sc in dynamic) if dynamic else None
+        pilot = pilot_tasks(todo, outputs) if scheduler is None and not kernels_cached(coupled) else ()
         jobs, reads = {}, {}            # FE job key -> (function, arguments, priority); task key -> its jobs
         for key in sorted(todo, key=lambda k: k not in pilot):      # the pilot's jobs first
             for fe_key, func, args in fe_jobs(todo[key]):

@@ -82,7 +82,7 @@ def test_on_a_local_cluster_the_workers_store_the_tasks_of_their_batches(tmp_pat
     by_client = []
     real_put = PartStore.put
     monkeypatch.setattr(PartStore, "put", lambda self, key, result: by_client.append(key) or real_put(self, key, result))
-    monkeypatch.setattr(engine, "kernels_cached", lambda: True)     # no pilot task: the batches above
+    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)     # no pilot task: the batches above
     out = tmp_path / "dask.nc"
     res = run_sweep(st, out, workers=2, progress=False, keep_parts=True)
     assert (res.dataset["status"] == STATUS.index("ok")).all()

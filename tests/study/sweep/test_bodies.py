@@ -68,7 +68,7 @@ def test_a_dask_sweep_computes_each_map_once_before_the_tasks_that_read_it(tmp_p
         submitted.append((func.__name__, future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
-    monkeypatch.setattr(engine, "kernels_cached", lambda: True)     # no pilot task (test_pilot)
+    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)     # no pilot task (test_pilot)
     res = run_sweep(st, tmp_path / "dask.nc", workers=2, progress=False)
     maps = [key for name, key, _ in submitted if name == "compute_map"]
     assert len(maps) == len(set(maps)) == 4
@@ -135,7 +135,7 @@ def test_a_compliance_sweep_on_dask_equals_the_one_that_computes_its_fe_in_the_t
         submitted.append((func.__name__, future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
-    monkeypatch.setattr(engine, "kernels_cached", lambda: True)     # no pilot task (test_pilot)
+    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)     # no pilot task (test_pilot)
     res = run_sweep(st, tmp_path / "dask.nc", workers=2, progress=False)
     names = [name for name, _, _ in submitted]
     assert names.count("compute_body") == 4 and names.count("compute_map") == 1

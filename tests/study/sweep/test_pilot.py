@@ -29,6 +29,9 @@ scalars = ["ste_p2p", "dte_rms"]
 
 def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_this_checkout(tmp_path, monkeypatch):
     from solver.mbs.kernels.statics import solve_dense
+    # (imported before the cache folder moves below: numba fixes a kernel's folder at import)
+    from solver.mbs.kernels.explicit import verlet
+    from solver.mbs.kernels.explicit_coupled import verlet_coupled
     # the folder is the one numba itself files this checkout's kernels in
     assert kernel_cache_folder() == Path(solve_dense._cache._cache_path)
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
@@ -43,6 +46,12 @@ def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_this_checkout(tmp_
     own.parent.mkdir(parents=True)
     own.write_bytes(b"")
     assert kernels_cached()
+    # a cache filled by the paper model's runs lacks the coupled time stepping (and the reverse)
+    assert not kernels_cached(coupled=True) and not kernels_cached(coupled=False)
+    (kernel_cache_folder() / verlet._cache._cache_file._index_name).write_bytes(b"")
+    assert kernels_cached(coupled=False) and not kernels_cached(coupled=True)
+    (kernel_cache_folder() / verlet_coupled._cache._cache_file._index_name).write_bytes(b"")
+    assert kernels_cached(coupled=True)
 
 
 def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, monkeypatch):
@@ -57,7 +66,7 @@ def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, mon
         batches.append(args[0])
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
-    monkeypatch.setattr(engine, "kernels_cached", lambda: False)
+    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: False)
     res = run_sweep(st, tmp_path / "cold.nc", workers=2, progress=False)
     (pilot, before), *rest = submitted
     assert before == [] and len(rest) == len(submitted) - 1 >= 2
@@ -68,7 +77,7 @@ def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, mon
     assert (res.dataset["status"] == STATUS.index("ok")).all()
     # a warm cache: no pilot, no waiting, the same numbers
     submitted.clear()
-    monkeypatch.setattr(engine, "kernels_cached", lambda: True)
+    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)
     warm = run_sweep(st, tmp_path / "warm.nc", workers=2, progress=False)
     assert all(after == [] for _, after in submitted)
     for name in ("ste_p2p", "dte_rms"):
