@@ -28,10 +28,10 @@ scalars = ["ste_p2p", "dte_rms"]
 
 
 def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_this_checkout(tmp_path, monkeypatch):
-    from solver.mbs.kernels.statics import solve_dense
     # (imported before the cache folder moves below: numba fixes a kernel's folder at import)
     from solver.mbs.kernels.explicit import verlet
     from solver.mbs.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.kernels.statics import solve_dense
     # the folder is the one numba itself files this checkout's kernels in
     assert kernel_cache_folder() == Path(solve_dense._cache._cache_path)
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
