@@ -125,3 +125,14 @@ def assert_forces_are_minus_the_energy_gradient(m, th1, th2, phi, teeth, rec, nc
         p0[i] -= h
         fd = -(mesh_potential(m, th1, th2, p1) - mesh_potential(m, th1, th2, p0)) / (2 * h)
         assert q[2 + i] == pytest.approx(fd, rel=1e-5, abs=1e-6)
+
+
+def small_scene(**kw):
+    """The small 24-tooth pair (the small_pair scene, contact ratio 1.6), one mesh pitch of rotation."""
+    return load_scene("small_pair").replace(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.25,
+                                               "quasi_static.torque": 100.0, **kw})
+
+
+# the small pair's driven gear lightened: a web of 8 mm with 4 holes
+LIGHT = {"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
+         "gear2.body.hole_circle_radius": 19.5}

@@ -3,25 +3,15 @@ import math
 
 import numpy as np
 import pytest
-from helpers import solid_scene
+from helpers import LIGHT, small_scene, solid_scene
 
 from solver.fe.ltca import LTCAError, lagrange_weights, mesh_points, solve_contact
 from study.inputs.compliance import gear_compliance
 from study.inputs.gearsetup import gear_setups
-from study.scene import SceneError, load_scene
+from study.scene import SceneError
 from study.verify import fe_reference as ref_mod
 
 pytestmark = pytest.mark.usefixtures("private_fe_cache")
-
-
-def small_scene(**kw):
-    """The small 24-tooth pair (the small_pair scene, contact ratio 1.6), one mesh pitch of rotation."""
-    return load_scene("small_pair").replace(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.25,
-                                               "quasi_static.torque": 100.0, **kw})
-
-
-LIGHT = {"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
-         "gear2.body.hole_circle_radius": 19.5}
 
 
 def test_rigid_bodies_share_the_load_equally_in_closed_form():

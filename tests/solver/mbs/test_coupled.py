@@ -5,8 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
-from test_ltca import LIGHT, small_scene
+from helpers import LIGHT, assert_energy_closes_at_second_order, slow_transient_against_statics, small_scene, solid_scene
 
 from solver.fe.ltca import mesh_points
 from solver.identify.coupling import body_torsion_fit, body_windup
