@@ -5,7 +5,6 @@ example when no scene is given, writes the archive and prints a summary.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 
@@ -131,8 +130,7 @@ def kept_springs_and_model(scene: Scene):
     from study.inputs.cache import FE_CACHE
     # the FE cache's folder and generation: springs read from another cache, or from one
     # cleared since, are made again
-    key = (tuple(getattr(scene, f.name) for f in dataclasses.fields(scene) if f.name != "dynamic"), mean_load(scene),
-           str(FE_CACHE.folder), FE_CACHE.generation)
+    key = (scene.model_sections(), mean_load(scene), str(FE_CACHE.folder), FE_CACHE.generation)
     if _LAST_MODEL[0] != key:
         springs = scene_springs(scene)
         _LAST_MODEL[:] = [key, springs, kept_scene_model(scene, springs)]

@@ -256,6 +256,11 @@ class Scene:
         m = self.coupling_model
         return "paper" if m == "none" else m
 
+    def model_sections(self) -> tuple:
+        """Every section of the scene but ``dynamic``: what its model depends on (the points of a
+        study that differ only in their dynamic run share one model)."""
+        return tuple(getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "dynamic")
+
     def is_lightened(self, g: int) -> bool:
         """True when gear g's body differs from a solid disc (holes or a thinner web)."""
         gs = self.gear(g)

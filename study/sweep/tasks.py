@@ -125,7 +125,7 @@ BATCHES_PER_WORKER = 4
 def model_group(scene: Scene) -> tuple:
     """What a task's model depends on: every scene field but ``dynamic.*`` (the points of one
     group share the model a worker keeps)."""
-    return tuple(getattr(scene, f.name) for f in dataclasses.fields(scene) if f.name != "dynamic")
+    return scene.model_sections()
 
 
 def batches(tasks: list[Task], workers: int) -> list[tuple[Task, ...]]:
