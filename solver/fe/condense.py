@@ -163,27 +163,25 @@ class RimBlock:
                          + F.indptr.astype(np.int64).tobytes())
         for r in reads:
             h.update(np.asarray(r, np.int64).tobytes() + b"|")
-        key = h.hexdigest() + str(F.shape)
-        rs = self.read_sets.pop(key, None)
-        if rs is None:
-            rs = _read_set(self, F, reads)
-            while len(self.read_sets) >= SOLVES_KEPT:
-                self.read_sets.pop(next(iter(self.read_sets)))
-        self.read_sets[key] = rs
-        return rs
+        return _kept(self.read_sets, h.hexdigest() + str(F.shape), lambda: _read_set(self, F, reads))
 
     def rim_solve(self, f: np.ndarray) -> np.ndarray:
         """K_rr^-1 f [m] for loads f (n_interior, k) [N]; the last `SOLVES_KEPT` results are
         kept by the loads' bytes (every web of the rim solves its teeth's reference loads)."""
         import hashlib
-        key = hashlib.sha1(f.tobytes()).hexdigest() + str(f.shape)
-        y = self.solves.pop(key, None)
-        if y is None:
-            y = self.model.solve(f)
-            while len(self.solves) >= SOLVES_KEPT:
-                self.solves.pop(next(iter(self.solves)))
-        self.solves[key] = y
-        return y
+        return _kept(self.solves, hashlib.sha1(f.tobytes()).hexdigest() + str(f.shape), lambda: self.model.solve(f))
+
+
+def _kept(store: dict, key: str, make):
+    """``store[key]``, made by ``make()`` when it is not among the last `SOLVES_KEPT` used (the
+    least recently used goes first: a dict keeps its insertion order, most recently used last)."""
+    value = store.pop(key, None)
+    if value is None:
+        while len(store) >= SOLVES_KEPT:
+            store.pop(next(iter(store)))
+        value = make()
+    store[key] = value
+    return value
 
 
 @dataclass
