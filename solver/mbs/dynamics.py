@@ -363,9 +363,17 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
         peak = float(np.max(out[:, L.O_FMAX])) if out.shape[0] else 0.0
         covered = not auto or status or load_covered(model, step_torque, fraction, peak)
         if not covered and attempt < 3:
-            step_torque = math.copysign(1.25 * peak * model.base_radii[1], step_torque if step_torque else 1.0)
-            dt, omega_max = stable_time_step(model, step_torque, fraction, implicit_dampers=imex)
-            continue
+            raised = math.copysign(1.25 * peak * model.base_radii[1], step_torque if step_torque else 1.0)
+            try:
+                dt, omega_max = stable_time_step(model, raised, fraction, implicit_dampers=imex)
+            except ValueError:
+                # no static equilibrium under the load reached (more than the pair carries statically,
+                # e.g. far above its critical speeds): no bound to tighten the step to; the run is kept
+                # and marked inaccurate below
+                pass
+            else:
+                step_torque = raised
+                continue
         res = DynamicResult(*result_fields(out), grid[0], int(step), int(status),
                             status_message(status, step, grid[0], delta_max), omega_max, int(max_act))
         res.contacts = contact_records(out)
