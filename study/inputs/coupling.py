@@ -33,9 +33,11 @@ from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import GearSetup
 
 
-def body_torsion(setup: GearSetup) -> BodyTorsionFit:
-    """Body spring [N·m/rad] and tooth springs without the body wind-up of the gear, about the
-    pivot of `tooth_pivot` (so `BodyTorsionFit.k_total` is the plain FE spring about it)."""
+def pitch_compliances(setup: GearSetup) -> tuple[np.ndarray, np.ndarray]:
+    """(c_total, c_adjacent) (Z,) [m/N] of the gear's bore-clamped FE body at the pitch point,
+    read along the line of action at the tooth centreline: each tooth's own compliance, and its
+    mean compliance under a load on either neighbour (the body's wind-up the neighbours share).
+    A lightened body: every tooth loaded; a solid body: one, the rest by symmetry."""
     geo = setup.geometry
     z = geo.teeth
     u = np.array([math.tan(geo.spec.pressure_angle)])
@@ -43,15 +45,30 @@ def body_torsion(setup: GearSetup) -> BodyTorsionFit:
         c, _ = gear_compliance(setup, list(range(z)), 1, u=u)
         G = c.g[:, 0, :, 0]                        # read tooth, load tooth
         a = np.arange(z)
-        c_tot = G[a, a]
-        c_adj = 0.5 * (G[a, (a - 1) % z] + G[a, (a + 1) % z])
-    else:
-        c, _ = gear_compliance(setup, [0], 1, u=u)
-        G = c.g[:, 0, 0, 0]                        # read offsets -1, 0, 1
-        c_tot = np.full(z, G[1])
-        c_adj = np.full(z, 0.5 * (G[0] + G[2]))
+        return G[a, a], 0.5 * (G[a, (a - 1) % z] + G[a, (a + 1) % z])
+    c, _ = gear_compliance(setup, [0], 1, u=u)
+    G = c.g[:, 0, 0, 0]                            # read offsets -1, 0, 1
+    return np.full(z, G[1]), np.full(z, 0.5 * (G[0] + G[2]))
+
+
+def body_torsion(setup: GearSetup) -> BodyTorsionFit:
+    """Body spring [N·m/rad] and tooth springs without the body wind-up of the gear, about the
+    pivot of `tooth_pivot` (so `BodyTorsionFit.k_total` is the plain FE spring about it)."""
+    geo = setup.geometry
+    c_tot, c_adj = pitch_compliances(setup)
     r_q, k_q = tooth_pivot(setup, float(np.mean(c_adj)))
     return body_torsion_fit(c_tot, c_adj, load_case(geo, 0, r_q).lever, geo.base_radius, r_q, k_q)
+
+
+def plain_windup(setup: GearSetup) -> float:
+    """Compliance [m/N] along the line of action of the body wind-up from the bore that the
+    plain model's tooth springs of the gear hold: c_body of `body_torsion` (the mean over the
+    teeth of the FE compliance under the neighbours' pitch-point loads), of the body the springs
+    stand for: the gear's own when its springs come from its FE ('fe-ratio', 'fe'), else the
+    solid body's (a solid gear; 'uniform' springs, the calibrated solid-gear k_phi)."""
+    from study.inputs.springs import uses_fe_springs
+    body = setup if uses_fe_springs(setup) else setup.solid()
+    return float(np.mean(pitch_compliances(body)[1]))
 
 
 # fit weight of a tip-corner contact's nominal load share [1]: a corner outside the path of
