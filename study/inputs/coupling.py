@@ -29,8 +29,18 @@ import numpy as np
 from solver.fe.body import load_case
 from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, local_compliance, tooth_compliance_fit
 from solver.mbs.model import Model
-from study.inputs.compliance import PROFILE_POINTS, gear_compliance
+from study.inputs.compliance import PROFILE_POINTS, compliance_cached, gear_compliance
 from study.inputs.gearsetup import GearSetup
+
+
+def _pitch_roll(setup: GearSetup) -> np.ndarray:
+    """The roll grid of the pitch point alone [-]."""
+    return np.array([math.tan(setup.geometry.spec.pressure_angle)])
+
+
+def pitch_compliances_cached(setup: GearSetup) -> bool:
+    """True when `pitch_compliances` of the gear needs no FE solve (memory or disk cache)."""
+    return compliance_cached(setup, list(range(setup.teeth)), 1, u=_pitch_roll(setup))
 
 
 def pitch_compliances(setup: GearSetup) -> tuple[np.ndarray, np.ndarray]:
@@ -40,7 +50,7 @@ def pitch_compliances(setup: GearSetup) -> tuple[np.ndarray, np.ndarray]:
     A lightened body: every tooth loaded; a solid body: one, the rest by symmetry."""
     geo = setup.geometry
     z = geo.teeth
-    u = np.array([math.tan(geo.spec.pressure_angle)])
+    u = _pitch_roll(setup)
     if setup.lightened:
         c, _ = gear_compliance(setup, list(range(z)), 1, u=u)
         G = c.g[:, 0, :, 0]                        # read tooth, load tooth
@@ -66,9 +76,13 @@ def plain_windup(setup: GearSetup) -> float:
     teeth of the FE compliance under the neighbours' pitch-point loads), of the body the springs
     stand for: the gear's own when its springs come from its FE ('fe-ratio', 'fe'), else the
     solid body's (a solid gear; 'uniform' springs, the calibrated solid-gear k_phi)."""
+    return float(np.mean(pitch_compliances(windup_body(setup))[1]))
+
+
+def windup_body(setup: GearSetup) -> GearSetup:
+    """The body whose wind-up the plain model's springs of the gear hold (`plain_windup`)."""
     from study.inputs.springs import uses_fe_springs
-    body = setup if uses_fe_springs(setup) else setup.solid()
-    return float(np.mean(pitch_compliances(body)[1]))
+    return setup if uses_fe_springs(setup) else setup.solid()
 
 
 # fit weight of a tip-corner contact's nominal load share [1]: a corner outside the path of
