@@ -27,14 +27,16 @@ The mesh alone (``stiffness_mesh``, ``pair_stiffness_mesh``): the same tangent w
 bodies' wind-up from the bore taken out, what ISO 6336-1's c' and c_gamma_alpha describe.
 * A body-coupled model carries the wind-up as its body springs (hub -> rim, k_body): the
   tangent matrix without them, condensed onto the driven rim with the driver rim prescribed
-  (the bodies rigid below the rim). The body springs sit in series with the rest, so in single
-  contact 1/k_m = 1/k_mesh + rb1**2/k_body1 + rb2**2/k_body2 exactly.
+  (the bodies rigid below the rim). The body springs sit in series with the rest, so where the
+  contacts act along the line of action (flank contacts, levers rb1 and rb2 on the rims),
+  1/k_m = 1/k_mesh + rb1**2/k_body1 + rb2**2/k_body2; a tip corner's other lever departs from it.
 * The plain model lumps the wind-up into every tooth spring (a spring fitted to a bore-clamped
   body). Given the bodies' wind-up as compliances c_w along the line of action [m/N]
   (``windup``), each loaded tooth spring's tangent k_t [N·m/rad] is replaced by that of the
   tooth alone at the pitch point, 1 / (1/k_t - c_w/h**2), h the pitch lever (`pitch_lever`;
   the split of `solver.identify.coupling.body_torsion_fit` with a rigid body). Without
-  ``windup`` the plain model's mesh alone is unknown (NaN).
+  ``windup`` the plain model's mesh alone is unknown (NaN); so it is at an angle where a
+  loaded spring is stiffer than the wind-up alone (c_w/h**2 >= 1/k_t: it cannot hold it).
 """
 from __future__ import annotations
 

@@ -77,7 +77,8 @@ def mesh_variables(states, model, scene, torque: float, windup=None) -> tuple[di
     if model.coupled:
         how = ("the bodies rigid below the rim: the tangent matrix of mesh_stiffness without the body springs "
                "(hub -> rim), condensed onto the driven rim with the driver rim prescribed; the body springs are in "
-               "series with it: 1/k_pair = 1/k_mesh + rb1^2/k_body1 + rb2^2/k_body2 where one pair is in mesh")
+               "series with it: 1/k_pair = 1/k_mesh + rb1^2/k_body1 + rb2^2/k_body2 wherever the contacts act along "
+               "the line of action (a tip corner's other lever aside)")
     elif windup is not None:
         how = ("the plain model lumps the body wind-up into every tooth spring: each loaded spring's tangent k with "
                "the wind-up c_w of its body taken out at the pitch point, 1/(1/k - c_w/h^2), h the pitch lever; "
