@@ -26,22 +26,20 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         w(f"  STE: mean {s['ste_mean']:.3f} um (elastic part {s['ste_elastic_mean']:.3f} um), "
           f"peak-to-peak {s['ste_p2p']:.3f} um over {float(ds['angle'][-1]):.4g} deg\n")
     if "mesh_stiffness_mean" in s:
-        w(f"  mesh stiffness (tangent, along the line of action): pair {s['mesh_stiffness_mean']:.1f} N/um mean, "
-          f"peak-to-peak {s['mesh_stiffness_p2p']:.1f} N/um (at the hubs: both bodies' wind-up from the bore in it)")
+        w(f"  mesh stiffness (tangent, along the line of action): pair {s['mesh_stiffness_mean']:.1f} N/um mean (both "
+          f"bodies' wind-up from the bore in it), peak-to-peak {s['mesh_stiffness_p2p']:.1f} N/um")
         if "mesh_stiffness_mesh_mean" in s:
-            w(f"; mesh alone {s['mesh_stiffness_mesh_mean']:.1f} N/um mean (the wind-up taken out)")
-        w("\n")
-        if "c_gamma_alpha_iso6336" in ds:
-            a = ds["c_gamma_alpha_iso6336"].attrs
-            w(f"    per face width [N/(mm·um)]    pair   mesh alone   ISO 6336-1 B   mesh alone / ISO   (ISO with the "
-              f"low-load factor {a['low_load_factor']:.3f} at F_t/b {a['load_per_width_N_per_mm']:.1f} N/mm)\n")
+            w(f"; mesh alone {s['mesh_stiffness_mesh_mean']:.1f} N/um mean")
+        w("\n    per face width [N/(mm·um)]    pair   mesh alone   ISO 6336-1 B   mesh alone / ISO\n")
         for name, what in (("c_prime", "c' single pair"), ("c_gamma_alpha", "c_gamma_alpha mesh")):
             m, alone, iso = s[name], s.get(f"{name}_mesh", float("nan")), s[f"{name}_iso6336"]
             w(f"    {what:<28s} {m:6.2f}   {alone:10.2f}   {iso:12.2f}   {alone / iso:16.3f}\n")
-        if "c_gamma_alpha_iso6336" in ds and "value_without_C_M_and_low_load_factor" in ds["c_prime_iso6336"].attrs:
+        a = ds["c_prime_iso6336"].attrs if "c_prime_iso6336" in ds else {}
+        if "value_without_C_M_and_low_load_factor" in a:
             el = [ds[f"{n}_iso6336"].attrs["value_without_C_M_and_low_load_factor"] for n in ("c_prime", "c_gamma_alpha")]
-            w(f"    ISO without C_M 0.8 and the low-load factor (the elastic pair of perfect involutes): c' {el[0]:.2f}, "
-              f"c_gamma_alpha {el[1]:.2f}\n")
+            w(f"    ISO: Method B with the low-load factor {a['low_load_factor']:.3f} (F_t/b {a['load_per_width_N_per_mm']:.1f} "
+              f"N/mm); without it and C_M 0.8 (an elastic pair of perfect involutes): c' {el[0]:.2f}, c_gamma_alpha "
+              f"{el[1]:.2f}\n")
     if "tooth_stiffness_pitch" in ds:
         k = ds["tooth_stiffness_pitch"]
         line = "  tooth stiffness at the pitch point [N/um], the body rigid: " + ", ".join(

@@ -174,3 +174,16 @@ def test_mesh_alone_round_trips_through_the_archive_and_the_summary(solid_pairs,
             if name in SCALARS:
                 assert SCALARS[name].units == RUN_VARIABLES[name].units == back[name].attrs["units"]
                 assert s[name] == float(ds[name]) and name in MESH_SCALARS
+
+
+def test_printed_summary_puts_the_mesh_alone_beside_the_pair_and_iso(solid_pairs, capsys):
+    from study.report.summary import print_summary
+    ds = solid_pairs["compliance"]
+    print_summary(ds, "solid.nc", 1.0)
+    out = capsys.readouterr().out
+    row = next(line for line in out.splitlines() if line.strip().startswith("c_gamma_alpha mesh")).split()
+    pair, alone, iso, ratio = (float(x) for x in row[-4:])
+    assert (pair, alone, iso) == pytest.approx((float(ds["c_gamma_alpha"]), float(ds["c_gamma_alpha_mesh"]),
+                                                float(ds["c_gamma_alpha_iso6336"])), abs=0.006)
+    assert ratio == pytest.approx(alone / iso, abs=2e-3)
+    assert "low-load factor 0.875 (F_t/b 58.5 N/mm)" in out and "the body rigid" in out
