@@ -238,6 +238,9 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = run_variables.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
+    data["tooth_stiffness"].attrs["body_windup"] = (
+        "in it: the plain model's spring holds its body's wind-up from the bore" if not model.coupled else
+        "not in it: the body spring holds the wind-up from the bore (attribute body_stiffness_N_m_rad)")
     if gear_variables:
         setups = gear_setups(scene)
         c, v = lightening_variables(setups, root_stresses(setups))    # mass, inertia; root stress from the springs' FE

@@ -187,3 +187,5 @@ def test_printed_summary_puts_the_mesh_alone_beside_the_pair_and_iso(solid_pairs
                                                 float(ds["c_gamma_alpha_iso6336"])), abs=0.006)
     assert ratio == pytest.approx(alone / iso, abs=2e-3)
     assert "low-load factor 0.875 (F_t/b 58.5 N/mm)" in out and "the body rigid" in out
+    assert "not in it" in ds["tooth_stiffness"].attrs["body_windup"]
+    assert solid_pairs["paper"]["tooth_stiffness"].attrs["body_windup"].startswith("in it")
