@@ -243,7 +243,7 @@ def pitch_point_stiffness(model: Model, force: float, windup=(0.0, 0.0)) -> np.n
     return out
 
 
-def body_windup(model: Model, windup=None) -> tuple[float, float]:
+def body_windup_compliance(model: Model, windup=None) -> tuple[float, float]:
     """(gear 1, gear 2) compliance [m/N] along the line of action of each body's wind-up from
     the bore to the rim: rb**2 / k_body of a body-coupled model (its body springs); for the
     plain model, whose tooth springs hold it, ``windup`` as given (None: 0, unknown)."""

@@ -56,7 +56,7 @@ def mesh_variables(states, model, scene, torque: float, windup=None) -> tuple[di
     ISO 6336-1 Method B beside them. ``windup``: (gear 1, gear 2) [m/N] the body wind-up the
     plain model's tooth springs hold (`study.inputs.coupling.plain_windup`; the one given to
     `mesh_states`), None for a body-coupled model."""
-    from solver.mbs.mesh_stiffness import body_windup, pitch_point_stiffness
+    from solver.mbs.mesh_stiffness import body_windup_compliance, pitch_point_stiffness
     z1, z2 = model.teeth
     angle = np.degrees(states.angle)
     width = min(g.spec.face_width for g in model.geometry)
@@ -70,7 +70,7 @@ def mesh_variables(states, model, scene, torque: float, windup=None) -> tuple[di
     eps = model.pair.contact_ratio
     load = torque if abs(torque) > 1e-9 else 1.0        # the load mesh_states linearises at
     iso = iso_stiffness(scene, eps, load)
-    cw = body_windup(model, windup)
+    cw = body_windup_compliance(model, windup)
     cw_um = [c * units.UM_PER_M for c in cw]
     load_note = f"at static equilibrium under {torque:g} N·m"
     both = "includes both bodies' wind-up from the bore (the hubs' TE)"
