@@ -211,9 +211,17 @@ MESH_S_PER_ANGLE = 2e-3
 
 
 def mesh_seconds(scene) -> float:
-    """Estimated run time [s] of the linearised mesh over the STE angles."""
+    """Estimated run time [s] of the linearised mesh over the STE angles, and for the plain
+    model the FE bodies of the wind-up its springs hold that the cache lacks
+    (`study.inputs.coupling.plain_windup`: the mesh alone)."""
     from study.scene_model import static_angles
-    return static_angles(scene).size * MESH_S_PER_ANGLE
+    s = static_angles(scene).size * MESH_S_PER_ANGLE
+    if scene.coupling_model == "none":
+        from study.inputs.coupling import pitch_compliances_cached, windup_body
+        from study.inputs.gearsetup import gear_setups
+        bodies = {b.key: b for b in map(windup_body, gear_setups(scene))}
+        s += sum(body_seconds(b) for b in bodies.values() if not pitch_compliances_cached(b))
+    return s
 
 
 def error_period_note(scene) -> str | None:

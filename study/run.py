@@ -26,6 +26,7 @@ from study.archive.lightening import lightening_variables
 from study.archive.mesh import dynamic_force_variables, mesh_variables
 from study.archive.modes import modal_variables
 from study.archive.netcdf import provenance
+from study.inputs.coupling import plain_windup
 from study.inputs.gearsetup import gear_setups
 from study.inputs.springs import root_stresses
 from study.plausibility import critical_speed_warning, report_warnings, scene_warnings
@@ -237,6 +238,9 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, max_time)
     coords, data = run_variables.stiffness_variables((springs[0][0], springs[1][0]), (springs[0][1], springs[1][1]))
+    data["tooth_stiffness"].attrs["body_windup"] = (
+        "in it: the plain model's spring holds its body's wind-up from the bore" if not model.coupled else
+        "not in it: the body spring holds the wind-up from the bore (attribute body_stiffness_N_m_rad)")
     if gear_variables:
         setups = gear_setups(scene)
         c, v = lightening_variables(setups, root_stresses(setups))    # mass, inertia; root stress from the springs' FE
@@ -293,8 +297,10 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
         coords.update(c); data.update(v)
     if static and mesh_outputs:
         t0 = time.perf_counter()
-        states = mesh_states(model, st.angle, scene.quasi_static.torque)
-        c, v = mesh_variables(states, model, scene, scene.quasi_static.torque)
+        # the plain model's springs hold the bodies' wind-up: the FE body's, taken out for the mesh alone
+        windup = None if model.coupled else tuple(plain_windup(s) for s in gear_setups(scene))
+        states = mesh_states(model, st.angle, scene.quasi_static.torque, windup)
+        c, v = mesh_variables(states, model, scene, scene.quasi_static.torque, windup)
         coords.update(c); data.update(v)
         attrs["wall_time_mesh_stiffness_s"] = time.perf_counter() - t0
     if dynamic:

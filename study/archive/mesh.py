@@ -16,16 +16,27 @@ from solver.peers import iso6336
 from study.archive.schema import variable
 
 
-def iso_stiffness(scene, contact_ratio: float) -> tuple[float, float, float]:
-    """(c', c_gamma_alpha [N/(mm·um)], C_R [1]) of the scene's pair by ISO 6336-1 Method B:
+def iso_stiffness(scene, contact_ratio: float, torque: float) -> dict:
+    """ISO 6336-1 Method B stiffness of the scene's pair at ``torque`` [N·m] on the driven gear:
     no profile shift, C_M 0.8, the basic-rack factor of gear 1, the gear-blank factor C_R of
-    each gear's web (mean of the two; the standard has no holes), c_gamma_alpha = c'
-    (0.75 eps_alpha + 0.25) with the geometric transverse contact ratio eps_alpha."""
+    each gear's web (mean of the two; the standard has no holes), the low-load factor
+    (F_t/b / 100 N/mm)^0.25 below 100 N/mm (F_t = |torque| / r2 at the driven gear's reference
+    circle, K_A = 1, b the smaller face width), c_gamma_alpha = c' (0.75 eps_alpha + 0.25) with
+    the geometric transverse contact ratio eps_alpha. Returns c_prime, c_gamma_alpha
+    [N/(mm·um)] with the factor, the same without it (``*_full_load``) and without C_M either
+    (``*_elastic``: the theoretical stiffness of the elastic pair, c'_th C_R C_B), c_r,
+    load_per_width [N/mm] and low_load_factor [1]."""
     g1, g2 = scene.gear1, scene.gear2
     c_r = 0.5 * sum(iso6336.blank_factor(g.body.web_thickness, g.face_width, g.body.rim_height, g.module)
                     for g in (g1, g2))
-    c1 = iso6336.single_stiffness(g1.teeth, g2.teeth, g1.dedendum, g1.pressure_angle, c_r)
-    return c1, c1 * (0.75 * contact_ratio + 0.25), c_r
+    c_full = iso6336.single_stiffness(g1.teeth, g2.teeth, g1.dedendum, g1.pressure_angle, c_r)
+    r2 = 0.5 * g2.teeth * g2.module * units.MM          # scene mm -> m
+    w = abs(torque) / r2 / (min(g1.face_width, g2.face_width))   # N / mm
+    f = iso6336.low_load_factor(w)
+    ratio = 0.75 * contact_ratio + 0.25
+    return {"c_prime": c_full * f, "c_gamma_alpha": c_full * f * ratio, "c_prime_full_load": c_full,
+            "c_gamma_alpha_full_load": c_full * ratio, "c_prime_elastic": c_full / iso6336.C_M,
+            "c_gamma_alpha_elastic": c_full / iso6336.C_M * ratio, "c_r": c_r, "load_per_width": w, "low_load_factor": f}
 
 
 def whole_periods(angle_deg, z1: int) -> np.ndarray:
@@ -38,56 +49,118 @@ def whole_periods(angle_deg, z1: int) -> np.ndarray:
     return a < a[0] + n * period - 1e-9 if n >= 1 else np.ones(a.size, bool)
 
 
-def mesh_variables(states, model, scene, torque: float) -> tuple[dict, dict]:
+def mesh_variables(states, model, scene, torque: float, windup=None) -> tuple[dict, dict]:
     """Archive variables of `solver.mbs.mesh_stiffness.mesh_states` over the STE angles
-    (``states`` at ``torque`` [N·m]) for the pair ``model`` of ``scene``."""
-    from solver.mbs.mesh_stiffness import pitch_point_stiffness
+    (``states`` at ``torque`` [N·m]) for the pair ``model`` of ``scene``: the pair's stiffness
+    (at the hubs, both bodies' wind-up from the bore in it), the mesh alone (without it) and
+    ISO 6336-1 Method B beside them. ``windup``: (gear 1, gear 2) [m/N] the body wind-up the
+    plain model's tooth springs hold (`study.inputs.coupling.plain_windup`; the one given to
+    `mesh_states`), None for a body-coupled model."""
+    from solver.mbs.mesh_stiffness import body_windup_compliance, pitch_point_stiffness
     z1, z2 = model.teeth
     angle = np.degrees(states.angle)
     width = min(g.spec.face_width for g in model.geometry)
     k = units.stiffness_n_per_um(states.stiffness)
     sel = whole_periods(angle, z1) & np.isfinite(k)
-    mean = float(np.mean(k[sel])) if sel.any() else float("nan")
-    p2p = float(np.ptp(k[sel])) if sel.any() else float("nan")
     loaded = states.loaded_pairs()
     eps_loaded = float(np.mean(loaded[sel & states.converged])) if (sel & states.converged).any() else float("nan")
-    c1 = float(units.stiffness_per_width(np.nanmax(states.pair_stiffness), width)) if states.converged.any() else float("nan")
-    cga = float(units.stiffness_per_width(mean / units.UM, width))
+    mean, p2p, c1, cga = _stiffness_scalars(k, states.pair_stiffness, sel, width)
+    k_mesh = units.stiffness_n_per_um(states.stiffness_mesh)
+    mean_m, _p2p_m, c1_m, cga_m = _stiffness_scalars(k_mesh, states.pair_stiffness_mesh, sel, width)
     eps = model.pair.contact_ratio
-    c1_iso, cga_iso, c_r = iso_stiffness(scene, eps)
+    load = torque if abs(torque) > 1e-9 else 1.0        # the load mesh_states linearises at
+    iso = iso_stiffness(scene, eps, load)
+    cw = body_windup_compliance(model, windup)
+    cw_um = [c * units.UM_PER_M for c in cw]
     load_note = f"at static equilibrium under {torque:g} N·m"
+    both = "includes both bodies' wind-up from the bore (the hubs' TE)"
+    if model.coupled:
+        how = ("the bodies rigid below the rim: the tangent matrix of mesh_stiffness without the body springs "
+               "(hub -> rim), condensed onto the driven rim with the driver rim prescribed; the body springs are in "
+               "series with it: 1/k_pair = 1/k_mesh + rb1^2/k_body1 + rb2^2/k_body2 wherever the contacts act along "
+               "the line of action (a tip corner's other lever aside)")
+    elif windup is not None:
+        how = ("the plain model lumps the body wind-up into every tooth spring: each loaded spring's tangent k with "
+               "the wind-up c_w of its body taken out at the pitch point, 1/(1/k - c_w/h^2), h the pitch lever; "
+               "c_w from the bore-clamped FE body (study.inputs.coupling.plain_windup: mean compliance of a tooth "
+               "under its neighbours' pitch-point loads, of the solid body for springs that are not the FE's)")
+    else:
+        how = "unknown: a plain model given no body wind-up"
+    windup_attrs = {"body_windup_um_per_N": np.array(cw_um), "comment": how}
+    iso_attrs = {"low_load_factor": iso["low_load_factor"], "load_per_width_N_per_mm": iso["load_per_width"],
+                 "K_A": 1.0}
     coords = {"driven_tooth": variable("driven_tooth", np.arange(z2))}
     data = {
         "mesh_stiffness": variable("mesh_stiffness", k,
                                    comment=f"dF/dTE {load_note}, the pair linearised as for the modes "
                                        "(solver.mbs.mesh_stiffness): the driver hub prescribed, every tooth at its "
-                                       "static response; F = driven torque / rb2"),
-        "mesh_stiffness_mean": variable("mesh_stiffness_mean", mean),
-        "mesh_stiffness_p2p": variable("mesh_stiffness_p2p", p2p),
+                                       f"static response; F = driven torque / rb2; {both}"),
+        "mesh_stiffness_mean": variable("mesh_stiffness_mean", mean, comment=both),
+        "mesh_stiffness_p2p": variable("mesh_stiffness_p2p", p2p, comment=both),
         "c_prime": variable("c_prime", c1,
                             comment="each loaded pair's share of the tangent mesh stiffness (the pair as if alone in mesh), "
-                                f"its largest value over the STE angles, over the face width {width * 1e3:g} mm"),
-        "c_gamma_alpha": variable("c_gamma_alpha", cga),
-        "c_prime_iso6336": variable("c_prime_iso6336", c1_iso,
-                                    comment=f"C_M 0.8, C_R {c_r:.4f} (mean of the two webs; holes are not in the standard), "
-                                        "C_B of the basic rack, no profile shift; the standard states a spread of about 20 %"),
-        "c_gamma_alpha_iso6336": variable("c_gamma_alpha_iso6336", cga_iso,
-                                          comment=f"c' (0.75 eps_alpha + 0.25), eps_alpha = {eps:.4f} (geometric)"),
+                                f"its largest value over the STE angles, over the face width {width * 1e3:g} mm; {both}"),
+        "c_gamma_alpha": variable("c_gamma_alpha", cga, comment=f"mesh_stiffness_mean / b; {both}"),
+        "mesh_stiffness_mesh_mean": variable("mesh_stiffness_mesh_mean", mean_m, **windup_attrs),
+        "c_prime_mesh": variable("c_prime_mesh", c1_m, **windup_attrs),
+        "c_gamma_alpha_mesh": variable("c_gamma_alpha_mesh", cga_m, **windup_attrs),
+        "c_prime_iso6336": variable("c_prime_iso6336", iso["c_prime"], **iso_attrs,
+                                    value_without_low_load_factor=iso["c_prime_full_load"],
+                                    value_without_C_M_and_low_load_factor=iso["c_prime_elastic"],
+                                    comment=f"c'_th C_M C_R C_B (F_t/b / 100 N/mm)^0.25 (the low-load factor "
+                                        f"{iso['low_load_factor']:.4f} at F_t/b = {iso['load_per_width']:.4g} N/mm, "
+                                        f"1 from 100 N/mm; F_t = |T| / r2 at the reference circle, K_A = 1): "
+                                        f"C_M 0.8, C_R {iso['c_r']:.4f} (mean of the two webs; holes are not in the "
+                                        "standard), C_B of the basic rack, no profile shift; the mesh alone, no body "
+                                        "wind-up from the bore: compare with c_prime_mesh. C_M (measured over "
+                                        "theoretical) and the low-load factor are the standard's corrections for real, "
+                                        "measured gears; the model's elastic pair of perfect involutes compares with "
+                                        "value_without_C_M_and_low_load_factor (docs/outputs.md); the standard states "
+                                        "a spread of about 20 %"),
+        "c_gamma_alpha_iso6336": variable("c_gamma_alpha_iso6336", iso["c_gamma_alpha"], **iso_attrs,
+                                          value_without_low_load_factor=iso["c_gamma_alpha_full_load"],
+                                          value_without_C_M_and_low_load_factor=iso["c_gamma_alpha_elastic"],
+                                          comment=f"c_prime_iso6336 (0.75 eps_alpha + 0.25), eps_alpha = {eps:.4f} "
+                                              "(geometric); compare with c_gamma_alpha_mesh"),
         "loaded_contact_ratio": variable("loaded_contact_ratio", eps_loaded,
                                          comment=f"{load_note}, over whole mesh periods of the STE, tip-corner contacts "
                                              f"included; the geometric transverse contact ratio is {eps:.4f}"),
         "ste_tooth_force_gear2": variable("ste_tooth_force_gear2", states.tooth_force[:, z1:], comment=load_note),
         "ste_mate_tooth": variable("ste_mate_tooth", _mates(states.mate, z1)),
     }
-    kt = units.stiffness_n_per_um(pitch_point_stiffness(model, torque / model.base_radii[1]))
-    zmax = max(z1, z2)
-    K = np.full((2, zmax), np.nan)
-    K[0, :z1], K[1, :z2] = kt[:z1], kt[z1:]
-    data["tooth_stiffness_pitch"] = variable("tooth_stiffness_pitch", K,
-                                             comment=f"tangent of the tooth's spring under the whole load {torque:g} N·m / rb "
-                                                 "at the pitch point, n_k k_phi phi^(n_k-1) / h^2, h the lever arm of "
-                                                 "the line of action about the pivot (solver.mbs.mesh_stiffness)")
+    force = load / model.base_radii[1]
+    try:
+        alone = units.stiffness_n_per_um(pitch_point_stiffness(model, force, (0.0, 0.0) if model.coupled else cw))
+    except ValueError:      # a plain spring stiffer than its body's wind-up alone: it cannot hold it
+        alone = np.full(z1 + z2, np.nan)
+    bore = 1.0 / (1.0 / alone + np.repeat([c * units.UM_PER_M for c in cw], (z1, z2)))
+    spring = "k_phi n_k phi^(n_k-1) / h^2, h the lever arm of the line of action about the pivot"
+    for name, kt, what in (
+            ("tooth_stiffness_pitch", alone,
+             f"the tooth alone, its body rigid below the rim: {spring}"
+             + (", in series with the local compliance c_loc at the pitch point" if model.teeth_coupled else "")
+             + ("" if model.coupled else ", with the body wind-up c_w the plain model's spring holds taken out: "
+                "1/(1/k - c_w)")),
+            ("tooth_stiffness_pitch_bore", bore,
+             "tooth_stiffness_pitch in series with its body's wind-up from the bore c_w (body_windup_um_per_N): what "
+             "a tooth of the bore-clamped body reads" + ("" if model.coupled else " (the plain model's spring itself)"))):
+        K = np.full((2, max(z1, z2)), np.nan)
+        K[0, :z1], K[1, :z2] = kt[:z1], kt[z1:]
+        data[name] = variable(name, K, comment=f"the tangent under the whole load {torque:g} N·m / rb at the pitch point; "
+                                               f"{what} (solver.mbs.mesh_stiffness.pitch_point_stiffness)",
+                              body_windup_um_per_N=np.array(cw_um))
     return coords, data
+
+
+def _stiffness_scalars(k: np.ndarray, pair: np.ndarray, sel: np.ndarray, width: float) -> tuple:
+    """(mean [N/um], peak-to-peak [N/um], c' [N/(mm·um)], c_gamma_alpha [N/(mm·um)]) of a mesh
+    stiffness ``k`` [N/um] over the angles ``sel`` and its pair shares ``pair`` [N/m]."""
+    ok = sel & np.isfinite(k)
+    mean = float(np.mean(k[ok])) if ok.any() else float("nan")
+    p2p = float(np.ptp(k[ok])) if ok.any() else float("nan")
+    shares = pair[np.isfinite(k)]
+    c1 = float(units.stiffness_per_width(np.nanmax(shares), width)) if shares.size else float("nan")
+    return mean, p2p, c1, float(units.stiffness_per_width(mean / units.UM, width))
 
 
 def _mates(mate: np.ndarray, z1: int) -> np.ndarray:

@@ -101,17 +101,31 @@ RUN_VARIABLES: dict[str, Var] = {
     **_peaks("ste", frequency=False),
     # ---- the mesh under load: `study.archive.mesh.mesh_variables`
     "driven_tooth": Var(("driven_tooth",), "1", "driven tooth index (counter-clockwise from tooth 0)"),
-    "mesh_stiffness": Var(("angle",), "N um-1", "tangent mesh stiffness along the line of action"),
-    "mesh_stiffness_mean": Var((), "N um-1", "mean tangent mesh stiffness over whole mesh periods of the STE"),
-    "mesh_stiffness_p2p": Var((), "N um-1", "peak-to-peak of the tangent mesh stiffness over the STE"),
-    "c_prime": Var((), "N mm-1 um-1", "single stiffness c' of a tooth pair per face width (largest over the STE)"),
-    "c_gamma_alpha": Var((), "N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width (mean over the STE)"),
-    "c_prime_iso6336": Var((), "N mm-1 um-1", "single stiffness c' by ISO 6336-1 Method B"),
-    "c_gamma_alpha_iso6336": Var((), "N mm-1 um-1", "mesh stiffness c_gamma_alpha by ISO 6336-1 Method B"),
+    "mesh_stiffness": Var(("angle",), "N um-1", "tangent mesh stiffness of the pair along the line of action, "
+                                                "the bodies' wind-up from the bore included"),
+    "mesh_stiffness_mean": Var((), "N um-1", "mean tangent mesh stiffness of the pair over whole mesh periods of the STE, "
+                                             "the bodies' wind-up from the bore included"),
+    "mesh_stiffness_p2p": Var((), "N um-1", "peak-to-peak of the tangent mesh stiffness of the pair over the STE"),
+    "c_prime": Var((), "N mm-1 um-1", "single stiffness c' of a tooth pair per face width (largest over the STE), the "
+                                      "bodies' wind-up from the bore included"),
+    "c_gamma_alpha": Var((), "N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width (mean over the STE), the bodies' "
+                                            "wind-up from the bore included"),
+    "mesh_stiffness_mesh_mean": Var((), "N um-1", "mean tangent stiffness of the mesh alone (the bodies' wind-up from "
+                                                  "the bore taken out) over whole mesh periods of the STE"),
+    "c_prime_mesh": Var((), "N mm-1 um-1", "single stiffness c' of a tooth pair per face width of the mesh alone (the "
+                                           "bodies' wind-up from the bore taken out; largest over the STE)"),
+    "c_gamma_alpha_mesh": Var((), "N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width of the mesh alone (the "
+                                                 "bodies' wind-up from the bore taken out; mean over the STE)"),
+    "c_prime_iso6336": Var((), "N mm-1 um-1", "single stiffness c' by ISO 6336-1 Method B with its low-load factor"),
+    "c_gamma_alpha_iso6336": Var((), "N mm-1 um-1", "mesh stiffness c_gamma_alpha by ISO 6336-1 Method B with its "
+                                                    "low-load factor"),
     "loaded_contact_ratio": Var((), "1", "loaded contact ratio: mean number of loaded tooth pairs"),
     "ste_tooth_force_gear2": Var(("angle", "driven_tooth"), "N", "normal contact force on each driven tooth"),
     "ste_mate_tooth": Var(("driver_tooth",), "1", "driven tooth that each driver tooth meets in the STE (-1: none)"),
-    "tooth_stiffness_pitch": Var(("gear", "tooth"), "N um-1", "tooth stiffness at the pitch point along the line of action"),
+    "tooth_stiffness_pitch": Var(("gear", "tooth"), "N um-1", "tooth stiffness at the pitch point along the line of "
+                                                              "action, the body rigid below the rim (no wind-up from the bore)"),
+    "tooth_stiffness_pitch_bore": Var(("gear", "tooth"), "N um-1", "tooth stiffness at the pitch point along the line of "
+                                                                   "action with the body's wind-up from the bore in series"),
     # ---- dynamic TE: `study.archive.run_variables.dynamic_variables`, `efficiency_variable`
     "time": Var(("time",), "s", "time", {"comment": "elapsed time from the start of the run, not a calendar time"}),
     "dte": Var(("time",), "um", "dynamic transmission error rb1*theta1 + rb2*theta2"),

@@ -19,8 +19,9 @@ def summarize(ds: xr.Dataset) -> dict:
         out["ste_mean"] = float(np.nanmean(ste))
         out["ste_elastic_mean"] = float(np.nanmean(ste) - flank_side(ds) * off)
         out["ste_p2p"] = float(np.nanmax(ste) - np.nanmin(ste))
-    for name in ("mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
-                 "c_gamma_alpha_iso6336", "loaded_contact_ratio", "dynamic_factor"):
+    for name in ("mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "mesh_stiffness_mesh_mean",
+                 "c_prime_mesh", "c_gamma_alpha_mesh", "c_prime_iso6336", "c_gamma_alpha_iso6336",
+                 "loaded_contact_ratio", "dynamic_factor"):
         if name in ds:
             out[name] = float(ds[name])
     if "dte" in ds:

@@ -33,10 +33,11 @@ def compliance_key(setup: GearSetup, teeth: list, spread: int, u: np.ndarray) ->
     return key, load, read
 
 
-def compliance_cached(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFILE_POINTS) -> bool:
+def compliance_cached(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFILE_POINTS,
+                      u: np.ndarray | None = None) -> bool:
     """True when the compliance `gear_compliance` would compute is in the cache (memory or disk)."""
     from solver.fe.ltca import profile_grid
-    key, _, _ = compliance_key(setup, teeth, spread, profile_grid(setup.geometry, n_u))
+    key, _, _ = compliance_key(setup, teeth, spread, profile_grid(setup.geometry, n_u) if u is None else u)
     return key in FE_CACHE.compliance or (FE_CACHE.folder / f"ltca-{key}.npz").exists()
 
 

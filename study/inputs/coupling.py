@@ -29,29 +29,60 @@ import numpy as np
 from solver.fe.body import load_case
 from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, local_compliance, tooth_compliance_fit
 from solver.mbs.model import Model
-from study.inputs.compliance import PROFILE_POINTS, gear_compliance
+from study.inputs.compliance import PROFILE_POINTS, compliance_cached, gear_compliance
 from study.inputs.gearsetup import GearSetup
+
+
+def _pitch_roll(setup: GearSetup) -> np.ndarray:
+    """The roll grid of the pitch point alone [-]."""
+    return np.array([math.tan(setup.geometry.spec.pressure_angle)])
+
+
+def pitch_compliances_cached(setup: GearSetup) -> bool:
+    """True when `pitch_compliances` of the gear needs no FE solve (memory or disk cache)."""
+    return compliance_cached(setup, list(range(setup.teeth)), 1, u=_pitch_roll(setup))
+
+
+def pitch_compliances(setup: GearSetup) -> tuple[np.ndarray, np.ndarray]:
+    """(c_total, c_adjacent) (Z,) [m/N] of the gear's bore-clamped FE body at the pitch point,
+    read along the line of action at the tooth centreline: each tooth's own compliance, and its
+    mean compliance under a load on either neighbour (the body's wind-up the neighbours share).
+    A lightened body: every tooth loaded; a solid body: one, the rest by symmetry."""
+    geo = setup.geometry
+    z = geo.teeth
+    u = _pitch_roll(setup)
+    if setup.lightened:
+        c, _ = gear_compliance(setup, list(range(z)), 1, u=u)
+        G = c.g[:, 0, :, 0]                        # read tooth, load tooth
+        a = np.arange(z)
+        return G[a, a], 0.5 * (G[a, (a - 1) % z] + G[a, (a + 1) % z])
+    c, _ = gear_compliance(setup, [0], 1, u=u)
+    G = c.g[:, 0, 0, 0]                            # read offsets -1, 0, 1
+    return np.full(z, G[1]), np.full(z, 0.5 * (G[0] + G[2]))
 
 
 def body_torsion(setup: GearSetup) -> BodyTorsionFit:
     """Body spring [N·m/rad] and tooth springs without the body wind-up of the gear, about the
     pivot of `tooth_pivot` (so `BodyTorsionFit.k_total` is the plain FE spring about it)."""
     geo = setup.geometry
-    z = geo.teeth
-    u = np.array([math.tan(geo.spec.pressure_angle)])
-    if setup.lightened:
-        c, _ = gear_compliance(setup, list(range(z)), 1, u=u)
-        G = c.g[:, 0, :, 0]                        # read tooth, load tooth
-        a = np.arange(z)
-        c_tot = G[a, a]
-        c_adj = 0.5 * (G[a, (a - 1) % z] + G[a, (a + 1) % z])
-    else:
-        c, _ = gear_compliance(setup, [0], 1, u=u)
-        G = c.g[:, 0, 0, 0]                        # read offsets -1, 0, 1
-        c_tot = np.full(z, G[1])
-        c_adj = np.full(z, 0.5 * (G[0] + G[2]))
+    c_tot, c_adj = pitch_compliances(setup)
     r_q, k_q = tooth_pivot(setup, float(np.mean(c_adj)))
     return body_torsion_fit(c_tot, c_adj, load_case(geo, 0, r_q).lever, geo.base_radius, r_q, k_q)
+
+
+def plain_windup(setup: GearSetup) -> float:
+    """Compliance [m/N] along the line of action of the body wind-up from the bore that the
+    plain model's tooth springs of the gear hold: c_body of `body_torsion` (the mean over the
+    teeth of the FE compliance under the neighbours' pitch-point loads), of the body the springs
+    stand for: the gear's own when its springs come from its FE ('fe-ratio', 'fe'), else the
+    solid body's (a solid gear; 'uniform' springs, the calibrated solid-gear k_phi)."""
+    return float(np.mean(pitch_compliances(windup_body(setup))[1]))
+
+
+def windup_body(setup: GearSetup) -> GearSetup:
+    """The body whose wind-up the plain model's springs of the gear hold (`plain_windup`)."""
+    from study.inputs.springs import uses_fe_springs
+    return setup if uses_fe_springs(setup) else setup.solid()
 
 
 # fit weight of a tip-corner contact's nominal load share [1]: a corner outside the path of

@@ -26,16 +26,28 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         w(f"  STE: mean {s['ste_mean']:.3f} um (elastic part {s['ste_elastic_mean']:.3f} um), "
           f"peak-to-peak {s['ste_p2p']:.3f} um over {float(ds['angle'][-1]):.4g} deg\n")
     if "mesh_stiffness_mean" in s:
-        w(f"  mesh stiffness (tangent, along the line of action): mean {s['mesh_stiffness_mean']:.1f} N/um, "
-          f"peak-to-peak {s['mesh_stiffness_p2p']:.1f} N/um\n")
-        w("    per face width [N/(mm·um)]   model   ISO 6336-1 B   ratio\n")
+        w(f"  mesh stiffness (tangent, along the line of action): pair {s['mesh_stiffness_mean']:.1f} N/um mean (both "
+          f"bodies' wind-up from the bore in it), peak-to-peak {s['mesh_stiffness_p2p']:.1f} N/um")
+        if "mesh_stiffness_mesh_mean" in s:
+            w(f"; mesh alone {s['mesh_stiffness_mesh_mean']:.1f} N/um mean")
+        w("\n    per face width [N/(mm·um)]    pair   mesh alone   ISO 6336-1 B   mesh alone / ISO\n")
         for name, what in (("c_prime", "c' single pair"), ("c_gamma_alpha", "c_gamma_alpha mesh")):
-            m, iso = s[name], s[f"{name}_iso6336"]
-            w(f"    {what:<28s} {m:6.2f}   {iso:12.2f}   {m / iso:5.3f}\n")
+            m, alone, iso = s[name], s.get(f"{name}_mesh", float("nan")), s[f"{name}_iso6336"]
+            w(f"    {what:<28s} {m:6.2f}   {alone:10.2f}   {iso:12.2f}   {alone / iso:16.3f}\n")
+        a = ds["c_prime_iso6336"].attrs if "c_prime_iso6336" in ds else {}
+        if "value_without_C_M_and_low_load_factor" in a:
+            el = [ds[f"{n}_iso6336"].attrs["value_without_C_M_and_low_load_factor"] for n in ("c_prime", "c_gamma_alpha")]
+            w(f"    ISO: Method B with the low-load factor {a['low_load_factor']:.3f} (F_t/b {a['load_per_width_N_per_mm']:.1f} "
+              f"N/mm); without it and C_M 0.8 (an elastic pair of perfect involutes): c' {el[0]:.2f}, c_gamma_alpha "
+              f"{el[1]:.2f}\n")
     if "tooth_stiffness_pitch" in ds:
         k = ds["tooth_stiffness_pitch"]
-        w("  tooth stiffness at the pitch point [N/um]: " + ", ".join(
-            f"gear {g} {float(k.sel(gear=g).min()):.1f}-{float(k.sel(gear=g).max()):.1f}" for g in (1, 2)) + "\n")
+        line = "  tooth stiffness at the pitch point [N/um], the body rigid: " + ", ".join(
+            f"gear {g} {_range(k.sel(gear=g))}" for g in (1, 2))
+        if "tooth_stiffness_pitch_bore" in ds:
+            kb = ds["tooth_stiffness_pitch_bore"]
+            line += "; with the wind-up from the bore: " + ", ".join(f"gear {g} {_range(kb.sel(gear=g))}" for g in (1, 2))
+        w(line + "\n")
     runup = "order_amplitude" in ds
     if "dte_rms" in s and not runup:
         w(f"  DTE after {ds.attrs['spectrum_start_s']:.3g} s: mean {s['dte_mean']:.3f} um, RMS {s['dte_rms']:.3f} um, "
@@ -91,3 +103,9 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
             w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in shown) + more + "\n")
     w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
       + f", total {wall:.2f} s\n")
+
+
+def _range(k: xr.DataArray) -> str:
+    """'lo-hi' of the finite values of ``k`` with one decimal (one value when they are equal)."""
+    lo, hi = float(k.min()), float(k.max())
+    return f"{lo:.1f}" if f"{lo:.1f}" == f"{hi:.1f}" else f"{lo:.1f}-{hi:.1f}"

@@ -42,12 +42,22 @@ SCALARS = {
     "ste_mean": Scalar("um", "mean static transmission error", "static"),
     "ste_elastic_mean": Scalar("um", "mean static transmission error less the rigid backlash offset", "static"),
     "ste_p2p": Scalar("um", "peak-to-peak static transmission error", "static"),
-    "mesh_stiffness_mean": Scalar("N um-1", "mean tangent mesh stiffness along the line of action over the STE", "static"),
-    "mesh_stiffness_p2p": Scalar("N um-1", "peak-to-peak of the tangent mesh stiffness over the STE", "static"),
-    "c_prime": Scalar("N mm-1 um-1", "single stiffness c' of a tooth pair per face width (largest over the STE)", "static"),
-    "c_gamma_alpha": Scalar("N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width (mean over the STE)", "static"),
-    "c_prime_iso6336": Scalar("N mm-1 um-1", "single stiffness c' by ISO 6336-1 Method B", "static"),
-    "c_gamma_alpha_iso6336": Scalar("N mm-1 um-1", "mesh stiffness c_gamma_alpha by ISO 6336-1 Method B", "static"),
+    "mesh_stiffness_mean": Scalar("N um-1", "mean tangent mesh stiffness of the pair along the line of action over the "
+                                            "STE, the bodies' wind-up from the bore included", "static"),
+    "mesh_stiffness_p2p": Scalar("N um-1", "peak-to-peak of the tangent mesh stiffness of the pair over the STE", "static"),
+    "c_prime": Scalar("N mm-1 um-1", "single stiffness c' of a tooth pair per face width (largest over the STE), the "
+                                     "bodies' wind-up from the bore included", "static"),
+    "c_gamma_alpha": Scalar("N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width (mean over the STE), the bodies' "
+                                           "wind-up from the bore included", "static"),
+    "mesh_stiffness_mesh_mean": Scalar("N um-1", "mean tangent stiffness of the mesh alone (the bodies' wind-up from the "
+                                                 "bore taken out) over the STE", "static"),
+    "c_prime_mesh": Scalar("N mm-1 um-1", "single stiffness c' of a tooth pair per face width of the mesh alone (the "
+                                          "bodies' wind-up from the bore taken out)", "static"),
+    "c_gamma_alpha_mesh": Scalar("N mm-1 um-1", "mesh stiffness c_gamma_alpha per face width of the mesh alone (the "
+                                                "bodies' wind-up from the bore taken out)", "static"),
+    "c_prime_iso6336": Scalar("N mm-1 um-1", "single stiffness c' by ISO 6336-1 Method B with its low-load factor", "static"),
+    "c_gamma_alpha_iso6336": Scalar("N mm-1 um-1", "mesh stiffness c_gamma_alpha by ISO 6336-1 Method B with its "
+                                                   "low-load factor", "static"),
     "loaded_contact_ratio": Scalar("1", "loaded contact ratio: mean number of loaded tooth pairs in the STE", "static"),
     "dte_mean": Scalar("um", "mean dynamic transmission error after the ramp", "dynamic"),
     "dte_rms": Scalar("um", "RMS of the dynamic transmission error about its mean after the ramp", "dynamic"),
@@ -80,7 +90,8 @@ for _g, _which in ((1, "driver"), (2, "driven gear")):
     })
 # the outputs of the linearised mesh and the tooth loads (`study.run.run_scene`'s mesh_outputs):
 # a study that asks for none of them skips that part
-MESH_SCALARS = ("mesh_stiffness", "mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha", "c_prime_iso6336",
+MESH_SCALARS = ("mesh_stiffness", "mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha",
+                "mesh_stiffness_mesh_mean", "c_prime_mesh", "c_gamma_alpha_mesh", "c_prime_iso6336",
                 "c_gamma_alpha_iso6336", "loaded_contact_ratio", "dynamic_factor")
 # GEAR_VARIABLES (`study.archive.schema`): the per-gear archive variables a study archives as *_gear{g}
 
