@@ -1,5 +1,6 @@
 """Mass properties of a gear: the rigid tooth (from its outline polygon) and the body below the
-root circle (rings at their thickness, less the holes). SI: kg, m, kg·m².
+root circle (rings at their thickness, less the openings: round holes, slots or windows, from
+their exact outline). SI: kg, m, kg·m².
 """
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.geometry import BodySpec, GearGeometry
+from solver.openings import opening_area_moment, shape_of
 
 
 @dataclass(frozen=True)
@@ -48,8 +50,12 @@ def tooth_inertia(g: GearGeometry, density: float, pivot_radius: float) -> Tooth
 
 
 def hole_inertia(body: BodySpec, density: float) -> tuple[float, float]:
-    """Mass [kg] and polar inertia about the gear axis [kg·m²] of the web material the holes
-    take out (each hole a disc of the web thickness, moved to the hole circle); zero without holes."""
+    """Mass [kg] and polar inertia about the gear axis [kg·m²] of the web material the openings
+    take out, at the web thickness; zero without holes. Round holes: each a disc moved to the
+    hole circle; slots and windows: their exact outline integrated (`solver.openings`)."""
+    if body.opening != "round" and body.holes:
+        area, j0 = opening_area_moment(shape_of(body))
+        return density * body.web_thickness * area, density * body.web_thickness * j0
     mh = density * math.pi * body.hole_radius**2 * body.web_thickness
     return body.holes * mh, body.holes * mh * (0.5 * body.hole_radius**2 + body.hole_circle_radius**2)
 
