@@ -229,16 +229,6 @@ def opening_edge_sizes(body: BodySpec, h: float) -> tuple[float, float]:
     return edge, edge
 
 
-def rim_edge_size(h: float) -> float:
-    """Element size [m] on the rim's inner circle for the outline size ``h`` [m]."""
-    return min(2 * h, 5.0 * h)
-
-
-def hub_edge_size(h: float) -> float:
-    """Element size [m] on the hub's outer circle for the outline size ``h`` [m]."""
-    return 5.0 * h
-
-
 def _opening_loop(geo, pieces: list, size: float, corners: tuple | None, corner_radius: float = 0.0) -> int:
     """A closed curve loop of gmsh geo lines and circle arcs (each arc in pieces of at most a
     quarter turn: gmsh draws arcs below half a turn) of an opening's outline, points of ``size``
