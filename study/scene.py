@@ -80,6 +80,22 @@ class BodySection:
     corner_radius: float = _f(2.0, "mm", "fillet radius of a window's four corners (0: sharp)", 0.0)
 
 
+OPENING_WORDS = {"round": "holes", "slot": "slots", "window": "windows"}
+
+
+def opening_text(b: BodySection) -> str:
+    """A body section's openings in words [mm, deg]: '6 holes of R_h 6 mm', '6 slots 8 mm wide
+    over 30 deg', '5 windows 12 mm high between spokes of 8 mm, corners R 2 mm'; 'no holes'."""
+    if not b.holes:
+        return "no holes"
+    if b.opening == "slot":
+        return f"{b.holes} slots {b.slot_width:g} mm wide over {b.slot_angle:g} deg on R {b.hole_circle_radius:g} mm"
+    if b.opening == "window":
+        return (f"{b.holes} windows {b.window_height:g} mm high between spokes of {b.spoke_width:g} mm, "
+                f"corners R {b.corner_radius:g} mm")
+    return f"{b.holes} holes of R_h {b.hole_radius:g} mm"
+
+
 @dataclass(frozen=True)
 class SpringSection:
     """Torsion spring of each tooth about its pivot (eq. 1.2): T = k_phi phi^n_k + c_phi dphi^n_c."""
