@@ -135,6 +135,15 @@ def solid_scene(scene, gears=(1, 2)):
     return scene.solid(gears=tuple(gears))
 
 
+def equal_mass(scene, reference, g: int = 2):
+    """``scene`` with gear g's openings sized (``hole_radius``, ``slot_width`` or ``spoke_width``)
+    so that the gear weighs what gear g of ``reference`` weighs (a Scene, or a mass in kg) ->
+    Scene; SceneError naming the size field when no valid size reaches it."""
+    from study.mass_match import equal_mass as sized
+    _check_scene("equal_mass", scene)
+    return sized(scene, reference, g)
+
+
 def check_dynamic_window(scene) -> None:
     """SceneError when the scene's dynamic run leaves no steady part after its ramps for the DTE
     summary and spectrum (`lightgear run` checks it; integrator studies end with the ramps on purpose)."""
