@@ -144,6 +144,47 @@ def equal_mass(scene, reference, g: int = 2):
     return sized(scene, reference, g)
 
 
+def describe_openings(scene, g: int = 2) -> str:
+    """Gear g's openings in words [mm, deg] ('6 slots 5.35 mm wide over 30 deg on R 32.36 mm') -> str."""
+    from study.scene import opening_text
+    _check_scene("describe_openings", scene)
+    return opening_text(scene.gear(g).body)
+
+
+def opening_outline(scene, g: int = 2, angle: float | None = None):
+    """The exact outline of gear g's first opening sampled every 10 um -> (x, y) [mm] in the gear
+    frame, turned to polar angle ``angle`` [deg] (default: where the scene puts it, hole_phase);
+    (empty, empty) without holes."""
+    import math
+
+    import numpy as np
+
+    from solver import units
+    from solver.openings import local_outline, place, polygon, shape_of
+    _check_scene("opening_outline", scene)
+    body = scene.body_spec(g)
+    if not body.holes:
+        return np.empty(0), np.empty(0)
+    turn = body.hole_phase if angle is None else math.radians(angle)
+    x, y = polygon(place(local_outline(shape_of(body)), turn), 10 * units.UM)
+    return x / units.MM, y / units.MM
+
+
+def opening_order_amplitude(scene, angle, te) -> float:
+    """Amplitude of ``te`` (any unit, over the driver angles ``angle`` [deg]) at the order N of
+    the driven gear's openings, fitted with the first three mesh harmonics and their sidebands
+    (`study.verify.model_validation.order_amplitude`); NaN without openings."""
+    import numpy as np
+
+    from study.verify.model_validation import order_amplitude
+    _check_scene("opening_order_amplitude", scene)
+    n = scene.gear2.body.holes
+    if not n:
+        return float("nan")
+    driven = np.radians(np.asarray(angle, float)) * scene.gear1.teeth / scene.gear2.teeth
+    return order_amplitude(driven, np.asarray(te, float), n, scene.gear2.teeth)
+
+
 def check_dynamic_window(scene) -> None:
     """SceneError when the scene's dynamic run leaves no steady part after its ramps for the DTE
     summary and spectrum (`lightgear run` checks it; integrator studies end with the ramps on purpose)."""
@@ -533,4 +574,5 @@ __all__ = ["Scene", "SceneError", "StudyError", "BudgetError", "Study", "Outputs
            "render", "stiffness", "identify_spring", "fit_contact", "reference", "precision", "precision_table",
            "stability_suite", "validation", "validate_design_space", "validate_relief", "validation_errors",
            "validation_misses", "sample_outputs", "sample_tables", "sample_points", "sample_point_label",
-           "study_from_dict", "export", "script_main"]
+           "study_from_dict", "export", "script_main", "equal_mass", "describe_openings", "opening_outline",
+           "opening_order_amplitude"]
