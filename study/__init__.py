@@ -481,6 +481,17 @@ def validate_design_space(scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), rims=
     return design_space_dataset(scene, holes=holes, webs=webs, rims=rims, rotation=rotation, step=step, log=log)
 
 
+def validate_bodies(scenes: dict, step: float = 0.1, models=("fe-reference", "compliance"), log=None):
+    """STE of ``models`` and the FE reference for named scenes ({name: Scene}, bodies of any
+    opening shape), each over two periods of its driven gear's openings at ``step`` [deg] ->
+    Dataset over (body, model): mean, elastic mean and p2p [um], opening-order amplitude [um]
+    (`study.verify.model_validation.bodies_dataset`); errors with `validation_errors`."""
+    from study.verify.model_validation import bodies_dataset
+    for sc in scenes.values():
+        _check_scene("validate_bodies", sc)
+    return bodies_dataset(dict(scenes), step=step, models=tuple(models), log=log)
+
+
 def validate_relief(scene, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=(25.0, 50.0, 100.0), step: float = 0.1,
                     log=None):
     """STE peak-to-peak of every model and the FE reference for the scene's pair with its driven
@@ -575,4 +586,4 @@ __all__ = ["Scene", "SceneError", "StudyError", "BudgetError", "Study", "Outputs
            "stability_suite", "validation", "validate_design_space", "validate_relief", "validation_errors",
            "validation_misses", "sample_outputs", "sample_tables", "sample_points", "sample_point_label",
            "study_from_dict", "export", "script_main", "equal_mass", "describe_openings", "opening_outline",
-           "opening_order_amplitude"]
+           "opening_order_amplitude", "validate_bodies"]

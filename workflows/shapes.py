@@ -1,6 +1,7 @@
 """Lightening shapes at equal mass: round holes against arc slots against spoked windows.
 
-    python -m workflows.shapes [STUDY] [-o results/shapes] [--workers N] [--no-progress]
+    python -m workflows.shapes [STUDY] [-o results/shapes] [--workers N] [--reference [--step 0.1]]
+        [--no-progress]
 
 Runs a study whose points are bodies of one gear with differently shaped openings (default: the
 embedded ``shapes`` study, the paper's pair with six round holes, six slots and six windows that
@@ -12,7 +13,9 @@ each take out the same mass), and writes
   harmonics and their sidebands, `study.verify.model_validation.order_amplitude`), DTE RMS and
   DTE amplitude at order N [um], largest root stress [MPa] and its ratio to the solid gear's;
 * ``shapes.png``: one figure: the openings drawn on the web (one of each, to scale) and the STE of
-  each body over the driver angle.
+  each body over the driver angle;
+* with ``--reference``, ``reference.txt``: the default model against the FE reference for each
+  body (`study.validate_bodies`: elastic mean STE, p2p, opening order over two opening periods).
 
 Exit codes: 0 done; 1 a point did not run (its message printed); 2 invalid input (one line).
 """
@@ -87,9 +90,10 @@ def figure(ds, points: list, rows: list[dict], path, title: str) -> Path:
                      label=f"{p.scene.gear2.body.opening}: p2p {row['ste_p2p']:.3f} um, order N {row['ste_hole_order']:.1f} nm")
     ax0.set_aspect("equal")
     ax0.set_xlabel("x [mm]")
-    ax0.set_ylabel("y [mm] (one opening of each body, turned to the top)")
-    ax0.legend(fontsize=7, loc="lower center")
-    ax0.set_title(f"openings at equal mass ({rows[0]['mass_gear2']:.4f} kg gear)", fontsize=10)
+    ax0.set_ylabel("y [mm]")
+    ax0.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.18))
+    ax0.set_title(f"one opening of each body, to scale (gear of {rows[0]['mass_gear2']:.4f} kg);\n"
+                  "grey: root circle (dotted), rim and hub", fontsize=9)
     ax1.set_xlabel("driver angle [deg]")
     ax1.set_ylabel("static transmission error STE [um]")
     ax1.legend(fontsize=8)
@@ -123,7 +127,29 @@ def run(args) -> int:
            if s != study.STATUS.index("ok")]
     for b in bad:
         print(f"  {b}", file=sys.stderr)
+    if args.reference:
+        ref = reference_table(points, args.step)
+        (out / "reference.txt").write_text(ref + "\n")
+        print(f"\n{ref}")
     return 1 if bad else 0
+
+
+def reference_table(points: list, step: float) -> str:
+    """The default model against the FE reference (`study.validate_bodies`) for every body of the
+    study: the FE figures and the errors, in %, of elastic mean STE / p2p / opening order."""
+    scenes = {study.describe_openings(p.scene): p.scene for p in points if p.scene is not None}
+    ds = study.validate_bodies(scenes, step=step, log=lambda line: print(f"  {line}", flush=True))
+    err = study.validation_errors(ds).sel(model="compliance")
+    ref = ds.sel(model="fe-reference")
+    width = max(len(n) for n in scenes)
+    lines = [f"{'driven gear openings':<{width}}  FE elastic mean um  FE p2p um  FE order N nm  default model error %",
+             "-" * (width + 75)]
+    for name in scenes:
+        e = err.sel(body=name)
+        lines.append(f"{name:<{width}}  {float(ref['ste_elastic_mean'].sel(body=name)):>18.3f}  "
+                     f"{float(ref['ste_p2p'].sel(body=name)):>9.3f}  {1e3 * float(ref['hole_amplitude'].sel(body=name)):>13.1f}  "
+                     f"{100 * float(e['elastic_mean']):+.2f} / {100 * float(e['p2p']):+.2f} / {100 * float(e['hole']):+.2f}")
+    return "\n".join(lines)
 
 
 def main(argv=None) -> int:
@@ -131,6 +157,9 @@ def main(argv=None) -> int:
     p.add_argument("study", nargs="?", default="shapes", help="study TOML or embedded study (default: shapes)")
     p.add_argument("-o", "--output", default=DEFAULT_OUT, help="output folder (archive, table, figure)")
     p.add_argument("--workers", type=int, default=0, help="LocalCluster workers (0, the default: in this process)")
+    p.add_argument("--reference", action="store_true",
+                   help="also the default model against the FE reference for every body (reference.txt)")
+    p.add_argument("--step", type=float, default=0.1, help="driver angle step of the --reference STE [deg]")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
     try:
