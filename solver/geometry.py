@@ -23,7 +23,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from solver.openings import between_openings, shape_of, window_corners
+from solver.openings import angular_half_width, between_openings, radial_extent, shape_of, window_corners
 
 
 class GeometryError(ValueError):
@@ -443,6 +443,17 @@ def _validate_window(body: BodySpec, r_rim: float, r_hub: float, prefix: str) ->
     if not window_corners(shape_of(body))[3] >= 0:
         raise GeometryError(f"{prefix}.corner_radius", f"{rho * 1e3:.4g} mm is too large for the window: the fillets of its two "
                             f"inner corners overlap on the inner arc (radius {r_in * 1e3:.4g} mm between spokes of {ws * 1e3:.4g} mm)")
+
+
+def opening_half_angle(body: BodySpec) -> float:
+    """Half the polar angle [rad] one opening of the body covers seen from the gear centre
+    (`solver.openings.angular_half_width`; round holes: asin(hole_radius / hole_circle_radius))."""
+    return angular_half_width(shape_of(body))
+
+
+def opening_radii(body: BodySpec) -> tuple[float, float]:
+    """(innermost, outermost) radius [m] the body's openings reach (`solver.openings.radial_extent`)."""
+    return radial_extent(shape_of(body))
 
 
 def bore_radius(g: GearGeometry, body: BodySpec) -> float:

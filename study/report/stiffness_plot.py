@@ -10,8 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from solver.geometry import hole_angles
-from solver.openings import angular_half_width, shape_of
+from solver.geometry import hole_angles, opening_half_angle
 from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, archive_scene, figure_title, need, save_figure, unit_text
 from study.scene import OPENING_WORDS
 
@@ -45,7 +44,7 @@ def stiffness_plot(ds: xr.Dataset, path) -> Path:
             if b.holes == 0:
                 continue
             pitch = 360.0 / sc.gear(g).teeth
-            half = math.degrees(angular_half_width(shape_of(sc.body_spec(g)))) / pitch
+            half = math.degrees(opening_half_angle(sc.body_spec(g))) / pitch
             what = OPENING_WORDS[b.opening][:-1]
             for centre in hole_angles(b.holes, b.hole_phase, 360.0):
                 c = (centre % 360.0) / pitch
