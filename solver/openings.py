@@ -169,7 +169,9 @@ def local_outline(s: OpeningShape) -> list:
             else:
                 lo.append(Arc((p.centre[0], -p.centre[1]), p.radius, -p.a1, -p.a0))
         pieces = [Arc((0.0, 0.0), r_out, -g_out, g_out), *up, Arc((0.0, 0.0), r_in, g_in, -g_in), *lo]
-        return [p for p in pieces if not (isinstance(p, Arc) and p.a1 == p.a0)]
+        tiny = 1e-12 * rc      # corners of half the height meet: no straight side left between them
+        return [p for p in pieces if not (p.a1 == p.a0 if isinstance(p, Arc)
+                                          else math.hypot(p.p1[0] - p.p0[0], p.p1[1] - p.p0[1]) < tiny)]
     raise ValueError(f"unknown opening {s.kind!r}: one of {', '.join(OPENINGS)}")
 
 

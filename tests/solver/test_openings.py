@@ -118,6 +118,14 @@ def test_outline_is_closed_counter_clockwise_and_continuous():
             assert np.allclose(p.end, q.start, atol=1e-15)
         assert outline_moments(pieces)[0] > 0            # counter-clockwise: positive area
     assert any(isinstance(p, Line) for p in local_outline(window()))
+    # corners of half the height meet: no zero-length side is left (the mesher would make a
+    # degenerate element on it), and the ends are half circles of the window's height
+    full = local_outline(window(n=3, rho=6.0))
+    assert not any(isinstance(p, Line) for p in full)
+    for p, q in zip(full, full[1:] + full[:1]):
+        assert np.allclose(p.end, q.start, atol=1e-15)
+    x, y = polygon(full, 0.5e-6)
+    assert opening_area_moment(window(n=3, rho=6.0))[0] / 3 == pytest.approx(polygon_properties(x, y)[0], rel=2e-8)
 
 
 def test_a_window_of_no_size_is_the_solid_web():
