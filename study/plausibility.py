@@ -215,9 +215,12 @@ def scene_warnings(scene) -> list[str]:
     out = []
     for g in (1, 2):
         b, h = scene.gear(g).body, mesh_size_mm(scene, g)
-        if b.holes and b.hole_radius < h:
-            out.append(f"gear{g}.body.hole_radius: {b.hole_radius:.4g} mm is smaller than the FE mesh size "
-                       f"({h:.4g} mm): the hole is no lightening the model can see (millimetres meant?)")
+        field = {"round": "hole_radius", "slot": "slot_width", "window": "window_height"}[b.opening]
+        size = getattr(b, field)          # a round hole's radius; a slot's width, a window's height
+        if b.holes and size < h:
+            out.append(f"gear{g}.body.{field}: {size:.4g} mm is smaller than the FE mesh size "
+                       f"({h:.4g} mm): the {'hole' if b.opening == 'round' else b.opening} is no lightening the model "
+                       "can see (millimetres meant?)")
     out += unread_spring_warnings(scene)
     d = scene.dynamic
     if d.enabled:

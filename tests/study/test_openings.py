@@ -149,3 +149,10 @@ def test_window_corner_stiffness_converges_with_the_mesh():
     ratios = [fe_ratio(gear_setup(scene.replace(**{"fe.mesh_size": h}), 2))[1] for h in (0.75, 0.375)]
     assert np.ptp(ratios[1]) > 0.005                                      # the windows soften some teeth
     np.testing.assert_allclose(ratios[0], ratios[1], rtol=0.01)
+
+
+def test_a_slot_narrower_than_the_mesh_is_warned_about_by_its_width():
+    scene = load_scene(None, ["gear2.body.opening='slot'", "gear2.body.slot_width=0.3"])
+    (line,) = study.plausibility_warnings(scene)
+    assert line.startswith("gear2.body.slot_width: 0.3 mm is smaller than the FE mesh size")
+    assert study.plausibility_warnings(load_scene(None, ["gear2.body.opening='slot'"])) == []
