@@ -7,7 +7,7 @@ within a limit (relative to the solid gear's, and optionally in MPa):
 
     python -m workflows.lightest_gear [SCENE.toml] [--ste-factor 2.0] [--dte-factor 4.0]
         [--stress-ratio 1.15] [--stress-max MPA] [--speed 100] [--grid gear2.body.holes=3,6,9 ...]
-        [--refine 2] [-o results/lightest_gear] [--workers N]
+        [--shapes round,slot,window] [--refine 2] [-o results/lightest_gear] [--workers N]
 
 1. the solid gear, at the same speed: the reference of the factors;
 2. a coarse grid over the four body fields (full factorial, `study.make_study` + `study.run_sweep`
@@ -17,6 +17,9 @@ within a limit (relative to the solid gear's, and optionally in MPa):
    (larger holes, thinner rim and web; never beyond the grid's range), every combination, the
    hole count kept: the lightest feasible body of the grid has an infeasible (or no) lighter
    neighbour, so the limit lies within that half step. Archived as ``refine.nc`` (point layout);
+   With ``--shapes`` each opening shape runs its own coarse grid (``coarse_slot.nc``,
+   ``coarse_window.nc``), sized by its own field in place of the hole radius (a slot's width,
+   wider is lighter; a window's spokes, narrower is lighter), and all compete for the answer;
 4. ``tradeoff.png``: mass saved against STE p2p and DTE RMS over every body run, coloured by root
    stress, the Pareto set, the TE limits and the chosen body; ``lightest.txt``: the answer, also
    printed.
