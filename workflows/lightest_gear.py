@@ -16,7 +16,7 @@ within a limit (relative to the solid gear's, and optionally in MPa):
    continuous fields (hole radius, rim, web) are moved half a grid step towards the lighter side
    (larger holes, thinner rim and web; never beyond the grid's range), every combination, the
    hole count kept: the lightest feasible body of the grid has an infeasible (or no) lighter
-   neighbour, so the limit lies within that half step. Archived as ``refine.nc`` (point layout);
+   neighbour, so the limit lies within that half step. Archived as ``refine.nc`` (point layout).
    With ``--shapes`` each opening shape runs its own coarse grid (``coarse_slot.nc``,
    ``coarse_window.nc``), sized by its own field in place of the hole radius (a slot's width,
    wider is lighter; a window's spokes, narrower is lighter), and all compete for the answer;
