@@ -13,11 +13,11 @@ from study.errors import SceneError
 # Elements of the outline size across the rim: fewer and the FE body has no element layer
 # between the tooth roots and the web or the holes (the spring map reads points outside the mesh).
 RIM_ELEMENTS = 2
-# Elements across a ligament of the web (between two openings, an opening and the rim or the
-# hub), of the size the body mesh puts on the opening's edge: fewer and the ligament has no
-# element across it (the FE raises them to quadratic: one carries a linear strain across, so
-# the ligament bends); the round holes of the standard studies keep at least this one.
-LIGAMENT_ELEMENTS = 1
+# Longest an element across a web ligament (between two openings, an opening and the rim or
+# the hub) may be against its width: the mesh puts the size of the opening's edge along the
+# ligament and one element across it, and beyond this aspect ratio the (quadratic) elements
+# spoil the ligament's bending stiffness. A thinner ligament takes a finer mesh.
+LIGAMENT_ASPECT = 4.0
 # Samples of the stored DTE after the ramp that a spectrum and the summary need.
 STEADY_SAMPLES = 16
 # Largest plausible elastic approach of the teeth along the line of action, as a fraction of
@@ -34,7 +34,7 @@ def mesh_size_mm(scene, g: int) -> float:
 
 def check_fe_mesh(scene) -> None:
     """fe.mesh_size at most the smaller module; a rim at least RIM_ELEMENTS elements thick; the
-    web's ligaments at least LIGAMENT_ELEMENTS (`check_ligaments`)."""
+    web's ligaments at least 1/LIGAMENT_ASPECT of an element (`check_ligaments`)."""
     h = scene.fe.mesh_size
     m_min = min(scene.gear1.module, scene.gear2.module)
     if h > m_min:
@@ -52,7 +52,7 @@ def check_fe_mesh(scene) -> None:
 
 def check_ligaments(scene, g: int) -> None:
     """Gear g's web ligaments (between neighbouring openings, from the openings to the rim and to
-    the hub) at least LIGAMENT_ELEMENTS elements of the size the body mesh uses on the opening's
+    the hub) at least 1/LIGAMENT_ASPECT of the element size the body mesh uses on the opening's
     edge (`solver.fe.mesh.opening_edge_sizes`); SceneError naming
     the field that sets the ligament. Checked on a body that fits its gear
     (`solver.geometry.validate_body` first)."""
@@ -74,13 +74,13 @@ def check_ligaments(scene, g: int) -> None:
     for field, where, width in ((gap_field, "between neighbouring openings", between_openings(shape)),
                                 (size_field, "between the openings and the rim", r_rim - r_out),
                                 (size_field, "between the openings and the hub", r_in - r_hub)):
-        if width < LIGAMENT_ELEMENTS * edge:
+        if width < edge / LIGAMENT_ASPECT:
             raise SceneError(f"gear{g}.body.{field}",
-                             f"the web {where} is {width / units.MM:.4g} mm wide, thinner than the FE mesh can hold: it "
-                             f"needs {LIGAMENT_ELEMENTS} element{'s' if LIGAMENT_ELEMENTS > 1 else ''} of the size the body mesh uses on the opening's edge "
-                             f"({edge / units.MM:.4g} mm, from {'fe.mesh_size' if scene.fe.mesh_size else 'module/4'} = "
-                             f"{h / units.MM:.4g} mm and the opening's size), i.e. >= {LIGAMENT_ELEMENTS * edge / units.MM:.4g} mm "
-                             "(a finer fe.mesh_size allows a thinner ligament)")
+                             f"the web {where} is {width / units.MM:.4g} mm wide, thinner than the FE mesh can hold: "
+                             f"the body mesh puts elements of {edge / units.MM:.4g} mm along the opening's edge (from "
+                             f"{'fe.mesh_size' if scene.fe.mesh_size else 'module/4'} = {h / units.MM:.4g} mm and the "
+                             f"opening's size), at most {LIGAMENT_ASPECT:g} times the ligament's width, so it needs "
+                             f">= {edge / LIGAMENT_ASPECT / units.MM:.4g} mm (a finer fe.mesh_size allows a thinner ligament)")
 
 
 RUNUP_REVOLUTIONS = 2.0       # driven revolutions a run-up must give its order tracking

@@ -55,13 +55,13 @@ def test_the_paper_gear_takes_five_windows_from_the_defaults():
     ({"gear2.body.opening": "window", "gear2.body.spoke_width": 45.0}, "gear2.body.spoke_width", "no window"),
     ({"gear2.body.opening": "window", "gear2.body.holes": 1}, "gear2.body.holes", "at least 2"),
     ({"gear2.body.opening": "oval"}, "gear2.body.opening", "one of"),
-    # ligaments thinner than one element of the opening's edge size (1.571 mm for 12 mm openings)
-    ({"gear2.body.hole_circle_radius": 35.5}, "gear2.body.hole_radius", "thinner than the FE mesh"),
-    ({"gear2.body.holes": 12, "gear2.body.hole_radius": 7.6}, "gear2.body.holes", "thinner than the FE mesh"),
-    ({"gear2.body.opening": "slot", "gear2.body.slot_width": 8.0, "gear2.body.slot_angle": 45.0},
+    # ligaments thinner than a quarter of the opening's edge size (1.571 mm for 12 mm openings)
+    ({"gear2.body.hole_circle_radius": 36.0}, "gear2.body.hole_radius", "thinner than the FE mesh"),
+    ({"gear2.body.holes": 12, "gear2.body.hole_radius": 8.2}, "gear2.body.holes", "thinner than the FE mesh"),
+    ({"gear2.body.opening": "slot", "gear2.body.slot_width": 8.0, "gear2.body.slot_angle": 45.7},
      "gear2.body.slot_angle", "thinner than the FE mesh"),
-    ({"gear2.body.opening": "window", "gear2.body.spoke_width": 1.2}, "gear2.body.spoke_width", "1.571 mm"),
-    ({"gear2.body.opening": "window", "gear2.body.window_height": 17.0, "gear2.body.hole_circle_radius": 32.5},
+    ({"gear2.body.opening": "window", "gear2.body.spoke_width": 0.3}, "gear2.body.spoke_width", ">= 0.3927 mm"),
+    ({"gear2.body.opening": "window", "gear2.body.window_height": 19.0, "gear2.body.hole_circle_radius": 32.5},
      "gear2.body.window_height", "and the rim"),
 ])
 def test_invalid_shapes_are_refused_naming_the_field(overrides, field, words):
@@ -71,10 +71,10 @@ def test_invalid_shapes_are_refused_naming_the_field(overrides, field, words):
 
 
 def test_a_finer_mesh_holds_a_thinner_ligament():
-    thin = ["gear2.body.opening='window'", "gear2.body.spoke_width=1.2"]
+    thin = ["gear2.body.opening='window'", "gear2.body.spoke_width=0.3"]
     with pytest.raises(SceneError):
         load_scene(None, thin)
-    assert load_scene(None, [*thin, "fe.mesh_size=0.2"]).gear2.body.spoke_width == 1.2
+    assert load_scene(None, [*thin, "fe.mesh_size=0.05"]).gear2.body.spoke_width == 0.3
 
 
 def test_equal_mass_sizes_each_shape_to_the_reference_mass():
