@@ -19,9 +19,11 @@ Conventions
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
+
+from solver.openings import angular_half_width, between_openings, radial_extent, shape_of, window_corners
 
 
 class GeometryError(ValueError):
@@ -68,8 +70,12 @@ class BodySpec:
     From the root circle inwards: rim of radial height ``rim_height`` (l1) at the full face
     width, web of radial height ``web_height`` (l2) and axial thickness ``web_thickness`` (t1),
     hub of radial height ``hub_height`` (l3) at the full face width, then the bore.
-    ``holes`` circular holes of radius ``hole_radius`` on the circle ``hole_circle_radius``
-    pierce the web, the first at polar angle ``hole_phase`` from tooth 0's axis.
+    ``holes`` openings centred on the circle ``hole_circle_radius`` pierce the web, the first at
+    polar angle ``hole_phase`` from tooth 0's axis. Their shape is ``opening``
+    (`solver.openings`): 'round' holes of radius ``hole_radius``; 'slot', arc slots of radial width
+    ``slot_width`` over ``slot_angle`` [rad] (between the centres of their round ends); 'window',
+    the web between spokes of width ``spoke_width`` over a radial height ``window_height``, the
+    corners rounded with ``corner_radius``. The fields of the other shapes are not read.
     A solid gear has ``web_thickness`` = face width (or ``web_height`` = 0) and no holes.
     """
 
@@ -81,6 +87,33 @@ class BodySpec:
     hole_radius: float = 0.0
     hole_circle_radius: float = 0.0
     hole_phase: float = 0.0
+    opening: str = "round"
+    slot_width: float = 0.0
+    slot_angle: float = 0.0
+    spoke_width: float = 0.0
+    corner_radius: float = 0.0
+    window_height: float = 0.0
+
+
+# The fields each opening shape reads besides holes, hole_circle_radius and hole_phase.
+SHAPE_FIELDS = {"round": ("hole_radius",), "slot": ("slot_width", "slot_angle"),
+                "window": ("spoke_width", "corner_radius", "window_height")}
+
+
+def body_settings(body: BodySpec) -> dict:
+    """The body as a dict of the fields that shape it, for cache keys: a round-holed body (or one
+    without holes) exactly as before the other shapes existed; a slot or a window with its own
+    fields and without the round hole's radius."""
+    out = asdict(body)
+    for name in ("opening", *SHAPE_FIELDS["slot"], *SHAPE_FIELDS["window"]):
+        del out[name]
+    if body.holes == 0:
+        out.update(hole_radius=0.0, hole_circle_radius=0.0, hole_phase=0.0)
+    elif body.opening != "round":
+        del out["hole_radius"]
+        out["opening"] = body.opening
+        out.update({name: getattr(body, name) for name in SHAPE_FIELDS[body.opening]})
+    return out
 
 
 def hole_angles(holes: int, first: float, turn: float = 2.0 * math.pi) -> np.ndarray:
@@ -332,10 +365,21 @@ def validate_body(g: GearGeometry, body: BodySpec, prefix: str = "gear.body") ->
         raise GeometryError(f"{prefix}.holes", f"must be an integer >= 0, got {body.holes}")
     if body.holes == 0:
         return
-    if not (body.hole_radius > 0):
-        raise GeometryError(f"{prefix}.hole_radius", f"must be positive when holes > 0, got {body.hole_radius * 1e3:.4g} mm")
+    if body.opening not in SHAPE_FIELDS:
+        raise GeometryError(f"{prefix}.opening", f"must be one of {', '.join(repr(k) for k in SHAPE_FIELDS)}, got {body.opening!r}")
     r_rim = rf - body.rim_height
     r_hub = r_rim - body.web_height
+    if body.opening == "round":
+        _validate_round(body, r_rim, r_hub, prefix)
+    elif body.opening == "slot":
+        _validate_slot(body, r_rim, r_hub, prefix)
+    else:
+        _validate_window(body, r_rim, r_hub, prefix)
+
+
+def _validate_round(body: BodySpec, r_rim: float, r_hub: float, prefix: str) -> None:
+    if not (body.hole_radius > 0):
+        raise GeometryError(f"{prefix}.hole_radius", f"must be positive when holes > 0, got {body.hole_radius * 1e3:.4g} mm")
     rc, rh = body.hole_circle_radius, body.hole_radius
     if rc + rh > r_rim + 1e-12:
         raise GeometryError(f"{prefix}.hole_radius", f"holes cut the rim: hole_circle_radius + hole_radius = {(rc + rh) * 1e3:.4g} mm > {r_rim * 1e3:.4g} mm (root radius - rim_height)")
@@ -345,6 +389,73 @@ def validate_body(g: GearGeometry, body: BodySpec, prefix: str = "gear.body") ->
         raise GeometryError(f"{prefix}.holes", f"{body.holes} holes of radius {rh * 1e3:.4g} mm on radius {rc * 1e3:.4g} mm cut each other")
 
 
+def _radial_fit(body: BodySpec, field: str, what: str, half: float, r_rim: float, r_hub: float, prefix: str) -> None:
+    """The opening's radial extent hole_circle_radius -/+ ``half`` [m] within the web."""
+    rc = body.hole_circle_radius
+    if rc + half > r_rim + 1e-12:
+        raise GeometryError(f"{prefix}.{field}", f"{what} cut the rim: they reach out to hole_circle_radius + {half * 1e3:.4g} mm = "
+                            f"{(rc + half) * 1e3:.4g} mm > {r_rim * 1e3:.4g} mm (root radius - rim_height)")
+    if rc - half < r_hub - 1e-12:
+        raise GeometryError(f"{prefix}.{field}", f"{what} cut the hub: they reach in to hole_circle_radius - {half * 1e3:.4g} mm = "
+                            f"{(rc - half) * 1e3:.4g} mm < {r_hub * 1e3:.4g} mm (rim and web end there)")
+
+
+def _validate_slot(body: BodySpec, r_rim: float, r_hub: float, prefix: str) -> None:
+    w, theta = body.slot_width, body.slot_angle
+    if not (w > 0) or not math.isfinite(w):
+        raise GeometryError(f"{prefix}.slot_width", f"must be positive for slots, got {w * 1e3:.4g} mm")
+    if not (0 <= theta < 2 * math.pi):
+        raise GeometryError(f"{prefix}.slot_angle", f"must lie in [0, 360) deg, got {math.degrees(theta):.4g} deg")
+    _radial_fit(body, "slot_width", "slots", 0.5 * w, r_rim, r_hub, prefix)
+    gap = between_openings(shape_of(body))
+    if gap <= 0:
+        what = "its two ends meet" if body.holes == 1 else "neighbouring slots cut each other"
+        raise GeometryError(f"{prefix}.slot_angle", f"{what}: {body.holes} slot(s) of {math.degrees(theta):.4g} deg and width "
+                            f"{w * 1e3:.4g} mm on radius {body.hole_circle_radius * 1e3:.4g} mm leave {gap * 1e3:.4g} mm "
+                            f"between them (at most {math.degrees(_slot_angle_max(body)):.4g} deg)")
+
+
+def _slot_angle_max(body: BodySpec) -> float:
+    """The largest slot_angle [rad] at which the slots' ends just touch."""
+    x = min(1.0, 0.5 * body.slot_width / body.hole_circle_radius)
+    return max(2 * math.pi / body.holes - 2 * math.asin(x), 0.0)
+
+
+def _validate_window(body: BodySpec, r_rim: float, r_hub: float, prefix: str) -> None:
+    if body.holes < 2:
+        raise GeometryError(f"{prefix}.holes", f"windows between spokes need at least 2 (spokes and windows alternate), got {body.holes}")
+    for name in ("spoke_width", "window_height"):
+        v = getattr(body, name)
+        if not (v > 0) or not math.isfinite(v):
+            raise GeometryError(f"{prefix}.{name}", f"must be positive for windows, got {v * 1e3:.4g} mm")
+    rho, height, ws = body.corner_radius, body.window_height, body.spoke_width
+    if not (rho >= 0) or not math.isfinite(rho):
+        raise GeometryError(f"{prefix}.corner_radius", f"must be >= 0, got {rho * 1e3:.4g} mm")
+    _radial_fit(body, "window_height", "windows", 0.5 * height, r_rim, r_hub, prefix)
+    r_in = body.hole_circle_radius - 0.5 * height
+    sharp = window_corners(shape_of(replace(body, corner_radius=0.0)))
+    if not sharp[3] > 0:
+        raise GeometryError(f"{prefix}.spoke_width", f"{body.holes} spokes of {ws * 1e3:.4g} mm meet outside the windows' inner "
+                            f"radius {r_in * 1e3:.4g} mm (hole_circle_radius - window_height/2): no window is left between them")
+    if rho > 0.5 * height * (1 + 1e-12):
+        raise GeometryError(f"{prefix}.corner_radius", f"{rho * 1e3:.4g} mm is more than half the window height "
+                            f"({0.5 * height * 1e3:.4g} mm): the corners of one side overlap")
+    if not window_corners(shape_of(body))[3] >= 0:
+        raise GeometryError(f"{prefix}.corner_radius", f"{rho * 1e3:.4g} mm is too large for the window: the fillets of its two "
+                            f"inner corners overlap on the inner arc (radius {r_in * 1e3:.4g} mm between spokes of {ws * 1e3:.4g} mm)")
+
+
+def opening_half_angle(body: BodySpec) -> float:
+    """Half the polar angle [rad] one opening of the body covers seen from the gear centre
+    (`solver.openings.angular_half_width`; round holes: asin(hole_radius / hole_circle_radius))."""
+    return angular_half_width(shape_of(body))
+
+
+def opening_radii(body: BodySpec) -> tuple[float, float]:
+    """(innermost, outermost) radius [m] the body's openings reach (`solver.openings.radial_extent`)."""
+    return radial_extent(shape_of(body))
+
+
 def bore_radius(g: GearGeometry, body: BodySpec) -> float:
     return g.root_radius - body.rim_height - body.web_height - body.hub_height
 
@@ -352,7 +463,8 @@ def bore_radius(g: GearGeometry, body: BodySpec) -> float:
 def solid_body(body: BodySpec, face_width: float) -> BodySpec:
     """The same body made solid: the web as thick as the face [m], no holes (hole sizes zeroed,
     so every solid variant of a body is the same BodySpec)."""
-    return replace(body, web_thickness=face_width, holes=0, hole_radius=0.0, hole_circle_radius=0.0, hole_phase=0.0)
+    return replace(body, web_thickness=face_width, holes=0, hole_radius=0.0, hole_circle_radius=0.0, hole_phase=0.0,
+                   opening="round", slot_width=0.0, slot_angle=0.0, spoke_width=0.0, corner_radius=0.0, window_height=0.0)
 
 
 def gear_outline(g: GearGeometry, **kw):

@@ -1,14 +1,16 @@
 """Mass properties of a gear: the rigid tooth (from its outline polygon) and the body below the
-root circle (rings at their thickness, less the holes). SI: kg, m, kg·m².
+root circle (rings at their thickness, less the openings: round holes, slots or windows, from
+their exact outline). SI: kg, m, kg·m².
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from solver.geometry import BodySpec, GearGeometry
+from solver.openings import opening_area_moment, shape_of
 
 
 @dataclass(frozen=True)
@@ -48,8 +50,12 @@ def tooth_inertia(g: GearGeometry, density: float, pivot_radius: float) -> Tooth
 
 
 def hole_inertia(body: BodySpec, density: float) -> tuple[float, float]:
-    """Mass [kg] and polar inertia about the gear axis [kg·m²] of the web material the holes
-    take out (each hole a disc of the web thickness, moved to the hole circle); zero without holes."""
+    """Mass [kg] and polar inertia about the gear axis [kg·m²] of the web material the openings
+    take out, at the web thickness; zero without holes. Round holes: each a disc moved to the
+    hole circle; slots and windows: their exact outline integrated (`solver.openings`)."""
+    if body.opening != "round" and body.holes:
+        area, j0 = opening_area_moment(shape_of(body))
+        return density * body.web_thickness * area, density * body.web_thickness * j0
     mh = density * math.pi * body.hole_radius**2 * body.web_thickness
     return body.holes * mh, body.holes * mh * (0.5 * body.hole_radius**2 + body.hole_circle_radius**2)
 
@@ -107,3 +113,48 @@ def gear_mass(g: GearGeometry, body: BodySpec, density: float) -> GearMass:
     m, i = gear_inertia(g, body, density)
     ms, is_ = gear_inertia(g, solid_body(body, g.spec.face_width), density)
     return GearMass(m, i, ms, is_)
+
+
+# The field that sizes each opening shape for a mass: what a drawing scales to take out more or less.
+SIZE_FIELDS = {"round": "hole_radius", "slot": "slot_width", "window": "spoke_width"}
+
+
+def removed_mass(body: BodySpec, density: float) -> float:
+    """Mass [kg] the openings take out of the web (at the web thickness); zero without holes."""
+    return hole_inertia(body, density)[0]
+
+
+def size_for_removed_mass(g: GearGeometry, body: BodySpec, density: float, mass: float,
+                          prefix: str = "gear.body") -> BodySpec:
+    """The body with its openings sized to take ``mass`` [kg] out of the web: the hole radius of
+    round holes, the width of slots, the spoke width of windows (`SIZE_FIELDS`; every other field
+    kept). The size is found within the range where the body is valid (`validate_body`);
+    GeometryError naming the field when no valid size removes that mass."""
+    from scipy.optimize import brentq
+
+    from solver.geometry import GeometryError, validate_body
+    if body.holes == 0:
+        raise GeometryError(f"{prefix}.holes", "a body without openings cannot be sized for a mass")
+    field = SIZE_FIELDS[body.opening]
+
+    def sized(x):
+        return replace(body, **{field: x})
+
+    def valid(x):
+        try:
+            validate_body(g, sized(x), prefix)
+            return True
+        except GeometryError:
+            return False
+    small = 1e-9 * g.root_radius
+    validate_body(g, sized(small), prefix)              # the place of the openings must fit at all
+    lo, hi = small, g.root_radius                        # valid, invalid: bisection to the largest valid size
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if valid(mid) else (lo, mid)
+    ends = sorted([removed_mass(sized(small), density), removed_mass(sized(lo), density)])
+    if not ends[0] <= mass <= ends[1]:
+        raise GeometryError(f"{prefix}.{field}", f"no valid {field} makes {body.holes} {body.opening} openings take out "
+                            f"{mass:.5g} kg: between {ends[0]:.5g} and {ends[1]:.5g} kg (the other fields as given)")
+    x = brentq(lambda v: removed_mass(sized(v), density) - mass, small, lo, xtol=1e-12 * g.root_radius, rtol=1e-13)
+    return sized(x)

@@ -135,6 +135,56 @@ def solid_scene(scene, gears=(1, 2)):
     return scene.solid(gears=tuple(gears))
 
 
+def equal_mass(scene, reference, g: int = 2):
+    """``scene`` with gear g's openings sized (``hole_radius``, ``slot_width`` or ``spoke_width``)
+    so that the gear weighs what gear g of ``reference`` weighs (a Scene, or a mass in kg) ->
+    Scene; SceneError naming the size field when no valid size reaches it."""
+    from study.mass_match import equal_mass as sized
+    _check_scene("equal_mass", scene)
+    return sized(scene, reference, g)
+
+
+def describe_openings(scene, g: int = 2) -> str:
+    """Gear g's openings in words [mm, deg] ('6 slots 5.35 mm wide over 30 deg on R 32.36 mm') -> str."""
+    from study.scene import opening_text
+    _check_scene("describe_openings", scene)
+    return opening_text(scene.gear(g).body)
+
+
+def opening_outline(scene, g: int = 2, angle: float | None = None):
+    """The exact outline of gear g's first opening sampled every 10 um -> (x, y) [mm] in the gear
+    frame, turned to polar angle ``angle`` [deg] (default: where the scene puts it, hole_phase);
+    (empty, empty) without holes."""
+    import math
+
+    import numpy as np
+
+    from solver import units
+    from solver.openings import local_outline, place, polygon, shape_of
+    _check_scene("opening_outline", scene)
+    body = scene.body_spec(g)
+    if not body.holes:
+        return np.empty(0), np.empty(0)
+    turn = body.hole_phase if angle is None else math.radians(angle)
+    x, y = polygon(place(local_outline(shape_of(body)), turn), 10 * units.UM)
+    return x / units.MM, y / units.MM
+
+
+def opening_order_amplitude(scene, angle, te) -> float:
+    """Amplitude of ``te`` (any unit, over the driver angles ``angle`` [deg]) at the order N of
+    the driven gear's openings, fitted with the first three mesh harmonics and their sidebands
+    (`study.verify.model_validation.order_amplitude`); NaN without openings."""
+    import numpy as np
+
+    from study.verify.model_validation import order_amplitude
+    _check_scene("opening_order_amplitude", scene)
+    n = scene.gear2.body.holes
+    if not n:
+        return float("nan")
+    driven = np.radians(np.asarray(angle, float)) * scene.gear1.teeth / scene.gear2.teeth
+    return order_amplitude(driven, np.asarray(te, float), n, scene.gear2.teeth)
+
+
 def check_dynamic_window(scene) -> None:
     """SceneError when the scene's dynamic run leaves no steady part after its ramps for the DTE
     summary and spectrum (`lightgear run` checks it; integrator studies end with the ramps on purpose)."""
@@ -431,6 +481,17 @@ def validate_design_space(scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), rims=
     return design_space_dataset(scene, holes=holes, webs=webs, rims=rims, rotation=rotation, step=step, log=log)
 
 
+def validate_bodies(scenes: dict, step: float = 0.1, models=("fe-reference", "compliance"), log=None):
+    """STE of ``models`` and the FE reference for named scenes ({name: Scene}, bodies of any
+    opening shape), each over two periods of its driven gear's openings at ``step`` [deg] ->
+    Dataset over (body, model): mean, elastic mean and p2p [um], opening-order amplitude [um]
+    (`study.verify.model_validation.bodies_dataset`); errors with `validation_errors`."""
+    from study.verify.model_validation import bodies_dataset
+    for sc in scenes.values():
+        _check_scene("validate_bodies", sc)
+    return bodies_dataset(dict(scenes), step=step, models=tuple(models), log=log)
+
+
 def validate_relief(scene, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=(25.0, 50.0, 100.0), step: float = 0.1,
                     log=None):
     """STE peak-to-peak of every model and the FE reference for the scene's pair with its driven
@@ -524,4 +585,5 @@ __all__ = ["Scene", "SceneError", "StudyError", "BudgetError", "Study", "Outputs
            "render", "stiffness", "identify_spring", "fit_contact", "reference", "precision", "precision_table",
            "stability_suite", "validation", "validate_design_space", "validate_relief", "validation_errors",
            "validation_misses", "sample_outputs", "sample_tables", "sample_points", "sample_point_label",
-           "study_from_dict", "export", "script_main"]
+           "study_from_dict", "export", "script_main", "equal_mass", "describe_openings", "opening_outline",
+           "opening_order_amplitude", "validate_bodies"]

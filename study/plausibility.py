@@ -13,6 +13,11 @@ from study.errors import SceneError
 # Elements of the outline size across the rim: fewer and the FE body has no element layer
 # between the tooth roots and the web or the holes (the spring map reads points outside the mesh).
 RIM_ELEMENTS = 2
+# Longest an element across a web ligament (between two openings, an opening and the rim or
+# the hub) may be against its width: the mesh puts the size of the opening's edge along the
+# ligament and one element across it, and beyond this aspect ratio the (quadratic) elements
+# spoil the ligament's bending stiffness. A thinner ligament takes a finer mesh.
+LIGAMENT_ASPECT = 4.0
 # Samples of the stored DTE after the ramp that a spectrum and the summary need.
 STEADY_SAMPLES = 16
 # Largest plausible elastic approach of the teeth along the line of action, as a fraction of
@@ -28,7 +33,8 @@ def mesh_size_mm(scene, g: int) -> float:
 
 
 def check_fe_mesh(scene) -> None:
-    """fe.mesh_size at most the smaller module; a rim at least RIM_ELEMENTS elements thick."""
+    """fe.mesh_size at most the smaller module; a rim at least RIM_ELEMENTS elements thick; the
+    web's ligaments at least 1/LIGAMENT_ASPECT of an element (`check_ligaments`)."""
     h = scene.fe.mesh_size
     m_min = min(scene.gear1.module, scene.gear2.module)
     if h > m_min:
@@ -41,6 +47,40 @@ def check_fe_mesh(scene) -> None:
                              f"outline size ({'fe.mesh_size' if scene.fe.mesh_size else 'module/4'} = {hg:.4g} mm), "
                              f"i.e. >= {RIM_ELEMENTS * hg:.4g} mm, got {b.rim_height:.4g} mm "
                              "(a finer fe.mesh_size allows a thinner rim)")
+        check_ligaments(scene, g)
+
+
+def check_ligaments(scene, g: int) -> None:
+    """Gear g's web ligaments (between neighbouring openings, from the openings to the rim and to
+    the hub) at least 1/LIGAMENT_ASPECT of the element size the body mesh uses on the opening's
+    edge (`solver.fe.mesh.opening_edge_sizes`); SceneError naming
+    the field that sets the ligament. Checked on a body that fits its gear
+    (`solver.geometry.validate_body` first)."""
+    from solver.fe.mesh import opening_edge_sizes
+    from solver.openings import between_openings, radial_extent, shape_of
+    gs = scene.gear(g)
+    b = gs.body
+    if b.holes == 0 or b.web_height == 0:
+        return
+    body, geo = scene.body_spec(g), scene.geometry(g)
+    h = mesh_size_mm(scene, g) * units.MM
+    edge, _corner = opening_edge_sizes(body, h)
+    r_rim = geo.root_radius - body.rim_height
+    r_hub = r_rim - body.web_height
+    shape = shape_of(body)
+    r_in, r_out = radial_extent(shape)
+    size_field = {"round": "hole_radius", "slot": "slot_width", "window": "window_height"}[b.opening]
+    gap_field = {"round": "holes", "slot": "slot_angle", "window": "spoke_width"}[b.opening]
+    for field, where, width in ((gap_field, "between neighbouring openings", between_openings(shape)),
+                                (size_field, "between the openings and the rim", r_rim - r_out),
+                                (size_field, "between the openings and the hub", r_in - r_hub)):
+        if width < edge / LIGAMENT_ASPECT:
+            raise SceneError(f"gear{g}.body.{field}",
+                             f"the web {where} is {width / units.MM:.4g} mm wide, thinner than the FE mesh can hold: "
+                             f"the body mesh puts elements of {edge / units.MM:.4g} mm along the opening's edge (from "
+                             f"{'fe.mesh_size' if scene.fe.mesh_size else 'module/4'} = {h / units.MM:.4g} mm and the "
+                             f"opening's size), at most {LIGAMENT_ASPECT:g} times the ligament's width, so it needs "
+                             f">= {edge / LIGAMENT_ASPECT / units.MM:.4g} mm (a finer fe.mesh_size allows a thinner ligament)")
 
 
 RUNUP_REVOLUTIONS = 2.0       # driven revolutions a run-up must give its order tracking
@@ -175,9 +215,12 @@ def scene_warnings(scene) -> list[str]:
     out = []
     for g in (1, 2):
         b, h = scene.gear(g).body, mesh_size_mm(scene, g)
-        if b.holes and b.hole_radius < h:
-            out.append(f"gear{g}.body.hole_radius: {b.hole_radius:.4g} mm is smaller than the FE mesh size "
-                       f"({h:.4g} mm): the hole is no lightening the model can see (millimetres meant?)")
+        field = {"round": "hole_radius", "slot": "slot_width", "window": "window_height"}[b.opening]
+        size = getattr(b, field)          # a round hole's radius; a slot's width, a window's height
+        if b.holes and size < h:
+            out.append(f"gear{g}.body.{field}: {size:.4g} mm is smaller than the FE mesh size "
+                       f"({h:.4g} mm): the {'hole' if b.opening == 'round' else b.opening} is no lightening the model "
+                       "can see (millimetres meant?)")
     out += unread_spring_warnings(scene)
     d = scene.dynamic
     if d.enabled:

@@ -255,6 +255,7 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
         "contact_ratio": model.pair.contact_ratio,
         "mesh_order": float(z2),
         "hole_order": float(scene.gear2.body.holes),
+        **run_variables.opening_attrs(scene),
         "driven_speed_rad_s": driven_speed,
         "ramp_time_s": d.ramp_time,
         "wall_time_springs_s": t_springs,

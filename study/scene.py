@@ -66,6 +66,34 @@ class BodySection:
     hole_radius: float = _f(6.0, "mm", "R_h: hole radius", 0.0)
     hole_circle_radius: float = _f(32.36, "mm", "R_ch: radius of the circle through the hole centres", 0.0)
     hole_phase: float = _f(0.0, "deg", "polar angle of the first hole centre from tooth 0's axis", -360.0, 360.0)
+    opening: str = _f("round", "", "shape of the openings: 'round' holes of hole_radius, 'slot' arc (kidney) slots "
+                      "of slot_width over slot_angle, 'window' windows between spokes of spoke_width over window_height "
+                      "with corner_radius; holes counts them, hole_circle_radius and hole_phase place their centres",
+                      choices=("round", "slot", "window"))
+    slot_width: float = _f(8.0, "mm", "radial width of an arc slot (its two ends are half circles of this diameter)",
+                           0, lo_open=True)
+    slot_angle: float = _f(30.0, "deg", "angular span of an arc slot between the centres of its two end arcs "
+                           "(0: a round hole of diameter slot_width)", 0.0, 360.0, hi_open=True)
+    spoke_width: float = _f(8.0, "mm", "width of the straight spokes between the windows", 0, lo_open=True)
+    window_height: float = _f(12.0, "mm", "radial height of a window: outer minus inner radius, centred on "
+                              "hole_circle_radius", 0, lo_open=True)
+    corner_radius: float = _f(2.0, "mm", "fillet radius of a window's four corners (0: sharp)", 0.0)
+
+
+OPENING_WORDS = {"round": "holes", "slot": "slots", "window": "windows"}
+
+
+def opening_text(b: BodySection) -> str:
+    """A body section's openings in words [mm, deg]: '6 holes of R_h 6 mm', '6 slots 8 mm wide
+    over 30 deg', '5 windows 12 mm high between spokes of 8 mm, corners R 2 mm'; 'no holes'."""
+    if not b.holes:
+        return "no holes"
+    if b.opening == "slot":
+        return f"{b.holes} slots {b.slot_width:g} mm wide over {b.slot_angle:g} deg on R {b.hole_circle_radius:g} mm"
+    if b.opening == "window":
+        return (f"{b.holes} windows {b.window_height:g} mm high between spokes of {b.spoke_width:g} mm, "
+                f"corners R {b.corner_radius:g} mm")
+    return f"{b.holes} holes of R_h {b.hole_radius:g} mm"
 
 
 @dataclass(frozen=True)
@@ -225,7 +253,10 @@ class Scene:
                         hub_height=b.hub_height * units.MM, web_thickness=b.web_thickness * units.MM,
                         holes=b.holes, hole_radius=b.hole_radius * units.MM,
                         hole_circle_radius=b.hole_circle_radius * units.MM,
-                        hole_phase=b.hole_phase * units.DEG)
+                        hole_phase=b.hole_phase * units.DEG, opening=b.opening,
+                        slot_width=b.slot_width * units.MM, slot_angle=b.slot_angle * units.DEG,
+                        spoke_width=b.spoke_width * units.MM, corner_radius=b.corner_radius * units.MM,
+                        window_height=b.window_height * units.MM)
 
     def material_spec(self) -> Material:
         m = self.material

@@ -7,7 +7,7 @@ within a limit (relative to the solid gear's, and optionally in MPa):
 
     python -m workflows.lightest_gear [SCENE.toml] [--ste-factor 2.0] [--dte-factor 4.0]
         [--stress-ratio 1.15] [--stress-max MPA] [--speed 100] [--grid gear2.body.holes=3,6,9 ...]
-        [--refine 2] [-o results/lightest_gear] [--workers N]
+        [--shapes round,slot,window] [--refine 2] [-o results/lightest_gear] [--workers N]
 
 1. the solid gear, at the same speed: the reference of the factors;
 2. a coarse grid over the four body fields (full factorial, `study.make_study` + `study.run_sweep`
@@ -16,7 +16,10 @@ within a limit (relative to the solid gear's, and optionally in MPa):
    continuous fields (hole radius, rim, web) are moved half a grid step towards the lighter side
    (larger holes, thinner rim and web; never beyond the grid's range), every combination, the
    hole count kept: the lightest feasible body of the grid has an infeasible (or no) lighter
-   neighbour, so the limit lies within that half step. Archived as ``refine.nc`` (point layout);
+   neighbour, so the limit lies within that half step. Archived as ``refine.nc`` (point layout).
+   With ``--shapes`` each opening shape runs its own coarse grid (``coarse_slot.nc``,
+   ``coarse_window.nc``), sized by its own field in place of the hole radius (a slot's width,
+   wider is lighter; a window's spokes, narrower is lighter), and all compete for the answer;
 4. ``tradeoff.png``: mass saved against STE p2p and DTE RMS over every body run, coloured by root
    stress, the Pareto set, the TE limits and the chosen body; ``lightest.txt``: the answer, also
    printed.
@@ -60,7 +63,23 @@ FIELDS = {"gear2.body.holes": "n_holes", "gear2.body.hole_radius": "hole_radius"
           "gear2.body.rim_height": "rim_thickness", "gear2.body.web_thickness": "web_thickness"}
 COARSE = {"gear2.body.holes": [3, 6, 9], "gear2.body.hole_radius": [5.0, 7.0],
           "gear2.body.rim_height": [5.0, 7.0], "gear2.body.web_thickness": [6.0, 10.0]}
-LIGHTER = {"hole_radius": +1, "rim_thickness": -1, "web_thickness": -1}   # direction in which the body loses mass
+# the other opening shapes (--shapes): the field that sizes each (in place of the hole radius)
+# and its coarse values [mm]; the slot's span, the window's height and corners as the scene gives
+SHAPE_SIZE = {"round": "gear2.body.hole_radius", "slot": "gear2.body.slot_width", "window": "gear2.body.spoke_width"}
+SHAPE_COARSE = {"gear2.body.slot_width": [5.0, 7.0], "gear2.body.spoke_width": [16.0, 10.0]}
+SIZE_NAMES = {"gear2.body.hole_radius": "hole_radius", "gear2.body.slot_width": "slot_width",
+              "gear2.body.spoke_width": "spoke_width"}
+OPENING = "gear2.body.opening"
+# direction in which the body loses mass
+LIGHTER = {"hole_radius": +1, "slot_width": +1, "spoke_width": -1, "rim_thickness": -1, "web_thickness": -1}
+
+
+def fields_of(opening: str) -> dict:
+    """{dotted field: table column} of a body with openings of shape ``opening``: the four of
+    `FIELDS`, the hole radius replaced by the shape's size field (`SHAPE_SIZE`)."""
+    size = SHAPE_SIZE[opening]
+    return {(size if path == "gear2.body.hole_radius" else path): (SIZE_NAMES[size] if path == "gear2.body.hole_radius"
+                                                                  else name) for path, name in FIELDS.items()}
 SCALARS = ["ste_p2p", "dte_rms", "mass_gear2", "mass_saving_gear2", "inertia_gear2",
            "root_stress_max_gear2", "root_stress_ratio_gear2"]
 
@@ -76,19 +95,25 @@ class Limits:
 # ---------------------------------------------------------------- selection (any candidate table)
 
 def candidates(ds: xr.Dataset, base: dict | None = None) -> xr.Dataset:
-    """A study archive (grid or point layout) as a table over ``candidate``: the four body fields
-    (variables n_holes ... web_thickness; from ``base``, {dotted field: value}, where the study
-    does not sweep them), status and the scalars (each broadcast over the study's points)."""
+    """A study archive (grid or point layout) as a table over ``candidate``: the body fields
+    (variables n_holes, hole_radius, slot_width, spoke_width, rim_thickness, web_thickness and
+    opening; from ``base``, {dotted field: value}, where the study does not sweep them; an
+    opening 'round' and NaN sizes where neither gives them), status and the scalars (each
+    broadcast over the study's points)."""
     keep = [v for v in ["status", *SCALARS] if v in ds]
     status = ds["status"]
     data = {}
     for v in keep:
         data[v] = ("candidate", ds[v].broadcast_like(status).transpose(*status.dims).values.ravel())
-    for path, name in FIELDS.items():
+    columns = {**FIELDS, **SIZE_NAMES, OPENING: "opening"}
+    for path, name in columns.items():
         if name in ds.coords:
             data[name] = ("candidate", ds[name].broadcast_like(status).transpose(*status.dims).values.ravel())
         else:
-            data[name] = ("candidate", np.full(status.size, (base or {})[path]))
+            default = "round" if name == "opening" else math.nan
+            data[name] = ("candidate", np.full(status.size, (base or {}).get(path, default),
+                                               dtype=object if name == "opening" else float))
+    data["opening"] = ("candidate", data["opening"][1].astype(str))
     return xr.Dataset(data)
 
 
@@ -110,8 +135,11 @@ def ranked(table: xr.Dataset, mask: xr.DataArray) -> list[int]:
 
 
 def body_of(table: xr.Dataset, i: int) -> dict:
-    """{dotted field: value} of candidate ``i``."""
-    return {path: table[name].values[i].item() for path, name in FIELDS.items()}
+    """{dotted field: value} of candidate ``i``: the fields of its shape (`fields_of`), and its
+    opening when not round."""
+    opening = str(table["opening"].values[i]) if "opening" in table else "round"
+    body = {path: table[name].values[i].item() for path, name in fields_of(opening).items()}
+    return body if opening == "round" else {**body, OPENING: opening}
 
 
 def refine_points(seeds: list[dict], grid: dict) -> list[dict]:
@@ -121,7 +149,9 @@ def refine_points(seeds: list[dict], grid: dict) -> list[dict]:
     out, seen = [], {tuple(sorted(s.items())) for s in seeds}
     for seed in seeds:
         levels = []
-        for path, name in FIELDS.items():
+        opening = seed.get(OPENING, "round")
+        fields = fields_of(opening)
+        for path, name in fields.items():
             x = seed[path]
             if name not in LIGHTER:
                 levels.append([x])
@@ -131,7 +161,9 @@ def refine_points(seeds: list[dict], grid: dict) -> list[dict]:
             nxt = min(side, key=lambda v: abs(v - x)) if side else None
             levels.append([x] if nxt is None else [x, float(round((x + nxt) / 2, 6))])
         for combo in itertools.product(*levels):
-            body = dict(zip(FIELDS, combo))
+            body = dict(zip(fields, combo))
+            if opening != "round":
+                body[OPENING] = opening
             key = tuple(sorted(body.items()))
             if key not in seen:
                 seen.add(key)
@@ -163,11 +195,21 @@ def solid_of(scene):
     return study.solid_scene(scene, gears=(2,)).replace(**{"coupling.model": lightened.coupling_model_name})
 
 
+def _openings(best: dict) -> str:
+    """The openings of a table row in words."""
+    n, opening = int(best["n_holes"]), str(best.get("opening", "round"))
+    if opening == "slot":
+        return f"{n} slots {best['slot_width']:g} mm wide"
+    if opening == "window":
+        return f"{n} windows between spokes of {best['spoke_width']:g} mm"
+    return f"{n} holes of {best['hole_radius']:g} mm radius"
+
+
 def answer(best: dict, solid: dict, speed: float) -> str:
     """The one-paragraph answer for the chosen candidate ``best`` (a row of the table as a dict)."""
     ste = 100 * (best["ste_p2p"] / solid["ste_p2p"] - 1)
     dte = 100 * (best["dte_rms"] / solid["dte_rms"] - 1)
-    return (f"{best['n_holes']:d} holes of {best['hole_radius']:g} mm radius, a {best['rim_thickness']:g} mm rim and a "
+    return (f"{_openings(best)}, a {best['rim_thickness']:g} mm rim and a "
             f"{best['web_thickness']:g} mm web save {best['mass_saving_gear2']:.1f} % mass "
             f"({best['mass_gear2']:.3f} kg against {solid['mass_gear2']:.3f} kg solid; inertia "
             f"{best['inertia_gear2']:.0f} against {solid['inertia_gear2']:.0f} kg mm2) for {ste:+.1f} % STE p2p "
@@ -181,12 +223,14 @@ def _row(table, i) -> dict:
 
 
 def parse_grid(items: list[str]) -> dict:
-    grid = {k: list(v) for k, v in COARSE.items()}
+    """The coarse grid: `COARSE` and the other shapes' size axes (`SHAPE_COARSE`), each axis
+    replaced by a ``field=v1,v2,...`` of ``items``."""
+    grid = {k: list(v) for k, v in {**COARSE, **SHAPE_COARSE}.items()}
     for item in items:
         field, _, values = item.partition("=")
         field = field.strip()
-        if field not in FIELDS:
-            raise SceneError(field or "--grid", f"the grid is over {', '.join(FIELDS)}; got {item!r}")
+        if field not in grid:
+            raise SceneError(field or "--grid", f"the grid is over {', '.join(grid)}; got {item!r}")
         if not values:
             raise SceneError(field, "a grid axis must look like field=v1,v2,...")
         grid[field] = [study.parse_overrides([f"x={v}"])["x"] for v in values.split(",")]
@@ -199,17 +243,25 @@ def run(args) -> int:
     limits = Limits(args.ste_factor, args.dte_factor, args.stress_ratio, args.stress_max)
     scene = base_scene(args.scene, args.set, args.speed, args.duration, args.angle_step)
     grid = parse_grid(args.grid)
+    shapes = parse_shapes(args.shapes)
     outputs = {"scalars": SCALARS}
-    coarse_study = study.make_study(scene, grid=grid, outputs=outputs, title="lightest driven gear: coarse grid")
+    coarse = {}          # shape -> (its coarse study, archive name)
+    for shape in shapes:
+        fields = fields_of(shape)
+        base = scene if shape == "round" else scene.replace(**{OPENING: shape})
+        coarse[shape] = (study.make_study(base, grid={p: grid[p] for p in fields}, outputs=outputs,
+                                          title=f"lightest driven gear: coarse grid{'' if shape == 'round' else ', ' + shape + 's'}"),
+                         "coarse.nc" if shape == "round" else f"coarse_{shape}.nc")
     solid_study = study.make_study(solid_of(scene), grid={"dynamic.speed": [args.speed]}, outputs=outputs,
                                    title="lightest driven gear: the solid reference")
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
-    n = int(np.prod(coarse_study.shape))
+    n = sum(int(np.prod(st.shape)) for st, _ in coarse.values())
     print(f"lightest driven gear at {args.speed:g} rad/s: STE p2p <= {limits.ste_factor:g} x solid, DTE RMS <= "
           f"{limits.dte_factor:g} x solid, root stress <= {limits.stress_ratio:g} x solid"
           + (f" and <= {limits.stress_max:g} MPa" if math.isfinite(limits.stress_max) else "")
-          + f"; DTE over {scene.dynamic.duration:g} s; coarse grid {n} bodies -> {out}", flush=True)
+          + f"; DTE over {scene.dynamic.duration:g} s; coarse grid {n} bodies"
+          + (f" ({', '.join(shapes)})" if shapes != ["round"] else "") + f" -> {out}", flush=True)
     lost = 0
     with study.local_cluster(args.workers) as address:
         kw = {"workers": 0 if address is None else None, "scheduler": address, "progress": not args.no_progress}
@@ -218,12 +270,17 @@ def run(args) -> int:
         solid = _row(solid_table, 0)
         if res.dataset["status"].values.ravel()[0] != 1:
             raise RuntimeError(f"the solid reference did not run: {res.dataset['message'].values.ravel()[0]}")
-        res = study.run_sweep(coarse_study, out / "coarse.nc", **kw)
-        lost += res.pending
-        tables = [candidates(res.dataset)]
-        order = ranked(tables[0], feasible(tables[0], solid, limits))
-        print(f"  coarse grid: {len(order)} of {n} bodies feasible ({res.wall_time:.0f} s)", flush=True)
-        seeds = [body_of(tables[0], i) for i in order[: args.refine]]
+        tables, wall = [], 0.0
+        for st, name in coarse.values():
+            res = study.run_sweep(st, out / name, **kw)
+            lost += res.pending
+            wall += res.wall_time
+            tables.append(candidates(res.dataset, {p: st.base_value(p) for p in (*FIELDS, *SIZE_NAMES, OPENING)}))
+        first = xr.concat(tables, "candidate")
+        order = ranked(first, feasible(first, solid, limits))
+        print(f"  coarse grid: {len(order)} of {n} bodies feasible ({wall:.0f} s)", flush=True)
+        seeds = [body_of(first, i) for i in order[: args.refine]]
+        tables = [first]
         points = refine_points(seeds, grid)
         if points:
             fine = study.make_study(scene, points=points, outputs=outputs, title="lightest driven gear: refinement")
@@ -266,6 +323,15 @@ def tradeoff(table: xr.Dataset, solid_table: xr.Dataset, limits: Limits, chosen:
     return study.tradeoff_figure(ds, pareto, path, te_limits=te_limits, chosen=chosen)
 
 
+def parse_shapes(text: str) -> list[str]:
+    """``'round,slot'`` -> ['round', 'slot']; SceneError naming --shapes for an unknown shape."""
+    shapes = [x.strip() for x in text.split(",") if x.strip()]
+    bad = [x for x in shapes if x not in SHAPE_SIZE]
+    if not shapes or bad:
+        raise SceneError("--shapes", f"a comma-separated list of {', '.join(SHAPE_SIZE)}; got {text!r}")
+    return list(dict.fromkeys(shapes))
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("scene", nargs="?", default=None, help="scene TOML (default: the paper example)")
@@ -280,7 +346,10 @@ def main(argv=None) -> int:
                    help="DTE run [s] (default: twice the ramp, then one revolution of the driven gear)")
     p.add_argument("--angle-step", type=float, default=0.2, help="STE driver angle step [deg]")
     p.add_argument("--grid", action="append", default=[], metavar="FIELD=V1,V2",
-                   help="replace a coarse grid axis (gear2.body.holes, hole_radius, rim_height, web_thickness)")
+                   help="replace a coarse grid axis (gear2.body.holes, hole_radius, rim_height, web_thickness; "
+                        "slot_width, spoke_width with --shapes)")
+    p.add_argument("--shapes", default="round", help="opening shapes searched, comma-separated: round, slot, "
+                   "window (each its own coarse grid, its size field in place of the hole radius)")
     p.add_argument("--refine", type=int, default=2, help="lightest feasible bodies refined around (0: none)")
     p.add_argument("-o", "--output", default=DEFAULT_OUT, help="output folder (archives, figure, answer)")
     p.add_argument("--workers", type=int, default=None, help="LocalCluster workers (default: one per core; 0: in process)")

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.geometry import BodySpec, GearGeometry, bore_radius, hole_angles, validate_body
+from solver.openings import Line, local_outline, place, shape_of
 
 REGION_RIM, REGION_WEB, REGION_HUB = 0, 1, 2
 REGION_NAMES = ("teeth and rim", "web", "hub")
@@ -172,18 +173,27 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str, rim: b
     # rim (with the teeth); the outline is defined either way: the size field measures from it
     if rim:
         surfaces[REGION_RIM] = geo.addPlaneSurface([outline, rim_in if rim_in is not None else bore])
+    corners = ([], [])      # window fillets (curves) and sharp corners (points): refined by the size field
     if has_web:
         holes = []
-        h_hole = min(h_body, 2 * math.pi * body.hole_radius / 24) if body.holes else h_body
-        for t in hole_angles(body.holes, body.hole_phase):
-            holes.append(circle(body.hole_circle_radius * math.cos(t), body.hole_circle_radius * math.sin(t),
-                                body.hole_radius, h_hole))
+        if body.holes and body.opening != "round" and not _is_round_slot(body):
+            h_edge, _ = opening_edge_sizes(body, h)
+            for t in hole_angles(body.holes, body.hole_phase):
+                holes.append(_opening_loop(geo, place(local_outline(shape_of(body)), t), h_edge,
+                                           corners if body.opening == "window" else None, body.corner_radius))
+        else:   # round holes, and slots of no span: round holes of the slot's width
+            r_hole = 0.5 * body.slot_width if _is_round_slot(body) else body.hole_radius
+            h_hole = min(h_body, 2 * math.pi * r_hole / 24) if body.holes else h_body
+            for t in hole_angles(body.holes, body.hole_phase):
+                holes.append(circle(body.hole_circle_radius * math.cos(t), body.hole_circle_radius * math.sin(t),
+                                    r_hole, h_hole))
         surfaces[REGION_WEB] = geo.addPlaneSurface([rim_in, *holes, hub_out if hub_out is not None else bore])
     if has_hub:
         surfaces[REGION_HUB] = geo.addPlaneSurface([hub_out if hub_out is not None else rim_in, bore])
     geo.synchronize()
 
-    _size_field(gmsh, g, curves, fillets, h, h_body, GRADINGS[grading])
+    corner_size = opening_edge_sizes(body, h)[1] if any(corners) else None
+    _size_field(gmsh, g, curves, fillets, h, h_body, GRADINGS[grading], corners, corner_size)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 1)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
@@ -193,11 +203,66 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str, rim: b
     return _collect(gmsh, surfaces, r_bore, h)
 
 
-def _size_field(gmsh, g: GearGeometry, curves: list, fillets: list, h: float, h_body: float, grade: dict) -> None:
+def _is_round_slot(body: BodySpec) -> bool:
+    """A slot of no angular span: a round hole of the slot's width, meshed as one."""
+    return body.opening == "slot" and body.slot_angle == 0.0
+
+
+# Elements along a full turn of an opening's arc (round holes: 24 on the circle) and a window's
+# corner fillets (6 on a quarter turn); the size field grows from a corner's size to the web's
+# over CORNER_GROWTH times their difference (a growth rate of 1/3).
+ARC_ELEMENTS = 24
+CORNER_GROWTH = 3.0
+
+
+def opening_edge_sizes(body: BodySpec, h: float) -> tuple[float, float]:
+    """(element size along an opening's edges, at a window's corners) [m] of the body mesh for
+    the outline size ``h`` [m]: at most the web's 5 h, ARC_ELEMENTS on the circle of a round hole
+    (of a slot's end circle, of a circle as high as a window); a window's corners ARC_ELEMENTS
+    on the circle of their fillet, at least h/2 (as the tooth fillets; sharp corners h/2)."""
+    h_body = 5.0 * h
+    if body.opening == "window":
+        edge = min(h_body, 2 * math.pi * 0.5 * body.window_height / ARC_ELEMENTS)
+        return edge, min(edge, max(2 * math.pi * body.corner_radius / ARC_ELEMENTS, h / 2))
+    r = 0.5 * body.slot_width if body.opening == "slot" else body.hole_radius
+    edge = min(h_body, 2 * math.pi * r / ARC_ELEMENTS)
+    return edge, edge
+
+
+def _opening_loop(geo, pieces: list, size: float, corners: tuple | None, corner_radius: float = 0.0) -> int:
+    """A closed curve loop of gmsh geo lines and circle arcs (each arc in pieces of at most a
+    quarter turn: gmsh draws arcs below half a turn) of an opening's outline, points of ``size``
+    [m]. With ``corners`` (a window's): its fillet arcs (of ``corner_radius`` [m]) go to
+    corners[0], its sharp corners (``corner_radius`` = 0) to corners[1]."""
+    first = geo.addPoint(*pieces[0].start, 0.0, size)
+    prev, tags = first, []
+    for i, p in enumerate(pieces):
+        end = first if i == len(pieces) - 1 else geo.addPoint(*p.end, 0.0, size)
+        if isinstance(p, Line):
+            tags.append(geo.addLine(prev, end))
+            if corners is not None and corner_radius == 0.0:
+                corners[1].extend([prev, end])
+        else:
+            k = max(1, math.ceil(abs(p.a1 - p.a0) / (0.5 * math.pi) - 1e-9))
+            c = geo.addPoint(*p.centre, 0.0, size)
+            a = np.linspace(p.a0, p.a1, k + 1)
+            chain = [prev, *[geo.addPoint(*p.point(x), 0.0, size) for x in a[1:-1]], end]
+            arcs = [geo.addCircleArc(chain[j], c, chain[j + 1]) for j in range(k)]
+            tags += arcs
+            if corners is not None and corner_radius > 0.0 and p.radius == corner_radius:
+                corners[0].extend(arcs)
+        prev = end
+    return geo.addCurveLoop(tags)
+
+
+def _size_field(gmsh, g: GearGeometry, curves: list, fillets: list, h: float, h_body: float, grade: dict,
+                corners=((), ()), corner_size: float | None = None) -> None:
     """Background size field [m] of a `GRADINGS` entry: ``h`` within ``outline_fine_m`` modules
     of the outline, growing linearly to ``h_body`` over ``outline_growth_m`` modules plus
     ``outline_growth_h`` h; ``h/2`` within ``fillet_fine_h`` h of the fillets, growing to
-    ``h_body`` at ``fillet_growth_h`` h."""
+    ``h_body`` at ``fillet_growth_h`` h; ``corner_size`` within that size of a window's corners
+    (``corners``: its fillet curves and sharp corner points), growing to ``h_body`` over
+    CORNER_GROWTH times the difference."""
     m = g.spec.module
     f = gmsh.model.mesh.field
     d_out = f.add("Distance")
@@ -221,6 +286,20 @@ def _size_field(gmsh, g: GearGeometry, curves: list, fillets: list, h: float, h_
         f.setNumber(tf, "DistMin", grade["fillet_fine_h"] * h)
         f.setNumber(tf, "DistMax", grade["fillet_growth_h"] * h)
         fields.append(tf)
+    if corner_size is not None:
+        d_c = f.add("Distance")
+        if corners[0]:
+            f.setNumbers(d_c, "CurvesList", corners[0])
+            f.setNumber(d_c, "Sampling", 20)
+        if corners[1]:
+            f.setNumbers(d_c, "PointsList", corners[1])
+        tc = f.add("Threshold")
+        f.setNumber(tc, "InField", d_c)
+        f.setNumber(tc, "SizeMin", corner_size)
+        f.setNumber(tc, "SizeMax", h_body)
+        f.setNumber(tc, "DistMin", corner_size)
+        f.setNumber(tc, "DistMax", corner_size + CORNER_GROWTH * (h_body - corner_size))
+        fields.append(tc)
     fm = f.add("Min")
     f.setNumbers(fm, "FieldsList", fields)
     f.setAsBackgroundMesh(fm)

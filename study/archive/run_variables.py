@@ -27,6 +27,7 @@ from solver.mbs.energy_guard import energy_error_limit
 from solver.mbs.kernels.status import COMPLETED
 from study.archive.schema import variable
 from study.archive.spectra import amplitude_spectrum, named_peaks, ste_order_spectrum
+from study.scene import opening_text
 
 
 def scene_title(scene) -> str:
@@ -38,8 +39,7 @@ def scene_title(scene) -> str:
         b = g.body
         if not scene.is_lightened(n):
             return f"{name} solid"
-        holes = f"{b.holes} holes of R_h {b.hole_radius:g} mm" if b.holes else "no holes"
-        return f"{name} {holes}, web {b.web_thickness:g} mm, rim {b.rim_height:g} mm"
+        return f"{name} {opening_text(b)}, web {b.web_thickness:g} mm, rim {b.rim_height:g} mm"
     parts = [f"z {g1.teeth}/{g2.teeth}, m {g1.module:g} mm", body("driver", g1, 1), body("driven", g2, 2)]
     d, qs = scene.dynamic, scene.quasi_static
     load = f"{(d.torque if d.enabled else qs.torque):g} N·m"
@@ -48,6 +48,17 @@ def scene_title(scene) -> str:
     parts.append(load)
     parts.append(f"{scene.coupling_model_name} model")     # the model run, 'auto' resolved
     return "; ".join(parts)
+
+
+def opening_attrs(scene) -> dict:
+    """Global attributes naming each gear's openings: ``opening_gearN`` ('round', 'slot',
+    'window', or 'none' without holes) and ``openings_gearN`` (in words, `study.scene.opening_text`)."""
+    out = {}
+    for g in (1, 2):
+        b = scene.gear(g).body
+        out[f"opening_gear{g}"] = b.opening if b.holes else "none"
+        out[f"openings_gear{g}"] = opening_text(b)
+    return out
 
 
 def static_variables(res, offset_m: float) -> dict:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from solver import units
 from solver.fe.mesh import default_mesh_size
-from solver.geometry import BodySpec, GearGeometry, Material, ToothSpec, pair_geometry, solid_body
+from solver.geometry import BodySpec, GearGeometry, Material, ToothSpec, body_settings, pair_geometry, solid_body
 from study.inputs.cache import FE_CACHE
 from study.scene import Scene, SpringSection
 
@@ -62,10 +62,9 @@ class GearSetup:
     def settings(self) -> dict:
         """Everything the FE of this gear depends on (geometry, body, material, pivot, mesh
         size and grading, load, code version): the content of the cache keys."""
-        body = self.body
-        if body.holes == 0:  # hole sizes do not matter without holes: one cache entry for all of them
-            body = dataclasses.replace(body, hole_radius=0.0, hole_circle_radius=0.0, hole_phase=0.0)
-        out = dict(tooth=dataclasses.asdict(self.tooth), body=dataclasses.asdict(body),
+        # hole sizes do not matter without holes (one cache entry for all of them); a round-holed
+        # body keeps the key it had before the other opening shapes existed
+        out = dict(tooth=dataclasses.asdict(self.tooth), body=body_settings(self.body),
                    material=dataclasses.asdict(self.material), pivot=self.pivot_radius,
                    size=self.mesh_size_setting, force=self.force, version=FE_VERSION)
         if self.mesh_grading != "fine":   # the fine mesh keeps the keys it had before the grading existed

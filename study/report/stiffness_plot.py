@@ -10,8 +10,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from solver.geometry import hole_angles
+from solver.geometry import hole_angles, opening_half_angle
 from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, archive_scene, figure_title, need, save_figure, unit_text
+from study.scene import OPENING_WORDS
 
 
 def stiffness_plot(ds: xr.Dataset, path) -> Path:
@@ -43,12 +44,13 @@ def stiffness_plot(ds: xr.Dataset, path) -> Path:
             if b.holes == 0:
                 continue
             pitch = 360.0 / sc.gear(g).teeth
-            half = math.degrees(math.asin(min(1.0, b.hole_radius / b.hole_circle_radius))) / pitch
+            half = math.degrees(opening_half_angle(sc.body_spec(g))) / pitch
+            what = OPENING_WORDS[b.opening][:-1]
             for centre in hole_angles(b.holes, b.hole_phase, 360.0):
                 c = (centre % 360.0) / pitch
                 ax.axvspan(c - half, c + half, color=C_HOLE, alpha=0.15, lw=0,
-                           label=f"hole of gear {g} (angular extent)" if first else None)
-                ax.axvline(c, color=C_HOLE, ls="--", lw=0.8, label="hole centre" if first else None)
+                           label=f"{what} of gear {g} (angular extent)" if first else None)
+                ax.axvline(c, color=C_HOLE, ls="--", lw=0.8, label=f"{what} centre" if first else None)
                 first = False
     ax.set_xlabel("tooth index [–] (tooth k's axis at k·360°/Z from tooth 0)")
     ax.set_ylabel(f"spring stiffness k_φ [{unit_text(k)}]")

@@ -22,6 +22,7 @@ from study.report.plot_style import archive_title
 from study.report.render_canvas import NAN_COLOR, WINDOW, RenderResult, fit_parallel, plotter, project, write_png
 from study.report.render_geometry import extrude, placement
 from study.report.render_inputs import pair_bodies, required_scene, tooth_stiffness
+from study.scene import opening_text
 
 STIFFNESS_CMAP = "viridis"
 
@@ -95,7 +96,8 @@ def _pair_caption(ds, sc, coloured) -> str:
     for g in (1, 2):
         b = sc.gear(g).body
         k = tooth_stiffness(ds, g)
-        desc = f"{b.holes} holes R {b.hole_radius:g} mm, web {b.web_thickness:g} mm" if sc.is_lightened(g) else "solid"
+        holes = f"{b.holes} holes R {b.hole_radius:g} mm" if b.opening == "round" or not b.holes else opening_text(b)
+        desc = f"{holes}, web {b.web_thickness:g} mm" if sc.is_lightened(g) else "solid"
         kk = f"k_phi {k.min():.4g} .. {k.max():.4g}" if np.ptp(k) > 0 else f"every tooth k_phi {k[0]:.4g}"
         grey = "" if g in coloured else " (outside the colour range: grey)"
         lines.append(f"gear {g}: {sc.gear(g).teeth} teeth, {desc}; {kk} N·mm/rad^{sc.gear(g).spring.n_k:g}{grey}")

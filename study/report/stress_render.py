@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from solver import units
+from solver.geometry import opening_half_angle, opening_radii
 from study.report.plot_style import archive_title
 from study.report.render_canvas import RenderResult, fit_parallel, plotter, write_png
 from study.report.render_geometry import Body2D, extrude, fe_body, transform
@@ -57,7 +58,7 @@ def fe_stress_render(ds: xr.Dataset, path, g: int, fields: list) -> RenderResult
     r_tip = geo.tip_radius / units.MM
     # view: from just above the hole circle's outer edge (or mid-web) to the tip, +-3.5 pitches
     if n_holes:
-        r_in = (body.hole_circle_radius + 0.6 * body.hole_radius) / units.MM
+        r_in = (body.hole_circle_radius + 0.6 * (opening_radii(body)[1] - body.hole_circle_radius)) / units.MM
     else:
         r_in = (geo.root_radius - body.rim_height - 0.5 * body.web_height) / units.MM
     r_in = min(r_in, (geo.root_radius - 2 * geo.spec.module) / units.MM)
@@ -155,4 +156,4 @@ def _hole_half_pitches(sc, g) -> float:
     b = sc.gear(g).body
     if not b.holes:
         return 0.0
-    return 2 * math.degrees(math.asin(min(1.0, b.hole_radius / b.hole_circle_radius))) / (360.0 / sc.gear(g).teeth)
+    return 2 * math.degrees(opening_half_angle(sc.body_spec(g))) / (360.0 / sc.gear(g).teeth)

@@ -19,9 +19,10 @@ import xarray as xr
 
 from solver import units
 from solver.fe.ltca import ltca_sweep, mesh_points
+from study.archive.run_variables import opening_attrs
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
-from study.scene import Scene, SceneError
+from study.scene import Scene, SceneError, opening_text
 from study.scene_model import geometry_model, static_angles
 
 # the reference holds about four times the arrays of a static analysis an angle (contacts and
@@ -117,7 +118,9 @@ def reference_dataset(scene: Scene, angles=None, progress: bool = False) -> xr.D
         "ste_tooth_force": cf_variable(("angle", "driver_tooth"), res.tooth_force, "N", "normal contact force on each driver tooth"),
         "extended_contact_force": cf_variable("angle", res.extended, "N", "force carried by tip-corner contacts outside the path of contact"),
     }
-    attrs = {"title": f"FE reference (LTCA): {scene.title}", "scene": scene.to_toml(),
+    shaped = [opening_text(scene.gear(g).body) for g in (1, 2) if scene.gear(g).body.holes and scene.gear(g).body.opening != "round"]
+    attrs = {"title": f"FE reference (LTCA): {scene.title}" + "".join(f"; {t}" for t in shaped), "scene": scene.to_toml(),
+             **opening_attrs(scene),
              "backlash_offset_um": off * units.UM_PER_M, "contact_ratio": model.pair.contact_ratio,
              "mesh_order": float(scene.gear2.teeth), "hole_order": float(scene.gear2.body.holes),
              "static_torque_N_m": res.torque, "wall_time_reference_s": wall,

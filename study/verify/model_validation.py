@@ -124,6 +124,39 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def bodies_dataset(scenes: dict, step: float = 0.1, models=MODELS, log=None) -> xr.Dataset:
+    """STE figures of every model for named scenes (``{name: Scene}``: bodies of any opening
+    shape), each at its quasi-static torque over two periods of its driven gear's openings
+    (360/N deg of the driven gear each; 120 deg without openings) at ``step`` [deg] of the driver.
+    ``log``: called with a line per body."""
+    names = list(scenes)
+    shape = (len(names), len(models))
+    figs = {k: np.full(shape, np.nan) for k in ("mean", "elastic_mean", "p2p", "hole", "wall")}
+    rotations = []
+    for i, name in enumerate(names):
+        sc = scenes[name]
+        n = sc.gear2.body.holes
+        rotation = 2 * 360.0 / n * sc.gear2.teeth / sc.gear1.teeth if n else 120.0
+        rotations.append(rotation)
+        f = ste_figures(sc, _angles(rotation, step), models)
+        for m, model in enumerate(models):
+            for key in figs:
+                figs[key][i, m] = f[model][key]
+        if log:
+            log(f"{name}: " + ", ".join(f"{model} p2p {f[model]['p2p']:.3f} um" for model in models))
+    dims, coords = _model_grid(models, body=(np.array(names), "", "body of gear 2"))
+    v = cf_variable
+    data = {"ste_mean": v(dims, figs["mean"], "um", "mean static transmission error"),
+            "ste_elastic_mean": v(dims, figs["elastic_mean"], "um", "mean STE less the backlash offset jn/2"),
+            "ste_p2p": v(dims, figs["p2p"], "um", "peak-to-peak static transmission error"),
+            "hole_amplitude": v(dims, figs["hole"], "um", "STE amplitude at the opening order of gear 2"),
+            "wall_time": v(dims, figs["wall"], "s", "wall time of the model's STE (its FE included unless cached)"),
+            "rotation": v("body", np.array(rotations), "degree", "driver rotation of the STE (two opening periods)")}
+    attrs = {"title": "STE of the models against the FE reference for bodies of gear 2", "angle_step_deg": step,
+             "scenes": "\n\n".join(f"# {n}\n{scenes[n].to_toml()}" for n in names), **_target_attrs(), **provenance()}
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
 def _model_grid(models, **axes) -> tuple[tuple, dict]:
     """Dimensions and coordinates of a grid of figures over ``axes`` (name: (values, unit, long
     name), in order) and the models compared, last."""

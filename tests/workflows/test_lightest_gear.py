@@ -150,3 +150,57 @@ def test_small_pair_end_to_end_gives_the_lightest_body_its_figure_and_archives(t
         assert f"save {float(best['mass_saving_gear2']):.1f} % mass" in said
         assert f"root stress {float(best['root_stress_max_gear2']):.1f} MPa" in said
     assert (out / "tradeoff.png").stat().st_size > 10_000
+
+
+def test_other_shapes_are_sized_by_their_own_field_and_refined_towards_less_mass():
+    """A slot is sized by its width (wider is lighter), a window by its spokes (narrower is
+    lighter); a candidate's body names its opening, and the answer says the shape."""
+    from workflows.lightest_gear import SHAPE_COARSE, fields_of
+    assert fields_of("round") == FIELDS
+    assert "gear2.body.spoke_width" in fields_of("window") and "gear2.body.hole_radius" not in fields_of("window")
+    grid = {**COARSE, **SHAPE_COARSE, "gear2.body.spoke_width": [8.0, 12.0, 16.0]}
+    seed = {"gear2.body.holes": 6, "gear2.body.spoke_width": 12.0, "gear2.body.rim_height": 7.0,
+            "gear2.body.web_thickness": 10.0, "gear2.body.opening": "window"}
+    pts = refine_points([seed], grid)
+    assert {p["gear2.body.spoke_width"] for p in pts} == {10.0, 12.0}        # narrower spokes are lighter
+    assert all(p["gear2.body.opening"] == "window" and "gear2.body.hole_radius" not in p for p in pts)
+    ds = synthetic_grid().rename(hole_radius="slot_width")
+    table = candidates(ds, {"gear2.body.opening": "slot"})
+    assert set(table["opening"].values) == {"slot"} and np.isnan(table["hole_radius"].values).all()
+    body = body_of(table, 0)
+    assert body["gear2.body.opening"] == "slot" and body["gear2.body.slot_width"] == 5.0
+    row = {"n_holes": 6, "opening": "window", "spoke_width": 12.0, "rim_thickness": 5.0, "web_thickness": 6.0,
+           "mass_saving_gear2": 25.0, "mass_gear2": 1.5, "inertia_gear2": 700.0, "ste_p2p": 1.1, "dte_rms": 2.5,
+           "root_stress_max_gear2": 330.0, "root_stress_ratio_gear2": 1.1}
+    assert answer(row, SOLID, 100.0).startswith("6 windows between spokes of 12 mm, a 5 mm rim")
+
+
+def test_an_unknown_shape_is_a_one_line_error(capsys, tmp_path):
+    assert main(["--shapes", "round,star", "--workers", "0", "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: --shapes") and "\n" not in err
+
+
+def test_small_pair_searches_round_holes_and_windows(tmp_path, capsys, private_fe_cache):
+    """Both shapes run their coarse grid (its own archive each) and compete for the answer."""
+    from study.scene import load_scene
+    scene = load_scene("small_pair").replace(**{"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4,
+                                                "gear2.body.hole_radius": 3.0, "gear2.body.hole_circle_radius": 19.5,
+                                                "gear2.body.window_height": 8.0,
+                                                "quasi_static.rotation": 30.0, "dynamic.ramp_time": 0.002})
+    (tmp_path / "scene.toml").write_text(scene.to_toml())
+    out = tmp_path / "out"
+    rc = main([str(tmp_path / "scene.toml"), "--shapes", "round,window", "--grid", "gear2.body.holes=4",
+               "--grid", "gear2.body.hole_radius=3.0", "--grid", "gear2.body.spoke_width=6.0",
+               "--grid", "gear2.body.rim_height=4.0", "--grid", "gear2.body.web_thickness=8.0", "--refine", "0",
+               "--ste-factor", "5", "--dte-factor", "5", "--stress-ratio", "5", "--angle-step", "0.5",
+               "--set", "fe.mesh_size=2.0", "--duration", "0.01", "--workers", "0", "--no-progress", "-o", str(out)])
+    text = capsys.readouterr().out
+    assert rc == 0, text
+    assert "coarse grid: 2 of 2 bodies feasible" in text
+    with xr.open_dataset(out / "coarse.nc") as r, xr.open_dataset(out / "coarse_window.nc") as w:
+        m_round, m_window = float(r["mass_saving_gear2"].squeeze()), float(w["mass_saving_gear2"].squeeze())
+        assert w.attrs["base_scene"].count('opening = "window"') == 1
+    # four windows between 6 mm spokes take far more than four 3 mm holes: the lightest is the windows
+    assert m_window > m_round
+    assert (out / "lightest.txt").read_text().startswith("4 windows between spokes of 6 mm")
