@@ -211,6 +211,17 @@ def print_summary(ds, path, wall_time: float) -> None:
     show(ds, path, wall_time)
 
 
+def add_default_model(ds, default):
+    """Store the default model's run archive ``default`` beside ``ds``, a run of the same scene
+    by another model (``ste_default``, ``dte_default`` [um], the default's mesh mode and 1Z
+    critical speed in attributes): its summary then leads with both models' numbers and its
+    STE and DTE figures draw both. Returns ``ds``."""
+    from study.archive.summary import add_default_model as add
+    _check(hasattr(ds, "data_vars") and hasattr(default, "data_vars"), "add_default_model", "ds, default",
+           "two run archives (xarray.Dataset)", (ds, default))
+    return add(ds, default)
+
+
 # ---------------------------------------------------------------- studies
 
 def load_study(path):
