@@ -416,4 +416,5 @@ def sample_tables(ds: xr.Dataset, outputs: list[str] | None = None, limits: dict
     tab = xr.Dataset(arrays)
     tab["output_units"] = xr.DataArray([units[v] for v in outputs], dims="output",
                                        attrs={"long_name": "units of the output (and of its mean and percentiles)"})
-    return tab.assign_attrs(confidence_level=level, bootstrap_resamples=N_BOOT)
+    tab["sample_percentile"].attrs["min_independent_builds"] = np.array([min_builds(q, level) for q in QUANTILES])
+    return tab.assign_attrs(confidence_level=level, bootstrap_resamples=N_BOOT, independent_builds=int(free.sum()))

@@ -192,6 +192,35 @@ def sobol_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path):
     return save_figure(fig, path)
 
 
+def _with_interval(v: tuple[float, float, float]) -> str:
+    return f"{v[0]:.4g} [{v[1]:.4g}, {v[2]:.4g}]" if np.isfinite(v[1:]).all() else f"{v[0]:.4g} (no interval)"
+
+
+def sample_table_text(ds: xr.Dataset, tables: xr.Dataset, outputs: list[str]) -> str:
+    """The statistics of a sampled study as a printed table: per output and grid point the
+    builds kept, the mean and P5 / P50 / P95 with their 95 % intervals (none where the sample
+    cannot support one) and each limit's probability of exceedance."""
+    lines = []
+    for var in outputs:
+        unit = pretty_unit(ds[var].attrs.get("units"))
+        lines.append(f"  {var} [{unit}]: {ds[var].attrs.get('long_name', var)}")
+        for at in grid_points(ds):
+            t = tables.isel(at)
+            cells = [f"{int(t['sample_count'].sel(output=var))} builds",
+                     f"mean {_with_interval(_est(t['sample_mean'].sel(output=var)))}"]
+            cells += [f"P{100 * q:g} {_with_interval(_est(t['sample_percentile'].sel(output=var, quantile=q)))}"
+                      for q in QUANTILES]
+            if "exceedance_probability" in t and var in t["limit"].values:
+                e = _est(t["exceedance_probability"].sel(limit=var))
+                lim = float(t["limit_value"].sel(limit=var))
+                cells.append(f"P(> {lim:g}) {e[0]:.3f} [{e[1]:.3f}, {e[2]:.3f}]")
+            lines.append(f"    {point_label(ds, at)}: " + "; ".join(cells))
+    if any("(no interval)" in line for line in lines):
+        lines.append(f"  (no interval: {tables.attrs['independent_builds']} independent builds a grid point cannot bound "
+                     f"that percentile at 95 %; a P95 takes {min_builds(0.95)}, a median {min_builds(0.5)})")
+    return "\n".join(lines)
+
+
 def sample_figures(ds: xr.Dataset, name, skip, limits: dict | None = None) -> list:
     """Every view of a sampled study (``name(stem)`` -> PNG path, ``skip(what, why)`` prints
     what is left out); the tables go to ``study_tables.nc`` beside them."""
@@ -223,4 +252,6 @@ def sample_figures(ds: xr.Dataset, name, skip, limits: dict | None = None) -> li
     write_netcdf(tables.assign_attrs(attrs, comment="computed by `lightgear render` from the sampled study's builds "
                                                     "(study.report.distributions)"), path)
     print(f"  study tables: {path}")
+    if varying:
+        print(sample_table_text(ds, tables, varying))
     return out

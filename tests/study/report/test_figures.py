@@ -183,7 +183,12 @@ def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
     path = tmp_path / "run.nc"
     write_netcdf(ds, path)
     assert main(["render", str(path), "--no-renders"]) == 0
-    assert {p.name for p in tmp_path.glob("*.png")} == {"ste.png", "dte.png", "spectrum.png", "tooth_stiffness.png", "campbell.png"}
+    # named after the archive: two archives rendered into one folder keep their own figures
+    assert {p.name for p in tmp_path.glob("*.png")} == {f"run_{n}.png" for n in ("ste", "dte", "spectrum", "tooth_stiffness",
+                                                                              "campbell")}
+    write_netcdf(ds, tmp_path / "other.nc")
+    assert main(["render", str(tmp_path / "other.nc"), "--no-renders"]) == 0
+    assert len(list(tmp_path.glob("run_*.png"))) == len(list(tmp_path.glob("other_*.png"))) == 5
 
 
 def test_hole_passes_on_the_ste_axis_follow_the_gear_ratio():

@@ -256,10 +256,16 @@ def test_a_sampled_study_resumes_after_an_interruption(sampled_run, tmp_path, mo
 def test_render_of_a_sampled_study_with_a_limit(sampled_run, tmp_path, capsys):
     res, path = sampled_run
     assert main(["render", str(path), "-o", str(tmp_path), "--limit", "ste_p2p=6.0"]) == 0
-    for stem in ("distribution_ste_p2p", "convergence_ste_p2p"):
-        assert (tmp_path / f"{stem}.png").stat().st_size > 10_000
-    assert "Sobol indices: a plain sample" in capsys.readouterr().out
-    with xr.open_dataset(tmp_path / "study_tables.nc", engine="netcdf4") as f:
+    for stem in ("distribution_ste_p2p", "convergence_ste_p2p"):      # named after the archive
+        assert (tmp_path / f"{path.stem}_{stem}.png").stat().st_size > 10_000
+    said = capsys.readouterr().out
+    assert "Sobol indices: a plain sample" in said
+    # the statistics printed as a table: each grid point's mean, P5, P50, P95 and exceedance
+    assert "  ste_p2p [µm]:" in said or "  ste_p2p [um]:" in said
+    for g in ("gear1.errors.grade = 0", "gear1.errors.grade = 6"):
+        row = next(line for line in said.splitlines() if line.strip().startswith(g + ":"))
+        assert all(w in row for w in ("builds", "mean ", "P5 ", "P50 ", "P95 ", "P(> 6)")), row
+    with xr.open_dataset(tmp_path / f"{path.stem}_study_tables.nc", engine="netcdf4") as f:
         tab = f.load()
     ds = res.dataset
     for g in range(2):
@@ -268,6 +274,8 @@ def test_render_of_a_sampled_study_with_a_limit(sampled_run, tmp_path, capsys):
         assert float(p.sel(bound="estimate")) == np.mean(y > 6.0)
         pct = tab["sample_percentile"].isel(gear1_errors_grade=g).sel(output="ste_p2p", bound="estimate")
         np.testing.assert_allclose(pct.values, np.quantile(y, [0.05, 0.5, 0.95]))
+        row = next(line for line in said.splitlines() if line.strip().startswith(f"gear1.errors.grade = {[0, 6][g]}:"))
+        assert f"P95 {np.quantile(y, 0.95):.4g}" in row and f"mean {np.mean(y):.4g}" in row
     # a limit on an output the archive does not have, or a malformed one: exit 2 before any work
     assert main(["render", str(path), "-o", str(tmp_path / "x"), "--limit", "dte_rms=0.5"]) == 2
     assert main(["render", str(path), "-o", str(tmp_path / "x"), "--limit", "ste_p2p=abc"]) == 2
