@@ -241,8 +241,7 @@ def sweep_command(args) -> int:
     except SchedulerUnreachable as e:
         raise UsageError("--scheduler", str(e)) from None
     except KeyboardInterrupt:
-        print(f"interrupted: finished points are kept in {parts_folder(output)}; run the same command to resume",
-              file=sys.stderr)
+        print(f"lightgear sweep: interrupted: {kept_parts_text(parts_folder(output))}", file=sys.stderr)
         return 130
     ds = res.dataset
     counts = {name: int((ds["status"].values == i).sum()) for i, name in enumerate(STATUS)}
@@ -263,6 +262,15 @@ def sweep_command(args) -> int:
             print(f"    {cause}", file=sys.stderr)
         return 1
     return 0
+
+
+def kept_parts_text(folder: Path) -> str:
+    """What an interrupted sweep really kept: the finished analyses in its parts folder, or nothing."""
+    kept = len(list(folder.glob("*.pkl"))) if folder.is_dir() else 0
+    if not kept:
+        return "no analysis had finished: nothing kept (the same command starts the study again)"
+    return (f"{kept} finished {'analysis' if kept == 1 else 'analyses'} kept in {folder}; "
+            "the same command resumes from them")
 
 
 # ---------------------------------------------------------------- fit-contact

@@ -474,6 +474,20 @@ def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | 
             client.cancel(list(futures))
 
 
+@contextlib.contextmanager
+def quiet_on_interrupt():
+    """Within: a Ctrl-C (KeyboardInterrupt) first silences dask's loggers, then goes on: the
+    cluster then closes under the running tasks, and its connection errors (CommClosedError
+    tracebacks) are no news to the user, who gets the one line of the command."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        import logging
+        for name in ("distributed", "tornado", "asyncio"):
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        raise
+
+
 def lost_cause(e: BaseException) -> str:
     """One line on why dask gave no result for a point (a worker died running it: KilledWorker)."""
     text = str(e).strip().splitlines()[0] if str(e).strip() else ""
@@ -544,7 +558,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
             for k in w:
                 users.setdefault(k, []).append(idx)
         with contextlib.closing(run), tqdm(total=len(waiting), desc=study.title[:40], unit="point",
-                                           disable=not progress, file=sys.stderr) as bar:
+                                           disable=not progress, file=sys.stderr) as bar, quiet_on_interrupt():
             for n_done, (key, res) in enumerate(run, 1):
                 if "lost" in res:
                     lost[key] = res["lost"]
