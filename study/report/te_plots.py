@@ -41,7 +41,21 @@ def _runs(mask: np.ndarray):
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
 
 
+LOADED_SHARE = 0.10      # a contact carrying less of the pair's load than this does not count as loaded
 _ZONES = {2: ("2 loaded contacts", "#f5cba7"), 3: ("3 or more loaded contacts", "#e59866")}
+
+
+def loaded_contacts(ds: xr.Dataset) -> np.ndarray | None:
+    """Number of contacts carrying at least `LOADED_SHARE` of the pair's normal load at each STE
+    angle (from ``ste_tooth_force``; ``ste_contacts``, every touching contact, without it): a
+    tooth entering or leaving the mesh with a few newtons is no load share."""
+    if "ste_tooth_force" in ds:
+        f = np.abs(ds["ste_tooth_force"].transpose("angle", ...).values)
+        total = f.sum(axis=1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(total > 0, f / total, 0.0)
+        return (share >= LOADED_SHARE).sum(axis=1)
+    return ds["ste_contacts"].values if "ste_contacts" in ds else None
 _ZONE_WORD = {1: "1", 2: "2", 3: "3"}
 
 
@@ -97,7 +111,8 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     ang = ds["angle"].values
     off = float(ds.attrs.get("backlash_offset_um", 0.0))
     ste = ds["ste"].values - off            # the elastic part: the rigid half-backlash offset taken out
-    contacts = ds["ste_contacts"].values if "ste_contacts" in ds else None
+    contacts = loaded_contacts(ds)
+    by_share = "ste_tooth_force" in ds
     solid = ds["ste_solid"].values - off if "ste_solid" in ds else None
     holes = hole_mesh_angles(ds, ang[-1])
     nrow = 3 if solid is not None else 2
@@ -107,7 +122,9 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     main, other, which = model_curves(ds, "STE")
     dflt = ds["ste_default"].values - off if other else None
     figure_title(fig, ds, f"Static transmission error (STE), elastic part: STE less the {off:.3f} µm half-backlash offset; "
-                          f"shading: loaded contacts ({loaded}geometric {eps:.3f}; tip corners count)" + which, width=130)
+                          f"shading: loaded contacts ({loaded}geometric {eps:.3f}; tip corners count"
+                          + (f"; a contact counts when it carries at least {100 * LOADED_SHARE:g} % of the load)" if by_share
+                             else ")") + which, width=130)
     ax = axes[0]
     if contacts is not None:
         _shade_contacts(ax, ang, contacts)
@@ -122,7 +139,7 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     ax.set_ylabel(f"STE − {off:.3f} µm [µm]")
     ax.set_xlim(ang[0], ang[-1])
     lo, hi = ax.get_ylim()
-    ax.set_ylim(lo, hi + 0.3 * (hi - lo))        # room for the legend above the curves
+    ax.set_ylim(lo, hi + 0.5 * (hi - lo))        # room for the legend above the curves
     ax.legend(loc="upper right", fontsize=9, ncol=4, framealpha=0.9)
     ax.grid(alpha=0.3)
     # zoom: three mesh periods
