@@ -344,9 +344,11 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
         a = ds["dte_amplitude"].attrs
         res = a.get("resolution_Hz", float("nan"))
         f_rot = float(ds.attrs.get("driven_speed_rad_s", 0.0)) / (2 * np.pi)
+        unresolved = ds["dte_peak_amplitude"].attrs.get("not_resolved", "") if "dte_peak_amplitude" in ds else ""
         spectrum_panel(axes[i, 0], order, amp, peaks, xmax, "DTE",
-                        f"{a.get('window', '?')} window, resolution {res:.3g} Hz = {res / f_rot:.3g} orders, "
-                        f"from {a.get('start_s', float('nan')) * 1e3:.3g} ms" if f_rot > 0 else "")
+                        (f"{a.get('window', '?')} window, resolution {res:.3g} Hz = {res / f_rot:.3g} orders, "
+                         f"from {a.get('start_s', float('nan')) * 1e3:.3g} ms" if f_rot > 0 else "")
+                        + (f"\n{unresolved}" if unresolved else ""))
         ax = axes[i, 0]
         ax.set_xlabel("order of the driven gear's rotation [–]")
         if f_rot > 0:
@@ -368,6 +370,8 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
             need_deg = 360.0 * 2 * HANN_MAIN_LOBE_BINS / n_h * ratio
             note = (f"\nhole sidebands kZ ± jN not resolved: their main lobes (± {HANN_MAIN_LOBE_BINS * res:.3g} orders) "
                     f"overlap at N = {n_h:g}; an STE over {need_deg:.0f}° of driver rotation or more resolves them")
+        if "ste_peak_amplitude" in ds and ds["ste_peak_amplitude"].attrs.get("not_resolved"):
+            note += "\n" + ds["ste_peak_amplitude"].attrs["not_resolved"]
         spectrum_panel(axes[i, 0], order, amp, _peak_table(ds, "ste"), xmax, "STE",
                         f"{a.get('window', '?')} window, resolution {res:.3g} orders "
                         f"({a.get('record_driven_revolutions', float('nan')):.3g} driven revolutions), "
