@@ -18,7 +18,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
-LANGUAGES = {"python", "toml", "sh", "text"}      # text: a map or a table, nothing to run
+LANGUAGES = {"python", "toml", "sh", "text"}      # text: a map or a table, nothing to run; sh: also an unlabelled block of commands
 
 
 @dataclass(frozen=True)
@@ -32,12 +32,25 @@ class Block:
         return f"{self.page}:{self.line}"
 
 
+PROGRAMS = ("lightgear ", "python -m ", "make ", "dask ")
+
+
+def looks_like_commands(text: str) -> bool:
+    """Every line a command of a known program, a continuation or a comment."""
+    lines = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+    return bool(lines) and all(line.startswith(PROGRAMS) or line[:1].isspace() or re.match(r"[A-Z_]+=", line)
+                               for line in lines)
+
+
 def blocks(lang: str | None = None) -> list[Block]:
+    """The fenced blocks of the pages (of language ``lang``); a block without a language that
+    holds only command lines counts as a shell block."""
     out = []
     for page in PAGES:
         text = page.read_text()
         for m in FENCE.finditer(text):
-            b = Block(str(page.relative_to(ROOT)), text.count("\n", 0, m.start()) + 1, m.group(1), m.group(2))
+            kind = m.group(1) or ("sh" if looks_like_commands(m.group(2)) else "")
+            b = Block(str(page.relative_to(ROOT)), text.count("\n", 0, m.start()) + 1, kind, m.group(2))
             if lang is None or b.lang == lang:
                 out.append(b)
     return out
@@ -77,7 +90,7 @@ CHEAP_PYTHON = {"docs/tolerance.md"}
 def test_every_block_says_what_it_holds():
     assert blocks(), "no fenced blocks found"
     unlabelled = [str(b) for b in blocks() if b.lang not in LANGUAGES]
-    assert unlabelled == [], f"fenced blocks without one of the languages {sorted(LANGUAGES)}"
+    assert unlabelled == [], f"fenced blocks to label with one of the languages {sorted(LANGUAGES)}"
 
 
 def python_params():
