@@ -261,6 +261,17 @@ def print_summary(ds, path, wall_time: float) -> None:
     show(ds, path, wall_time)
 
 
+def add_default_model(ds, default):
+    """Store the default model's run archive ``default`` beside ``ds``, a run of the same scene
+    by another model (``ste_default``, ``dte_default`` [um], the default's mesh mode and 1Z
+    critical speed in attributes): its summary then leads with both models' numbers and its
+    STE and DTE figures draw both. Returns ``ds``."""
+    from study.archive.summary import add_default_model as add
+    _check(hasattr(ds, "data_vars") and hasattr(default, "data_vars"), "add_default_model", "ds, default",
+           "two run archives (xarray.Dataset)", (ds, default))
+    return add(ds, default)
+
+
 # ---------------------------------------------------------------- studies
 
 def load_study(path):
@@ -359,12 +370,13 @@ def tradeoff_figure(ds, pareto_flags, path, te_limits=None, chosen=None):
     return figure(ds, pareto_flags, path, te_limits=te_limits, chosen=chosen)
 
 
-def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None) -> list:
+def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None, prefix: str = "") -> list:
     """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
     files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a
     path or an xarray.Dataset; ``limits`` ({output: value}, sampled studies): the probability
-    of exceeding each. The renders of a lightened body draw its FE fields from the FE cache
-    (solved and cached once when missing)."""
+    of exceeding each; ``prefix``: put before every file name (`lightgear render` gives the
+    archive's stem, ``h3_ste.png``). The renders of a lightened body draw its FE fields from
+    the FE cache (solved and cached once when missing)."""
     from pathlib import Path
 
     from study.report.figures import make_figures
@@ -381,7 +393,7 @@ def render(archive, out_dir=None, renders: bool = True, limits: dict | None = No
     if renders and "scene" in archive.attrs and "tooth_stiffness" in archive and "status" not in archive:
         from study.inputs.springs import archive_body_fields
         fields = archive_body_fields(archive)      # what the renders of a lightened body draw: FE cache, else solved
-    return make_figures(archive, Path(out_dir), renders=renders, limits=limits, fields=fields)
+    return make_figures(archive, Path(out_dir), prefix=prefix, renders=renders, limits=limits, fields=fields)
 
 
 # ---------------------------------------------------------------- the other commands
@@ -561,13 +573,36 @@ def export(archive, outdir=None) -> list:
     import xarray as xr
 
     from study.report.export import export_csv
+    from study.sweep.outputs import summary_rows
     if isinstance(archive, xr.Dataset):
         _check(outdir is not None, "export", "outdir", "a folder (needed for a Dataset)", outdir)
-        return export_csv(archive, Path(outdir))
+        return export_csv(archive, Path(outdir), summary_rows(archive))
     _check(_is_path(archive), "export", "archive", "a NetCDF path or a Dataset", archive)
     path = Path(archive)
     with xr.open_dataset(path, engine="netcdf4") as ds:
-        return export_csv(ds, Path(outdir) if outdir is not None else path.with_name(f"{path.stem}_csv"))
+        return export_csv(ds, Path(outdir) if outdir is not None else path.with_name(f"{path.stem}_csv"),
+                          summary_rows(ds))
+
+
+def write_report(archive, out_dir=None, renders: bool = True) -> list:
+    """A report to hand on of a run, study or tolerance-study archive (path): one self-contained
+    HTML page (figures embedded as base64 PNG) and its Markdown twin, with the scene or study as
+    run, the summary table with units, the validation status of the model used and the figures,
+    written into ``out_dir`` (default: beside the archive) as ``STEM_report.html`` and
+    ``STEM_report.md`` (the figures beside them, ``STEM_*.png``) -> [html, md] paths."""
+    from pathlib import Path
+
+    from study.report.report_page import write_report as write
+    from study.sweep.outputs import report_rows
+    _check(_is_path(archive), "write_report", "archive", "an archive's path", archive)
+    path = Path(archive)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such archive: {path}")
+    out_dir = Path(out_dir) if out_dir is not None else path.parent
+    ds = read(path)
+    figures = [p for p in render(ds, out_dir, renders=renders, prefix=f"{path.stem}_") if p.suffix == ".png"]
+    summary, extra = report_rows(ds)
+    return write(ds, path.stem, out_dir, figures, summary, extra)
 
 
 def script_main(name: str, main) -> int:
@@ -586,4 +621,5 @@ __all__ = ["Scene", "SceneError", "StudyError", "BudgetError", "Study", "Outputs
            "stability_suite", "validation", "validate_design_space", "validate_relief", "validation_errors",
            "validation_misses", "sample_outputs", "sample_tables", "sample_points", "sample_point_label",
            "study_from_dict", "export", "script_main", "equal_mass", "describe_openings", "opening_outline",
-           "opening_order_amplitude", "validate_bodies"]
+           "opening_order_amplitude", "validate_bodies",
+           "write_report", "add_default_model"]

@@ -141,7 +141,7 @@ def run_command(args) -> int:
     study.write(ds, args.output)
     print_summary(ds, args.output, time.perf_counter() - t0)
     if args.figures:
-        for path in study.render(ds, Path(args.output).parent):
+        for path in study.render(ds, Path(args.output).parent, prefix=f"{Path(args.output).stem}_"):
             print(f"  figure: {path}")
     problems = run_problems(ds)
     for msg in problems:
@@ -241,8 +241,7 @@ def sweep_command(args) -> int:
     except SchedulerUnreachable as e:
         raise UsageError("--scheduler", str(e)) from None
     except KeyboardInterrupt:
-        print(f"interrupted: finished points are kept in {parts_folder(output)}; run the same command to resume",
-              file=sys.stderr)
+        print(f"lightgear sweep: interrupted: {kept_parts_text(parts_folder(output))}", file=sys.stderr)
         return 130
     ds = res.dataset
     counts = {name: int((ds["status"].values == i).sum()) for i, name in enumerate(STATUS)}
@@ -263,6 +262,15 @@ def sweep_command(args) -> int:
             print(f"    {cause}", file=sys.stderr)
         return 1
     return 0
+
+
+def kept_parts_text(folder: Path) -> str:
+    """What an interrupted sweep really kept: the finished analyses in its parts folder, or nothing."""
+    kept = len(list(folder.glob("*.pkl"))) if folder.is_dir() else 0
+    if not kept:
+        return "no analysis had finished: nothing kept (the same command starts the study again)"
+    return (f"{kept} finished {'analysis' if kept == 1 else 'analyses'} kept in {folder}; "
+            "the same command resumes from them")
 
 
 # ---------------------------------------------------------------- fit-contact
@@ -294,7 +302,8 @@ def fit_contact_command(args) -> int:
 
 def render_arguments(p) -> None:
     p.add_argument("archive", help="run or sweep archive (NetCDF)")
-    p.add_argument("-o", "--output", default=None, help="directory for the PNGs (default: beside the archive)")
+    p.add_argument("-o", "--output", default=None, help="directory for the PNGs, named ARCHIVE-STEM_*.png "
+                                                        "(default: beside the archive)")
     p.add_argument("--no-renders", action="store_true", help="plots only (no pyvista renders, no FE)")
     p.add_argument("--limit", dest="limits", action="append", default=[], metavar="OUTPUT=VALUE",
                    help="sampled study: the probability of exceeding a limit, e.g. --limit dte_rms=0.5 "
@@ -308,7 +317,7 @@ def render_command(args) -> int:
     limits = checked_limits(path, args.limits)
     writable_folder(Path(args.output) if args.output else path.parent)
     t0 = time.perf_counter()
-    for p in study.render(path, args.output, renders=not args.no_renders, limits=limits):
+    for p in study.render(path, args.output, renders=not args.no_renders, limits=limits, prefix=f"{path.stem}_"):
         print(f"  figure: {p}")
     print(f"  {time.perf_counter() - t0:.1f} s")
     return 0
@@ -331,6 +340,24 @@ def checked_archive(name) -> Path:
     if "code_fingerprint" not in attrs:
         raise UsageError("archive", f"{path} is NetCDF but not a lightgear archive (no lightgear provenance attributes)")
     return path
+
+
+# ---------------------------------------------------------------- report
+
+def report_arguments(p) -> None:
+    p.add_argument("archive", help="run, study or tolerance-study archive (NetCDF)")
+    p.add_argument("-o", "--output", default=None, help="directory for the report and its figures "
+                                                        "(default: beside the archive)")
+    p.add_argument("--no-renders", action="store_true", help="plots only (no pyvista renders, no FE)")
+
+
+def report_command(args) -> int:
+    import study
+    path = checked_archive(args.archive)
+    writable_folder(Path(args.output) if args.output else path.parent)
+    for p in study.write_report(path, args.output, renders=not args.no_renders):
+        print(f"  report: {p}")
+    return 0
 
 
 # ---------------------------------------------------------------- export
@@ -489,6 +516,8 @@ COMMANDS = {
     "fit-contact": ("fit the contact law k_con*delta^m1 to Weber's contact deflection", fit_contact_arguments,
                     fit_contact_command),
     "render": ("plots and renders (PNG) of a run or sweep archive", render_arguments, render_command),
+    "report": ("a report to hand on: one self-contained HTML page and its Markdown twin (scene, summary table "
+               "with units, the model's validation, figures)", report_arguments, report_command),
     "export": ("an archive's variables as CSV (one file per dimension group, units in the header)", export_arguments,
                export_command),
     "precision": ("work-precision study: TE error against wall time for every solver of a scene", precision_arguments,

@@ -89,6 +89,11 @@ def _pct(tab: xr.Dataset, out: str, at: dict, q: float = 0.95) -> tuple[float, f
     return tuple(float(v.sel(bound=b)) for b in ("estimate", "low", "high"))
 
 
+def _bounded(p: tuple[float, float, float]) -> str:
+    """'7.31 [6.51, 7.55]', or the estimate alone where the sample cannot bound it."""
+    return f"{p[0]:.3g} [{p[1]:.3g}, {p[2]:.3g}]" if np.isfinite(p[1:]).all() else f"{p[0]:.3g}"
+
+
 def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
     """The one-paragraph answer from a sampled study's archive and tables."""
     unit = ds[out].attrs.get("units", "")
@@ -100,13 +105,15 @@ def answer(ds: xr.Dataset, tab: xr.Dataset, out: str, limits: dict) -> str:
     if len(points) >= 2:
         change = "raises" if p95[-1][0] > p95[0][0] else "lowers"
         parts.append(f"Going from {labels[0]} to {labels[-1]} {change} the P95 of {out} from "
-                     f"{p95[0][0]:.3g} [{p95[0][1]:.3g}, {p95[0][2]:.3g}] to {p95[-1][0]:.3g} "
-                     f"[{p95[-1][1]:.3g}, {p95[-1][2]:.3g}] {unit} (median {p50[0][0]:.3g} -> {p50[-1][0]:.3g} {unit})")
+                     f"{_bounded(p95[0])} to {_bounded(p95[-1])} {unit} (median {p50[0][0]:.3g} -> {p50[-1][0]:.3g} {unit})")
         for lab, p in zip(labels[1:-1], p95[1:-1]):
-            parts.append(f"{lab}: P95 {p[0]:.3g} [{p[1]:.3g}, {p[2]:.3g}] {unit}")
+            parts.append(f"{lab}: P95 {_bounded(p)} {unit}")
     else:
-        parts.append(f"The P95 of {out} is {p95[0][0]:.3g} [{p95[0][1]:.3g}, {p95[0][2]:.3g}] {unit} "
-                     f"(median {p50[0][0]:.3g} {unit})")
+        parts.append(f"The P95 of {out} is {_bounded(p95[0])} {unit} (median {p50[0][0]:.3g} {unit})")
+    if not all(np.isfinite(p[1:]).all() for p in p95):
+        need = int(tab["sample_percentile"].attrs["min_independent_builds"][list(tab["quantile"].values).index(0.95)])
+        parts.append(f"No 95 % interval bounds these P95s: {tab.attrs['independent_builds']} independent builds a "
+                     f"grid point are fewer than the {need} it takes (a larger --size gives one)")
     if out in limits and "exceedance_probability" in tab:
         probs = [[tab["exceedance_probability"].isel(at).sel(limit=out, bound=b).item() for b in ("estimate", "low", "high")]
                  for at in points]

@@ -26,7 +26,16 @@ from solver import units
 from solver.mbs.energy_guard import energy_error_limit
 from solver.mbs.kernels.status import COMPLETED
 from study.archive.schema import variable
-from study.archive.spectra import amplitude_spectrum, named_peaks, ste_order_spectrum
+from study.archive.spectra import (
+    HANN_MAIN_LOBE_BINS,
+    Peak,
+    amplitude_spectrum,
+    fill_gaps,
+    hole_period_note,
+    named_peaks,
+    ste_order_spectrum,
+    tone_amplitude,
+)
 from study.scene import opening_text
 
 
@@ -75,8 +84,9 @@ def static_variables(res, offset_m: float) -> dict:
     return coords, data
 
 
-def peak_variables(prefix: str, peaks, frequency_per_order: float | None = None) -> tuple[dict, dict]:
-    """A small table of named spectral peaks along dimension ``{prefix}_peak`` (names as coordinate)."""
+def peak_variables(prefix: str, peaks, frequency_per_order: float | None = None, note: str = "") -> tuple[dict, dict]:
+    """A small table of named spectral peaks along dimension ``{prefix}_peak`` (names as coordinate);
+    ``note``: why some named orders are NaN (the amplitudes' attribute ``not_resolved``)."""
     dim = f"{prefix}_peak"
     coords = {dim: variable(dim, np.array([p.name for p in peaks], dtype=object))}
     data = {
@@ -84,6 +94,8 @@ def peak_variables(prefix: str, peaks, frequency_per_order: float | None = None)
         f"{dim}_order": variable(f"{dim}_order", np.array([p.order for p in peaks])),
         f"{dim}_amplitude": variable(f"{dim}_amplitude", np.array([p.amplitude for p in peaks])),
     }
+    if note:
+        data[f"{dim}_amplitude"].attrs["not_resolved"] = note
     if frequency_per_order is not None:
         data[f"{dim}_frequency"] = variable(f"{dim}_frequency", np.array([p.order for p in peaks]) * frequency_per_order)
     return coords, data
@@ -102,8 +114,15 @@ def ste_spectrum_variables(angle_deg, ste_um, z1: int, z2: int, hole_order: floa
     data = {"ste_amplitude": variable("ste_amplitude", amp, resolution_orders=res, zero_padding=pad,
                                   record_driven_revolutions=1.0 / res,
                                   comment="driven rotation = driver rotation * z1/z2; NaN samples interpolated")}
-    c, d = peak_variables("ste", named_peaks(order, amp, hole_order, z2, res,
-                                             revolution_orders=(z2 / z1, 1.0) if revolutions else None))
+    peaks = named_peaks(order, amp, hole_order, z2, res, revolution_orders=(z2 / z1, 1.0) if revolutions else None)
+    x, _ = fill_gaps(ste_um)
+    for i, p in enumerate(peaks):
+        # a once-per-revolution order with whole periods in the record but inside the window's
+        # lobe of DC (R1 on an STE over one driver revolution): the window's leakage of the mean
+        # and of the next orders makes its peak; measured by its own fit instead
+        if p.name in ("R1", "R2") and p.nominal <= HANN_MAIN_LOBE_BINS * res and p.nominal / res >= 1.0 - 1e-3:
+            peaks[i] = Peak(p.name, p.nominal, p.nominal, tone_amplitude(x, p.nominal / res))
+    c, d = peak_variables("ste", peaks, note=hole_period_note(hole_order, res))
     coords.update(c); data.update(d)
     return coords, data
 
@@ -132,7 +151,7 @@ def dynamic_variables(res, spectrum_start: float, driven_speed: float, hole_orde
         if f_rot > 0 and mesh_order:
             peaks = named_peaks(f / f_rot, a, hole_order, mesh_order, 1.0 / (sel.sum() * dt) / f_rot,
                                 revolution_orders=revolution_orders)
-            c, v = peak_variables("dte", peaks, f_rot)
+            c, v = peak_variables("dte", peaks, f_rot, note=hole_period_note(hole_order, 1.0 / (sel.sum() * dt) / f_rot))
             coords.update(c); data.update(v)
     attrs.update(dt_s=res.dt, steps=res.steps, omega_max_rad_s=res.omega_max, dynamic_status=res.message,
                  max_active_teeth=res.max_active_teeth)

@@ -84,6 +84,30 @@ def sideband_orders(hole_order: float, mesh_order: float, resolution: float | No
     return max(1, int(0.5 * float(mesh_order) / n + 1e-9))
 
 
+def hole_period_note(hole_order: float, resolution: float) -> str:
+    """Why a record names no hole order: '' when it spans at least one hole period (1/N of a
+    driven revolution), else the reason (a record shorter than one hole period cannot tell the
+    hole pattern from the window's leakage of its mean). ``resolution`` [orders] = 1 / the
+    record's length in driven revolutions."""
+    n = float(hole_order) if hole_order and hole_order > 0 else 0.0
+    if n <= 0 or not resolution > 0 or n / resolution >= 1.0 - 1e-9:
+        return ""
+    return (f"hole orders not resolved: the record spans {n / resolution:.2f} of a hole period ({360.0 / resolution:.3g} "
+            f"deg of the driven gear's rotation, a hole period {360.0 / n:.3g} deg); a hole order needs at least one "
+            "hole period in the record")
+
+
+def tone_amplitude(x, cycles: float) -> float:
+    """Amplitude of the sinusoid of ``cycles`` periods over the record ``x`` (uniform samples),
+    by least squares with a constant: exact for a periodic signal over whole periods, where a
+    windowed spectrum puts a one-period tone inside the window's lobe of DC."""
+    x = np.asarray(x, float)
+    phase = 2 * np.pi * cycles * np.arange(x.size) / x.size
+    basis = np.column_stack([np.ones(x.size), np.cos(phase), np.sin(phase)])
+    coef, *_ = np.linalg.lstsq(basis, x, rcond=None)
+    return float(np.hypot(coef[1], coef[2]))
+
+
 def sideband_name(kz: str, j: int, sign: str) -> str:
     return f"{kz}{sign}N" if j == 1 else f"{kz}{sign}{j}N"
 
@@ -121,11 +145,13 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
     way; it is NaN when that largest value is not a local maximum (no peak, or only the skirt
     of a neighbouring peak the record is too short to resolve). The sidebands kZ +- jN named
     are those the record resolves (`sideband_orders`); none when the hole order is closer
-    than a main lobe's width. Maxima on DC's main lobe (window leakage of the mean) are never
-    unexplained peaks."""
+    than a main lobe's width; no hole order (jN, kZ +- jN) when the record is shorter than one
+    hole period (`hole_period_note`). Maxima on DC's main lobe (window leakage of the mean) are
+    never unexplained peaks."""
     order = np.asarray(order, float)
     amp = np.asarray(amplitude, float)
     tol = max(HANN_MAIN_LOBE_BINS * resolution, 1e-9)
+    no_holes = bool(hole_period_note(hole_order, resolution))     # shorter than a hole period: no jN, no kZ+-jN
     sidebands = sideband_orders(hole_order, mesh_order, resolution)
     table = named_orders(hole_order, mesh_order, mesh_harmonics, hole_harmonics, revolution_orders, sidebands)
     finite = np.array([0.0] + [o for _, o in table if np.isfinite(o)])
@@ -142,6 +168,8 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
             sel = np.abs(order - o) <= w
             nominal.append(o)
         i = np.flatnonzero(sel)[np.argmax(amp[sel])] if sel.any() else None
+        if no_holes and name.endswith("N"):
+            i = None
         if i is not None and is_peak[i]:
             peaks.append(Peak(name, o, float(order[i]), float(amp[i])))
         else:     # nothing there, or only the skirt of a neighbour's lobe (not resolved)

@@ -87,3 +87,64 @@ def amplitude_at_order(ds: xr.Dataset, order: float, half_width: float = 0.5) ->
     o = ds["order"].values
     sel = np.abs(o - order) <= half_width
     return float(ds["dte_amplitude"].values[sel].max()) if sel.any() else float("nan")
+
+
+# ---------------------------------------------------------------- a second model beside
+
+def add_default_model(ds: xr.Dataset, default: xr.Dataset) -> xr.Dataset:
+    """Store the default model's run ``default`` beside the run archive ``ds`` of another model
+    of the same scene (the paper example runs the paper's model): ``ste_default(angle)`` and
+    ``dte_default(time)`` [um] and its modes as attributes (``default_coupling_model``,
+    ``default_mesh_mode_frequency_hz``, ``default_critical_speed_1z_rad_s``). Returns ``ds``."""
+    name = str(default.attrs.get("coupling_model", "default"))
+    ds.attrs["default_coupling_model"] = name
+    if "ste" in ds and "ste" in default and default.sizes["angle"] == ds.sizes["angle"]:
+        ds["ste_default"] = ("angle", default["ste"].values, {
+            "units": "um", "long_name": f"static transmission error of the default model ({name})"})
+    if "dte" in ds and "dte" in default:
+        t, td = ds["time"].values, default["time"].values
+        dte = default["dte"].values if td.shape == t.shape and np.allclose(td, t) else np.interp(t, td, default["dte"].values)
+        ds["dte_default"] = ("time", dte, {
+            "units": "um", "long_name": f"dynamic transmission error of the default model ({name})"})
+    if "mesh_mode_frequency_hz" in default.attrs:
+        ds.attrs["default_mesh_mode_frequency_hz"] = float(default.attrs["mesh_mode_frequency_hz"])
+        ds.attrs["default_critical_speed_1z_rad_s"] = float(_at(default, "critical_speed", excitation="1Z", mode=0))
+    return ds
+
+
+def _te_numbers(ds: xr.Dataset, ste: str, dte: str) -> dict:
+    """STE peak-to-peak and elastic mean, DTE mean, RMS and peak-to-peak after the ramp [um] of
+    the curves ``ste`` and ``dte`` of a run archive (NaN where it lacks one)."""
+    nan = float("nan")
+    out = dict.fromkeys(("ste_p2p", "ste_elastic_mean", "dte_mean", "dte_rms", "dte_p2p"), nan)
+    if ste in ds:
+        v = ds[ste].values
+        out["ste_p2p"] = float(np.nanmax(v) - np.nanmin(v))
+        out["ste_elastic_mean"] = float(np.nanmean(v) - flank_side(ds) * ds.attrs.get("backlash_offset_um", 0.0))
+    if dte in ds:
+        v = ds[dte].values[ds["time"].values >= ds.attrs.get("spectrum_start_s", 0.0)]
+        if v.size:
+            out.update(dte_mean=float(v.mean()), dte_rms=float(np.sqrt(np.mean((v - v.mean()) ** 2))),
+                       dte_p2p=float(np.ptp(v)))
+    return out
+
+
+COMPARED = (("ste_p2p", "STE peak-to-peak", "um"), ("ste_elastic_mean", "STE mean, elastic part", "um"),
+            ("dte_rms", "DTE RMS after the ramp", "um"), ("dte_p2p", "DTE peak-to-peak after the ramp", "um"),
+            ("mesh_mode_frequency", "mesh mode", "Hz"), ("critical_speed_z", "1Z critical driver speed", "rad/s"))
+
+
+def model_comparison(ds: xr.Dataset) -> list[tuple[str, str, float, float]]:
+    """The default model's numbers beside those of the model the archive ran (after
+    `add_default_model`): [(quantity, unit, default's value, archive model's value)]; [] for an
+    archive with no second model."""
+    if "default_coupling_model" not in ds.attrs:
+        return []
+    ran, dflt = _te_numbers(ds, "ste", "dte"), _te_numbers(ds, "ste_default", "dte_default")
+    nan = float("nan")
+    ran["mesh_mode_frequency"] = float(ds.attrs.get("mesh_mode_frequency_hz", nan))
+    dflt["mesh_mode_frequency"] = float(ds.attrs.get("default_mesh_mode_frequency_hz", nan))
+    ran["critical_speed_z"] = float(_at(ds, "critical_speed", excitation="1Z", mode=0)) if "critical_speed" in ds else nan
+    dflt["critical_speed_z"] = float(ds.attrs.get("default_critical_speed_1z_rad_s", nan))
+    return [(what, unit, dflt[key], ran[key]) for key, what, unit in COMPARED
+            if np.isfinite(dflt[key]) or np.isfinite(ran[key])]

@@ -6,12 +6,18 @@ and first-order and total Sobol indices of the drawn fields. No solver, no plott
 
 Which builds count: those whose ``status`` is 'ok' and whose value is finite (`effects.kept`).
 
-Confidence intervals (level `CONFIDENCE`) come from a bootstrap over the sample's independent
+Confidence intervals (level `CONFIDENCE`). A percentile's interval is distribution-free: the
+order statistics X_(l) <= x_q <= X_(u) of the independent builds whose binomial coverage
+P(l <= B < u), B ~ Binomial(n, q), is at least the level (`quantile_interval`). Where the
+sample cannot support one (8 builds cannot bound a P95 at 95 %: even their largest value lies
+below the P95 with probability 0.95^8 = 0.66) the interval is NaN, and `min_builds` says how
+many builds it takes. The mean's interval comes from a bootstrap over the sample's independent
 draws, `N_BOOT` resamples, percentile method. A plain design's builds are independent draws (for
 'lhs' and 'sobol' more evenly spread than that, so the intervals are on the safe side); in the
 Saltelli design the d + 2 builds of one row (A, B and every AB_i) share their draws, so a
-resample takes whole rows and every build counts in the statistics (each build's inputs follow
-the distributions). The probability of exceeding a limit takes the Clopper-Pearson interval with
+resample takes whole rows, a percentile's interval takes the A and B builds (2 x size
+independent draws), and every build counts in the estimates (each build's inputs follow the
+distributions). The probability of exceeding a limit takes the Clopper-Pearson interval with
 the number of rows as the number of independent trials, so that no exceedance in n rows still
 says how large the probability may be.
 
@@ -80,6 +86,14 @@ def rows_of(ds: xr.Dataset) -> np.ndarray:
     return ds["sample_row"].values if "sample_row" in ds else np.arange(ds.sizes["sample"])
 
 
+def independent_builds(ds: xr.Dataset) -> np.ndarray:
+    """Which builds are independent draws (a boolean mask over ``sample``): every build of a plain
+    design, the A and B builds of a Saltelli design (the AB_i builds repeat their draws)."""
+    if "sample_block" in ds:
+        return ds["sample_block"].values <= 1
+    return np.ones(ds.sizes["sample"], bool)
+
+
 def grouped(values: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """Values over the builds -> (rows, builds per row) in row order, NaN where a row has fewer."""
     values = np.asarray(values, dtype=float)
@@ -135,15 +149,65 @@ def _interval(boot: np.ndarray, level: float) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
+def _order_indices(n: int, q: float, level: float) -> tuple[int, int]:
+    """1-based indices (l, u) of the order statistics that bound the ``q`` quantile of ``n``
+    independent values with coverage at least ``level``, each tail at most (1 - level) / 2:
+    l the largest with P(B <= l - 1) <= a, u the smallest with P(B >= u) <= a, B ~ Binomial(n, q).
+    l < 1 or u > n: the sample cannot support that end."""
+    from scipy.stats import binom
+    a = (1.0 - level) / 2.0
+    lower = int(binom.ppf(a, n, q))                       # smallest k with P(B <= k) >= a: P(B <= lower - 1) < a
+    if lower >= 1 and binom.cdf(lower, n, q) <= a:            # ppf's rounding: the largest l that keeps the tail
+        lower += 1
+    u = int(binom.ppf(1.0 - a, n, q)) + 1             # P(B <= u - 1) >= 1 - a
+    return lower, u
+
+
+def quantile_interval(values: np.ndarray, q: float, level: float = CONFIDENCE) -> tuple[float, float]:
+    """Distribution-free ``level`` interval of the ``q`` quantile from independent ``values``
+    (NaN left out): the order statistics of `_order_indices`. (NaN, NaN) where the sample cannot
+    support one (too few values for that quantile and level: `min_builds`)."""
+    v = np.sort(np.asarray(values, dtype=float)[np.isfinite(values)])
+    if v.size == 0:
+        return np.nan, np.nan
+    lower, u = _order_indices(v.size, q, level)
+    if lower < 1 or u > v.size:
+        return np.nan, np.nan
+    return float(v[lower - 1]), float(v[u - 1])
+
+
+def min_builds(q: float, level: float = CONFIDENCE, limit: int = 100_000) -> int:
+    """The fewest independent builds whose order statistics bound the ``q`` quantile at
+    ``level`` (e.g. 72 for a P95 at 95 %, 6 for the median)."""
+    from scipy.stats import binom
+    a = (1.0 - level) / 2.0
+    n = np.arange(1, limit + 1)
+    ok = (binom.cdf(0, n, q) <= a) & (binom.sf(n - 1, n, q) <= a)     # X_(1) below and X_(n) above often enough
+    return int(n[np.argmax(ok)]) if ok.any() else limit
+
+
+def interval_note(n: int, q: float, level: float = CONFIDENCE) -> str:
+    """Why a percentile has no interval: '8 independent builds cannot bound the P95 at 95 % (it takes 72)'."""
+    return (f"{n} independent builds cannot bound the P{100 * q:g} at {100 * level:g} % "
+            f"(it takes {min_builds(q, level)})")
+
+
 def summary_statistics(values: np.ndarray, rows: np.ndarray | None = None, quantiles=QUANTILES,
-                       level: float = CONFIDENCE, n_boot: int = N_BOOT, seed: int = 0) -> dict:
-    """Mean and ``quantiles`` of ``values`` (NaN left out) with bootstrap intervals over ``rows``
-    (the independent draw of each value; default: each value its own) ->
-    ``{"n": count, "mean": (est, lo, hi), q: (est, lo, hi) ...}``."""
+                       level: float = CONFIDENCE, n_boot: int = N_BOOT, seed: int = 0,
+                       independent: np.ndarray | None = None) -> dict:
+    """Mean and ``quantiles`` of ``values`` (NaN left out): the mean with a bootstrap interval
+    over ``rows`` (the independent draw of each value; default: each value its own), each
+    quantile with its distribution-free interval from the ``independent`` values (a boolean mask;
+    default: the first value of each row) -> ``{"n": count, "n_independent": count,
+    "mean": (est, lo, hi), q: (est, lo, hi) ...}``; an interval the sample cannot support is NaN."""
     values = np.asarray(values, dtype=float)
     rows = np.arange(values.size) if rows is None else np.asarray(rows)
+    if independent is None:
+        independent = np.zeros(values.size, bool)
+        independent[np.unique(rows, return_index=True)[1]] = True
     finite = np.isfinite(values)
-    out: dict = {"n": int(finite.sum())}
+    free = values[finite & np.asarray(independent, bool)]
+    out: dict = {"n": int(finite.sum()), "n_independent": int(free.size)}
     if finite.sum() < 2:
         out["mean"] = (np.nan,) * 3
         out.update({q: (np.nan,) * 3 for q in quantiles})
@@ -154,9 +218,8 @@ def summary_statistics(values: np.ndarray, rows: np.ndarray | None = None, quant
     v = values[finite]
     with np.errstate(all="ignore"):
         out["mean"] = (float(v.mean()), *_interval(np.nanmean(boot, axis=1), level))
-        qs = row_quantiles(boot, list(quantiles))
-    for q, b in zip(quantiles, qs):
-        out[q] = (float(np.quantile(v, q)), *_interval(b, level))
+    for q in quantiles:
+        out[q] = (float(np.quantile(v, q)), *quantile_interval(free, q, level))
     return out
 
 
@@ -179,7 +242,8 @@ def exceedance(values: np.ndarray, limit: float, rows: np.ndarray | None = None,
 
 
 def convergence(values: np.ndarray, wall_time: np.ndarray, rows: np.ndarray | None = None, q: float = 0.95,
-                level: float = CONFIDENCE, n_boot: int = 400, seed: int = 0) -> dict:
+                level: float = CONFIDENCE, n_boot: int = 400, seed: int = 0,
+                independent: np.ndarray | None = None) -> dict:
     """Mean and the ``q`` quantile with their intervals over the first 2^k rows (k = 2, 3, ...,
     then all), and the compute time those builds took (sum of their ``wall_time`` [s]) ->
     {"rows", "builds", "time", "mean", "quantile": arrays, the last two (prefixes, 3)}."""
@@ -190,7 +254,8 @@ def convergence(values: np.ndarray, wall_time: np.ndarray, rows: np.ndarray | No
     mean, quant, time, builds = [], [], [], []
     for n in sizes:
         sel = rows < n
-        s = summary_statistics(values[sel], rows[sel], (q,), level, n_boot, seed)
+        s = summary_statistics(values[sel], rows[sel], (q,), level, n_boot, seed,
+                               None if independent is None else np.asarray(independent)[sel])
         mean.append(s["mean"])
         quant.append(s[q])
         time.append(float(np.nansum(wall_time[sel])))
@@ -278,17 +343,18 @@ def sample_tables(ds: xr.Dataset, outputs: list[str] | None = None, limits: dict
     fields = drawn_fields(ds)
     s1 = np.full(gshape + (no, len(fields), nb), np.nan)
     st = np.full_like(s1, np.nan)
+    free = independent_builds(ds)
     for at in points:
         pos = tuple(at[d] for d in grid_dims(ds))
         wt = wall.isel(at).transpose("sample").values
         for j, var in enumerate(outputs):
             y = output_at(ds, var, at)
-            s = summary_statistics(y, rows, QUANTILES, level)
+            s = summary_statistics(y, rows, QUANTILES, level, independent=free)
             mean[pos + (j,)] = s["mean"]
             count[pos + (j,)] = s["n"]
             for k, q in enumerate(QUANTILES):
                 pct[pos + (j, k)] = s[q]
-            c = convergence(y, wt, rows, 0.95, level)
+            c = convergence(y, wt, rows, 0.95, level, independent=free)
             if conv is None:
                 nr = c["rows"].size
                 conv = {k: np.full(gshape + (no, nr, nb), np.nan) for k in ("mean", "quantile")}
@@ -312,7 +378,9 @@ def sample_tables(ds: xr.Dataset, outputs: list[str] | None = None, limits: dict
     arrays |= _over_grid(ds, {"sample_percentile": pct}, ("output", "quantile", "bound"),
                          {**out_c, "quantile": xr.DataArray(list(QUANTILES), dims="quantile",
                                                             attrs={"units": "1", "long_name": "probability"}), **bound},
-                         {"sample_percentile": {"long_name": "percentile of the output over the builds", "comment": note}})
+                         {"sample_percentile": {"long_name": "percentile of the output over the builds",
+                                                "comment": note + " (order statistics of the independent builds, "
+                                                "binomial coverage; NaN where the sample cannot support one)"}})
     arrays |= _over_grid(ds, {"sample_count": count}, ("output",), out_c,
                          {"sample_count": {"units": "1", "long_name": "builds ok with a finite value"}})
     if limits:
@@ -348,4 +416,5 @@ def sample_tables(ds: xr.Dataset, outputs: list[str] | None = None, limits: dict
     tab = xr.Dataset(arrays)
     tab["output_units"] = xr.DataArray([units[v] for v in outputs], dims="output",
                                        attrs={"long_name": "units of the output (and of its mean and percentiles)"})
-    return tab.assign_attrs(confidence_level=level, bootstrap_resamples=N_BOOT)
+    tab["sample_percentile"].attrs["min_independent_builds"] = np.array([min_builds(q, level) for q in QUANTILES])
+    return tab.assign_attrs(confidence_level=level, bootstrap_resamples=N_BOOT, independent_builds=int(free.sum()))

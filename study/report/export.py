@@ -3,7 +3,8 @@
 One file per dimension group: the variables over the same dimensions share a file, in long
 form (one row per combination of their dimensions' values: the dimension coordinates and
 the other coordinates along them first, then the variables). Dimensionless variables go to
-``scalars.csv`` (name, value, unit, long name), the global attributes to
+``scalars.csv`` (name, value, unit, long name; for a run archive also its summary scalars:
+STE peak-to-peak, DTE mean, RMS and peak-to-peak, ...), the global attributes to
 ``attributes.csv``. Every column's header is ``name [unit]`` (``[-]`` for a dimensionless
 number, nothing for a label). Floats are written with 15 significant digits: a value reads
 back within 1e-15 of the archive's, and a step of 0.1 degree prints as 0.3, not
@@ -40,13 +41,18 @@ def _fmt(v) -> str:
     return str(v.item() if hasattr(v, "item") else v)
 
 
-def export_csv(ds: xr.Dataset, outdir) -> list[Path]:
-    """Write the CSV files of ``ds`` into ``outdir`` (made if needed); return their paths."""
+def export_csv(ds: xr.Dataset, outdir, summary: list | None = None) -> list[Path]:
+    """Write the CSV files of ``ds`` into ``outdir`` (made if needed); return their paths.
+    ``summary``: rows (name, value, unit, long name) of the run's summary scalars (STE
+    peak-to-peak, DTE RMS and mean, ...) that ``scalars.csv`` lists after the archive's own."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     groups: dict[tuple, list] = {}
     for name, var in ds.data_vars.items():
         groups.setdefault(tuple(var.dims), []).append(name)
+    summary = [r for r in (summary or []) if r[0] not in ds.data_vars]
+    if summary:
+        groups.setdefault((), [])
     paths = []
     for dims, names in groups.items():
         path = outdir / f"{group_name(dims)}.csv"
@@ -56,6 +62,8 @@ def export_csv(ds: xr.Dataset, outdir) -> list[Path]:
                 w.writerow(["name", "value", "unit", "long_name"])
                 for n in names:
                     w.writerow([n, _fmt(ds[n].values[()]), ds[n].attrs.get("units", ""), ds[n].attrs.get("long_name", "")])
+                for n, value, unit, long_name in summary:
+                    w.writerow([n, _fmt(float(value)), unit, long_name])
         else:
             sub = ds[names]
             df = sub.to_dataframe().reset_index()

@@ -22,6 +22,7 @@ _PRETTY_UNITS = {"um": "µm", "degree": "°", "N mm rad-1": "N·mm/rad", "N m ra
                  "N mm-1 um-1": "N/(mm·µm)"}
 C_LIGHT, C_SOLID, C_HOLE, C_SIDE, C_OTHER = "#c0392b", "#2c3e50", "#2980b9", "#27ae60", "#7d3c98"
 C_REV = "#d68910"     # once-per-revolution orders of gears with pitch errors or eccentricity
+C_DEFAULT = "#16a085"  # the default model's curve beside another model's (the paper example)
 
 
 def pretty_unit(unit: str | None) -> str:

@@ -22,6 +22,7 @@ from study.report.distributions import (
     QUANTILES,
     drawn_fields,
     grid_points,
+    min_builds,
     output_at,
     point_label,
     sample_outputs,
@@ -29,6 +30,7 @@ from study.report.distributions import (
 )
 from study.report.plot_style import C_HOLE, C_LIGHT, C_SOLID, axis_label, figure_title, pretty_unit, save_figure
 
+ERROR_FLOOR = 1e-6      # errors below this fraction of the output's scale are ties, not points on a log axis
 COLOURS = (C_HOLE, C_LIGHT, C_SOLID, "#27ae60", "#7d3c98", "#d68910", "#16a085", "#7f8c8d")
 
 
@@ -56,13 +58,18 @@ def distribution_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path, limi
         sel = {d: i for d, i in at.items()}
         pct = tables["sample_percentile"].isel(sel).sel(output=var)
         p5, p50, p95 = (_est(pct.sel(quantile=q)) for q in QUANTILES)
-        label = f"{point_label(ds, at)} ({y.size} builds): P95 {p95[0]:.3g} [{p95[1]:.3g}, {p95[2]:.3g}] {unit}"
+        bound = (f"[{p95[1]:.3g}, {p95[2]:.3g}]" if np.isfinite(p95[1:]).all() else
+                 f"(no 95 % interval: it takes {min_builds(0.95)} independent builds)")
+        label = f"{point_label(ds, at)} ({y.size} builds): P95 {p95[0]:.3g} {unit} {bound}"
         if limit is not None and "exceedance_probability" in tables:
             e = _est(tables["exceedance_probability"].isel(sel).sel(limit=var))
             label += f"\nP(> {limit:g}) = {e[0]:.3f} [{e[1]:.3f}, {e[2]:.3f}]"
         ax_c.step(y, np.arange(1, y.size + 1) / y.size, where="post", color=c, lw=1.4, label=label)
         for q, (est, lo, hi) in zip(QUANTILES, (p5, p50, p95)):
-            ax_c.errorbar([est], [q], xerr=[[est - lo], [hi - est]], fmt="o", ms=4, color=c, capsize=3, lw=1.2)
+            if np.isfinite([lo, hi]).all():
+                ax_c.errorbar([est], [q], xerr=[[est - lo], [hi - est]], fmt="o", ms=4, color=c, capsize=3, lw=1.2)
+            else:           # the sample cannot bound this percentile: the estimate alone, open
+                ax_c.plot([est], [q], "o", ms=5, mfc="white", color=c)
         ax_h.hist(y, bins=bins, density=True, histtype="stepfilled", alpha=0.25, color=c)
         ax_h.hist(y, bins=bins, density=True, histtype="step", color=c, lw=1.2, label=point_label(ds, at))
         for est in (p5[0], p50[0], p95[0]):
@@ -75,7 +82,8 @@ def distribution_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path, limi
     ax_c.set_xlabel(axis_label(ds[var], var))
     ax_c.set_ylabel("fraction of builds at or below [–]")
     ax_c.set_ylim(-0.02, 1.02)
-    ax_c.set_title("empirical CDF; dots: P5, P50, P95 with their 95 % intervals", fontsize=9)
+    ax_c.set_title("empirical CDF; dots: P5, P50, P95 with their 95 % intervals (open: too few builds for one)",
+                   fontsize=9)
     ax_c.legend(fontsize=7.5, loc="lower right")
     ax_h.set_xlabel(axis_label(ds[var], var))
     ax_h.set_ylabel(f"probability density [1/{unit}]")
@@ -95,6 +103,7 @@ def convergence_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path):
     builds = tables["convergence_builds"].values
     for col, (name, what) in enumerate((("convergence_mean", "mean"), ("convergence_p95", "P95"))):
         top, bottom = axes[0, col], axes[1, col]
+        lows = []
         for k, at in enumerate(grid_points(ds)):
             c = _colour(k)
             t = tables[name].isel(at).sel(output=var)
@@ -104,14 +113,27 @@ def convergence_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path):
             top.plot(builds, est, marker="o", ms=3, color=c, label=point_label(ds, at))
             half = (hi - lo) / 2.0
             dist = np.abs(est - est[-1])
-            bottom.loglog(time, half, marker="o", ms=3, color=c, label=f"{point_label(ds, at)}: half-width of the 95 % interval")
-            ok = dist > 0
+            # a tie with the whole sample's value (or an interval of tied builds) is an error of 0,
+            # not 1e-16 on a log axis: below a millionth of the output's scale it is left out
+            floor = ERROR_FLOOR * max(float(np.nanmax(np.abs(est), initial=0.0)), float(np.nanmax(half, initial=0.0)))
+            shown = half > floor
+            bottom.loglog(time[shown], half[shown], marker="o", ms=3, color=c,
+                          label=f"{point_label(ds, at)}: half-width of the 95 % interval")
+            ok = dist > floor
             bottom.loglog(time[ok], dist[ok], marker="x", ms=4, ls="--", color=c,
                           label=f"{point_label(ds, at)}: distance to the whole sample's {what}")
+            lows.append(floor)
         top.set_xscale("log", base=2)
         top.set_xlabel("builds [–]")
         top.set_ylabel(f"{what} of {var} [{unit}]")
-        top.set_title(f"{what} with its 95 % interval (bootstrap) over the first builds", fontsize=9)
+        top.set_title(f"{what} with its 95 % interval ({'bootstrap' if what == 'mean' else 'order statistics'}) "
+                      "over the first builds", fontsize=9)
+        if name == "convergence_p95" and np.isnan(tables[name].sel(output=var, bound="low").values).any():
+            top.text(0.02, 0.02, "no band: too few independent builds to bound the P95 at 95 % "
+                                 f"(it takes {min_builds(0.95)})", transform=top.transAxes, fontsize=8, color="0.3")
+        ymin, ymax = bottom.get_ylim()
+        if bottom.has_data() and ymax / ymin > 1e6:      # readable: at most six decades down from the largest error
+            bottom.set_ylim(max(ymin, ymax * 1e-6, max(lows, default=0.0)), ymax)
         bottom.set_xlabel("compute time of those builds [s] (sum of their wall_time)")
         bottom.set_ylabel(f"error of the {what} [{unit}]")
         bottom.set_title(f"error of the {what} against run time (slope -1/2: Monte Carlo)", fontsize=9)
@@ -170,6 +192,35 @@ def sobol_figure(ds: xr.Dataset, tables: xr.Dataset, var: str, path):
     return save_figure(fig, path)
 
 
+def _with_interval(v: tuple[float, float, float]) -> str:
+    return f"{v[0]:.4g} [{v[1]:.4g}, {v[2]:.4g}]" if np.isfinite(v[1:]).all() else f"{v[0]:.4g} (no interval)"
+
+
+def sample_table_text(ds: xr.Dataset, tables: xr.Dataset, outputs: list[str]) -> str:
+    """The statistics of a sampled study as a printed table: per output and grid point the
+    builds kept, the mean and P5 / P50 / P95 with their 95 % intervals (none where the sample
+    cannot support one) and each limit's probability of exceedance."""
+    lines = []
+    for var in outputs:
+        unit = pretty_unit(ds[var].attrs.get("units"))
+        lines.append(f"  {var} [{unit}]: {ds[var].attrs.get('long_name', var)}")
+        for at in grid_points(ds):
+            t = tables.isel(at)
+            cells = [f"{int(t['sample_count'].sel(output=var))} builds",
+                     f"mean {_with_interval(_est(t['sample_mean'].sel(output=var)))}"]
+            cells += [f"P{100 * q:g} {_with_interval(_est(t['sample_percentile'].sel(output=var, quantile=q)))}"
+                      for q in QUANTILES]
+            if "exceedance_probability" in t and var in t["limit"].values:
+                e = _est(t["exceedance_probability"].sel(limit=var))
+                lim = float(t["limit_value"].sel(limit=var))
+                cells.append(f"P(> {lim:g}) {e[0]:.3f} [{e[1]:.3f}, {e[2]:.3f}]")
+            lines.append(f"    {point_label(ds, at)}: " + "; ".join(cells))
+    if any("(no interval)" in line for line in lines):
+        lines.append(f"  (no interval: {tables.attrs['independent_builds']} independent builds a grid point cannot bound "
+                     f"that percentile at 95 %; a P95 takes {min_builds(0.95)}, a median {min_builds(0.5)})")
+    return "\n".join(lines)
+
+
 def sample_figures(ds: xr.Dataset, name, skip, limits: dict | None = None) -> list:
     """Every view of a sampled study (``name(stem)`` -> PNG path, ``skip(what, why)`` prints
     what is left out); the tables go to ``study_tables.nc`` beside them."""
@@ -201,4 +252,6 @@ def sample_figures(ds: xr.Dataset, name, skip, limits: dict | None = None) -> li
     write_netcdf(tables.assign_attrs(attrs, comment="computed by `lightgear render` from the sampled study's builds "
                                                     "(study.report.distributions)"), path)
     print(f"  study tables: {path}")
+    if varying:
+        print(sample_table_text(ds, tables, varying))
     return out

@@ -7,15 +7,45 @@ import numpy as np
 import xarray as xr
 
 from study.archive.run_variables import largest_peaks
-from study.archive.summary import summarize
+from study.archive.summary import model_comparison, summarize
 
 NAMED_SHOWN = 0.01      # named peaks printed: those above this fraction of the largest
+
+# what each model is, in the words a comparison of two of them needs (docs/models.md)
+MODEL_ROLES = {"paper": "the paper's MUBOCO-PR: reproduces the paper",
+               "compliance": "agrees with the FE reference",
+               "body-torsion": "body torsion spring, no tooth-to-tooth coupling"}
+
+
+def model_label(name: str, default: bool = False) -> str:
+    """'default: compliance (agrees with the FE reference)', 'paper (the paper's MUBOCO-PR: ...)'."""
+    role = MODEL_ROLES.get(name)
+    return f"{'default: ' if default else ''}{name}" + (f" ({role})" if role else "")
+
+
+def comparison_lines(ds: xr.Dataset) -> list[str]:
+    """The table of the default model's numbers beside those of the model the archive ran
+    (`study.archive.summary.model_comparison`), as lines; [] when the archive has one model."""
+    rows = model_comparison(ds)
+    if not rows:
+        return []
+    dflt, ran = ds.attrs["default_coupling_model"], str(ds.attrs.get("coupling_model", "?"))
+    width = max(len(f"{q} [{u}]") for q, u, _, _ in rows) + 2
+    out = [f"  two models of this scene (docs/models.md): {model_label(dflt, True)}; {model_label(ran)}",
+           f"    {'':{width}s}{'default: ' + dflt:>22s}{ran:>14s}"]
+    for q, u, d, r in rows:
+        digits = 3 if u == "um" else 0
+        out.append(f"    {q + ' [' + u + ']':{width}s}{d:22.{digits}f}{r:14.{digits}f}")
+    out.append(f"  below: the {ran} model's run in full; ste_default, dte_default: the default's curves")
+    return out
 
 
 def print_summary(ds: xr.Dataset, path, wall: float) -> None:
     s = summarize(ds)
     w = sys.stdout.write
     w(f"{ds.attrs.get('title', '')}\n  archive: {path}\n")
+    for line in comparison_lines(ds):
+        w(line + "\n")
     line = f"  contact ratio {ds.attrs['contact_ratio']:.3f} (geometric)"
     if "loaded_contact_ratio" in s:
         line += f", {s['loaded_contact_ratio']:.3f} loaded (mean loaded pairs, tip corners included)"

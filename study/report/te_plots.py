@@ -20,6 +20,7 @@ import xarray as xr
 
 from study.archive.spectra import HANN_MAIN_LOBE_BINS, sideband_orders
 from study.report.plot_style import (
+    C_DEFAULT,
     C_HOLE,
     C_LIGHT,
     C_OTHER,
@@ -40,7 +41,21 @@ def _runs(mask: np.ndarray):
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
 
 
+LOADED_SHARE = 0.10      # a contact carrying less of the pair's load than this does not count as loaded
 _ZONES = {2: ("2 loaded contacts", "#f5cba7"), 3: ("3 or more loaded contacts", "#e59866")}
+
+
+def loaded_contacts(ds: xr.Dataset) -> np.ndarray | None:
+    """Number of contacts carrying at least `LOADED_SHARE` of the pair's normal load at each STE
+    angle (from ``ste_tooth_force``; ``ste_contacts``, every touching contact, without it): a
+    tooth entering or leaving the mesh with a few newtons is no load share."""
+    if "ste_tooth_force" in ds:
+        f = np.abs(ds["ste_tooth_force"].transpose("angle", ...).values)
+        total = f.sum(axis=1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(total > 0, f / total, 0.0)
+        return (share >= LOADED_SHARE).sum(axis=1)
+    return ds["ste_contacts"].values if "ste_contacts" in ds else None
 _ZONE_WORD = {1: "1", 2: "2", 3: "3"}
 
 
@@ -75,6 +90,18 @@ def hole_mesh_angles(ds: xr.Dataset, angle_max: float) -> np.ndarray:
     return theta[theta <= angle_max]
 
 
+def model_curves(ds: xr.Dataset, what: str) -> tuple[str, str | None, str]:
+    """Labels of the archive model's curve and of the default model's beside it (None when the
+    archive holds one model) for a ``what`` ('STE', 'DTE') plot, and a line for the title saying
+    which is which."""
+    if f"{what.lower()}_default" not in ds:
+        return what if what == "DTE" else "lightened pair", None, ""
+    from study.report.summary import model_label
+    ran, dflt = str(ds.attrs.get("coupling_model", "?")), str(ds.attrs["default_coupling_model"])
+    return (f"{ran} model", f"default model: {dflt}",
+            f"\ntwo models: {model_label(dflt, True)}; {model_label(ran)}")
+
+
 # ------------------------------------------------------------------ STE
 
 def ste_plot(ds: xr.Dataset, path) -> Path:
@@ -84,25 +111,35 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     ang = ds["angle"].values
     off = float(ds.attrs.get("backlash_offset_um", 0.0))
     ste = ds["ste"].values - off            # the elastic part: the rigid half-backlash offset taken out
-    contacts = ds["ste_contacts"].values if "ste_contacts" in ds else None
+    contacts = loaded_contacts(ds)
+    by_share = "ste_tooth_force" in ds
     solid = ds["ste_solid"].values - off if "ste_solid" in ds else None
     holes = hole_mesh_angles(ds, ang[-1])
     nrow = 3 if solid is not None else 2
     fig, axes = plt.subplots(nrow, 1, figsize=(11, 3.0 * nrow + 1.2), constrained_layout=True)
     eps = ds.attrs.get("contact_ratio", float("nan"))
     loaded = f"loaded contact ratio {float(ds['loaded_contact_ratio']):.3f}, " if "loaded_contact_ratio" in ds else ""
+    main, other, which = model_curves(ds, "STE")
+    dflt = ds["ste_default"].values - off if other else None
     figure_title(fig, ds, f"Static transmission error (STE), elastic part: STE less the {off:.3f} µm half-backlash offset; "
-                          f"shading: loaded contacts ({loaded}geometric {eps:.3f}; tip corners count)", width=130)
+                          f"shading: loaded contacts ({loaded}geometric {eps:.3f}; tip corners count"
+                          + (f"; a contact counts when it carries at least {100 * LOADED_SHARE:g} % of the load)" if by_share
+                             else ")") + which, width=130)
     ax = axes[0]
     if contacts is not None:
         _shade_contacts(ax, ang, contacts)
-    ax.plot(ang, ste, color=C_LIGHT, lw=1.0, label="lightened pair")
+    if other:
+        ax.plot(ang, dflt, color=C_DEFAULT, lw=1.0, label=other)
+    ax.plot(ang, ste, color=C_LIGHT, lw=1.0, label=main)
     if solid is not None:
-        ax.plot(ang, solid, color=C_SOLID, lw=0.9, alpha=0.8, label="solid driven gear")
+        ax.plot(ang, solid, color=C_SOLID, lw=0.9, alpha=0.8,
+                label="solid driven gear" + (f" ({main})" if other else ""))
     _mark_holes(ax, holes, ang[0], ang[-1])
     ax.set_xlabel("driver rotation [°]")
     ax.set_ylabel(f"STE − {off:.3f} µm [µm]")
     ax.set_xlim(ang[0], ang[-1])
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 0.5 * (hi - lo))        # room for the legend above the curves
     ax.legend(loc="upper right", fontsize=9, ncol=4, framealpha=0.9)
     ax.grid(alpha=0.3)
     # zoom: three mesh periods
@@ -113,9 +150,13 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
     sel = ang <= ang[0] + 3 * period
     if contacts is not None:
         _shade_contacts(ax, ang[sel], contacts[sel], words=True)
-    ax.plot(ang[sel], ste[sel], color=C_LIGHT, lw=1.5, marker=".", ms=3, label="lightened pair")
+    if other:
+        ax.plot(ang[sel], dflt[sel], color=C_DEFAULT, lw=1.5, marker=".", ms=3, label=other)
+    ax.plot(ang[sel], ste[sel], color=C_LIGHT, lw=1.5, marker=".", ms=3, label=main)
     if solid is not None:
         ax.plot(ang[sel], solid[sel], color=C_SOLID, lw=1.2, alpha=0.8, label="solid driven gear")
+    if other or solid is not None:
+        ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
     ax.set_xlabel(f"driver rotation [°] (zoom: three mesh periods of {period:.3f}°; numbers: loaded contacts)")
     ax.set_ylabel(f"STE − {off:.3f} µm [µm]")
     ax.set_xlim(ang[sel][0], ang[sel][-1])
@@ -135,7 +176,7 @@ def ste_plot(ds: xr.Dataset, path) -> Path:
         ax.set_xlabel("driver rotation [°]")
         ax.set_ylabel("STE difference [µm]")
         ax.set_xlim(ang[0], ang[-1])
-        ax.set_title("effect of the lightening: STE(lightened) − STE(solid)", fontsize=10)
+        ax.set_title("effect of the lightening: STE(lightened) − STE(solid)" + (f", {main}" if other else ""), fontsize=10)
         ax.legend(loc="upper right", fontsize=9, ncol=3, framealpha=0.9)
         ax.grid(alpha=0.3)
     return save_figure(fig, path)
@@ -157,7 +198,9 @@ def dte_plot(ds: xr.Dataset, path) -> Path:
     ramp = float(ds.attrs.get("ramp_time_s", 0.0))
     start = float(ds.attrs.get("spectrum_start_s", ramp))
     fig, axes = plt.subplots(2, 1, figsize=(11, 7.5), constrained_layout=True)
-    figure_title(fig, ds, "Dynamic transmission error (DTE)")
+    main, other, which = model_curves(ds, "DTE")
+    dflt = ds["dte_default"].values if other else None
+    figure_title(fig, ds, "Dynamic transmission error (DTE)" + which)
     ax = axes[0]
     speed_end = float(ds.attrs.get("runup_speed_end_rad_s", 0.0))
     if speed_end > 0:      # a run-up: one speed ramp over the whole run, no steady spectrum
@@ -169,9 +212,11 @@ def dte_plot(ds: xr.Dataset, path) -> Path:
     else:
         ax.axvspan(t[0], ramp, color="#f9e79f", alpha=0.7, lw=0, label=f"speed and torque ramp (0–{ramp * 1e3:.3g} ms)")
         ax.axvline(start, color="0.3", ls=":", lw=1.2, label=f"spectrum from {start * 1e3:.3g} ms")
-    ax.plot(t, dte, color=C_LIGHT, lw=0.6, label="DTE")
+    if other:
+        ax.plot(t, dflt, color=C_DEFAULT, lw=0.6, label=other)
+    ax.plot(t, dte, color=C_LIGHT, lw=0.6, label=main)
     if "ste" in ds:
-        ax.axhline(float(np.nanmean(ds["ste"].values)), color=C_SOLID, ls="--", lw=1.0, label="mean STE")
+        ax.axhline(float(np.nanmean(ds["ste"].values)), color=C_SOLID, ls="--", lw=1.0, label="mean STE" + (f" ({main})" if other else ""))
     ax.set_xlabel("time [s]")
     ax.set_ylabel("DTE [µm]")
     ax.set_xlim(t[0], t[-1])
@@ -191,9 +236,13 @@ def dte_plot(ds: xr.Dataset, path) -> Path:
     else:
         span, what = 0.1 * (t[-1] - t[0]), "last 10 %"
     sel = t >= max(t[-1] - span, start)
-    ax.plot(t[sel] * 1e3, dte[sel], color=C_LIGHT, lw=1.0)
+    if other:
+        ax.plot(t[sel] * 1e3, dflt[sel], color=C_DEFAULT, lw=1.0, label=other)
+    ax.plot(t[sel] * 1e3, dte[sel], color=C_LIGHT, lw=1.0, label=main)
     if "ste" in ds:
-        ax.axhline(float(np.nanmean(ds["ste"].values)), color=C_SOLID, ls="--", lw=1.0, label="mean STE")
+        ax.axhline(float(np.nanmean(ds["ste"].values)), color=C_SOLID, ls="--", lw=1.0,
+                   label="mean STE" + (f" ({main})" if other else ""))
+    if other or "ste" in ds:
         ax.legend(loc="lower right", fontsize=9)
     ax.set_xlabel(f"time [ms] (zoom on the end: {what})")
     ax.set_ylabel("DTE [µm]")
@@ -295,9 +344,11 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
         a = ds["dte_amplitude"].attrs
         res = a.get("resolution_Hz", float("nan"))
         f_rot = float(ds.attrs.get("driven_speed_rad_s", 0.0)) / (2 * np.pi)
+        unresolved = ds["dte_peak_amplitude"].attrs.get("not_resolved", "") if "dte_peak_amplitude" in ds else ""
         spectrum_panel(axes[i, 0], order, amp, peaks, xmax, "DTE",
-                        f"{a.get('window', '?')} window, resolution {res:.3g} Hz = {res / f_rot:.3g} orders, "
-                        f"from {a.get('start_s', float('nan')) * 1e3:.3g} ms" if f_rot > 0 else "")
+                        (f"{a.get('window', '?')} window, resolution {res:.3g} Hz = {res / f_rot:.3g} orders, "
+                         f"from {a.get('start_s', float('nan')) * 1e3:.3g} ms" if f_rot > 0 else "")
+                        + (f"\n{unresolved}" if unresolved else ""))
         ax = axes[i, 0]
         ax.set_xlabel("order of the driven gear's rotation [–]")
         if f_rot > 0:
@@ -319,6 +370,8 @@ def spectrum_plot(ds: xr.Dataset, path) -> Path:
             need_deg = 360.0 * 2 * HANN_MAIN_LOBE_BINS / n_h * ratio
             note = (f"\nhole sidebands kZ ± jN not resolved: their main lobes (± {HANN_MAIN_LOBE_BINS * res:.3g} orders) "
                     f"overlap at N = {n_h:g}; an STE over {need_deg:.0f}° of driver rotation or more resolves them")
+        if "ste_peak_amplitude" in ds and ds["ste_peak_amplitude"].attrs.get("not_resolved"):
+            note += "\n" + ds["ste_peak_amplitude"].attrs["not_resolved"]
         spectrum_panel(axes[i, 0], order, amp, _peak_table(ds, "ste"), xmax, "STE",
                         f"{a.get('window', '?')} window, resolution {res:.3g} orders "
                         f"({a.get('record_driven_revolutions', float('nan')):.3g} driven revolutions), "

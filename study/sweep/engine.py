@@ -460,9 +460,15 @@ def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | 
             fut = client.submit(run_after, tuple((t.key, t.scene, t.outputs) for t in batch), *waits, key=name,
                                 pure=False, parts=stored_here(keys))
             futures[fut] = keys
+        fe_done = {f: k for k, f in maps.items()}      # said as each ends (the progress bar counts them)
         del maps, after     # the tasks hold the maps' futures now; dask forgets each map once its tasks ran
         try:
-            for fut in as_completed(futures):
+            for fut in as_completed([*futures, *fe_done]):
+                if fut in fe_done:
+                    key = fe_done.pop(fut)
+                    fut.release()
+                    yield key, {"fe_done": True}
+                    continue
                 keys = futures.pop(fut)
                 try:
                     done = fut.result()
@@ -472,6 +478,48 @@ def _with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | 
                 yield from done
         finally:
             client.cancel(list(futures))
+            fe_done.clear()
+
+
+def study_progress(title: str, points: int, tasks: list, in_process: bool, workers: int | None, show: bool):
+    """The study's progress bar (`study.sweep.progress.StudyProgress`): its analyses and the FE
+    jobs they read, with their estimated costs, on the workers that run them."""
+    from study import estimate
+    from study.inputs.gearsetup import gear_setups
+    from study.sweep.bodies import compute_body, fe_jobs
+    from study.sweep.progress import COMPILE_S, START_S, StudyProgress
+    costs = estimate.progress_seconds(tasks) if show else {t.key: 1.0 for t in tasks}
+    fe_costs, first_reader = {}, {}
+    for t in tasks if show else ():
+        for fe_key, func, args in fe_jobs(t.scene):
+            if fe_key not in fe_costs:
+                # a compliance body loads every tooth at 8 profile points: about 1.5 spring maps
+                if func is compute_body:
+                    fe_costs[fe_key] = 1.5 * estimate.body_seconds(gear_setups(args[0])[args[1] - 1])
+                else:       # a spring map: its load cases, one a tooth (a solid reference loads one)
+                    setup, teeth = args[0], args[1]
+                    share = 1.0 if teeth is None else max(0.1, len(teeth) / setup.teeth)
+                    fe_costs[fe_key] = share * estimate.body_seconds(setup)
+                first_reader.setdefault(t.key, []).append(fe_key)
+    coupled = any(t.scene.coupling_model != "none" for t in tasks if t.outputs.dynamic) if tasks else None
+    startup = (0.0 if in_process else START_S) + (0.0 if kernels_cached(coupled) else COMPILE_S)
+    parallel = 1 if in_process else (workers or os.cpu_count() or 1)
+    return StudyProgress(title, points, fe_costs, costs, parallel, startup, show,
+                         fe_in_tasks=first_reader if in_process else None)
+
+
+@contextlib.contextmanager
+def quiet_on_interrupt():
+    """Within: a Ctrl-C (KeyboardInterrupt) first silences dask's loggers, then goes on: the
+    cluster then closes under the running tasks, and its connection errors (CommClosedError
+    tracebacks) are no news to the user, who gets the one line of the command."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        import logging
+        for name in ("distributed", "tornado", "asyncio"):
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        raise
 
 
 def lost_cause(e: BaseException) -> str:
@@ -506,8 +554,6 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     study too large to list or whose missing tasks are estimated to take longer in all
     (`study.estimate.sweep_estimate`, CPU seconds summed over the tasks).
     """
-    from tqdm import tqdm
-
     from study import estimate
     from study.archive.netcdf import write_netcdf
 
@@ -543,9 +589,13 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
         for idx, w in waiting.items():
             for k in w:
                 users.setdefault(k, []).append(idx)
-        with contextlib.closing(run), tqdm(total=len(waiting), desc=study.title[:40], unit="point",
-                                           disable=not progress, file=sys.stderr) as bar:
-            for n_done, (key, res) in enumerate(run, 1):
+        in_process = workers == 0 and not scheduler
+        with contextlib.closing(run), study_progress(study.title, len(waiting), [tasks[k] for k in todo], in_process,
+                                                     workers, progress) as bar, quiet_on_interrupt():
+            for key, res in run:
+                if res.get("fe_done"):
+                    bar.fe_done(key)
+                    continue
                 if "lost" in res:
                     lost[key] = res["lost"]
                 else:
@@ -556,8 +606,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
                 for idx in users.get(key, ()):
                     waiting[idx].discard(key)
                     finished += not waiting[idx]
-                bar.set_postfix_str(f"analyses {n_done}/{len(todo)}", refresh=False)
-                bar.update(finished)
+                bar.task_done(key, res.get("wall_time"), finished)
     shared = Counter(k for keys in of_point.values() for k in keys)
     per_point = {p.index: invalid_result(p, out) for p in points if p.scene is None}
     lost_points = {}

@@ -226,6 +226,49 @@ def outputs_from_table(table) -> Outputs:
     return Outputs(tuple(dict.fromkeys(scalars)), tuple(dict.fromkeys(curves)))
 
 
+def summary_rows(ds) -> list[tuple[str, float, str, str]]:
+    """A run archive's summary scalars (`study.archive.summary.summarize`: STE peak-to-peak,
+    DTE mean and RMS, ...) with their declared units and long names: [(name, value, units,
+    long name)]; [] for a sweep archive (its scalars are variables already)."""
+    if "status" in ds.data_vars:
+        return []
+    from study.archive.summary import summarize
+    return [(k, v, SCALARS[k].units, SCALARS[k].long_name) for k, v in summarize(ds).items() if k in SCALARS]
+
+
+def report_rows(ds) -> tuple[list[tuple], list[str]]:
+    """What a report (`study.report`) tables of an archive: rows (name, value or text, units,
+    long name) of its summary scalars, and Markdown blocks to add (the default model's numbers
+    beside the archive's; a sampled study's statistics over the builds)."""
+    import numpy as np
+    extra = []
+    if "status" not in ds.data_vars:        # a run
+        from study.archive.summary import model_comparison
+        rows = model_comparison(ds)
+        if rows:
+            dflt, ran = ds.attrs["default_coupling_model"], ds.attrs.get("coupling_model", "?")
+            extra.append("## Two models of this scene\n\n| quantity | unit | default: " + dflt + " | " + ran + " |\n"
+                         "|---|---|---|---|\n" + "\n".join(f"| {q} | {u} | {d:.4g} | {r:.4g} |" for q, u, d, r in rows))
+        return summary_rows(ds), extra
+    ok = ds["status"].values == STATUS.index("ok")
+    rows = []
+    for name, s in SCALARS.items():
+        if name not in ds.data_vars:
+            continue
+        v = ds[name].broadcast_like(ds["status"]).values[ok]
+        v = v[np.isfinite(v)]
+        text = (f"{v.min():.4g} to {v.max():.4g}, mean {v.mean():.4g} over {v.size} points" if v.size else
+                "no point ok")
+        rows.append((name, text, s.units, s.long_name))
+    if "sample" in ds.dims:
+        from study.report.distributions import sample_outputs, sample_tables
+        from study.report.sample_views import sample_table_text
+        outputs = [v for v in sample_outputs(ds) if v in SCALARS]
+        extra.append("## Statistics over the builds\n\n```text\n"
+                     + sample_table_text(ds, sample_tables(ds, outputs), outputs) + "\n```")
+    return rows, extra
+
+
 def summarize_sweep(ds) -> dict:
     """The scalars of a sweep archive: {name: DataArray over the swept dimensions}, NaN where
     the point's status is not ok (an output not over every swept dimension is broadcast)."""

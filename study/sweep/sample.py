@@ -14,8 +14,9 @@ The ``[sample]`` table of a study file (or ``make_study(..., sample=...)``)::
 
 Any numeric scene field can be drawn: ``uniform = [lo, hi]`` and ``normal = [mean, sd]`` for a
 real field, ``integers = [lo, hi]`` for an integer one (or a real one). A normal is truncated to
-its ``bounds`` and to the field's own range (``tip_relief >= 0``, say). A distribution that
-cannot be drawn (lo >= hi, sd <= 0, a field that is not a number, a range outside the field's)
+its ``bounds`` and to the field's own range (``tip_relief >= 0``, say). A zero-width
+distribution (lo = hi, sd = 0) holds the field at that value in every build: one tolerance
+switched off inside a sample. A distribution that cannot be drawn (lo > hi, sd < 0, a field that is not a number, a range outside the field's)
 is a `SceneError` naming the field, raised before any work.
 
 Draws: ``size`` points of the unit hypercube (one column per drawn field) by the method, each
@@ -66,6 +67,8 @@ class Distribution:
         if self.kind == "integers":
             x = np.minimum(np.floor(a + u * (b - a + 1.0)), b)
             return x.astype(np.int64) if self.integer else x
+        if b == 0.0:         # no spread: the mean in every build
+            return np.full(u.shape, float(a))
         from scipy.stats import truncnorm
         lo, hi = self.bounds
         return truncnorm.ppf(u, (lo - a) / b, (hi - a) / b, loc=a, scale=b)
@@ -73,10 +76,17 @@ class Distribution:
     def describe(self) -> str:
         """The distribution in words, e.g. 'normal(2, 0.5) within [1, 3]'."""
         a, b = self.params
+        if self.fixed:
+            return f"{self.kind} [{a:g}, {b:g}]: fixed at {a:g}"
         if self.kind == "normal":
             lo, hi = self.bounds
             return f"normal(mean {a:g}, sd {b:g}) within [{lo:g}, {hi:g}]"
         return f"{self.kind} [{a:g}, {b:g}]" + (" (ends included)" if self.kind == "integers" else "")
+
+    @property
+    def fixed(self) -> bool:
+        """A zero-width distribution (lo = hi, sd = 0): the same value in every build."""
+        return self.params[1] == 0.0 if self.kind == "normal" else self.params[0] == self.params[1]
 
     def spec(self) -> dict:
         """The TOML table this distribution was given as (bounds only where given)."""
@@ -248,16 +258,16 @@ def distribution(base: dict, path: str, spec) -> Distribution:
         lo, hi = _pair(path, kind, spec[kind], "lo, hi")
         if kind == "integers" and not (float(lo).is_integer() and float(hi).is_integer()):
             raise SceneError(path, f"[sample] integers takes two integers, got {spec[kind]!r}")
-        if not lo < hi:
-            raise SceneError(path, f"[sample] {kind} [lo, hi] needs lo < hi, got [{lo}, {hi}]")
+        if not lo <= hi:     # lo = hi: the field held at that value (a tolerance switched off)
+            raise SceneError(path, f"[sample] {kind} [lo, hi] needs lo <= hi (lo = hi: a fixed value), got [{lo}, {hi}]")
         for v, what in ((lo, "lower end"), (hi, "upper end")):
             _check_in_field(base, path, int(v) if integer else float(v), f"{kind} {what}")
         if kind == "integers":
             lo, hi = int(lo), int(hi)
         return Distribution(path, kind, (lo, hi), (lo, hi), integer)
     mean, sd = _pair(path, kind, spec[kind], "mean, sd")
-    if not sd > 0:
-        raise SceneError(path, f"[sample] normal [mean, sd] needs sd > 0, got sd = {sd}")
+    if not sd >= 0:      # sd = 0: the field held at its mean (a tolerance switched off)
+        raise SceneError(path, f"[sample] normal [mean, sd] needs sd >= 0 (0: a fixed value), got sd = {sd}")
     given = None
     lo, hi = field_lo, field_hi
     if "bounds" in spec:

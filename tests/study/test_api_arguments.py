@@ -113,7 +113,7 @@ def test_every_cli_command_has_its_function_in_the_api():
     from study.cli import COMMANDS
     api = {"run": "run_scene", "stiffness": "stiffness", "sweep": "run_sweep", "fit-contact": "fit_contact",
            "render": "render", "precision": "precision", "reference": "reference", "scenes": "scenes",
-           "fields": "fields", "outputs": "outputs", "export": "export"}
+           "fields": "fields", "outputs": "outputs", "export": "export", "report": "write_report"}
     for command in COMMANDS:
         assert command in api and api[command] in study.__all__, command
         doc = getattr(study, api[command]).__doc__

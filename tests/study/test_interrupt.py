@@ -143,8 +143,30 @@ def test_sweep_stops_on_sigint_and_sigterm_and_resumes(tmp_path, workers):
         assert code == 130 and took < STOP_WITHIN_S, err
         assert "interrupted" in err and not out.exists()
         assert len(list(parts.glob("*.pkl"))) == 1
+        # one line, saying what was really kept (no dask traceback)
+        lines = [line for line in err.splitlines() if line.strip()]
+        assert lines == [f"lightgear sweep: interrupted: 1 finished analysis kept in {parts}; the same command "
+                         "resumes from them"], err
         # resumable: the same study at a sane step reuses the stored static task
         done = cli(["sweep", fast, "-o", out, "--workers", 0, "--no-progress"], tmp_path)
         assert done.wait(timeout=600) == 0, (tmp_path / "err.txt").read_text()
         text = (tmp_path / "out.txt").read_text()
         assert "computed 1, reused 1" in text and "ok 1" in text
+
+
+def test_an_interrupt_before_any_analysis_finished_says_nothing_was_kept(tmp_path, monkeypatch, capsys):
+    """Ctrl-C before the first analysis is stored: one line, and no claim of kept points in a
+    folder that does not exist."""
+    import study.sweep.engine as engine
+    from study.cli import main
+
+    def put(self, key, result):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(engine.PartStore, "put", put)
+    study = slow_study(tmp_path, "0.0", speeds="50.0, 60.0")
+    out = tmp_path / "s.nc"
+    assert main(["sweep", str(study), "-o", str(out), "--workers", "0", "--no-progress"]) == 130
+    err = capsys.readouterr().err
+    assert [line for line in err.splitlines() if line.strip()] == [
+        "lightgear sweep: interrupted: no analysis had finished: nothing kept (the same command starts the study again)"]
+    assert not out.exists() and "kept in" not in err

@@ -51,8 +51,8 @@ def test_set_holes_puts_the_count_run_in_the_archive_and_figure_titles(eight_hol
         title = ds.attrs["title"]
     assert "8 holes" in title and "6 holes" not in title
     pngs = sorted(eight_holes.glob("*.png"))
-    assert {p.stem for p in pngs} >= {"ste", "dte", "spectrum", "tooth_stiffness", "campbell", "gear_pair",
-                                      "fe_stress_gear2"}
+    assert {p.stem for p in pngs} >= {f"h8_{n}" for n in ("ste", "dte", "spectrum", "tooth_stiffness", "campbell",
+                                                           "gear_pair", "fe_stress_gear2")}
     for p in pngs:
         t = Image.open(p).info.get("Title", "")
         assert "8 holes" in t and "6 holes" not in t, (p.name, t)

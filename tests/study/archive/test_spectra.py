@@ -187,3 +187,45 @@ def test_every_resolved_hole_sideband_is_named_and_dc_leakage_is_no_peak():
     assert sideband_orders(n, z, 3.0) == 0
     coarse = [p.name for p in named_peaks(o, amp, n, z, resolution=3.0)]
     assert "Z" in coarse and not any("Z-" in nm or "Z+" in nm for nm in coarse)
+
+
+def _dte_record(speed, duration, n_holes=4, z=20, start=0.0):
+    """A DTE of a 20-tooth pair with 4 holes over ``duration`` s at driven ``speed`` [rad/s]."""
+    f_rot = speed / (2 * np.pi)
+    dt = 1e-5
+    t = np.arange(int(round(duration / dt)) + 1) * dt
+    te = 40e-6 + 0.3e-6 * np.sin(2 * np.pi * z * f_rot * t) + 0.08e-6 * np.sin(2 * np.pi * n_holes * f_rot * t + 0.4)
+    res = SimpleNamespace(time=t, te=te, force_max=np.zeros_like(t), n_contacts=np.zeros(t.size, int),
+                          driver_torque=np.zeros_like(t), energy_error=np.zeros_like(t), potential=np.zeros_like(t),
+                          dissipated=np.zeros_like(t), status=0, dt=dt,
+                          steps=t.size, omega_max=1.0, message="ok", max_active_teeth=4)
+    coords, data, _ = run_variables.dynamic_variables(res, start, speed, n_holes, z)
+    return dict(zip(list(coords["dte_peak"].values), data["dte_peak_amplitude"].values)), data
+
+
+def test_a_record_shorter_than_one_hole_period_names_no_hole_order_and_says_why():
+    """52 deg of the driven gear's rotation (5 rad/s for 0.18 s) against a hole period of
+    90 deg: no N, no 2N (the record cannot tell the hole pattern from its own mean), NaN with
+    the reason; the mesh order, with 2.9 periods a tooth pitch, is still named. A record of two
+    hole periods names N again."""
+    amp, data = _dte_record(5.0, np.radians(52.0) / 5.0)
+    assert np.isnan(amp["N"]) and np.isnan(amp["2N"]) and np.isfinite(amp["Z"])
+    note = data["dte_peak_amplitude"].attrs["not_resolved"]
+    assert "0.58 of a hole period" in note and "90 deg" in note
+    amp, data = _dte_record(5.0, np.radians(180.0) / 5.0)
+    assert amp["N"] == pytest.approx(0.08, rel=0.2) and "not_resolved" not in data["dte_peak_amplitude"].attrs
+
+
+def test_the_once_per_revolution_order_of_a_whole_revolution_ste_is_measured():
+    """An STE over exactly one driver revolution (3601 angles at 0.1 deg) of a 67/67 pair with a
+    runout wave of 7 um and a twice-per-revolution one of 4 um: R1 is one period in the record,
+    inside the window's lobe of DC (the windowed spectrum reads NaN or 8-9 um there, by phase),
+    and is measured by its own fit: 7 um within 0.5 % at every phase."""
+    angle = np.arange(3601) * 0.1
+    theta = np.radians(angle)
+    for phase in (0.3, 1.2, 2.0):
+        ste = 40.0 + 7.0 * np.cos(theta + phase) + 4.0 * np.cos(2 * theta - 0.7) + 0.2 * np.cos(67 * theta)
+        c, d = run_variables.ste_spectrum_variables(angle, ste, 67, 67, 6.0, revolutions=True)
+        amp = dict(zip(list(c["ste_peak"].values), d["ste_peak_amplitude"].values))
+        assert amp["R1"] == pytest.approx(7.0, rel=0.005) and amp["R2"] == pytest.approx(7.0, rel=0.005), phase
+        assert d["ste_peak_order"].values[0] == 1.0 and amp["Z"] == pytest.approx(0.2, rel=0.16)

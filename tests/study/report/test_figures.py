@@ -183,7 +183,12 @@ def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
     path = tmp_path / "run.nc"
     write_netcdf(ds, path)
     assert main(["render", str(path), "--no-renders"]) == 0
-    assert {p.name for p in tmp_path.glob("*.png")} == {"ste.png", "dte.png", "spectrum.png", "tooth_stiffness.png", "campbell.png"}
+    # named after the archive: two archives rendered into one folder keep their own figures
+    assert {p.name for p in tmp_path.glob("*.png")} == {f"run_{n}.png" for n in ("ste", "dte", "spectrum", "tooth_stiffness",
+                                                                              "campbell")}
+    write_netcdf(ds, tmp_path / "other.nc")
+    assert main(["render", str(tmp_path / "other.nc"), "--no-renders"]) == 0
+    assert len(list(tmp_path.glob("run_*.png"))) == len(list(tmp_path.glob("other_*.png"))) == 5
 
 
 def test_hole_passes_on_the_ste_axis_follow_the_gear_ratio():
@@ -208,3 +213,30 @@ def test_axis_labels_leave_a_long_names_remark_to_the_archive():
     assert axis_label(speed) == "final driver speed [rad/s]"
     short = xr.DataArray([1.0], dims="x", attrs={"units": "mm", "long_name": "rim (l1)"})
     assert axis_label(short) == "rim (l1) [mm]"
+
+
+def test_contact_shading_counts_the_contacts_that_carry_a_share_of_the_load(tmp_path, monkeypatch):
+    """Where one tooth carries 918 of 1060 N and two others 71 N each, one contact is loaded,
+    not three; a real double contact (560 / 500 N) stays two, and three real shares stay three."""
+    from study.report import te_plots
+    ang = np.arange(0.0, 6.0, 0.1)
+    force = np.zeros((ang.size, 4))
+    force[:, 0] = 1060.0
+    force[10:20] = [918.0, 71.0, 71.0, 0.0]
+    force[20:30] = [560.0, 500.0, 0.0, 0.0]
+    force[30:40] = [400.0, 350.0, 310.0, 0.0]
+    touching = (force > 0).sum(axis=1)
+    ds = xr.Dataset({"ste": ("angle", np.full(ang.size, 40.0), {"units": "um"}),
+                     "ste_contacts": ("angle", touching),
+                     "ste_tooth_force": (("angle", "driver_tooth"), force, {"units": "N"})},
+                    coords={"angle": ang}, attrs={"backlash_offset_um": 33.0, "contact_ratio": 1.8})
+    n = te_plots.loaded_contacts(ds)
+    assert list(n[[5, 15, 25, 35]]) == [1, 1, 2, 3] and touching[15] == 3
+    figures = []
+    monkeypatch.setattr(te_plots, "save_figure", lambda fig, path: figures.append(fig) or path)
+    te_plots.ste_plot(ds, tmp_path / "ste.png")
+    ax = figures[0].axes[0]
+    spans = [(p.get_label(), p.get_x(), p.get_x() + p.get_width()) for p in ax.patches]
+    three = [(a, b) for label, a, b in spans if label == "3 or more loaded contacts"]
+    assert three and all(a > 2.9 and b < 4.0 for a, b in three)      # only 3.0-3.9 deg: the real triple share
+    assert "at least 10 % of the load" in figures[0]._suptitle.get_text()

@@ -10,7 +10,15 @@ from scipy import stats
 from sweep_cases import BASE, assert_refused_before_any_work, count_points, ctrl_c_after_stored
 
 from study.cli import main
-from study.report.distributions import exceedance, sample_tables, sobol_indices, summary_statistics
+from study.report.distributions import (
+    exceedance,
+    interval_note,
+    min_builds,
+    quantile_interval,
+    sample_tables,
+    sobol_indices,
+    summary_statistics,
+)
 from study.scene import SceneError
 from study.sweep.engine import parts_folder, run_sweep
 from study.sweep.grid import loads_study, make_study
@@ -74,9 +82,9 @@ def test_the_moments_of_each_distribution_within_sampling_error(method, dist, me
 
 
 @pytest.mark.parametrize("sample, field, reason", [
-    ('size = 8\n"gear1.errors.eccentricity" = {uniform = [6.0, 1.0]}', ECC, "needs lo < hi"),
+    ('size = 8\n"gear1.errors.eccentricity" = {uniform = [6.0, 1.0]}', ECC, "needs lo <= hi"),
     ('size = 8\n"gear1.errors.eccentricity" = {uniform = [-1.0, 3.0]}', ECC, "outside the field's range"),
-    ('size = 8\n"gear1.errors.eccentricity" = {normal = [2.0, -0.5]}', ECC, "sd > 0"),
+    ('size = 8\n"gear1.errors.eccentricity" = {normal = [2.0, -0.5]}', ECC, "sd >= 0"),
     ('size = 8\n"gear1.errors.eccentricity" = {normal = [2.0, 0.5], bounds = [3.0, 1.0]}', ECC, "lo < hi"),
     ('size = 8\n"gear1.errors.eccentricity" = {normal = [-2.0, 0.5]}', ECC, "outside the range"),
     ('size = 8\n"gear1.errors.eccentricity" = {uniform = [0.0, 1.0], bounds = [0.0, 1.0]}', ECC, "bounds go with"),
@@ -143,6 +151,50 @@ def test_sobol_indices_of_the_ishigami_function_within_their_intervals():
     assert sobol_indices(y, s.block, s.row)["rows"] == 1023
 
 
+@pytest.mark.parametrize("spec, value", [({"uniform": [2.0, 2.0]}, 2.0), ({"normal": [2.0, 0.0]}, 2.0),
+                                         ({"normal": [2.0, 0.0], "bounds": [1.0, 3.0]}, 2.0)])
+def test_a_zero_width_distribution_holds_the_field_at_its_value(spec, value):
+    """One tolerance switched off inside a sample: the field is the same in every build, the
+    other drawn fields still vary."""
+    st = make_study(small_scene(), grid=None, outputs=["ste_p2p"],
+                    sample={"size": 8, "method": "lhs", "seed": 2, ECC: spec,
+                            "gear1.errors.eccentricity_phase": {"uniform": [0.0, 360.0]}})
+    v = st.sample.values
+    assert np.all(v[ECC] == value) and np.ptp(v["gear1.errors.eccentricity_phase"]) > 0
+    assert "fixed at 2" in st.sample.fields[0].describe()
+    seeds = make_study(small_scene(), outputs=["ste_p2p"],
+                       sample={"size": 4, "gear1.errors.seed": {"integers": [5, 5]}}).sample.values["gear1.errors.seed"]
+    assert seeds.dtype.kind == "i" and set(seeds) == {5}
+
+
+def small_scene():
+    """The base scene of the sampled studies here."""
+    return sampled('size = 2\n"gear1.errors.eccentricity" = {uniform = [0.0, 1.0]}').base_scene()
+
+
+def test_a_percentile_interval_is_distribution_free_and_none_where_the_sample_cannot_bound_it():
+    """Order statistics with binomial coverage: the P95 interval of 8 builds does not exist (all
+    8 lie below the P95 with probability 0.95^8 = 0.66); the smallest sample that bounds it at
+    95 % has 72 builds, [X_(65)...] covering at least 95 % whatever the distribution."""
+    rng = np.random.default_rng(3)
+    assert np.isnan(quantile_interval(rng.normal(size=8), 0.95)).all()
+    assert "8 independent builds cannot bound the P95 at 95 % (it takes 72)" == interval_note(8, 0.95)
+    assert min_builds(0.95) == 72 and min_builds(0.05) == 72 and min_builds(0.5) == 6
+    assert 0.95 ** 72 <= 0.025 < 0.95 ** 71
+    # coverage, checked by simulation on a skewed distribution: at least 95 % of 4000 samples of 100
+    exact = stats.lognorm(1.0).ppf(0.95)
+    hits = [lo <= exact <= hi for lo, hi in (quantile_interval(stats.lognorm(1.0).rvs(100, random_state=rng), 0.95)
+                                             for _ in range(4000))]
+    assert np.mean(hits) >= 0.95 - 3 * math.sqrt(0.95 * 0.05 / 4000)
+    # the interval never lies beyond the sample (a bootstrap's could not exceed its maximum either,
+    # but it claimed a bound it could not give)
+    x = rng.normal(size=100)
+    lo, hi = quantile_interval(x, 0.95)
+    assert x.min() <= lo <= np.quantile(x, 0.95) <= hi <= x.max()
+    s = summary_statistics(x[:8])
+    assert np.isnan(s[0.95][1:]).all() and np.isfinite(s[0.5][1:]).all() and s["n_independent"] == 8
+
+
 def test_statistics_of_a_known_sample():
     rng = np.random.default_rng(1)
     x = rng.normal(3.0, 2.0, 2000)
@@ -204,10 +256,16 @@ def test_a_sampled_study_resumes_after_an_interruption(sampled_run, tmp_path, mo
 def test_render_of_a_sampled_study_with_a_limit(sampled_run, tmp_path, capsys):
     res, path = sampled_run
     assert main(["render", str(path), "-o", str(tmp_path), "--limit", "ste_p2p=6.0"]) == 0
-    for stem in ("distribution_ste_p2p", "convergence_ste_p2p"):
-        assert (tmp_path / f"{stem}.png").stat().st_size > 10_000
-    assert "Sobol indices: a plain sample" in capsys.readouterr().out
-    with xr.open_dataset(tmp_path / "study_tables.nc", engine="netcdf4") as f:
+    for stem in ("distribution_ste_p2p", "convergence_ste_p2p"):      # named after the archive
+        assert (tmp_path / f"{path.stem}_{stem}.png").stat().st_size > 10_000
+    said = capsys.readouterr().out
+    assert "Sobol indices: a plain sample" in said
+    # the statistics printed as a table: each grid point's mean, P5, P50, P95 and exceedance
+    assert "  ste_p2p [µm]:" in said or "  ste_p2p [um]:" in said
+    for g in ("gear1.errors.grade = 0", "gear1.errors.grade = 6"):
+        row = next(line for line in said.splitlines() if line.strip().startswith(g + ":"))
+        assert all(w in row for w in ("builds", "mean ", "P5 ", "P50 ", "P95 ", "P(> 6)")), row
+    with xr.open_dataset(tmp_path / f"{path.stem}_study_tables.nc", engine="netcdf4") as f:
         tab = f.load()
     ds = res.dataset
     for g in range(2):
@@ -216,6 +274,8 @@ def test_render_of_a_sampled_study_with_a_limit(sampled_run, tmp_path, capsys):
         assert float(p.sel(bound="estimate")) == np.mean(y > 6.0)
         pct = tab["sample_percentile"].isel(gear1_errors_grade=g).sel(output="ste_p2p", bound="estimate")
         np.testing.assert_allclose(pct.values, np.quantile(y, [0.05, 0.5, 0.95]))
+        row = next(line for line in said.splitlines() if line.strip().startswith(f"gear1.errors.grade = {[0, 6][g]}:"))
+        assert f"P95 {np.quantile(y, 0.95):.4g}" in row and f"mean {np.mean(y):.4g}" in row
     # a limit on an output the archive does not have, or a malformed one: exit 2 before any work
     assert main(["render", str(path), "-o", str(tmp_path / "x"), "--limit", "dte_rms=0.5"]) == 2
     assert main(["render", str(path), "-o", str(tmp_path / "x"), "--limit", "ste_p2p=abc"]) == 2
@@ -251,7 +311,10 @@ def test_sampled_ste_statistics_against_the_closed_form(tmp_path):
     pct = tab["sample_percentile"].sel(output="ste_p2p")
     for q in (0.05, 0.5, 0.95):
         _, lo, hi = pct.sel(quantile=q).values
-        assert lo - below - arm <= 4 + 20 * q + r <= hi + arm, (q, lo, hi, r)
+        if q == 0.5:
+            assert lo - below - arm <= 4 + 20 * q + r <= hi + arm, (q, lo, hi, r)
+        else:       # 24 builds cannot bound a P5 or P95 at 95 % (it takes 72): no interval
+            assert np.isnan(lo) and np.isnan(hi) and 24 < min_builds(q)
     _, lo, hi = tab["sample_mean"].sel(output="ste_p2p").values
     assert lo - below - arm <= 14 + r <= hi + arm
 
@@ -267,3 +330,31 @@ def test_a_sampled_study_on_dask_interrupted_and_resumed_in_process_gives_the_sa
     assert again.reused == 2 and again.computed == 10
     xr.testing.assert_identical(again.dataset.drop_vars("wall_time").assign_attrs(created="", history=""),
                                 res.dataset.drop_vars("wall_time").assign_attrs(created="", history=""))
+
+
+def test_the_convergence_figure_stays_readable_when_the_p95_ties(tmp_path, monkeypatch):
+    """Builds whose top values tie: the P95 of the first rows equals the whole sample's, an
+    error of 0 that a log axis would put 16 decades down. The axis keeps at most six decades,
+    and says why the P95 of a small sample has no band."""
+    from study.report import sample_views
+    n = 32
+    # the top quarter tied at 3 um but for the last bits (sums in another order: 0.1 + 0.2 != 0.3)
+    top = 3.0 + np.arange(8) * np.spacing(3.0)
+    y = np.r_[np.linspace(1.0, 2.0, n - 8), top]
+    y = y[np.random.default_rng(0).permutation(n)]
+    ds = xr.Dataset({"ste_p2p": ("sample", y, {"units": "um"}), "status": ("sample", np.ones(n, np.int8)),
+                     "wall_time": ("sample", np.full(n, 0.1), {"units": "s"})}, coords={"sample": np.arange(n)})
+    tables = sample_tables(ds)
+    p95 = tables["convergence_p95"].sel(output="ste_p2p")
+    est = p95.sel(bound="estimate").values
+    assert np.allclose(est[1:], 3.0, rtol=1e-15, atol=0) and (est[1:] != est[-1]).any()     # ties but for the last bit
+    assert np.isnan(p95.sel(bound="low").values).all()                          # 32 builds cannot bound a P95
+    figures = []
+    monkeypatch.setattr(sample_views, "save_figure", lambda fig, path: figures.append(fig) or path)
+    sample_views.convergence_figure(ds, tables, "ste_p2p", tmp_path / "c.png")
+    fig = figures[0]
+    for ax in fig.axes:
+        if ax.get_yscale() == "log":
+            lo, hi = ax.get_ylim()
+            assert hi / lo <= 1.01e6, (lo, hi)
+    assert any("too few independent builds to bound the P95" in t.get_text() for t in fig.axes[1].texts)
