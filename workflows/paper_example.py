@@ -5,9 +5,6 @@ names another), so that it reproduces the paper. Besides the run archive of the 
 it stores, for comparison:
   ste_default(angle)     STE of the default model ('auto': the compliance model for this
                          lightened pair, the one that agrees with the FE reference) [um]
-  dte_default(time)      DTE of the default model over the same run [um] (its run also fills
-                         the numba cache with the default model's time stepping, which
-                         `lightgear run` uses)
   ste_solid(angle)       STE of the same pair with a solid driven gear [um]
   ste_transient(angle)   STE from the paper's slow-ramp transient over the first
                          ``--transient-rotation`` degrees [um] (NaN beyond)
@@ -45,14 +42,9 @@ def main(argv=None) -> int:
         scene = scene.replace(**{"coupling.model": "paper"})     # the paper's model reproduces the paper
     ds = study.run_scene(scene)
     if "ste" in ds and default.coupling_model != scene.coupling_model:
-        # the default model's statics and, where the paper's run has one, its dynamic run: it
-        # compiles (and caches) the default model's kernels, which `lightgear run` takes next
-        dflt = study.run_scene(default, dynamic=None if "dte" in ds else False)
+        dflt = study.run_scene(default, dynamic=False)       # the static analysis only
         ds["ste_default"] = ("angle", dflt["ste"].values, {
             "units": "um", "long_name": f"static transmission error of the default model ({default.coupling_model_name})"})
-        if "dte" in dflt and dflt.sizes["time"] == ds.sizes["time"]:
-            ds["dte_default"] = ("time", dflt["dte"].values, {
-                "units": "um", "long_name": f"dynamic transmission error of the default model ({default.coupling_model_name})"})
         ds.attrs["default_coupling_model"] = default.coupling_model_name
     if "ste" in ds:
         solid = study.run_scene(study.solid_scene(scene, gears=(2,)), dynamic=False)   # the driven gear solid
@@ -78,10 +70,6 @@ def main(argv=None) -> int:
         print(f"  STE peak-to-peak: {float(np.ptp(ds['ste'].values)):.3f} um by the paper's model, "
               f"{float(np.ptp(ds['ste_default'].values)):.3f} um by the default ({ds.attrs['default_coupling_model']}, "
               f"the model that agrees with the FE reference: docs/models.md)")
-    if "dte_default" in ds:
-        steady = ds["time"] >= ds.attrs["ramp_time_s"]
-        print(f"  DTE peak-to-peak after the ramps: {float(np.ptp(ds['dte'].where(steady, drop=True).values)):.3f} um by the "
-              f"paper's model, {float(np.ptp(ds['dte_default'].where(steady, drop=True).values)):.3f} um by the default")
     if "ste_solid" in ds:
         print(f"  solid driven gear: STE mean {float(ds['ste_solid'].mean()):.3f} um, "
               f"peak-to-peak {float(ds['ste_solid'].max() - ds['ste_solid'].min()):.3f} um")
