@@ -56,7 +56,7 @@ Glossary of the kernels' short names (SI units throughout):
     A, B          the gear-1 and the gear-2 tooth of a candidate pair (the contact search)
     ua, ub        roll parameters of the contact point on the flanks of tooth A and B [-]
     pose, frame   where a pair's teeth stand: base-circle centres, axis sines and cosines,
-                  eccentric offsets; the bearing axes and tooth pivots (`gearmesh._tooth_poses`)
+                  eccentric offsets; the bearing axes and tooth pivots (`gearmesh.pair_contacts`)
     dg, ser       a contact's gradient share of the flank deviations [m]; its series local
                   compliance and that compliance's gradient [m/N]
 """

@@ -50,7 +50,7 @@ def load_torque(t, torque, ramp, table):
     return table[n - 1, 1]
 
 
-@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True)
 def drive(t, par, table):
     """The loads at t [s] of the controls par (`layout` SPEED, SPEED_RAMP, TORQUE, TORQUE_RAMP)
     and the load profile ``table`` (`load_torque`): driver angle [rad], speed [rad/s] and
@@ -59,7 +59,7 @@ def drive(t, par, table):
     return th1, w1, acc1, load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
 
 
-@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True)
 def kick_gear_par(gp, dt, imex):
     """The gear_par of the Verlet kicks' arrowhead solve: a copy of gp, with the tooth inertia
     I_P + dt/4*c_phi [kg m²] where the tooth-root dampers are taken implicitly (imex; step dt
