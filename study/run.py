@@ -23,7 +23,7 @@ from solver.mbs.statics import solve_static
 from study import estimate
 from study.archive import run_variables
 from study.archive.lightening import lightening_variables
-from study.archive.mesh import dynamic_force_variables, mesh_variables
+from study.archive.mesh import dynamic_factor_reason, dynamic_force_variables, mesh_variables, steady_window
 from study.archive.modes import modal_variables
 from study.archive.netcdf import provenance
 from study.inputs.gearsetup import gear_setups
@@ -201,6 +201,10 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     free decay) and the critical-speed warning they give."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
+    if not dynamic and scene.dynamic.enabled:
+        # a static-only run: its title, modes and critical speeds at the STE's torque
+        # (`study.scene_model.mean_load`), not at the dynamic run's it leaves out
+        scene = scene.replace(**{"dynamic.enabled": False})
     warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
     report_warnings(warnings, warn)
     if dynamic:
@@ -308,8 +312,16 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
                                                   scene.gear2.body.holes, z2,
                                                   (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
+        _, periods, short = steady_window(scene, start, to_load_change=False)
+        attrs["steady_mesh_periods"] = periods
+        attrs["driver_speed_max_rad_s"] = max(d.speed, d.speed_end)
+        if short and not runup:     # DTE RMS and peak-to-peak left undefined (`study.archive.summary`)
+            attrs["steady_window_note"] = short
         if archive or mesh_outputs:     # (read by no study output but the dynamic factor, a mesh output)
-            c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
+            undefined = dynamic_factor_reason(scene, start)
+            end = steady_window(scene, start)[0]
+            c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model)
+                                           if mesh_outputs and undefined is None else math.nan, end, undefined)
             coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(run_variables.efficiency_variable(dy, d.torque, d.speed, start))

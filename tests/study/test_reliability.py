@@ -365,3 +365,47 @@ def test_a_point_whose_curve_the_archive_cannot_hold_is_said_on_the_terminal(tmp
     st = write_study(tmp_path, '"gear1.errors.eccentricity" = [0.0, 5.0]', 'scalars = ["ste_p2p"]\ncurves = ["ste"]')
     code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--no-progress")
     assert code == 0 and "1 points without some of their curves" in err and "ste not stored" in err
+
+
+# ---------------------------------------------------------------- outputs a run cannot support
+
+def paper_pair(**kw):
+    """The small pair on the paper's model (uniform springs: no FE), a short dynamic run."""
+    from tests.helpers import small_scene
+    return small_scene(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform",
+                          "dynamic.duration": 0.02, "dynamic.ramp_time": 0.004, "dynamic.speed": 100.0, **kw})
+
+
+def dynamic_fields(scene):
+    import warnings
+
+    from study.run import run_fields
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")      # no raw library warning either
+        return run_fields(scene, static=False, dynamic=True, modal=False, warn=False)
+
+
+def test_the_dynamic_factor_is_undefined_where_the_run_cannot_support_it():
+    from study.archive.summary import summarize
+    ok = dynamic_fields(paper_pair())
+    assert 0.8 < float(ok["dynamic_factor"]) < 2.0 and np.isfinite(summarize(ok)["dte_rms"])
+    for kw, says in (({"dynamic.torque": 0.0}, "no static load (dynamic.torque = 0"),
+                     ({"dynamic.speed": 0.0}, "stands still (dynamic.speed = 0)"),
+                     ({"dynamic.speed": 1.0}, "of a mesh period")):
+        run = dynamic_fields(paper_pair(**kw))
+        assert np.isnan(float(run["dynamic_factor"])), kw
+        assert says in run["dynamic_factor"].attrs["comment"], kw
+    # a window after the ramp of 0.11 of a mesh period: neither K_v nor the DTE spread
+    short = dynamic_fields(paper_pair(**{"dynamic.speed": 1.0}))
+    s = summarize(short)
+    assert np.isnan(s["dte_rms"]) and np.isnan(s["dte_p2p"]) and "of a mesh period" in short.attrs["steady_window_note"]
+
+
+def test_the_dynamic_factor_of_a_load_change_compares_forces_at_one_torque():
+    """50 -> 20 N·m at 15 ms: K_v over the steady part before the change, at the torque of the
+    static reference: the very number of the same run stopped at the change."""
+    change = dynamic_fields(paper_pair(**{"dynamic.torque_change_time": 0.015, "dynamic.torque_after": 20.0}))
+    stopped = dynamic_fields(paper_pair(**{"dynamic.duration": 0.015}))
+    assert float(change["dynamic_factor"]) == pytest.approx(float(stopped["dynamic_factor"]), rel=1e-12)
+    early = dynamic_fields(paper_pair(**{"dynamic.torque_change_time": 0.0085, "dynamic.torque_after": 20.0}))
+    assert np.isnan(float(early["dynamic_factor"])) and "load change" in early["dynamic_factor"].attrs["comment"]
