@@ -409,3 +409,24 @@ def test_the_dynamic_factor_of_a_load_change_compares_forces_at_one_torque():
     assert float(change["dynamic_factor"]) == pytest.approx(float(stopped["dynamic_factor"]), rel=1e-12)
     early = dynamic_fields(paper_pair(**{"dynamic.torque_change_time": 0.0085, "dynamic.torque_after": 20.0}))
     assert np.isnan(float(early["dynamic_factor"])) and "load change" in early["dynamic_factor"].attrs["comment"]
+
+
+def test_a_static_only_run_is_titled_and_analysed_at_the_torque_of_its_ste():
+    from study.run import run_fields
+    scene = paper_pair(**{"quasi_static.torque": 100.0, "dynamic.torque": 20.0})
+    st = run_fields(scene, static=True, dynamic=False, mesh_outputs=False, warn=False)
+    assert "100 N·m" in st.attrs["title"] and "20 N·m" not in st.attrs["title"]
+    same = run_fields(scene.replace(**{"dynamic.torque": 100.0}), static=True, dynamic=False, mesh_outputs=False,
+                      warn=False)
+    assert st.attrs["mesh_mode_frequency_hz"] == pytest.approx(same.attrs["mesh_mode_frequency_hz"], rel=1e-9)
+
+
+def test_the_summary_lists_the_critical_speeds_of_the_runs_speed_range():
+    import xarray as xr
+
+    from study.report.summary import critical_speed_line
+    ds = xr.Dataset({"critical_speed": (("excitation", "mode"), [[3197.0], [1598.0], [1066.0]])},
+                    coords={"excitation": ["1Z", "2Z", "3Z"], "mode": [0]}, attrs={"driver_speed_max_rad_s": 3300.0})
+    assert "1Z 3197" in critical_speed_line(ds)
+    ds.attrs["driver_speed_max_rad_s"] = 100.0
+    assert "none up to 200" in critical_speed_line(ds) and "the lowest 3Z 1066" in critical_speed_line(ds)
