@@ -402,6 +402,9 @@ def check_scene(scene: Scene) -> None:
                          f"of the run ({d.duration} s), got {d.torque_change_time} s")
     if d.spectrum_start >= d.duration:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
+    if scene.quasi_static.enabled:
+        from study.scene_model import check_two_angles
+        check_two_angles(scene, scene.quasi_static.angle_step)
     check_integrator_model(scene)
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)

@@ -430,3 +430,18 @@ def test_the_summary_lists_the_critical_speeds_of_the_runs_speed_range():
     assert "1Z 3197" in critical_speed_line(ds)
     ds.attrs["driver_speed_max_rad_s"] = 100.0
     assert "none up to 200" in critical_speed_line(ds) and "the lowest 3Z 1066" in critical_speed_line(ds)
+
+
+def test_an_angle_step_past_the_rotation_is_refused_before_work(tmp_path, capsys):
+    """One driver angle would print an STE peak-to-peak of 0 and archive ste_p2p = 0."""
+    code, _, err = run_cli(capsys, "run", "--set", "quasi_static.rotation=18", "--set", "quasi_static.angle_step=30",
+                           "-o", tmp_path / "r.nc")
+    assert code == 2 and "quasi_static.angle_step: a step of 30 deg leaves one driver angle" in err
+    code, _, err = run_cli(capsys, "reference", "--step", "500", "-o", tmp_path / "f.nc")
+    assert code == 2 and "--step: a step of 500 deg leaves one driver angle" in err
+    st = write_study(tmp_path, '"quasi_static.angle_step" = [0.5, 40.0]', 'scalars = ["ste_p2p"]')
+    code, out, _ = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--no-progress")
+    assert code == 0 and "invalid 1" in out and "quasi_static.angle_step: a step of 40 deg" in out
+    import xarray as xr
+    with xr.open_dataset(tmp_path / "s.nc") as ds:     # an invalid point, not a peak-to-peak of 0
+        assert ds["ste_p2p"].values[0] > 0 and np.isnan(ds["ste_p2p"].values[1])
