@@ -378,28 +378,42 @@ DYNAMIC_SAMPLES = 3          # dynamic tasks whose model gives the step of the e
 
 
 def study_points(study) -> int:
-    """Points of a study (grid product plus explicit points), counted without building them."""
+    """Points of a study (grid product, times the builds of its sample, plus explicit points),
+    counted without building them."""
     n = 1
     for a in study.axes:
         n *= len(a.values)
-    return (n if study.axes else 0) + len(study.extra)
+    n = n if study.axes else 0
+    if study.sample:        # every grid point (or the base scene alone) gets the whole sample
+        n = max(n, 1) * study.sample.builds
+    return n + len(study.extra)
+
+
+def study_sizes(study) -> str:
+    """The factors of `study_points` in words: '3 x 4', '1e+06 draws', '2 x 500 draws + 3'."""
+    parts = [str(len(a.values)) for a in study.axes]
+    if study.sample:
+        parts.append(f"{study.sample.builds:.4g} draws" if study.sample.builds >= 1e6 else f"{study.sample.builds} draws")
+    return " x ".join(parts) or "0"
 
 
 def check_study_size(study, max_time: float | None) -> int:
     """Refuse, before its points are built, a study too large to enumerate: memory beyond what
-    the machine has, or its checks alone beyond ``max_time`` [s]. Returns its point count."""
+    the machine has, or its checks alone beyond ``max_time`` [s]. Returns its point count
+    (grid points and sampled builds alike: `study_points`)."""
     n = study_points(study)
     need = n * POINT_BYTES
     have = available_memory()
-    sizes = " x ".join(str(len(a.values)) for a in study.axes) or "0"
+    sizes = study_sizes(study)
+    field, lever = ("sample.size", "draw fewer (sample.size)") if study.sample else ("grid", "sweep fewer values")
     if need > 0.5 * have:
-        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}{f' + {len(study.extra)}' if study.extra else ''}); "
-                                  f"only listing them needs about {bytes_text(need)}, more than half the {bytes_text(have)} "
-                                  "of memory available: sweep fewer values, or split the study")
+        raise BudgetError(field, f"the study has {n:.4g} points ({sizes}{f' + {len(study.extra)}' if study.extra else ''}); "
+                                 f"only listing them needs about {bytes_text(need)}, more than half the {bytes_text(have)} "
+                                 f"of memory available: {lever}, or split the study")
     if max_time is not None and n * POINT_CHECK_S > max_time:
-        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}); building and checking them alone takes "
-                                  f"about {duration_text(n * POINT_CHECK_S)}, beyond --max-time {max_time:.4g} s: "
-                                  "sweep fewer values, or split the study")
+        raise BudgetError(field, f"the study has {n:.4g} points ({sizes}); building and checking them alone takes "
+                                 f"about {duration_text(n * POINT_CHECK_S)}, beyond --max-time {max_time:.4g} s: "
+                                 f"{lever}, or split the study")
     return n
 
 

@@ -304,6 +304,10 @@ class Scene:
 
 # ---------------------------------------------------------------- building and checking
 
+# the integers a scene field or a study's seed may hold: those a NetCDF archive stores (int64)
+INT_MIN, INT_MAX = -2 ** 63, 2 ** 63 - 1
+
+
 def _coerce(value, typ, path):
     """``value`` as ``typ`` (bool, int, float or str), else SceneError; a bool is no number.
     NumPy scalars and arrays count as the Python numbers and lists they hold."""
@@ -315,7 +319,11 @@ def _coerce(value, typ, path):
     number = isinstance(value, int | float) and not isinstance(value, bool)
     if (typ is bool and isinstance(value, bool)) or (typ is str and isinstance(value, str)):
         return value
-    if typ is int and number and math.isfinite(value) and float(value) == int(value):
+    if typ is int and number and (isinstance(value, int) or (math.isfinite(value) and value.is_integer())):
+        # (a Python int as it is: 2^53 + 1 has no float of its own)
+        if not INT_MIN <= int(value) <= INT_MAX:
+            raise SceneError(path, f"must fit in 64 bits (the archive's integers), from {INT_MIN} to {INT_MAX}, "
+                                   f"got {int(value)}")
         return int(value)
     if typ is float and number and math.isfinite(value):
         return float(value)
@@ -364,12 +372,13 @@ def _build(cls, table, path: str):
         if md.get("choices") and v not in md["choices"]:
             raise SceneError(where, f"must be one of {', '.join(map(repr, md['choices']))}, got {v!r}")
         lo, hi = md.get("lo"), md.get("hi")
-        if lo is not None and not isinstance(v, tuple) and (v < lo or (md.get("lo_open") and v == lo)):
-            rel = ">" if md.get("lo_open") else ">="
-            raise SceneError(where, f"must be {rel} {lo}{unit}, got {v}{unit}")
-        if hi is not None and (v > hi or (md.get("hi_open") and v == hi)):
-            rel = "<" if md.get("hi_open") else "<="
-            raise SceneError(where, f"must be {rel} {hi}{unit}, got {v}{unit}")
+        for x in (v if isinstance(v, tuple) else (v,)):     # (a list: each of its numbers)
+            if lo is not None and (x < lo or (md.get("lo_open") and x == lo)):
+                rel = ">" if md.get("lo_open") else ">="
+                raise SceneError(where, f"must be {rel} {lo}{unit}, got {x}{unit}")
+            if hi is not None and (x > hi or (md.get("hi_open") and x == hi)):
+                rel = "<" if md.get("hi_open") else "<="
+                raise SceneError(where, f"must be {rel} {hi}{unit}, got {x}{unit}")
         kwargs[name] = v
     resolve_exclusive(cls, kwargs, path)
     return cls(**kwargs)

@@ -445,3 +445,57 @@ def test_an_angle_step_past_the_rotation_is_refused_before_work(tmp_path, capsys
     import xarray as xr
     with xr.open_dataset(tmp_path / "s.nc") as ds:     # an invalid point, not a peak-to-peak of 0
         assert ds["ste_p2p"].values[0] > 0 and np.isnan(ds["ste_p2p"].values[1])
+
+
+# ---------------------------------------------------------------- ranges, integers and seeds
+
+@pytest.mark.parametrize("field, value", [("gear1.errors.eccentricity_phase", 1e19),
+                                          ("gear2.errors.eccentricity_phase", -400.0),
+                                          ("gear1.modification.tip_start_roll", 1e5),
+                                          ("gear2.modification.profile_roll", [10.0, 1e6])])
+def test_every_angle_valued_field_has_a_range(field, value):
+    from study.scene import SceneError
+    from tests.helpers import small_scene
+    with pytest.raises(SceneError) as e:
+        small_scene(**{field: value})
+    assert e.value.field == field and "must be " in e.value.reason and "360.0 deg" in e.value.reason
+
+
+def test_integers_beyond_64_bits_are_refused_and_those_within_kept_exactly():
+    from study.scene import SceneError
+    from tests.helpers import small_scene
+    assert small_scene(**{"gear1.errors.seed": 2 ** 53 + 1}).gear1.errors.seed == 2 ** 53 + 1
+    with pytest.raises(SceneError, match="must fit in 64 bits"):
+        small_scene(**{"gear1.errors.seed": 2 ** 64})
+
+
+def sample_study(tmp_path, sample: str) -> str:
+    text = (Path("study/scenes/example_study.toml").read_text().split("[grid]")[0]
+            + f"[sample]\n{sample}\n[outputs]\nscalars = [\"ste_p2p\"]\n")
+    path = tmp_path / "sample.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def test_integer_draws_and_seeds_are_checked_before_any_build(tmp_path, capsys):
+    st = sample_study(tmp_path, 'size = 4\n"gear1.errors.grade" = {integers = [5, 6]}\n'
+                                '"gear1.errors.seed" = {integers = [0, 1e20]}')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0)
+    assert code == 2 and "gear1.errors.seed: [sample] integers upper end" in err and "64 bits" in err
+    st = sample_study(tmp_path, f'size = 4\nseed = {2 ** 64}\n"gear2.body.hole_radius" = {{uniform = [1.0, 1.5]}}')
+    code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0)
+    assert code == 2 and "sample.seed: must fit in 64 bits" in err and not (tmp_path / ".s.nc.parts").exists()
+
+
+def test_a_sample_is_counted_and_bounded_like_a_grid(tmp_path, capsys, monkeypatch):
+    from study.sweep.grid import Study
+    built = []
+    monkeypatch.setattr(Study, "points", lambda self: built.append(1) or [])
+    for size in ("1000000", "1000000000000"):
+        st = sample_study(tmp_path, f'size = {size}\n"gear2.body.hole_radius" = {{uniform = [1.0, 1.5]}}')
+        code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--max-time", 3600)
+        assert code == 2 and f"sample.size: the study has {float(size):.4g} points" in err and not built
+    monkeypatch.undo()
+    st = sample_study(tmp_path, 'size = 3\n"gear2.body.hole_radius" = {uniform = [1.0, 1.5]}')
+    code, out, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--no-progress")
+    assert code == 0 and "3 points (3" in out, out + err
