@@ -499,3 +499,22 @@ def test_a_sample_is_counted_and_bounded_like_a_grid(tmp_path, capsys, monkeypat
     st = sample_study(tmp_path, 'size = 3\n"gear2.body.hole_radius" = {uniform = [1.0, 1.5]}')
     code, out, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--no-progress")
     assert code == 0 and "3 points (3" in out, out + err
+
+
+def test_a_hole_order_the_record_does_not_resolve_is_not_fitted():
+    """4 holes (order 4 of the driven gear, 90 deg) on a 20/20 pair: a known amplitude over a
+    whole hole period is found; over 18 deg (19 or 181 angles) it is NaN with the reason, not
+    a least-squares fit of 21 columns reporting 1e7 times the STE."""
+    from study.verify.model_validation import order_amplitude, order_unresolved
+    z, holes = 20, 4
+
+    def ste(x):
+        return 1.0 + 0.3 * np.cos(holes * x + 0.4) + 0.8 * np.cos(z * x) + 0.1 * np.sin(2 * z * x)
+    whole = np.radians(np.arange(0.0, 90.0, 0.5))
+    assert order_amplitude(whole, ste(whole), holes, z) == pytest.approx(0.3, rel=1e-9)
+    assert order_unresolved(whole, holes) is None
+    for step in (1.0, 0.1):
+        short = np.radians(np.arange(0.0, 18.0 + 1e-9, step))
+        assert np.isnan(order_amplitude(short, ste(short), holes, z))
+    assert "fewer than the 21 columns" in order_unresolved(np.radians(np.arange(0.0, 18.5, 1.0)), holes)
+    assert "less than one period of order 4 (90 deg)" in order_unresolved(np.radians(np.arange(0.0, 18.05, 0.1)), holes)
