@@ -518,3 +518,16 @@ def test_a_hole_order_the_record_does_not_resolve_is_not_fitted():
         assert np.isnan(order_amplitude(short, ste(short), holes, z))
     assert "fewer than the 21 columns" in order_unresolved(np.radians(np.arange(0.0, 18.5, 1.0)), holes)
     assert "less than one period of order 4 (90 deg)" in order_unresolved(np.radians(np.arange(0.0, 18.05, 0.1)), holes)
+
+
+def test_a_sweep_point_with_a_tiny_time_step_is_estimated_and_refused_like_a_run(tmp_path, capsys):
+    """One point of many at dynamic.time_step = 1e-13 (ten million steps per microsecond of
+    the run): the sampled steps of the others would miss it."""
+    points = "".join(f'[[points]]\n"dynamic.speed" = {50.0 + i}\n' + ('"dynamic.time_step" = 1e-13\n' if i == 2 else "")
+                     for i in range(9))
+    path = tmp_path / "p.toml"
+    path.write_text(Path("study/scenes/example_study.toml").read_text().split("[grid]")[0] + points
+                    + '[outputs]\nscalars = ["dte_rms"]\n')
+    code, _, err = run_cli(capsys, "sweep", path, "-o", tmp_path / "s.nc", "--workers", 0)
+    assert code == 2 and "--max-time: the run is estimated at" in err and "dt down to 1e-13 s" in err
+    assert "dynamic.time_step (1e-13 s given)" in err and not (tmp_path / ".s.nc.parts").exists()
