@@ -19,6 +19,11 @@ STEADY_SAMPLES = 16
 # the module: beyond it the pseudo-rigid teeth leave the range where the model means anything
 # (teeth bent by a sizeable part of their height), and the statics find no equilibrium.
 DEFLECTION_FRACTION = 0.2
+# Smallest elastic approach a nonzero load must give [mm]: below some 10 nm the statics over a
+# revolution stop converging and the dynamic run's energy guard trips (the small 24-tooth pair
+# at 1e-3 N·m, 3.6 nm; fine at 1e-2 N·m, 29 nm), and the damping conversion fails after the
+# FE work blaming the damping ratio.
+MIN_APPROACH_MM = 1e-5
 
 
 def mesh_size_mm(scene, g: int) -> float:
@@ -104,10 +109,23 @@ def check_loads(scene) -> None:
         if torque == 0:
             continue
         d = approach_estimate_mm(scene, torque)
+        if d < MIN_APPROACH_MM:
+            raise SceneError(name, f"a load too small to resolve: {torque:.4g} N*m presses one tooth pair together by about "
+                             f"{d:.3g} mm (contact law and tooth springs), less than the {MIN_APPROACH_MM:g} mm the "
+                             f"solvers resolve; give at least {smallest_torque(scene):.2g} N*m in magnitude, or 0 for no load")
         if not d <= bound:
             raise SceneError(name, f"implausible load: {torque:.4g} N*m bends one tooth pair by about {d:.3g} mm "
                              f"(contact law and tooth springs), more than {DEFLECTION_FRACTION:g} x module = {bound:.4g} mm; "
                              "the pseudo-rigid tooth model does not hold there")
+
+
+def smallest_torque(scene) -> float:
+    """The torque [N·m] whose `approach_estimate_mm` is MIN_APPROACH_MM (bisection in log scale)."""
+    lo, hi = 1e-12, 1e6
+    for _ in range(60):
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if approach_estimate_mm(scene, mid) < MIN_APPROACH_MM else (lo, mid)
+    return hi
 
 
 def check_plausibility(scene) -> None:

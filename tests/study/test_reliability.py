@@ -531,3 +531,14 @@ def test_a_sweep_point_with_a_tiny_time_step_is_estimated_and_refused_like_a_run
     code, _, err = run_cli(capsys, "sweep", path, "-o", tmp_path / "s.nc", "--workers", 0)
     assert code == 2 and "--max-time: the run is estimated at" in err and "dt down to 1e-13 s" in err
     assert "dynamic.time_step (1e-13 s given)" in err and not (tmp_path / ".s.nc.parts").exists()
+
+
+def test_a_load_too_small_to_resolve_is_refused_before_the_fe_naming_the_torque(tmp_path, capsys, private_fe_cache):
+    code, _, err = run_cli(capsys, "run", "small_pair", "--set", "dynamic.torque=1e-6", "-o", tmp_path / "r.nc")
+    assert code == 2 and "dynamic.torque: a load too small to resolve: 1e-06 N*m" in err
+    assert "damping_ratio" not in err and not private_fe_cache.folder.exists()      # no FE body made
+    from study.plausibility import MIN_APPROACH_MM, approach_estimate_mm, smallest_torque
+    from tests.helpers import small_scene
+    t = smallest_torque(small_scene())
+    assert approach_estimate_mm(small_scene(), t) == pytest.approx(MIN_APPROACH_MM, rel=1e-6)
+    small_scene(**{"dynamic.torque": 1.01 * t, "dynamic.torque_change_time": 0.1, "dynamic.torque_after": 0.0})
