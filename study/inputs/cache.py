@@ -91,7 +91,8 @@ class FECache:
             return load(path)
         except UNREADABLE as e:
             if path.exists():       # (not a file another process was replacing)
-                warnings.warn(f"damaged FE cache file {path} ({type(e).__name__}: {e}): computing it again",
+                why = (str(e).splitlines() or [""])[0][:120]
+                warnings.warn(f"damaged FE cache file {path} ({type(e).__name__}: {why}): computing it again",
                               RuntimeWarning, stacklevel=3)
             return None
 
