@@ -28,10 +28,17 @@ EXIT_CODES = """exit codes:
 
 
 def writable_folder(folder: Path, option: str = "-o") -> None:
-    """Create ``folder`` if needed and prove that a file can be written in it, before any work."""
+    """Create ``folder`` if needed and prove that a file can be written in it, before any work.
+    Missing folders are created under the working directory (``results/...``), and elsewhere
+    one new folder in an existing one: a slip such as ``/nonexistent/dir`` never makes folders
+    at the root of the file system."""
     import tempfile
     if folder.exists() and not folder.is_dir():
         raise UsageError(option, f"{folder} is a file, not a directory")
+    if not folder.exists() and not folder.parent.is_dir() \
+            and not folder.resolve().is_relative_to(Path.cwd().resolve()):
+        raise UsageError(option, f"the folder {folder.parent} does not exist: outside the working directory lightgear "
+                                 f"creates only the last folder of a path; create {folder.parent} first")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=folder, prefix=".lightgear-probe"):

@@ -492,6 +492,21 @@ def loads_scene(text: str, source: str = "scene") -> Scene:
 SCENES_DIR = Path(__file__).parent / "scenes"
 
 
+# the tables that make a TOML file a study (`study.sweep.grid`), and those only a scene has
+STUDY_SECTIONS = ("grid", "points", "sample")
+
+
+def is_study_table(data: dict) -> bool:
+    """A TOML file's tables are a study's: a [grid], [[points]] or [sample], or a [scene] table
+    of overrides (a scene has no section of that name)."""
+    return any(k in data for k in STUDY_SECTIONS) or isinstance(data.get("scene"), dict)
+
+
+def is_scene_table(data: dict) -> bool:
+    """A TOML file's tables are a scene's: sections of a Scene and none of a study."""
+    return not is_study_table(data) and any(f.name in data for f in dataclasses.fields(Scene) if f.name != "title")
+
+
 def embedded_scenes() -> dict[str, tuple[Path, str, str]]:
     """The scenes and studies that ship with lightgear: name -> (file, 'scene' or 'study', title)."""
     out = {}
@@ -500,7 +515,7 @@ def embedded_scenes() -> dict[str, tuple[Path, str, str]]:
             raw = tomllib.loads(p.read_text())
         except (OSError, tomllib.TOMLDecodeError):
             continue
-        kind = "study" if ("grid" in raw or "points" in raw) else "scene"
+        kind = "study" if is_study_table(raw) else "scene"
         out[p.stem] = (p, kind, str(raw.get("title", "")))
     return out
 
@@ -527,6 +542,9 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
     apply ``key=value`` overrides."""
     text = default_scene_text() if path is None else read_text(scene_path(path))
     data = _tables(text, str(path or "scene"))
+    if is_study_table(data):
+        raise SceneError("scene", f"{path} is a study (its {', '.join(f'[{k}]' for k in STUDY_SECTIONS if k in data)} "
+                                  "over a [scene]), not a scene: run it with `lightgear sweep` (study.load_study)")
     items = [parse_override(item) for item in overrides]
     keys = {k for k, _v in items}
     for key, _v in items:

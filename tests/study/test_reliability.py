@@ -542,3 +542,28 @@ def test_a_load_too_small_to_resolve_is_refused_before_the_fe_naming_the_torque(
     t = smallest_torque(small_scene())
     assert approach_estimate_mm(small_scene(), t) == pytest.approx(MIN_APPROACH_MM, rel=1e-6)
     small_scene(**{"dynamic.torque": 1.01 * t, "dynamic.torque_change_time": 0.1, "dynamic.torque_after": 0.0})
+
+
+# ---------------------------------------------------------------- messages
+
+def test_a_study_given_to_run_and_a_scene_given_to_sweep_are_told_apart(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "run", "example_study", "-o", tmp_path / "r.nc")
+    assert code == 2 and "example_study is a study" in err and "lightgear sweep" in err and "unknown key" not in err
+    code, _, err = run_cli(capsys, "run", "study/scenes/tolerance.toml", "-o", tmp_path / "r.nc")
+    assert code == 2 and "is a study" in err
+    code, _, err = run_cli(capsys, "sweep", "paper", "-o", tmp_path / "s.nc")
+    assert code == 2 and "this file is a scene" in err and "lightgear run" in err and "unknown study key" not in err
+
+
+def test_an_output_folder_is_not_made_at_the_root_of_the_file_system(tmp_path, capsys):
+    missing = Path("/nonexistent-lightgear") / "dir"
+    code, _, err = run_cli(capsys, "run", "-o", missing / "x.nc")
+    assert code == 2 and "-o: the folder /nonexistent-lightgear does not exist" in err and not missing.parent.exists()
+    # one new folder in an existing one is made, as is any folder under the working directory
+    from study.cli import checked_output
+    assert checked_output(tmp_path / "new" / "x.nc").parent.is_dir()
+
+
+def test_the_documented_default_mesh_size_is_the_codes():
+    from solver.fe.mesh import default_mesh_size
+    assert default_mesh_size(1.0) == 0.25 and "default module/4" in Path("docs/cli.md").read_text()
