@@ -609,8 +609,12 @@ def scene_field(path: str) -> dataclasses.Field:
         fs = {x.name: x for x in fields(cls)} if dataclasses.is_dataclass(cls) else {}
         if p not in fs:
             where = ".".join(parts[:i])
-            close = difflib.get_close_matches(path, field_paths(), n=1, cutoff=0.6)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
+            # the names of this level that the typed part begins (gear2.bod -> gear2.body), else
+            # the closest whole path, else the name of this level closest to it
+            begun = [f"{where}.{n}" if where else n for n in fs if p and n.startswith(p)][:3]
+            close = begun or difflib.get_close_matches(path, field_paths(), n=1, cutoff=0.6) or \
+                [f"{where}.{n}" if where else n for n in difflib.get_close_matches(p, list(fs), n=1, cutoff=0.6)]
+            hint = f"; did you mean {' or '.join(map(repr, close))}?" if close else ""
             valid = f" (fields of {where}: {', '.join(fs)})" if fs and where else (
                 f" (sections: {', '.join(fs)})" if fs else f" ({where} is a value, not a table)")
             raise SceneError(path, f"no such scene field{valid}{hint}{' ' if hint else '; '}"

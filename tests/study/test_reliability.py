@@ -567,3 +567,12 @@ def test_an_output_folder_is_not_made_at_the_root_of_the_file_system(tmp_path, c
 def test_the_documented_default_mesh_size_is_the_codes():
     from solver.fe.mesh import default_mesh_size
     assert default_mesh_size(1.0) == 0.25 and "default module/4" in Path("docs/cli.md").read_text()
+
+
+def test_a_field_prefix_cut_short_suggests_the_fields_it_begins(capsys):
+    code, _, err = run_cli(capsys, "fields", "gear2.bod")
+    assert code == 2 and "did you mean 'gear2.body'?" in err
+    code, out, _ = run_cli(capsys, "fields", "gear2.body")
+    assert code == 0 and "gear2.body.holes" in out
+    code, _, err = run_cli(capsys, "fields", "gear2.body.hol")
+    assert code == 2 and "'gear2.body.holes' or 'gear2.body.hole_radius'" in err
