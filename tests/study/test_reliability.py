@@ -576,3 +576,17 @@ def test_a_field_prefix_cut_short_suggests_the_fields_it_begins(capsys):
     assert code == 0 and "gear2.body.holes" in out
     code, _, err = run_cli(capsys, "fields", "gear2.body.hol")
     assert code == 2 and "'gear2.body.holes' or 'gear2.body.hole_radius'" in err
+
+
+def test_the_study_tables_render_writes_are_an_archive_export_takes(tmp_path, capsys):
+    """(and the example study's DTE RMS is defined at each speed: its steady part covers more
+    than a mesh period at 50 rad/s)"""
+    import xarray as xr
+    code, _, err = run_cli(capsys, "sweep", "example_study", "-o", tmp_path / "s.nc", "--workers", 0, "--no-progress")
+    assert code == 0, err
+    with xr.open_dataset(tmp_path / "s.nc") as ds:
+        assert np.isfinite(ds["dte_rms"].values).all()
+    code, _, err = run_cli(capsys, "render", tmp_path / "s.nc", "-o", tmp_path / "fig", "--no-renders")
+    assert code == 0 and (tmp_path / "fig" / "study_tables.nc").is_file(), err
+    code, out, err = run_cli(capsys, "export", tmp_path / "fig" / "study_tables.nc", "-o", tmp_path / "csv")
+    assert code == 0 and "csv:" in out, err
