@@ -590,3 +590,27 @@ def test_the_study_tables_render_writes_are_an_archive_export_takes(tmp_path, ca
     assert code == 0 and (tmp_path / "fig" / "study_tables.nc").is_file(), err
     code, out, err = run_cli(capsys, "export", tmp_path / "fig" / "study_tables.nc", "-o", tmp_path / "csv")
     assert code == 0 and "csv:" in out, err
+
+
+def test_a_full_disk_is_said_as_such(tmp_path, capsys, monkeypatch):
+    """HDF5 reports a full disk as 'NetCDF: HDF error': the free space tells it."""
+    import shutil
+    from collections import namedtuple
+
+    import xarray as xr
+
+    from study.archive.netcdf import write_netcdf
+    from study.cli import guarded
+
+    def hdf_error(self, *a, **k):
+        raise RuntimeError("NetCDF: HDF error")
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", hdf_error)
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: usage(1e9, 1e9, 1000))
+    ds = xr.Dataset({"x": ("n", np.arange(10.0))})
+    assert guarded("lightgear run", lambda: write_netcdf(ds, tmp_path / "r.nc")) == 1
+    err = capsys.readouterr().err
+    assert "no space left on device: 0.0 MiB free" in err and "HDF error" not in err
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: usage(1e12, 0, 1e12))     # room: the error as it is
+    with pytest.raises(RuntimeError, match="HDF error"):
+        write_netcdf(ds, tmp_path / "r.nc")
