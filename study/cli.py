@@ -124,6 +124,10 @@ def run_command(args) -> int:
     from study.plausibility import check_dynamic_window
     from study.report.summary import print_summary
     scene = args_scene(args)
+    if args.no_dynamic and scene.dynamic.enabled:
+        # the scene without its dynamic run: the title, modes and critical speeds at the STE's
+        # torque (`study.scene_model.mean_load`), not at the torque of the run left out
+        scene = scene.replace(**{"dynamic.enabled": False})
     if not args.no_dynamic:
         check_dynamic_window(scene)       # the summary needs a steady part after the ramps
         check_dynamic_memory(scene)       # at once, before the solver is even loaded

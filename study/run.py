@@ -201,10 +201,6 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     free decay) and the critical-speed warning they give."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
-    if not dynamic and scene.dynamic.enabled:
-        # a static-only run: its title, modes and critical speeds at the STE's torque
-        # (`study.scene_model.mean_load`), not at the dynamic run's it leaves out
-        scene = scene.replace(**{"dynamic.enabled": False})
     warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
     report_warnings(warnings, warn)
     if dynamic:
