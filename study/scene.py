@@ -12,6 +12,7 @@ Errors: `SceneError` names the dotted field and the reason, before any work star
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import functools
@@ -551,9 +552,36 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
         partner = damping_partner(key.split("."))
         if partner and key.rsplit(".", 1)[0] + "." + partner in keys:
             raise SceneError(key, f"give either {key} or {key.rsplit('.', 1)[0]}.{partner}, not both")
+    base = copy.deepcopy(data) if items else None
     for key, value in items:
         set_dotted(data, key, value)
-    return scene_from_dict(data)
+    try:
+        return scene_from_dict(data)
+    except SceneError as e:
+        raise override_at_fault(e, base, items) from None
+
+
+def override_at_fault(error: SceneError, base: dict | None, items: list) -> SceneError:
+    """``error`` of a scene with overrides ``items`` [(key, value)] on ``base`` (its tables),
+    naming the override at fault where the error names another field that only the override
+    made invalid (``--set gear2.module=2``: the module, not the holes it made cut the hub);
+    the error as it is otherwise."""
+    if not items or error.field in {k for k, _v in items}:
+        return error
+    try:
+        scene_from_dict(copy.deepcopy(base))
+    except SceneError:
+        return error                # the scene is invalid without the overrides too
+    for key, value in items:
+        alone = copy.deepcopy(base)
+        set_dotted(alone, key, value)
+        try:
+            scene_from_dict(alone)
+        except SceneError as e:
+            if e.field == error.field:
+                return SceneError(key, f"{value!r} makes {error.field} invalid (valid before the override): {error.reason}")
+    keys = ", ".join(k for k, _v in items)
+    return SceneError(error.field, f"{error.reason} (valid before the overrides of {keys})")
 
 
 def default_scene_text() -> str:

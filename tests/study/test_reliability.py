@@ -619,3 +619,12 @@ def test_a_full_disk_is_said_as_such(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(shutil, "disk_usage", lambda p: usage(1e12, 0, 1e12))     # room: the error as it is
     with pytest.raises(RuntimeError, match="HDF error"):
         write_netcdf(ds, tmp_path / "r.nc")
+
+
+def test_an_override_that_invalidates_another_field_is_named(capsys):
+    code, _, err = run_cli(capsys, "run", "--set", "gear2.module=2", "--set", "dynamic.speed=50")
+    assert code == 2 and "invalid scene: gear2.module: 2 makes gear2.body.hole_radius invalid" in err
+    assert "holes cut the hub" in err
+    # an override that is itself at fault is named as before
+    code, _, err = run_cli(capsys, "run", "--set", "gear2.body.hole_radius=30")
+    assert code == 2 and "invalid scene: gear2.body.hole_radius: holes cut the rim" in err
