@@ -116,6 +116,21 @@ def static_force_max(scene: Scene, model: Model) -> float:
     return float(np.max(f)) if f.size and st.converged.all() else float("nan")
 
 
+def contact_loss_attrs(res, d) -> dict:
+    """Whether the teeth of dynamic run ``res`` (of the scene's dynamic section ``d``) lost
+    contact after the torque ramp: ``contact_lost_fraction`` [1], the share of the output
+    instants with no loaded contact, and for a run-up the driver speeds [rad/s] where it
+    happened (``contact_lost_speed_rad_s``, first and last). The response then left the
+    linear range the modal critical speeds stand for."""
+    after = (res.time > d.ramp_time) & np.isfinite(res.te)
+    lost = after & (res.n_contacts == 0)
+    out = {"contact_lost_fraction": float(lost.sum() / max(after.sum(), 1))}
+    if d.speed_end > 0 and lost.any():
+        speed = d.speed_end * res.time[lost] / d.duration
+        out["contact_lost_speed_rad_s"] = np.array([speed.min(), speed.max()])
+    return out
+
+
 # the springs and model of the last scene run with keep_model: (what they depend on, springs, model)
 _LAST_MODEL: list = [None, None, None]
 
@@ -321,6 +336,7 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
             coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(run_variables.efficiency_variable(dy, d.torque, d.speed, start))
+        attrs.update(contact_loss_attrs(dy, d))
         if runup:
             attrs["runup_speed_end_rad_s"] = d.speed_end
             if dy.status in COMPLETED:    # completed: the map is kept, an inaccurate one with its flag

@@ -24,8 +24,10 @@ def critical_speed_line(ds: xr.Dataset) -> str:
     top = float(ds.attrs.get("driver_speed_max_rad_s", 0.0))
     limit = CRITICAL_SPEED_SPAN * top if top > 0 else float("inf")
     shown = [f"{e} {v:.0f}" for e, v in zip(names, cs) if v <= limit]
+    linear = (" (linear estimates: the teeth lost contact in this run)"
+              if ds.attrs.get("contact_lost_fraction", 0.0) > 0 else "")
     if shown:
-        return "    critical driver speeds [rad/s]: " + ", ".join(shown) + "\n"
+        return "    critical driver speeds [rad/s]" + linear + ": " + ", ".join(shown) + "\n"
     low = int(np.nanargmin(cs))
     return (f"    critical driver speeds [rad/s]: none up to {limit:.0f} ({CRITICAL_SPEED_SPAN:g} x the run's "
             f"{top:g} rad/s); the lowest {names[low]} {cs[low]:.0f}\n")
@@ -92,6 +94,19 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
             parts.append(f"{k}Z at {sp[np.argmax(cut)]:.0f} rad/s {cut.max():.3g} um")
         w(f"  run-up {sp[0]:.0f}-{sp[-1]:.0f} rad/s ({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us), "
           "resonance peaks (order, driver speed, DTE amplitude): " + ", ".join(parts) + "\n")
+        lost = ds.attrs.get("contact_lost_speed_rad_s")
+        if lost is not None and "critical_speed" in ds:
+            # the teeth separated: the response left the linear range the modal speeds stand for
+            cs = ds["critical_speed"].sel(mode=0)
+            peaks = []
+            for k in (1, 2, 3):
+                sel = np.abs(order - k * z) <= 0.5
+                modal = float(cs.sel(excitation=f"{k}Z"))
+                if sp[0] <= modal <= sp[-1]:
+                    at = float(sp[np.argmax(amp[:, sel].max(axis=1))])
+                    peaks.append(f"{k}Z measured {at:.0f} rad/s, modal {modal:.0f} ({100 * (at / modal - 1):+.1f} %)")
+            w(f"    the teeth lost contact between {lost[0]:.0f} and {lost[1]:.0f} rad/s: the response left the linear "
+              "range, and the critical speeds are linear estimates" + (": " + ", ".join(peaks) if peaks else "") + "\n")
     if "mass" in ds:
         for g in (1, 2):
             line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "

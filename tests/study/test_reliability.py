@@ -628,3 +628,24 @@ def test_an_override_that_invalidates_another_field_is_named(capsys):
     # an override that is itself at fault is named as before
     code, _, err = run_cli(capsys, "run", "--set", "gear2.body.hole_radius=30")
     assert code == 2 and "invalid scene: gear2.body.hole_radius: holes cut the rim" in err
+
+
+def test_a_run_up_whose_teeth_lose_contact_says_its_critical_speeds_are_linear(capsys, tmp_path):
+    from study.report.summary import print_summary
+    from study.run import run_fields
+
+    def runup(speed_end):
+        scene = paper_pair(**{"dynamic.speed_end": speed_end, "dynamic.torque": 20.0, "dynamic.ramp_time": 0.002,
+                              "dynamic.duration": 0.1})      # (the tracked speeds from some 430 rad/s)
+        return run_fields(scene, static=False, dynamic=True, warn=False, mesh_outputs=False).dataset()
+    rattles = runup(1500.0)         # through 2Z and 1Z (about 250 and 495 rad/s) at 20 N·m: the teeth separate
+    lo, hi = rattles.attrs["contact_lost_speed_rad_s"]
+    z1 = float(rattles["critical_speed"].sel(excitation="1Z", mode=0))
+    assert rattles.attrs["contact_lost_fraction"] > 0 and 0 < lo <= hi < 1500.0
+    capsys.readouterr()
+    print_summary(rattles, tmp_path / "r.nc", 1.0)
+    out = capsys.readouterr().out
+    assert f"the teeth lost contact between {lo:.0f} and {hi:.0f} rad/s" in out and "linear estimates" in out
+    assert "1Z measured" in out and f"modal {z1:.0f}" in out
+    steady = dynamic_fields(paper_pair())       # 100 rad/s, far below the resonances: always in contact
+    assert steady.attrs["contact_lost_fraction"] == 0.0 and "contact_lost_speed_rad_s" not in steady.attrs
