@@ -256,6 +256,46 @@ def body_seconds(setup) -> float:
     return (FE_S_PER_BODY + FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25) * load_factor()
 
 
+# Peak memory of an FE body beyond the process's own (mesh, P2 assembly, factorisation, load
+# cases): maximum RSS of one spring map's body, 392 MB at 3 700 elements (the small pair's),
+# 750 MB at 20 500 and 822 MB at 23 400 (the paper's driven gear) -> 22 kB an element over a
+# process of some 310 MB, growing like the time beyond FE_REF_ELEMENTS (the factor's fill-in).
+FE_BYTES_PER_ELEMENT = 2.2e4
+# the FE reference holds both bodies factorised with their influence coefficients: the small
+# pair's reference peaked at 525 MB (215 MB over the process for two bodies of 81 MB by
+# `body_bytes`): 1.3 x
+REFERENCE_BODY_MEMORY = 1.4
+# share of the available memory above which a part is refused, and above which it is warned of
+MEMORY_REFUSE, MEMORY_WARN = 0.8, 0.5
+
+
+def body_bytes(setup) -> float:
+    """Estimated peak memory [bytes] of one FE body (`body_elements`)."""
+    n = body_elements(setup)
+    return FE_BYTES_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25
+
+
+def check_fe_memory(scene, factor: float = 1.0, setups=None) -> str | None:
+    """Refuse, before any FE work, bodies whose estimated memory (`body_bytes`; the two largest
+    are held at once, ``factor`` times that: the FE reference's influence coefficients)
+    exceeds MEMORY_REFUSE of the memory available (BudgetError naming fe.mesh_size); a line to
+    warn with above MEMORY_WARN, else None. ``setups``: the gear setups to count (default: the
+    bodies the scene needs and the FE cache lacks)."""
+    setups = [s for _, s, _ in fe_bodies(scene)] if setups is None else list(setups)
+    if not setups:
+        return None
+    sizes = sorted((body_bytes(s), body_elements(s)) for s in setups)[-2:]
+    need = factor * sum(b for b, _ in sizes)
+    have = available_memory()
+    what = (f"the FE bodies need about {bytes_text(need)} ({' and '.join(f'{n:.3g}' for _, n in sizes)} elements), "
+            f"{{}} the {bytes_text(have)} of memory available")
+    if need > MEMORY_REFUSE * have:
+        raise BudgetError("fe.mesh_size", what.format("more than") + ": a coarser fe.mesh_size (or fewer teeth)")
+    if need > MEMORY_WARN * have:
+        return "fe.mesh_size: " + what.format("more than half of") + "; a coarser fe.mesh_size needs less"
+    return None
+
+
 def fe_bodies(scene) -> list:
     """(label, setup, teeth) of the FE bodies the scene's springs need and the cache lacks."""
     from study.inputs.cache import FE_CACHE
@@ -461,18 +501,29 @@ def sweep_estimate(tasks) -> Estimate:
     """Estimated seconds of a study's tasks (`study.sweep.tasks.Task`), summed: FE bodies (each
     distinct body the cache lacks), statics (per static task, by its angles) and dynamics
     (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
+    from study.inputs.cache import FE_CACHE
     from study.run import dynamic_choice
-    from study.sweep.bodies import spring_maps
     est = Estimate()
-    bodies = {}
+    bodies, body_s = {}, {}
     static_s = 0.0
     dyn = [t for t in tasks if t.outputs.dynamic]
     for t in tasks:
-        for key, setup, _teeth in spring_maps(t.scene):
-            bodies.setdefault(key, setup)
+        try:        # the bodies of its springs or of its coupling model (compliance: fits at three loads)
+            needed = fe_bodies(t.scene)
+        except Exception:  # noqa: BLE001 - a scene that cannot be prepared: its task records why
+            needed = []
+        for _label, setup, teeth in needed:
+            key = FE_CACHE.key({**setup.settings, "teeth": list(range(setup.teeth)) if teeth is None else teeth})
+            if key not in bodies:
+                bodies[key] = setup
+                body_s[key] = body_seconds(setup) * (3.0 if t.scene.coupling_model == "compliance" else 1.0)
         if t.outputs.static and t.scene.quasi_static.method == "static":
             static_s += static_angle_count(t.scene) * STATIC_S_PER_ANGLE_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
-    est.seconds["FE bodies"] = sum(body_seconds(s) for s in bodies.values())
+    est.seconds["FE bodies"] = sum(body_s.values())
+    line = check_fe_memory(None, setups=bodies.values())        # BudgetError beyond the memory available
+    if line:
+        from study.plausibility import report_warnings
+        report_warnings([line], True)
     est.seconds["statics"] = static_s
     # the runs whose step is given (dynamic.time_step) each at their own step, one model per
     # distinct step and pair; the others at the worst step of up to DYNAMIC_SAMPLES of them

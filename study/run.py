@@ -220,6 +220,11 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     report_warnings(warnings, warn)
     if dynamic:
         estimate.check_dynamic_memory(scene)
+    if springs is None:     # the FE bodies' memory, before any of them is made
+        line = estimate.check_fe_memory(scene)
+        if line:
+            report_warnings([line], warn)
+            warnings.append(line)
     est = estimate.Estimate()
     bounded = max_time is not None      # the estimates serve only the bound
     if springs is None and bounded:
