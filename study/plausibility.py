@@ -164,7 +164,12 @@ def face_width_note(scene, swept: bool = False) -> str | None:
     """A line for the user when the face width cannot act on the STE: the contact law (k_con)
     and, unless a gear's springs come from the FE directly (spring.stiffness = 'fe'), the tooth
     springs are given per tooth, so a face width other than the calibration's (or a swept
-    one) changes only masses and inertias. None when it does act or stays at 17 mm."""
+    one) changes only masses and inertias. None when it does act or stays at 17 mm: with 'fe'
+    springs, and under the coupled models ('compliance', the default, and 'body-torsion'),
+    whose tooth springs come from the FE body at its face width (the small 24-tooth pair's mesh
+    stiffness rises 1.8 times from 20 to 40 mm of face) and read no k_phi."""
+    if scene.coupling_model != "none":
+        return None
     gears = [g for g in (1, 2) if scene.gear(g).spring.stiffness != "fe"]
     widths = {scene.gear(g).face_width for g in (1, 2)}
     if not gears or (not swept and widths == {FACE_WIDTH_REF_MM}):

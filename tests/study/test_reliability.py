@@ -317,17 +317,20 @@ def test_teeth_too_soft_for_the_load_are_named_not_a_solver_error(tmp_path, caps
 
 
 def test_a_face_width_that_only_changes_the_inertia_is_said(tmp_path, capsys):
-    """With per-tooth laws (k_con, k_phi scaled by 'fe-ratio' or 'uniform'), a 0.1 mm face gives
-    exactly the STE of 17 mm: the run says so and names the lever ('fe' springs)."""
+    """With per-tooth laws (k_con, k_phi scaled by 'fe-ratio' or 'uniform') on the paper's
+    model, a 0.1 mm face gives exactly the STE of 17 mm: the run says so and names the lever
+    ('fe' springs). The compliance model (the default) follows the face width: no note."""
     import study
     from study.plausibility import face_width_note
-    assert face_width_note(small_scene()) is None
+    uniform = {"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform"}
+    assert face_width_note(small_scene(**uniform)) is None
     thin = small_scene(**{"gear1.face_width": 0.1, "gear2.face_width": 0.1, "gear1.body.web_thickness": 0.1,
-                          "gear2.body.web_thickness": 0.1})
+                          "gear2.body.web_thickness": 0.1, **uniform})
     note = face_width_note(thin)
-    assert "masses and inertias only" in note and "'fe'" in note
+    assert thin.coupling_model == "none" and "masses and inertias only" in note and "'fe'" in note
     assert face_width_note(thin.replace(**{"gear1.spring.stiffness": "fe", "gear2.spring.stiffness": "fe"})) is None
-    a = study.run_scene(small_scene(), static=True, dynamic=False)
+    assert face_width_note(thin.replace(**{"coupling.model": "compliance"})) is None
+    a = study.run_scene(small_scene(**uniform), static=True, dynamic=False)
     b = study.run_scene(thin, static=True, dynamic=False)
     np.testing.assert_allclose(a["ste"].values, b["ste"].values, rtol=1e-9)     # what the note is about
     scene = tmp_path / "s.toml"
