@@ -99,9 +99,10 @@ def test_a_refusal_names_the_lever_of_its_largest_part(tmp_path, capsys):
 
 # ---------------------------------------------------------------- results that would pass as ok
 
-def write_study(tmp_path, grid: str, outputs: str = 'scalars = ["dte_rms"]') -> str:
+def write_study(tmp_path, grid: str, outputs: str = 'scalars = ["dte_rms"]', section: str = "grid") -> str:
+    """The example study's scene with ``grid`` as its [grid] (or the table ``section``)."""
     text = (Path("study/scenes/example_study.toml").read_text().split("[grid]")[0]
-            + f"[grid]\n{grid}\n[outputs]\n{outputs}\n")
+            + f"[{section}]\n{grid}\n[outputs]\n{outputs}\n")
     path = tmp_path / "st.toml"
     path.write_text(text)
     return str(path)
@@ -478,11 +479,7 @@ def test_integers_beyond_64_bits_are_refused_and_those_within_kept_exactly():
 
 
 def sample_study(tmp_path, sample: str) -> str:
-    text = (Path("study/scenes/example_study.toml").read_text().split("[grid]")[0]
-            + f"[sample]\n{sample}\n[outputs]\nscalars = [\"ste_p2p\"]\n")
-    path = tmp_path / "sample.toml"
-    path.write_text(text)
-    return str(path)
+    return write_study(tmp_path, sample, 'scalars = ["ste_p2p"]', section="sample")
 
 
 def test_integer_draws_and_seeds_are_checked_before_any_build(tmp_path, capsys):
