@@ -220,7 +220,8 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     report_warnings(warnings, warn)
     if dynamic:
         estimate.check_dynamic_memory(scene)
-    if springs is None:     # the FE bodies' memory, before any of them is made
+    if springs is None and not keep_model:     # the FE bodies' memory, before any of them is made (a
+        # study's worker: its estimate counted every body ahead)
         line = estimate.check_fe_memory(scene)
         if line:
             report_warnings([line], warn)
