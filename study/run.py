@@ -220,8 +220,9 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     report_warnings(warnings, warn)
     if dynamic:
         estimate.check_dynamic_memory(scene)
-    if springs is None and not keep_model:     # the FE bodies' memory, before any of them is made (a
-        # study's worker: its estimate counted every body ahead)
+    # the FE bodies' memory, before any of them is made (a study's worker leaves it to the
+    # study's estimate, which counted every body ahead)
+    if springs is None and not keep_model:
         line = estimate.check_fe_memory(scene)
         if line:
             report_warnings([line], warn)
