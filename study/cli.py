@@ -384,6 +384,11 @@ def precision_command(args) -> int:
     from study.verify.precision import setting_label
     check_precision_options(args)
     scene = precision_scene(args_scene(args))
+    # the memory of its runs' outputs and of its static angles, before the model is built
+    if args.only != "static":
+        estimate.check_dynamic_memory(scene.replace(**{"dynamic.duration": args.duration}), "--duration")
+    if args.only != "dynamic":
+        estimate.check_static_memory(scene.replace(**{"quasi_static.rotation": args.rotation}), field="--rotation")
     base = checked_output(args.output)
     max_time = checked_max_time(args)
     model = build_scene_model(scene)

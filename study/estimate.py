@@ -138,15 +138,16 @@ def dynamic_records(scene) -> int:
     return int(d.duration / d.output_step + 1e-9) + 1
 
 
-def check_dynamic_memory(scene) -> None:
-    """Refuse, before anything is built, a dynamic run whose output arrays do not fit in memory."""
+def check_dynamic_memory(scene, field: str = "dynamic.duration") -> None:
+    """Refuse, before anything is built, a dynamic run whose output arrays do not fit in memory
+    (BudgetError naming ``field``)."""
     if not scene.dynamic.enabled:
         return
     n = dynamic_records(scene)
     need = OUTPUT_COPIES * n * (L.N_OUT + L.CONTACT_SLOTS * L.O_CONTACT_COLS) * 8.0
     have = available_memory()
     if need > 0.8 * have:
-        raise BudgetError("dynamic.duration", f"the run's outputs need about {bytes_text(need)} ({n:.3g} records of "
+        raise BudgetError(field, f"the run's outputs need about {bytes_text(need)} ({n:.3g} records of "
                           f"dynamic.output_step = {scene.dynamic.output_step:.3g} s over {scene.dynamic.duration:.4g} s), "
                           f"more than the {bytes_text(have)} of memory available; shorten the run or raise "
                           "dynamic.output_step")

@@ -674,3 +674,10 @@ def test_fe_bodies_beyond_the_memory_are_refused_before_any_fe_work(tmp_path, ca
     assert estimate.check_fe_memory(None, setups=setups) is None
     monkeypatch.setattr(estimate, "available_memory", lambda: 250e6)
     assert "more than half of" in estimate.check_fe_memory(None, setups=setups)
+
+
+def test_precision_outputs_beyond_the_memory_are_refused_naming_its_option(tmp_path, capsys):
+    code, out, err = run_cli(capsys, "precision", "--duration", "1e7", "-o", tmp_path / "p.nc")
+    assert code == 2 and "--duration: the run's outputs need about" in err and "TiB" in err and "study ..." not in out
+    code, _, err = run_cli(capsys, "precision", "--only", "static", "--rotation", "1e12", "-o", tmp_path / "p.nc")
+    assert code == 2 and "--rotation: the static analysis needs about" in err
