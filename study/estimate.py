@@ -263,8 +263,8 @@ def body_seconds(setup) -> float:
 # process of some 310 MB, growing like the time beyond FE_REF_ELEMENTS (the factor's fill-in).
 FE_BYTES_PER_ELEMENT = 2.2e4
 # the FE reference holds both bodies factorised with their influence coefficients: the small
-# pair's reference peaked at 525 MB (215 MB over the process for two bodies of 81 MB by
-# `body_bytes`): 1.3 x
+# pair's reference peaked at 525 MB (215 MB over the process: estimated 228 MB with this
+# factor), the paper pair's at 1151 MB (841 MB over the process: estimated 1439 MB, 1.7 x)
 REFERENCE_BODY_MEMORY = 1.4
 # share of the available memory above which a part is refused, and above which it is warned of
 MEMORY_REFUSE, MEMORY_WARN = 0.8, 0.5
