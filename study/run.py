@@ -220,6 +220,11 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     report_warnings(warnings, warn)
     if dynamic:
         estimate.check_dynamic_memory(scene)
+    est = estimate.Estimate()
+    bounded = max_time is not None      # the estimates serve only the bound
+    if springs is None and bounded:
+        est.seconds["FE bodies"] = estimate.fe_seconds(scene)
+        estimate.check_time(est, max_time)
     # the FE bodies' memory, before any of them is made (a study's worker leaves it to the
     # study's estimate, which counted every body ahead)
     if springs is None and not keep_model:
@@ -227,11 +232,6 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
         if line:
             report_warnings([line], warn)
             warnings.append(line)
-    est = estimate.Estimate()
-    bounded = max_time is not None      # the estimates serve only the bound
-    if springs is None and bounded:
-        est.seconds["FE bodies"] = estimate.fe_seconds(scene)
-        estimate.check_time(est, max_time)
     t0 = time.perf_counter()
     if springs is None:
         estimate.run_fe_bodies(scene, progress)

@@ -661,7 +661,8 @@ def test_fe_bodies_beyond_the_memory_are_refused_before_any_fe_work(tmp_path, ca
                            "-o", tmp_path / "r.nc")
     assert code == 2 and "fe.mesh_size: the FE bodies need about" in err and "GiB" in err
     assert "a coarser fe.mesh_size" in err and not private_fe_cache.folder.exists()
-    code, _, err = run_cli(capsys, "reference", "small_pair", "--set", "gear2.teeth=10000", "-o", tmp_path / "f.nc")
+    code, _, err = run_cli(capsys, "reference", "small_pair", "--set", "gear2.teeth=10000", "--max-time", "1e9",
+                           "-o", tmp_path / "f.nc")
     assert code == 2 and "fe.mesh_size: the FE bodies need about" in err
     st = tmp_path / "big.toml"
     st.write_text('scene = "small_pair"\n[grid]\n"gear2.teeth" = [24, 10000]\n[outputs]\nscalars = ["ste_p2p"]\n')
