@@ -28,10 +28,17 @@ EXIT_CODES = """exit codes:
 
 
 def writable_folder(folder: Path, option: str = "-o") -> None:
-    """Create ``folder`` if needed and prove that a file can be written in it, before any work."""
+    """Create ``folder`` if needed and prove that a file can be written in it, before any work.
+    Missing folders are created under the working directory (``results/...``), and elsewhere
+    one new folder in an existing one: a slip such as ``/nonexistent/dir`` never makes folders
+    at the root of the file system."""
     import tempfile
     if folder.exists() and not folder.is_dir():
         raise UsageError(option, f"{folder} is a file, not a directory")
+    if not folder.exists() and not folder.parent.is_dir() \
+            and not folder.resolve().is_relative_to(Path.cwd().resolve()):
+        raise UsageError(option, f"the folder {folder.parent} does not exist: outside the working directory lightgear "
+                                 f"creates only the last folder of a path; create {folder.parent} first")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=folder, prefix=".lightgear-probe"):
@@ -117,6 +124,10 @@ def run_command(args) -> int:
     from study.plausibility import check_dynamic_window
     from study.report.summary import print_summary
     scene = args_scene(args)
+    if args.no_dynamic and scene.dynamic.enabled:
+        # the scene without its dynamic run: the title, modes and critical speeds at the STE's
+        # torque (`study.scene_model.mean_load`), not at the torque of the run left out
+        scene = scene.replace(**{"dynamic.enabled": False})
     if not args.no_dynamic:
         check_dynamic_window(scene)       # the summary needs a steady part after the ramps
         check_dynamic_memory(scene)       # at once, before the solver is even loaded
@@ -400,6 +411,11 @@ def precision_command(args) -> int:
     from study.verify.precision import setting_label
     check_precision_options(args)
     scene = precision_scene(args_scene(args))
+    # the memory of its runs' outputs and of its static angles, before the model is built
+    if args.only != "static":
+        estimate.check_dynamic_memory(scene.replace(**{"dynamic.duration": args.duration}), "--duration")
+    if args.only != "dynamic":
+        estimate.check_static_memory(scene.replace(**{"quasi_static.rotation": args.rotation}), field="--rotation")
     base = checked_output(args.output)
     max_time = checked_max_time(args)
     model = build_scene_model(scene)

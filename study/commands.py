@@ -87,6 +87,11 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
         raise SceneError("--step", f"must be positive, got {step}")
     angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
     estimate.check_time(estimate.reference_estimate(scene, angles), max_time)
+    from study.inputs.gearsetup import gear_setups
+    line = estimate.check_fe_memory(scene, estimate.REFERENCE_BODY_MEMORY, gear_setups(scene))
+    if line:
+        from study.plausibility import report_warnings
+        report_warnings([line], True)
     return reference_dataset(scene, angles, progress=progress)
 
 

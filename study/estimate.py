@@ -138,15 +138,16 @@ def dynamic_records(scene) -> int:
     return int(d.duration / d.output_step + 1e-9) + 1
 
 
-def check_dynamic_memory(scene) -> None:
-    """Refuse, before anything is built, a dynamic run whose output arrays do not fit in memory."""
+def check_dynamic_memory(scene, field: str = "dynamic.duration") -> None:
+    """Refuse, before anything is built, a dynamic run whose output arrays do not fit in memory
+    (BudgetError naming ``field``)."""
     if not scene.dynamic.enabled:
         return
     n = dynamic_records(scene)
     need = OUTPUT_COPIES * n * (L.N_OUT + L.CONTACT_SLOTS * L.O_CONTACT_COLS) * 8.0
     have = available_memory()
     if need > 0.8 * have:
-        raise BudgetError("dynamic.duration", f"the run's outputs need about {bytes_text(need)} ({n:.3g} records of "
+        raise BudgetError(field, f"the run's outputs need about {bytes_text(need)} ({n:.3g} records of "
                           f"dynamic.output_step = {scene.dynamic.output_step:.3g} s over {scene.dynamic.duration:.4g} s), "
                           f"more than the {bytes_text(have)} of memory available; shorten the run or raise "
                           "dynamic.output_step")
@@ -262,6 +263,46 @@ def body_seconds(setup) -> float:
     """Estimated run time [s] of one FE body: mesh, assembly, factorisation and load cases."""
     n = body_elements(setup)
     return (FE_S_PER_BODY + FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25) * load_factor()
+
+
+# Peak memory of an FE body beyond the process's own (mesh, P2 assembly, factorisation, load
+# cases): maximum RSS of one spring map's body, 392 MB at 3 700 elements (the small pair's),
+# 750 MB at 20 500 and 822 MB at 23 400 (the paper's driven gear) -> 22 kB an element over a
+# process of some 310 MB, growing like the time beyond FE_REF_ELEMENTS (the factor's fill-in).
+FE_BYTES_PER_ELEMENT = 2.2e4
+# the FE reference holds both bodies factorised with their influence coefficients: the small
+# pair's reference peaked at 525 MB (215 MB over the process: estimated 228 MB with this
+# factor), the paper pair's at 1151 MB (841 MB over the process: estimated 1439 MB, 1.7 x)
+REFERENCE_BODY_MEMORY = 1.4
+# share of the available memory above which a part is refused, and above which it is warned of
+MEMORY_REFUSE, MEMORY_WARN = 0.8, 0.5
+
+
+def body_bytes(setup) -> float:
+    """Estimated peak memory [bytes] of one FE body (`body_elements`)."""
+    n = body_elements(setup)
+    return FE_BYTES_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25
+
+
+def check_fe_memory(scene, factor: float = 1.0, setups=None) -> str | None:
+    """Refuse, before any FE work, bodies whose estimated memory (`body_bytes`; the two largest
+    are held at once, ``factor`` times that: the FE reference's influence coefficients)
+    exceeds MEMORY_REFUSE of the memory available (BudgetError naming fe.mesh_size); a line to
+    warn with above MEMORY_WARN, else None. ``setups``: the gear setups to count (default: the
+    bodies the scene needs and the FE cache lacks)."""
+    setups = [s for _, s, _ in fe_bodies(scene)] if setups is None else list(setups)
+    if not setups:
+        return None
+    sizes = sorted((body_bytes(s), body_elements(s)) for s in setups)[-2:]
+    need = factor * sum(b for b, _ in sizes)
+    have = available_memory()
+    what = (f"the FE bodies need about {bytes_text(need)} ({' and '.join(f'{n:.3g}' for _, n in sizes)} elements), "
+            f"{{}} the {bytes_text(have)} of memory available")
+    if need > MEMORY_REFUSE * have:
+        raise BudgetError("fe.mesh_size", what.format("more than") + ": a coarser fe.mesh_size (or fewer teeth)")
+    if need > MEMORY_WARN * have:
+        return "fe.mesh_size: " + what.format("more than half of") + "; a coarser fe.mesh_size needs less"
+    return None
 
 
 def fe_bodies(scene) -> list:
@@ -386,28 +427,42 @@ DYNAMIC_SAMPLES = 3          # dynamic tasks whose model gives the step of the e
 
 
 def study_points(study) -> int:
-    """Points of a study (grid product plus explicit points), counted without building them."""
+    """Points of a study (grid product, times the builds of its sample, plus explicit points),
+    counted without building them."""
     n = 1
     for a in study.axes:
         n *= len(a.values)
-    return (n if study.axes else 0) + len(study.extra)
+    n = n if study.axes else 0
+    if study.sample:        # every grid point (or the base scene alone) gets the whole sample
+        n = max(n, 1) * study.sample.builds
+    return n + len(study.extra)
+
+
+def study_sizes(study) -> str:
+    """The factors of `study_points` in words: '3 x 4', '1e+06 draws', '2 x 500 draws + 3'."""
+    parts = [str(len(a.values)) for a in study.axes]
+    if study.sample:
+        parts.append(f"{study.sample.builds:.4g} draws" if study.sample.builds >= 1e6 else f"{study.sample.builds} draws")
+    return " x ".join(parts) or "0"
 
 
 def check_study_size(study, max_time: float | None) -> int:
     """Refuse, before its points are built, a study too large to enumerate: memory beyond what
-    the machine has, or its checks alone beyond ``max_time`` [s]. Returns its point count."""
+    the machine has, or its checks alone beyond ``max_time`` [s]. Returns its point count
+    (grid points and sampled builds alike: `study_points`)."""
     n = study_points(study)
     need = n * POINT_BYTES
     have = available_memory()
-    sizes = " x ".join(str(len(a.values)) for a in study.axes) or "0"
+    sizes = study_sizes(study)
+    field, lever = ("sample.size", "draw fewer (sample.size)") if study.sample else ("grid", "sweep fewer values")
     if need > 0.5 * have:
-        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}{f' + {len(study.extra)}' if study.extra else ''}); "
-                                  f"only listing them needs about {bytes_text(need)}, more than half the {bytes_text(have)} "
-                                  "of memory available: sweep fewer values, or split the study")
+        raise BudgetError(field, f"the study has {n:.4g} points ({sizes}{f' + {len(study.extra)}' if study.extra else ''}); "
+                                 f"only listing them needs about {bytes_text(need)}, more than half the {bytes_text(have)} "
+                                 f"of memory available: {lever}, or split the study")
     if max_time is not None and n * POINT_CHECK_S > max_time:
-        raise BudgetError("grid", f"the study has {n:.4g} points ({sizes}); building and checking them alone takes "
-                                  f"about {duration_text(n * POINT_CHECK_S)}, beyond --max-time {max_time:.4g} s: "
-                                  "sweep fewer values, or split the study")
+        raise BudgetError(field, f"the study has {n:.4g} points ({sizes}); building and checking them alone takes "
+                                 f"about {duration_text(n * POINT_CHECK_S)}, beyond --max-time {max_time:.4g} s: "
+                                 f"{lever}, or split the study")
     return n
 
 
@@ -451,38 +506,68 @@ def task_seconds(scene, outputs) -> float:
     return s
 
 
+GIVEN_STEP_GROUPS = 20      # distinct given steps estimated one by one, the smallest (the others sampled)
+
+
 def sweep_estimate(tasks) -> Estimate:
     """Estimated seconds of a study's tasks (`study.sweep.tasks.Task`), summed: FE bodies (each
     distinct body the cache lacks), statics (per static task, by its angles) and dynamics
     (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
+    from study.inputs.cache import FE_CACHE
     from study.run import dynamic_choice
-    from study.sweep.bodies import spring_maps
     est = Estimate()
-    bodies = {}
+    bodies, body_s = {}, {}
     static_s = 0.0
     dyn = [t for t in tasks if t.outputs.dynamic]
     for t in tasks:
-        for key, setup, _teeth in spring_maps(t.scene):
-            bodies.setdefault(key, setup)
+        try:        # the bodies of its springs or of its coupling model (compliance: fits at three loads)
+            needed = fe_bodies(t.scene)
+        except Exception:  # noqa: BLE001 - a scene that cannot be prepared: its task records why
+            needed = []
+        for _label, setup, teeth in needed:
+            key = FE_CACHE.key({**setup.settings, "teeth": list(range(setup.teeth)) if teeth is None else teeth})
+            if key not in bodies:
+                bodies[key] = setup
+                body_s[key] = body_seconds(setup) * (3.0 if t.scene.coupling_model == "compliance" else 1.0)
         if t.outputs.static and t.scene.quasi_static.method == "static":
             static_s += static_angle_count(t.scene) * STATIC_S_PER_ANGLE_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
-    est.seconds["FE bodies"] = sum(body_seconds(s) for s in bodies.values())
+    est.seconds["FE bodies"] = sum(body_s.values())
+    line = check_fe_memory(None, setups=bodies.values())        # BudgetError beyond the memory available
+    if line:
+        from study.plausibility import report_warnings
+        report_warnings([line], True)
     est.seconds["statics"] = static_s
+    # the runs whose step is given (dynamic.time_step) each at their own step, one model per
+    # distinct step and pair; the others at the worst step of up to DYNAMIC_SAMPLES of them
+    given: dict = {}
+    for t in dyn:
+        d = t.scene.dynamic
+        if d.time_step > 0:
+            given.setdefault((d.time_step, d.method, t.scene.gear1.teeth, t.scene.gear2.teeth), []).append(t)
+    given = dict(sorted(given.items(), key=lambda kv: kv[0][0])[:GIVEN_STEP_GROUPS])     # the smallest steps
+    free = [t for t in dyn if not any(t in g for g in given.values())]
+    groups = [(g[0], g) for g in given.values()]
+    if free:
+        picks = [free[int(i)] for i in sorted({round(k * (len(free) - 1) / max(DYNAMIC_SAMPLES - 1, 1))
+                                                for k in range(min(DYNAMIC_SAMPLES, len(free)))})]
+        groups += [(t, None) for t in picks]
+    rates, dts, choice_of, seconds = [], [], [], 0.0
+    for t, group in groups:
+        model = estimate_model(t.scene)
+        choice = dynamic_choice(t.scene, model)
+        rate = dynamic_seconds(model, choice, 1.0)      # s of run time per s simulated
+        rates.append(rate)
+        dts.append(choice.dt)
+        choice_of.append(choice)
+        if group is not None:
+            seconds += rate * sum(u.scene.dynamic.duration for u in group)
+    if free:
+        seconds += max(r for (_, g), r in zip(groups, rates) if g is None) * sum(t.scene.dynamic.duration for t in free)
     if dyn:
-        picks = [dyn[int(i)] for i in sorted({round(k * (len(dyn) - 1) / max(DYNAMIC_SAMPLES - 1, 1))
-                                               for k in range(min(DYNAMIC_SAMPLES, len(dyn)))})]
-        rates, dts, choice_of = [], [], []
-        for t in picks:
-            model = estimate_model(t.scene)
-            choice = dynamic_choice(t.scene, model)
-            rates.append(dynamic_seconds(model, choice, 1.0))      # s of run time per s simulated
-            dts.append(choice.dt)
-            choice_of.append(choice)
-        rate = max(rates)
         part = f"dynamics ({len(dyn)} runs, dt down to {min(dts):.3g} s)"
-        est.seconds[part] = rate * sum(t.scene.dynamic.duration for t in dyn)
+        est.seconds[part] = seconds
         worst = int(np.argmax(rates))
-        est.levers[part] = dynamic_lever(picks[worst].scene, choice_of[worst]) + ", or fewer grid points"
+        est.levers[part] = dynamic_lever(groups[worst][0].scene, choice_of[worst]) + ", or fewer grid points"
     return est
 
 

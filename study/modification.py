@@ -21,9 +21,13 @@ from study.errors import SceneError
 SHAPES = {"linear": 1.0, "parabolic": 2.0}
 
 
-def _f(default, unit: str, doc: str, lo=None, choices=None):
-    return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=None, lo_open=False, choices=choices,
+def _f(default, unit: str, doc: str, lo=None, choices=None, hi=None):
+    return field(default=default, metadata=dict(unit=unit, doc=doc, lo=lo, hi=hi, lo_open=False, choices=choices,
                                                 optional=False))
+
+
+# roll angles [deg] beyond a turn are a slip (an involute's tip is at some 20-100 deg of roll)
+ROLL_MAX = 360.0
 
 
 @dataclass(frozen=True)
@@ -31,15 +35,16 @@ class ModificationSection:
     """Deviation of the flanks along their normal (both flanks of every tooth); 0 = none."""
     tip_relief: float = _f(0.0, "um", "tip relief: deviation at the tip circle (material removed)", 0.0)
     tip_shape: str = _f("linear", "", "tip relief profile: 'linear' or 'parabolic' from its start", choices=tuple(SHAPES))
-    tip_start_roll: float = _f(0.0, "deg", "roll angle where the tip relief starts (or tip_start_diameter, or tip_length)", 0.0)
+    tip_start_roll: float = _f(0.0, "deg", "roll angle where the tip relief starts (or tip_start_diameter, or tip_length)", 0.0, hi=ROLL_MAX)
     tip_start_diameter: float = _f(0.0, "mm", "diameter where the tip relief starts", 0.0)
     tip_length: float = _f(0.0, "mm", "length of the tip relief along the path of contact, from the tip", 0.0)
     root_relief: float = _f(0.0, "um", "root relief: deviation at the form circle (material removed)", 0.0)
     root_shape: str = _f("linear", "", "root relief profile: 'linear' or 'parabolic' from its start", choices=tuple(SHAPES))
-    root_start_roll: float = _f(0.0, "deg", "roll angle where the root relief starts (or root_start_diameter, or root_length)", 0.0)
+    root_start_roll: float = _f(0.0, "deg", "roll angle where the root relief starts (or root_start_diameter, or root_length)", 0.0, hi=ROLL_MAX)
     root_start_diameter: float = _f(0.0, "mm", "diameter where the root relief starts", 0.0)
     root_length: float = _f(0.0, "mm", "length of the root relief along the path of contact, from the form circle", 0.0)
-    profile_roll: tuple[float, ...] = _f((), "deg", "positions of the profile deviation table as roll angles (or profile_diameter)")
+    profile_roll: tuple[float, ...] = _f((), "deg", "positions of the profile deviation table as roll angles (or profile_diameter)",
+                                            0.0, hi=ROLL_MAX)
     profile_diameter: tuple[float, ...] = _f((), "mm", "positions of the profile deviation table as diameters")
     profile_deviation: tuple[float, ...] = _f((), "um", "profile deviation at those positions (positive: material removed), "
                                               "linear between them, constant beyond; added to the reliefs")

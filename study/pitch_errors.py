@@ -34,7 +34,8 @@ class ErrorsSection:
     seed: int = _f(0, "1", "seed of the random pitch deviations of grade (the same seed gives the same set)", 0)
     eccentricity: float = _f(0.0, "um", "offset of the teeth's centre from the bearing axis (radial runout "
                              "F_r ~ 2 x eccentricity)", 0.0)
-    eccentricity_phase: float = _f(0.0, "deg", "direction of that offset in the gear, from tooth 0's axis")
+    eccentricity_phase: float = _f(0.0, "deg", "direction of that offset in the gear, from tooth 0's axis",
+                                   -360.0, 360.0)
 
     @property
     def is_zero(self) -> bool:

@@ -24,6 +24,11 @@ STEADY_SAMPLES = 16
 # the module: beyond it the pseudo-rigid teeth leave the range where the model means anything
 # (teeth bent by a sizeable part of their height), and the statics find no equilibrium.
 DEFLECTION_FRACTION = 0.2
+# Smallest elastic approach a nonzero load must give [mm]: below some 10 nm the statics over a
+# revolution stop converging and the dynamic run's energy guard trips (the small 24-tooth pair
+# at 1e-3 N·m, 3.6 nm; fine at 1e-2 N·m, 29 nm), and the damping conversion fails after the
+# FE work blaming the damping ratio.
+MIN_APPROACH_MM = 1e-5
 
 
 def mesh_size_mm(scene, g: int) -> float:
@@ -144,10 +149,23 @@ def check_loads(scene) -> None:
         if torque == 0:
             continue
         d = approach_estimate_mm(scene, torque)
+        if d < MIN_APPROACH_MM:
+            raise SceneError(name, f"a load too small to resolve: {torque:.4g} N*m presses one tooth pair together by about "
+                             f"{d:.3g} mm (contact law and tooth springs), less than the {MIN_APPROACH_MM:g} mm the "
+                             f"solvers resolve; give at least {smallest_torque(scene):.2g} N*m in magnitude, or 0 for no load")
         if not d <= bound:
             raise SceneError(name, f"implausible load: {torque:.4g} N*m bends one tooth pair by about {d:.3g} mm "
                              f"(contact law and tooth springs), more than {DEFLECTION_FRACTION:g} x module = {bound:.4g} mm; "
                              "the pseudo-rigid tooth model does not hold there")
+
+
+def smallest_torque(scene) -> float:
+    """The torque [N·m] whose `approach_estimate_mm` is MIN_APPROACH_MM (bisection in log scale)."""
+    lo, hi = 1e-12, 1e6
+    for _ in range(60):
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if approach_estimate_mm(scene, mid) < MIN_APPROACH_MM else (lo, mid)
+    return hi
 
 
 def check_plausibility(scene) -> None:
@@ -186,7 +204,12 @@ def face_width_note(scene, swept: bool = False) -> str | None:
     """A line for the user when the face width cannot act on the STE: the contact law (k_con)
     and, unless a gear's springs come from the FE directly (spring.stiffness = 'fe'), the tooth
     springs are given per tooth, so a face width other than the calibration's (or a swept
-    one) changes only masses and inertias. None when it does act or stays at 17 mm."""
+    one) changes only masses and inertias. None when it does act or stays at 17 mm: with 'fe'
+    springs, and under the coupled models ('compliance', the default, and 'body-torsion'),
+    whose tooth springs come from the FE body at its face width (the small 24-tooth pair's mesh
+    stiffness rises 1.8 times from 20 to 40 mm of face) and read no k_phi."""
+    if scene.coupling_model != "none":
+        return None
     gears = [g for g in (1, 2) if scene.gear(g).spring.stiffness != "fe"]
     widths = {scene.gear(g).face_width for g in (1, 2)}
     if not gears or (not swept and widths == {FACE_WIDTH_REF_MM}):

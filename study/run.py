@@ -23,7 +23,7 @@ from solver.mbs.statics import solve_static
 from study import estimate
 from study.archive import run_variables
 from study.archive.lightening import lightening_variables
-from study.archive.mesh import dynamic_force_variables, mesh_variables
+from study.archive.mesh import dynamic_factor_reason, dynamic_force_variables, mesh_variables, steady_window
 from study.archive.modes import modal_variables
 from study.archive.netcdf import provenance
 from study.inputs.coupling import plain_windup
@@ -115,6 +115,21 @@ def static_force_max(scene: Scene, model: Model) -> float:
     st = solve_static(model, angles, d.torque, raise_on_failure=False, friction_speed=max(d.speed, d.speed_end))
     f = st.tooth_force[st.converged]
     return float(np.max(f)) if f.size and st.converged.all() else float("nan")
+
+
+def contact_loss_attrs(res, d) -> dict:
+    """Whether the teeth of dynamic run ``res`` (of the scene's dynamic section ``d``) lost
+    contact after the torque ramp: ``contact_lost_fraction`` [1], the share of the output
+    instants with no loaded contact, and for a run-up the driver speeds [rad/s] where it
+    happened (``contact_lost_speed_rad_s``, first and last). The response then left the
+    linear range the modal critical speeds stand for."""
+    after = (res.time > d.ramp_time) & np.isfinite(res.te)
+    lost = after & (res.n_contacts == 0)
+    out = {"contact_lost_fraction": float(lost.sum() / max(after.sum(), 1))}
+    if d.speed_end > 0 and lost.any():
+        speed = d.speed_end * res.time[lost] / d.duration
+        out["contact_lost_speed_rad_s"] = np.array([speed.min(), speed.max()])
+    return out
 
 
 # the springs and model of the last scene run with keep_model: (what they depend on, springs, model)
@@ -211,6 +226,13 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     if springs is None and bounded:
         est.seconds["FE bodies"] = estimate.fe_seconds(scene)
         estimate.check_time(est, max_time)
+    # the FE bodies' memory, before any of them is made (a study's worker leaves it to the
+    # study's estimate, which counted every body ahead)
+    if springs is None and not keep_model:
+        line = estimate.check_fe_memory(scene)
+        if line:
+            report_warnings([line], warn)
+            warnings.append(line)
     t0 = time.perf_counter()
     if springs is None:
         estimate.run_fe_bodies(scene, progress)
@@ -315,11 +337,20 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
                                                   scene.gear2.body.holes, z2,
                                                   (z2 / z1, 1.0) if scene.has_errors else None)
         coords.update(c); data.update(v); attrs.update(a)
+        _, periods, short = steady_window(scene, start, to_load_change=False)
+        attrs["steady_mesh_periods"] = periods
+        attrs["driver_speed_max_rad_s"] = max(d.speed, d.speed_end)
+        if short and not runup:     # DTE RMS and peak-to-peak left undefined (`study.archive.summary`)
+            attrs["steady_window_note"] = short
         if archive or mesh_outputs:     # (read by no study output but the dynamic factor, a mesh output)
-            c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model) if mesh_outputs else math.nan)
+            undefined = dynamic_factor_reason(scene, start)
+            end = steady_window(scene, start)[0]
+            c, v = dynamic_force_variables(dy, start, z1, z2, static_force_max(scene, model)
+                                           if mesh_outputs and undefined is None else math.nan, end, undefined)
             coords.update(c); data.update(v)
         if scene.contact.friction > 0 and not runup and load_table(scene) is None:
             data.update(run_variables.efficiency_variable(dy, d.torque, d.speed, start))
+        attrs.update(contact_loss_attrs(dy, d))
         if runup:
             attrs["runup_speed_end_rad_s"] = d.speed_end
             if dy.status in COMPLETED:    # completed: the map is kept, an inaccurate one with its flag

@@ -12,6 +12,7 @@ Errors: `SceneError` names the dotted field and the reason, before any work star
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import functools
@@ -335,6 +336,10 @@ class Scene:
 
 # ---------------------------------------------------------------- building and checking
 
+# the integers a scene field or a study's seed may hold: those a NetCDF archive stores (int64)
+INT_MIN, INT_MAX = -2 ** 63, 2 ** 63 - 1
+
+
 def _coerce(value, typ, path):
     """``value`` as ``typ`` (bool, int, float or str), else SceneError; a bool is no number.
     NumPy scalars and arrays count as the Python numbers and lists they hold."""
@@ -346,7 +351,11 @@ def _coerce(value, typ, path):
     number = isinstance(value, int | float) and not isinstance(value, bool)
     if (typ is bool and isinstance(value, bool)) or (typ is str and isinstance(value, str)):
         return value
-    if typ is int and number and math.isfinite(value) and float(value) == int(value):
+    if typ is int and number and (isinstance(value, int) or (math.isfinite(value) and value.is_integer())):
+        # (a Python int as it is: 2^53 + 1 has no float of its own)
+        if not INT_MIN <= int(value) <= INT_MAX:
+            raise SceneError(path, f"must fit in 64 bits (the archive's integers), from {INT_MIN} to {INT_MAX}, "
+                                   f"got {int(value)}")
         return int(value)
     if typ is float and number and math.isfinite(value):
         return float(value)
@@ -395,12 +404,13 @@ def _build(cls, table, path: str):
         if md.get("choices") and v not in md["choices"]:
             raise SceneError(where, f"must be one of {', '.join(map(repr, md['choices']))}, got {v!r}")
         lo, hi = md.get("lo"), md.get("hi")
-        if lo is not None and not isinstance(v, tuple) and (v < lo or (md.get("lo_open") and v == lo)):
-            rel = ">" if md.get("lo_open") else ">="
-            raise SceneError(where, f"must be {rel} {lo}{unit}, got {v}{unit}")
-        if hi is not None and (v > hi or (md.get("hi_open") and v == hi)):
-            rel = "<" if md.get("hi_open") else "<="
-            raise SceneError(where, f"must be {rel} {hi}{unit}, got {v}{unit}")
+        for x in (v if isinstance(v, tuple) else (v,)):     # (a list: each of its numbers)
+            if lo is not None and (x < lo or (md.get("lo_open") and x == lo)):
+                rel = ">" if md.get("lo_open") else ">="
+                raise SceneError(where, f"must be {rel} {lo}{unit}, got {x}{unit}")
+            if hi is not None and (x > hi or (md.get("hi_open") and x == hi)):
+                rel = "<" if md.get("hi_open") else "<="
+                raise SceneError(where, f"must be {rel} {hi}{unit}, got {x}{unit}")
         kwargs[name] = v
     resolve_exclusive(cls, kwargs, path)
     return cls(**kwargs)
@@ -433,6 +443,9 @@ def check_scene(scene: Scene) -> None:
                          f"of the run ({d.duration} s), got {d.torque_change_time} s")
     if d.spectrum_start >= d.duration:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
+    if scene.quasi_static.enabled:
+        from study.scene_model import check_two_angles
+        check_two_angles(scene, scene.quasi_static.angle_step)
     check_integrator_model(scene)
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
@@ -511,6 +524,21 @@ def loads_scene(text: str, source: str = "scene") -> Scene:
 SCENES_DIR = Path(__file__).parent / "scenes"
 
 
+# the tables that make a TOML file a study (`study.sweep.grid`), and those only a scene has
+STUDY_SECTIONS = ("grid", "points", "sample")
+
+
+def is_study_table(data: dict) -> bool:
+    """A TOML file's tables are a study's: a [grid], [[points]] or [sample], or a [scene] table
+    of overrides (a scene has no section of that name)."""
+    return any(k in data for k in STUDY_SECTIONS) or isinstance(data.get("scene"), dict)
+
+
+def is_scene_table(data: dict) -> bool:
+    """A TOML file's tables are a scene's: sections of a Scene and none of a study."""
+    return not is_study_table(data) and any(f.name in data for f in dataclasses.fields(Scene) if f.name != "title")
+
+
 def embedded_scenes() -> dict[str, tuple[Path, str, str]]:
     """The scenes and studies that ship with lightgear: name -> (file, 'scene' or 'study', title)."""
     out = {}
@@ -519,7 +547,7 @@ def embedded_scenes() -> dict[str, tuple[Path, str, str]]:
             raw = tomllib.loads(p.read_text())
         except (OSError, tomllib.TOMLDecodeError):
             continue
-        kind = "study" if ("grid" in raw or "points" in raw) else "scene"
+        kind = "study" if is_study_table(raw) else "scene"
         out[p.stem] = (p, kind, str(raw.get("title", "")))
     return out
 
@@ -546,15 +574,45 @@ def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] =
     apply ``key=value`` overrides."""
     text = default_scene_text() if path is None else read_text(scene_path(path))
     data = _tables(text, str(path or "scene"))
+    if is_study_table(data):
+        raise SceneError("scene", f"{path} is a study (its {', '.join(f'[{k}]' for k in STUDY_SECTIONS if k in data)} "
+                                  "over a [scene]), not a scene: run it with `lightgear sweep` (study.load_study)")
     items = [parse_override(item) for item in overrides]
     keys = {k for k, _v in items}
     for key, _v in items:
         partner = damping_partner(key.split("."))
         if partner and key.rsplit(".", 1)[0] + "." + partner in keys:
             raise SceneError(key, f"give either {key} or {key.rsplit('.', 1)[0]}.{partner}, not both")
+    base = copy.deepcopy(data) if items else None
     for key, value in items:
         set_dotted(data, key, value)
-    return scene_from_dict(data)
+    try:
+        return scene_from_dict(data)
+    except SceneError as e:
+        raise override_at_fault(e, base, items) from None
+
+
+def override_at_fault(error: SceneError, base: dict | None, items: list) -> SceneError:
+    """``error`` of a scene with overrides ``items`` [(key, value)] on ``base`` (its tables),
+    naming the override at fault where the error names another field that only the override
+    made invalid (``--set gear2.module=2``: the module, not the holes it made cut the hub);
+    the error as it is otherwise."""
+    if not items or error.field in {k for k, _v in items}:
+        return error
+    try:
+        scene_from_dict(copy.deepcopy(base))
+    except SceneError:
+        return error                # the scene is invalid without the overrides too
+    for key, value in items:
+        alone = copy.deepcopy(base)
+        set_dotted(alone, key, value)
+        try:
+            scene_from_dict(alone)
+        except SceneError as e:
+            if e.field == error.field:
+                return SceneError(key, f"{value!r} makes {error.field} invalid (valid before the override): {error.reason}")
+    keys = ", ".join(k for k, _v in items)
+    return SceneError(error.field, f"{error.reason} (valid before the overrides of {keys})")
 
 
 def default_scene_text() -> str:
@@ -610,8 +668,12 @@ def scene_field(path: str) -> dataclasses.Field:
         fs = {x.name: x for x in fields(cls)} if dataclasses.is_dataclass(cls) else {}
         if p not in fs:
             where = ".".join(parts[:i])
-            close = difflib.get_close_matches(path, field_paths(), n=1, cutoff=0.6)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
+            # the names of this level that the typed part begins (gear2.bod -> gear2.body), else
+            # the closest whole path, else the name of this level closest to it
+            begun = [f"{where}.{n}" if where else n for n in fs if p and n.startswith(p)][:3]
+            close = begun or difflib.get_close_matches(path, field_paths(), n=1, cutoff=0.6) or \
+                [f"{where}.{n}" if where else n for n in difflib.get_close_matches(p, list(fs), n=1, cutoff=0.6)]
+            hint = f"; did you mean {' or '.join(map(repr, close))}?" if close else ""
             valid = f" (fields of {where}: {', '.join(fs)})" if fs and where else (
                 f" (sections: {', '.join(fs)})" if fs else f" ({where} is a value, not a table)")
             raise SceneError(path, f"no such scene field{valid}{hint}{' ' if hint else '; '}"

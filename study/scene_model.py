@@ -247,6 +247,16 @@ def static_rotation(scene: Scene) -> float:
     return rot
 
 
+def check_two_angles(scene: Scene, step_deg: float, field: str = "quasi_static.angle_step") -> None:
+    """SceneError naming ``field`` when an angle step of ``step_deg`` [deg] leaves one driver
+    angle over the static rotation: an STE needs two at least (its peak-to-peak over one angle
+    would read 0)."""
+    rot = static_rotation(scene)
+    if step_deg > rot * (1 + 1e-9):
+        raise SceneError(field, f"a step of {step_deg:g} deg leaves one driver angle over the rotation of {rot:g} deg "
+                                "(quasi_static.rotation): the STE needs two at least; give a step no larger than the rotation")
+
+
 def static_angles(scene: Scene, step_deg: float | None = None, memory_factor: float = 1.0) -> np.ndarray:
     """Driver angles [rad] of the quasi-static analysis: `static_rotation` (whole periods of the
     pitch errors and eccentricities) at quasi_static.angle_step, or at ``step_deg`` [deg] (the
@@ -258,6 +268,7 @@ def static_angles(scene: Scene, step_deg: float | None = None, memory_factor: fl
     if not (math.isfinite(step) and step > 0):
         raise SceneError("--step", f"the driver angle step must be a positive number of degrees, got {step}")
     field = "quasi_static.angle_step" if step_deg is None else "--step"
+    check_two_angles(scene, step, field)
     n = int(check_static_memory(scene, step, factor=memory_factor, field=field))
     return np.radians(np.arange(n) * step)
 

@@ -47,6 +47,8 @@ def print_table(ds: xr.Dataset) -> None:
             r = ds.sel(pair=p)
             print(f"  compliance fit, {p:9s}: k_body {r['compliance_k_body'].values.round(-3)} N m/rad, pivot "
                   f"{r['compliance_pivot_radius'].values.round(3)} mm, RMS residual {r['compliance_fit_rms'].values.round(4)}")
+    if "comment" in ds["hole_amplitude"].attrs:
+        print(f"  hole order N: {ds['hole_amplitude'].attrs['comment']}")
     for p in ds["pair"].values:
         ref = ds.sel(pair=p, model="fe-reference")
         for m in ds["model"].values[1:]:

@@ -12,6 +12,8 @@ Units: SI (m) in and out. Triangles are linear (3 nodes); the FE raises the orde
 from __future__ import annotations
 
 import math
+import signal
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +22,24 @@ from solver.geometry import BodySpec, GearGeometry, bore_radius, hole_angles, va
 from solver.openings import Line, local_outline, place, shape_of
 
 REGION_RIM, REGION_WEB, REGION_HUB = 0, 1, 2
+KEPT_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def start_gmsh():
+    """The gmsh module, initialised, with the process's own handlers of SIGINT and SIGTERM
+    kept. interruptible=False: gmsh's Python layer must not install its SIGINT handler (that
+    fails outside the main thread, e.g. in dask workers). Its C library still puts its own
+    handlers in place at every initialize, and Python's handlers (a command's exit 130 with
+    its "interrupted" line, the compiled loops' stop) were then never called again in the
+    process: they are installed again here, from the main thread (only it may)."""
+    import gmsh
+    gmsh.initialize(interruptible=False)
+    if threading.current_thread() is threading.main_thread():
+        for sig in KEPT_SIGNALS:
+            handler = signal.getsignal(sig)
+            if handler is not None:         # (None: a handler not installed from Python)
+                signal.signal(sig, handler)
+    return gmsh
 REGION_NAMES = ("teeth and rim", "web", "hub")
 
 # How fast the elements grow away from the outline (sizes in modules m and outline sizes h):
@@ -112,11 +132,7 @@ def mesh_body(g: GearGeometry, body: BodySpec, size: float | None = None, prefix
     h = float(size) if size else default_mesh_size(g.spec.module)
     if not (h > 0) or h > g.spec.module:
         raise ValueError(f"fe.mesh_size: must lie in (0, module = {g.spec.module * 1e3:.4g} mm], got {h * 1e3:.4g} mm")
-    import gmsh
-
-    # interruptible=False: gmsh must not install signal handlers (fails outside the main thread,
-    # e.g. in dask workers).
-    gmsh.initialize(interruptible=False)
+    gmsh = start_gmsh()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("gear_body")
@@ -340,9 +356,7 @@ def mesh_annulus(r_in: float, r_split: float, r_out: float, size: float) -> Body
     tagged as web, outside as rim. An analytic check case for the FE (torsion of a thick ring)."""
     if not 0 < r_in < r_split < r_out:
         raise ValueError("mesh_annulus: need 0 < r_in < r_split < r_out")
-    import gmsh
-
-    gmsh.initialize(interruptible=False)
+    gmsh = start_gmsh()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("annulus")

@@ -174,11 +174,48 @@ def _mates(mate: np.ndarray, z1: int) -> np.ndarray:
     return out
 
 
-def dynamic_force_variables(res, start: float, z1: int, z2: int, static_force_max: float) -> tuple[dict, dict]:
+# a load below this [N·m] gives no static tooth force to divide by: K_v is undefined
+NO_LOAD_TORQUE = 1e-9
+
+
+def steady_window(scene, start: float, to_load_change: bool = True) -> tuple[float, float, str | None]:
+    """(end [s], mesh periods covered, reason or None) of the steady part of a dynamic run
+    from ``start`` [s] that its dynamic factor K_v and DTE RMS / peak-to-peak are taken over:
+    to the end of the run, or for K_v (``to_load_change``) with a load change to its start (the
+    forces are then compared at the torque of `static_force_max`, dynamic.torque). The reason, when there is one, says
+    why the window cannot support them: no static load, the driver standing still, or fewer
+    than one mesh period (every tooth pair's whole passage) after the ramp."""
+    d = scene.dynamic
+    z1 = scene.gear1.teeth
+    end = d.duration if d.torque_change_time <= 0 or not to_load_change else min(d.duration, d.torque_change_time)
+    speed = d.speed_end if d.speed_end > 0 else d.speed
+    periods = max(end - start, 0.0) * speed * z1 / (2 * math.pi)
+    if d.speed_end <= 0 and d.speed <= 0:
+        return end, periods, "the driver stands still (dynamic.speed = 0): no mesh period to take the forces over"
+    if periods < 1.0 - 1e-9:
+        load = f" up to the load change at {d.torque_change_time:g} s" if end < d.duration else ""
+        return end, periods, (f"the steady part after the ramp ({start:g} to {end:g} s{load}) covers {periods:.3g} of a "
+                              f"mesh period ({2 * math.pi / (z1 * speed) if speed > 0 else math.inf:.3g} s at "
+                              f"{speed:g} rad/s): lengthen dynamic.duration")
+    return end, periods, None
+
+
+def dynamic_factor_reason(scene, start: float) -> str | None:
+    """Why the dynamic factor K_v of the scene's dynamic run from ``start`` [s] is undefined
+    (archived as NaN with this reason), or None: no static load to divide by, or a steady
+    part that misses a mesh period (`steady_window`)."""
+    if abs(scene.dynamic.torque) < NO_LOAD_TORQUE:
+        return f"no static load (dynamic.torque = {scene.dynamic.torque:g} N·m): no static tooth force to divide by"
+    return steady_window(scene, start)[2]
+
+
+def dynamic_force_variables(res, start: float, z1: int, z2: int, static_force_max: float,
+                            end: float = math.inf, undefined: str | None = None) -> tuple[dict, dict]:
     """The loaded contacts of a dynamic run over ``time`` (slots: teeth, force), each tooth's
-    largest force after ``start`` [s] on both gears, and the dynamic factor K_v: the largest
-    dynamic tooth force over the largest static one (``static_force_max`` [N], at the same
-    torque over a whole revolution, `study.run.static_force_max`)."""
+    largest force from ``start`` to ``end`` [s] on both gears, and the dynamic factor K_v: the
+    largest dynamic tooth force over the largest static one (``static_force_max`` [N], at the
+    same torque over a whole revolution, `study.run.static_force_max`); NaN with the reason
+    ``undefined`` in its comment where the run cannot support it (`dynamic_factor_reason`)."""
     from solver.mbs.kernels import layout as L
     c = res.contacts
     if c is None:
@@ -192,7 +229,7 @@ def dynamic_force_variables(res, start: float, z1: int, z2: int, static_force_ma
         "dte_contact_tooth2": variable("dte_contact_tooth2", t2),
         "dte_contact_force": variable("dte_contact_force", f),
     }
-    sel = res.time >= start
+    sel = (res.time >= start) & (res.time <= end + 1e-12)
     fmax = np.full((2, max(z1, z2)), np.nan)
     for g, (t, z) in enumerate(((t1, z1), (t2, z2))):
         per = np.zeros((int(sel.sum()), z))
@@ -201,11 +238,18 @@ def dynamic_force_variables(res, start: float, z1: int, z2: int, static_force_ma
             ok = t[rows, s] >= 0
             np.add.at(per, (np.nonzero(ok)[0], t[rows, s][ok]), f[rows, s][ok])
         fmax[g, :z] = per.max(axis=0) if per.shape[0] else np.nan
+    until = f" to {end:g} s" if math.isfinite(end) else ""
     data["dte_tooth_force_max"] = variable("dte_tooth_force_max", fmax,
-                                           comment=f"over the steady part from {start:g} s (output instants)", start_s=float(start))
+                                           comment=f"over the steady part from {start:g} s{until} (output instants)",
+                                           start_s=float(start))
     fdyn = float(np.nanmax(fmax)) if np.isfinite(fmax).any() else float("nan")
-    kv = fdyn / static_force_max if static_force_max > 0 else float("nan")
-    data["dynamic_factor"] = variable("dynamic_factor", kv,
-                                      comment=f"largest dynamic tooth force {fdyn:.1f} N after {start:g} s, largest static "
-                                          f"{static_force_max:.1f} N (static, the same torque, over a whole revolution)")
+    if undefined is None and not static_force_max > 0:
+        undefined = "no static tooth force to divide by (the statics over a revolution did not converge)"
+    if undefined is not None:
+        data["dynamic_factor"] = variable("dynamic_factor", float("nan"), comment=f"undefined: {undefined}")
+    else:
+        data["dynamic_factor"] = variable("dynamic_factor", fdyn / static_force_max,
+                                          comment=f"largest dynamic tooth force {fdyn:.1f} N from {start:g}{until or ' s on'}, "
+                                              f"largest static {static_force_max:.1f} N (static, the same torque, over a "
+                                              "whole revolution)")
     return coords, data

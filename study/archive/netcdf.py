@@ -153,6 +153,33 @@ def write_netcdf(ds: xr.Dataset, path) -> None:
     try:
         ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
         os.replace(tmp, path)
+    except (OSError, RuntimeError) as e:
+        full = disk_full(e, path.parent, ds.nbytes)
+        if full:
+            raise full from None
+        raise
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+# room a write needs beyond the data [bytes]: NetCDF4/HDF5 headers, chunk indexes
+WRITE_MARGIN = 16 * 2 ** 20
+
+
+def disk_full(error: Exception, folder: Path, data_bytes: float) -> OSError | None:
+    """The error of a write into ``folder`` that a full disk caused, said as such (an OSError
+    with errno ENOSPC: 'no space left on device'), or None. HDF5 reports it as 'NetCDF: HDF
+    error' without an errno: the file system's free space (less than the data and a margin)
+    tells it then."""
+    import errno
+    import shutil
+    try:
+        free = shutil.disk_usage(folder).free
+    except OSError:
+        free = None
+    if getattr(error, "errno", None) != errno.ENOSPC and not (free is not None and free < data_bytes + WRITE_MARGIN):
+        return None
+    left = f"{free / 2 ** 20:.1f} MiB" if free is not None else "no room"
+    return OSError(errno.ENOSPC, f"no space left on device: {left} free in {folder} for an archive of about "
+                                 f"{data_bytes / 2 ** 20:.1f} MiB of data; free some space or write elsewhere (-o)")

@@ -198,7 +198,8 @@ def largest_peaks(ds: xr.Dataset, n: int = 5, min_order: float = 0.5):
     f = ds["frequency"].values
     o = ds["order"].values
     lobe = HANN_MAIN_LOBE_BINS * float(ds["dte_amplitude"].attrs.get("resolution_Hz", 0.0))
-    min_order = max(min_order, float(np.nanmax(o[f <= lobe])) if np.any(f <= lobe) else 0.0)
+    in_lobe = (f <= lobe) & np.isfinite(o)      # (no orders at standstill)
+    min_order = max(min_order, float(np.max(o[in_lobe])) if in_lobe.any() else 0.0)
     idx = [i for i in range(1, a.size - 1) if a[i] >= a[i - 1] and a[i] >= a[i + 1] and o[i] > min_order]
     idx.sort(key=lambda i: -a[i])
     return [(float(f[i]), float(o[i]), float(a[i])) for i in idx[:n]]

@@ -29,8 +29,10 @@ def summarize(ds: xr.Dataset) -> dict:
         sel = t >= ds.attrs.get("spectrum_start_s", 0.0)
         dte = ds["dte"].values[sel]
         out["dte_mean"] = float(np.mean(dte)) if dte.size else nan
-        out["dte_rms"] = float(np.sqrt(np.mean((dte - dte.mean()) ** 2))) if dte.size else nan
-        out["dte_p2p"] = float(np.ptp(dte)) if dte.size else nan
+        # (undefined where the steady part misses a mesh period: its note says why)
+        whole = dte.size and "steady_window_note" not in ds.attrs
+        out["dte_rms"] = float(np.sqrt(np.mean((dte - dte.mean()) ** 2))) if whole else nan
+        out["dte_p2p"] = float(np.ptp(dte)) if whole else nan
         out["tooth_force_max"] = float(np.max(ds["contact_force_max"].values[sel])) if dte.size else nan
         out["mesh_efficiency"] = float(ds["mesh_efficiency"]) if "mesh_efficiency" in ds else nan
     if "dte_amplitude" in ds:

@@ -25,6 +25,9 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import warnings
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +35,9 @@ import numpy as np
 BODY_SLOTS = 2      # factorised bodies kept: one per gear (each up to ~0.5 GB)
 RIM_SLOTS = 2       # condensed teeth-and-rim blocks kept (each up to ~0.4 GB with its factors)
 FIT_SLOTS = 16      # coupling fits kept (small: a few arrays of the tooth count)
+# what reading a damaged cache file raises: truncated or empty (zip, zlib, end of file), an
+# array or a variable missing or of another shape, a NetCDF file HDF cannot read
+UNREADABLE = (OSError, EOFError, zipfile.BadZipFile, zlib.error, KeyError, IndexError, ValueError, TypeError)
 
 
 class FECache:
@@ -63,25 +69,40 @@ class FECache:
         self.generation += 1
 
     def _read(self, held: dict, key: str, name: str, load):
-        """The result of ``key`` from ``held``, else loaded from the file ``name`` (None when
-        the file is missing or unreadable: it is then recomputed and overwritten)."""
+        """The result of ``key`` from ``held``, else loaded from the file ``name`` by
+        `read_file` (None when the file is missing or damaged: it is then recomputed and
+        overwritten)."""
         if key not in held:
-            path = self.folder / name
-            if not path.exists():
+            value = self.read_file(name, load)
+            if value is None:
                 return None
-            try:
-                held[key] = load(path)
-            except (OSError, KeyError, ValueError):
-                return None
+            held[key] = value
         return held[key]
+
+    def read_file(self, name: str, load):
+        """``load(path)`` of the cache file ``name``, or None when it is missing, or damaged
+        (truncated, empty, an array or a variable missing: every kind of file of the cache
+        alike): a warning names the file, and the caller computes the result again and
+        overwrites it."""
+        path = self.folder / name
+        if not path.exists():
+            return None
+        try:
+            return load(path)
+        except UNREADABLE as e:
+            if path.exists():       # (not a file another process was replacing)
+                why = (str(e).splitlines() or [""])[0][:120]
+                warnings.warn(f"damaged FE cache file {path} ({type(e).__name__}: {why}): computing it again",
+                              RuntimeWarning, stacklevel=3)
+            return None
 
     # ---- tooth stiffness maps
     def _read_array(self, held: dict, key: str, var: str) -> np.ndarray | None:
         """A copy of the variable ``var`` of the map file of ``key``, from ``held`` or disk, or None."""
         def load(path):
             import xarray as xr
-            with xr.open_dataset(path) as ds:
-                return ds[var].values.copy()
+            with xr.open_dataset(path) as ds:       # (a map written before its stresses were stored lacks them)
+                return ds[var].values.copy() if var in ds else None
         a = self._read(held, key, f"{key}.nc", load)
         return None if a is None else a.copy()
 
@@ -173,15 +194,10 @@ class FECache:
     # ---- arrays of a condensed rim (its condensed stiffness, the products of a load set)
     def read_arrays(self, name: str) -> dict | None:
         """The arrays of ``{name}.npz`` on disk, or None when missing or unreadable."""
-        path = self.folder / f"{name}.npz"
-        if not path.exists():
-            return None
-        import zipfile
-        try:
+        def load(path):
             with np.load(path) as d:
                 return {k: d[k] for k in d.files}
-        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
-            return None
+        return self.read_file(f"{name}.npz", load)
 
     def write_arrays(self, name: str, **arrays) -> None:
         """Store ``arrays`` as ``{name}.npz`` (two workers may write the same file at once:

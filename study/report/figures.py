@@ -147,7 +147,7 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
     beside the figures. They are computed here, from the points of the archive rendered, and
     not stored by ``lightgear sweep``: the archives of the parts of a split study open together
     as one (open_mfdataset), and a variance split or Pareto set of one part is wrong for the whole."""
-    from study.archive.netcdf import write_netcdf
+    from study.archive.netcdf import provenance, write_netcdf
     from study.report.effects import pareto_table, sensitivity_table, study_outputs, varies
     from study.report.study_views import main_effects_figure, sensitivity_figure, tradeoff_figure
     out, tables = [], []
@@ -176,7 +176,8 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
         out.append(tradeoff_figure(ds, pareto, name("tradeoff")))
     if tables:
         path = name("study_tables").with_suffix(".nc")
-        attrs = {k: ds.attrs[k] for k in ("title", "study_key") if k in ds.attrs}
+        # (with the provenance of an archive: `lightgear export` and `render` take it as one)
+        attrs = {**provenance(), **{k: ds.attrs[k] for k in ("title", "study_key") if k in ds.attrs}}
         write_netcdf(xr.merge(tables).assign_attrs(attrs, comment="computed by `lightgear render` from the "
                               "study archive's points (study.report.effects)"), path)
         print(f"  study tables: {path}")

@@ -224,7 +224,7 @@ def sample_table_text(ds: xr.Dataset, tables: xr.Dataset, outputs: list[str]) ->
 def sample_figures(ds: xr.Dataset, name, skip, limits: dict | None = None) -> list:
     """Every view of a sampled study (``name(stem)`` -> PNG path, ``skip(what, why)`` prints
     what is left out); the tables go to ``study_tables.nc`` beside them."""
-    from study.archive.netcdf import write_netcdf
+    from study.archive.netcdf import provenance, write_netcdf
     limits = dict(limits or {})
     outputs = sample_outputs(ds)
     tables = sample_tables(ds, outputs, limits)
@@ -248,7 +248,8 @@ def sample_figures(ds: xr.Dataset, name, skip, limits: dict | None = None) -> li
         skip("Sobol indices", f"a plain sample of {', '.join(drawn_fields(ds))}: the indices need the Saltelli "
                               "design ([sample] design = \"saltelli\")")
     path = name("study_tables").with_suffix(".nc")
-    attrs = {k: ds.attrs[k] for k in ("title", "study_key") if k in ds.attrs}
+    # (with the provenance of an archive: `lightgear export` and `render` take it as one)
+    attrs = {**provenance(), **{k: ds.attrs[k] for k in ("title", "study_key") if k in ds.attrs}}
     write_netcdf(tables.assign_attrs(attrs, comment="computed by `lightgear render` from the sampled study's builds "
                                                     "(study.report.distributions)"), path)
     print(f"  study tables: {path}")

@@ -40,6 +40,27 @@ def comparison_lines(ds: xr.Dataset) -> list[str]:
     return out
 
 
+CRITICAL_SPEED_SPAN = 2.0     # critical speeds listed: up to this many times the run's top driver speed
+
+
+def critical_speed_line(ds: xr.Dataset) -> str:
+    """The mesh mode's critical driver speeds [rad/s] of the excitations that matter for the
+    run: those up to CRITICAL_SPEED_SPAN times its top driver speed (all of them for a run
+    without one), and otherwise the lowest."""
+    cs = ds["critical_speed"].sel(mode=0).values
+    names = [str(e) for e in ds["excitation"].values]
+    top = float(ds.attrs.get("driver_speed_max_rad_s", 0.0))
+    limit = CRITICAL_SPEED_SPAN * top if top > 0 else float("inf")
+    shown = [f"{e} {v:.0f}" for e, v in zip(names, cs) if v <= limit]
+    linear = (" (linear estimates: the teeth lost contact in this run)"
+              if ds.attrs.get("contact_lost_fraction", 0.0) > 0 else "")
+    if shown:
+        return "    critical driver speeds [rad/s]" + linear + ": " + ", ".join(shown) + "\n"
+    low = int(np.nanargmin(cs))
+    return (f"    critical driver speeds [rad/s]: none up to {limit:.0f} ({CRITICAL_SPEED_SPAN:g} x the run's "
+            f"{top:g} rad/s); the lowest {names[low]} {cs[low]:.0f}\n")
+
+
 def print_summary(ds: xr.Dataset, path, wall: float) -> None:
     s = summarize(ds)
     w = sys.stdout.write
@@ -80,8 +101,11 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         w(line + "\n")
     runup = "order_amplitude" in ds
     if "dte_rms" in s and not runup:
-        w(f"  DTE after {ds.attrs['spectrum_start_s']:.3g} s: mean {s['dte_mean']:.3f} um, RMS {s['dte_rms']:.3f} um, "
-          f"peak-to-peak {s['dte_p2p']:.3f} um, largest contact force {s['tooth_force_max']:.1f} N "
+        short = ds.attrs.get("steady_window_note")
+        spread = (f"RMS and peak-to-peak undefined ({short})" if short else
+                  f"RMS {s['dte_rms']:.3f} um, peak-to-peak {s['dte_p2p']:.3f} um")
+        w(f"  DTE after {ds.attrs['spectrum_start_s']:.3g} s: mean {s['dte_mean']:.3f} um, {spread}, "
+          f"largest contact force {s['tooth_force_max']:.1f} N "
           f"({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us)\n")
         if np.isfinite(s["mesh_efficiency"]):
             w(f"  mesh efficiency after the ramp {s['mesh_efficiency'] * 100:.3f} % (flank friction and dampers)\n")
@@ -91,7 +115,9 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         fm = ds["dte_tooth_force_max"]
         w(f"  dynamic tooth force after {ds.attrs.get('spectrum_start_s', 0.0):.3g} s: largest "
           f"{float(fm.sel(gear=1).max()):.1f} N on the driver, {float(fm.sel(gear=2).max()):.1f} N on the driven gear; "
-          f"dynamic factor K_v {s['dynamic_factor']:.3f} ({ds['dynamic_factor'].attrs.get('comment', '')})\n")
+          + (f"dynamic factor K_v {s['dynamic_factor']:.3f} ({ds['dynamic_factor'].attrs.get('comment', '')})\n"
+             if np.isfinite(s["dynamic_factor"]) else
+             f"dynamic factor K_v {ds['dynamic_factor'].attrs.get('comment', 'undefined')}\n"))
     if "mesh_mode_frequency_hz" in ds.attrs:
         a = ds.attrs
         line = (f"  mesh mode: {a['mesh_mode_frequency_hz']:.0f} Hz, damping {a['mesh_mode_damping']:.4f} of critical "
@@ -99,9 +125,7 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
         if "mesh_mode_damping_decay" in a:
             line += f", {a['mesh_mode_damping_decay']:.4f} from the free decay ({a['mesh_mode_damping_at_decay']:.4f} modal there)"
         w(line + "\n")
-        cs = ds["critical_speed"].sel(mode=0)
-        w("    critical driver speeds [rad/s]: " + ", ".join(f"{e} {v:.0f}" for e, v in zip(ds["excitation"].values, cs.values)
-                                                          if v < 1000) + "\n")
+        w(critical_speed_line(ds))
     if "order_amplitude" in ds:
         sp, order, amp = ds["runup_speed"].values, ds["tracked_order"].values, ds["order_amplitude"].values
         z = ds.attrs["mesh_order"]
@@ -112,6 +136,19 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
             parts.append(f"{k}Z at {sp[np.argmax(cut)]:.0f} rad/s {cut.max():.3g} um")
         w(f"  run-up {sp[0]:.0f}-{sp[-1]:.0f} rad/s ({ds.attrs['dynamic_status']}, dt {ds.attrs['dt_s'] * 1e6:.3g} us), "
           "resonance peaks (order, driver speed, DTE amplitude): " + ", ".join(parts) + "\n")
+        lost = ds.attrs.get("contact_lost_speed_rad_s")
+        if lost is not None and "critical_speed" in ds:
+            # the teeth separated: the response left the linear range the modal speeds stand for
+            cs = ds["critical_speed"].sel(mode=0)
+            peaks = []
+            for k in (1, 2, 3):
+                sel = np.abs(order - k * z) <= 0.5
+                modal = float(cs.sel(excitation=f"{k}Z"))
+                if sp[0] <= modal <= sp[-1]:
+                    at = float(sp[np.argmax(amp[:, sel].max(axis=1))])
+                    peaks.append(f"{k}Z measured {at:.0f} rad/s, modal {modal:.0f} ({100 * (at / modal - 1):+.1f} %)")
+            w(f"    the teeth lost contact between {lost[0]:.0f} and {lost[1]:.0f} rad/s: the response left the linear "
+              "range, and the critical speeds are linear estimates" + (": " + ", ".join(peaks) if peaks else "") + "\n")
     if "mass" in ds:
         for g in (1, 2):
             line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "

@@ -56,6 +56,7 @@ from study.scene import (
     SceneError,
     default_scene_text,
     get_dotted,
+    is_scene_table,
     read_text,
     scene_fields_from_dict,
     scene_from_dict,
@@ -322,6 +323,10 @@ def _loads_study(text: str, folder: str | Path | None = None) -> Study:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise SceneError("study", f"not valid TOML: {e}") from None
+    if is_scene_table(raw):
+        raise SceneError("study", "this file is a scene (its sections are a scene's, with no [grid], [[points]] or "
+                                  "[sample]), not a study: run it with `lightgear run`, or sweep it from a study whose "
+                                  "scene = names it")
     for k in raw:
         if k not in STUDY_KEYS:
             raise SceneError(k, f"unknown study key (expected one of: {', '.join(STUDY_KEYS)})")

@@ -60,15 +60,18 @@ SCALARS = {
                                                    "low-load factor", "static"),
     "loaded_contact_ratio": Scalar("1", "loaded contact ratio: mean number of loaded tooth pairs in the STE", "static"),
     "dte_mean": Scalar("um", "mean dynamic transmission error after the ramp", "dynamic"),
-    "dte_rms": Scalar("um", "RMS of the dynamic transmission error about its mean after the ramp", "dynamic"),
-    "dte_p2p": Scalar("um", "peak-to-peak dynamic transmission error after the ramp", "dynamic"),
+    "dte_rms": Scalar("um", "RMS of the dynamic transmission error about its mean after the ramp (NaN when that "
+                            "covers less than a mesh period)", "dynamic"),
+    "dte_p2p": Scalar("um", "peak-to-peak dynamic transmission error after the ramp (NaN when that covers less "
+                            "than a mesh period)", "dynamic"),
     "amp_mesh_order": Scalar("um", "DTE amplitude at the mesh order Z2", "dynamic"),
     "amp_mesh2_order": Scalar("um", "DTE amplitude at twice the mesh order", "dynamic"),
     "amp_mesh3_order": Scalar("um", "DTE amplitude at three times the mesh order", "dynamic"),
     "amp_hole_order": Scalar("um", "DTE amplitude at the hole order N (NaN for a gear without holes)", "dynamic"),
     "tooth_force_max": Scalar("N", "largest tooth contact force of the dynamic run after the ramp", "dynamic"),
     "dynamic_factor": Scalar("1", "dynamic factor K_v: largest dynamic tooth force after the ramp over the largest "
-                                  "static one at the same torque", "dynamic"),
+                                  "static one at the same torque (NaN, its reason in the run archive, without a load, "
+                                  "at standstill or over less than a mesh period before any load change)", "dynamic"),
     "mesh_efficiency": Scalar("1", "work out over work in of the dynamic run after the ramp (NaN without flank "
                                    "friction, a run-up or a load change)", "dynamic"),
     "mesh_mode_frequency": Scalar("Hz", "natural frequency of the mesh mode at the mean load (mean over the mesh period)", "modes"),

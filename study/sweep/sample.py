@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from study.scene import SceneError, get_dotted, scene_field, scene_fields_from_dict, set_dotted
+from study.scene import INT_MAX, SceneError, get_dotted, scene_field, scene_fields_from_dict, set_dotted
 
 METHODS = ("random", "lhs", "sobol")
 DESIGNS = ("plain", "saltelli")
@@ -298,6 +298,8 @@ def parse_sample(table, base: dict, taken: tuple[str, ...] = ()) -> Sample:
     seed = flat.pop("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise SceneError("sample.seed", f"must be a non-negative integer, got {seed!r}")
+    if seed > INT_MAX:      # (its archive could not store it: refused before any build)
+        raise SceneError("sample.seed", f"must fit in 64 bits (the archive's integers): at most {INT_MAX}, got {seed}")
     design = flat.pop("design", "plain")
     if design not in DESIGNS:
         raise SceneError("sample.design", f"must be one of {', '.join(map(repr, DESIGNS))}, got {design!r}")

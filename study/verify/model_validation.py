@@ -38,11 +38,34 @@ TARGETS = {"elastic_mean": 0.02, "p2p": 0.10, "hole": 0.15, "relief_um": 0.5}
 COUPLING = {"paper": "paper", "body-torsion": "body-torsion", "compliance": "compliance"}
 
 
+# the fit's columns: a constant, cos and sin of the order and of the three mesh harmonics with
+# their sidebands at +-order
+ORDER_FIT_COLUMNS = 1 + 2 * (1 + 3 * 3)
+
+
+def order_unresolved(angle_rad: np.ndarray, order: float) -> str | None:
+    """Why the record over ``angle_rad`` (the driven gear's rotation [rad], evenly spaced)
+    cannot give the amplitude at ``order`` (`order_amplitude`), or None: fewer angles than
+    the fit has columns, or a rotation shorter than one period of the order (the fit then
+    trades the order against the constant and reports thousands of times the STE)."""
+    x = np.asarray(angle_rad, float)
+    if x.size < ORDER_FIT_COLUMNS:
+        return f"{x.size} angles, fewer than the {ORDER_FIT_COLUMNS} columns of the fit"
+    span = float(x[-1] - x[0]) + float(x[1] - x[0])
+    if order * span < 2 * math.pi * (1 - 1e-9):
+        return (f"the driven gear turns {math.degrees(span):.4g} deg, less than one period of order {order:g} "
+                f"({360 / order:.4g} deg): a longer rotation resolves it")
+    return None
+
+
 def order_amplitude(angle_rad: np.ndarray, te: np.ndarray, order: float, mesh_order: float) -> float:
     """Amplitude [units of te] at ``order`` of the driven gear's rotation (angle_rad: the driven
     gear's rotation [rad]), fitted jointly with the first three mesh harmonics and their
-    sidebands at +-order (least squares), so the mesh ripple does not leak into it."""
+    sidebands at +-order (least squares), so the mesh ripple does not leak into it. NaN where
+    the record cannot resolve the order (`order_unresolved`)."""
     x = np.asarray(angle_rad)
+    if order_unresolved(x, order):
+        return float("nan")
     cols = [np.ones_like(x)]
     freqs = [order] + [h * mesh_order + s * order for h in (1, 2, 3) for s in (-1, 0, 1)]
     for f in freqs:

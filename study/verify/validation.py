@@ -32,7 +32,7 @@ from solver.mbs.statics import solve_static
 from study.archive.netcdf import cf_variable, provenance
 from study.scene_model import build_scene_model, coupling_fit, gear_setup
 from study.verify.fe_reference import reference
-from study.verify.model_validation import order_amplitude
+from study.verify.model_validation import order_amplitude, order_unresolved
 
 MODELS = ("fe-reference", "plain", "plain-fe", "coupled", "compliance")
 PAIRS = ("solid", "lightened")
@@ -161,6 +161,10 @@ def validation_dataset(scene, angles) -> xr.Dataset:
             "wall_time": v(("pair", "model"), wall, "s", "wall time of the STE (FE compliance included for the reference)")}
     for k, (unit, doc) in METRIC_DOC.items():
         data[k] = v(("pair", "model"), tab[k], unit, doc)
+    n_holes = scene.gear2.body.holes or scene.gear1.body.holes
+    unresolved = order_unresolved(angles * scene.gear1.teeth / scene.gear2.teeth, n_holes) if n_holes else None
+    if unresolved:
+        data["hole_amplitude"].attrs["comment"] = f"undefined (NaN): {unresolved}"
     coords["gear"] = v("gear", np.array([1, 2]), "1", "gear (1 driver, 2 driven)")
     data["compliance_k_body"] = v(("pair", "gear"), fit["k_body"], "N m rad-1", "body torsion stiffness of the compliance model")
     data["compliance_pivot_radius"] = v(("pair", "gear"), fit["pivot"], "mm", "tooth pivot radius of the compliance model")

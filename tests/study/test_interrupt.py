@@ -125,6 +125,33 @@ def test_run_stops_on_a_signal(tmp_path, sig):
     assert "interrupted" in (tmp_path / "err.txt").read_text() and not (tmp_path / "r.nc").exists()
 
 
+def test_sigterm_is_still_handled_once_the_mesher_has_run(tmp_path, monkeypatch):
+    """gmsh puts its own C signal handlers in place at each initialize: a run whose FE body was
+    meshed in the same process still stops on SIGTERM with exit 130 and its line, in the dynamic
+    run after the FE."""
+    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))      # an empty FE cache: gmsh runs
+    scene = small_scene(tmp_path)
+    proc = cli(["run", scene, "--no-static", "--set", "gear2.spring.stiffness=fe-ratio", "--set",
+                f"dynamic.time_step={STEP}", "--max-time", "1e9", "-o", tmp_path / "r.nc"], tmp_path)
+    code, took = stop_after(proc, lambda: "dynamic run" in (tmp_path / "err.txt").read_text(), signal.SIGTERM)
+    err = (tmp_path / "err.txt").read_text()
+    assert any((tmp_path / "cache" / "fe").glob("*.nc")), "no FE body was meshed"
+    assert code == 130 and took < STOP_WITHIN_S, err
+    assert "interrupted" in err and not (tmp_path / "r.nc").exists()
+
+
+def test_the_mesher_leaves_the_processs_signal_handlers_in_place():
+    """(in a child process: without the handler SIGTERM ends it with 143)"""
+    code = ("import os, signal, sys, time\n"
+            "from solver.fe.mesh import mesh_annulus\n"
+            "signal.signal(signal.SIGTERM, lambda s, f: sys.exit(130))\n"
+            "mesh_annulus(0.01, 0.02, 0.03, 0.005)\n"
+            "os.kill(os.getpid(), signal.SIGTERM)\n"
+            "time.sleep(5)\n")
+    done = subprocess.run([sys.executable, "-c", code], env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=120)
+    assert done.returncode == 130
+
+
 @pytest.mark.parametrize("workers", [0, 2])
 def test_sweep_stops_on_sigint_and_sigterm_and_resumes(tmp_path, workers):
     # one speed: on two workers the dearest tasks go first, so the static task (milliseconds)
