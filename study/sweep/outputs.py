@@ -106,9 +106,10 @@ CURVES = {
 #             when it runs (study.scene_model.mean_load reads dynamic.enabled and dynamic.torque)
 #   dynamic   DTE: every field
 ERRORS = ("gear1.errors", "gear2.errors")    # pitch errors and runout: no part of a gear's mass or FE body
+RATING = ("gear1.material", "gear2.material")  # the bending rating's steel: read by the strength outputs (static) only
 ANALYSIS_FIELDS = {
-    "geometry": (("gear1", "gear2", "pair", "material.density"), ("gear1.spring", "gear2.spring", *ERRORS)),
-    "fe": (("gear1", "gear2", "pair", "material", "fe", "quasi_static.torque"), ERRORS),
+    "geometry": (("gear1", "gear2", "pair", "material.density"), ("gear1.spring", "gear2.spring", *ERRORS, *RATING)),
+    "fe": (("gear1", "gear2", "pair", "material", "fe", "quasi_static.torque"), (*ERRORS, *RATING)),
     "static": (("",), ("dynamic", "title")),
     "modes": (("", "dynamic.enabled", "dynamic.torque"), ("dynamic", "title")),
     "dynamic": (("",), ("title",)),
