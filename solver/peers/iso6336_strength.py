@@ -24,6 +24,7 @@ import math
 from solver.peers import iso6336
 
 RIM_FACTOR_LOW = 0.5      # smallest m_B the standards give Y_B for
+_TOL = 1e-9               # relative: an m_B from lengths in metres, 0.5 within rounding, is 0.5
 RIM_FACTOR_ONE = 1.2      # m_B from which Y_B = 1
 LEWICKI_TOOTH = 1.0       # m_B at and above which the tests and FE give tooth fracture
 LEWICKI_RIM = 0.5         # m_B below which they give rim fracture (0.5: either; 0.3: rim)
@@ -41,9 +42,9 @@ def rim_thickness_factor(m_b: float) -> tuple[float, bool]:
     1.2, 1 above; below 0.5 the curve extrapolated and False; NaN for m_B <= 0."""
     if not m_b > 0:
         return float("nan"), False
-    if m_b >= RIM_FACTOR_ONE:
+    if m_b >= RIM_FACTOR_ONE * (1 - _TOL):
         return 1.0, True
-    return 1.6 * math.log(2.242 / m_b), m_b >= RIM_FACTOR_LOW
+    return 1.6 * math.log(2.242 / m_b), m_b >= RIM_FACTOR_LOW * (1 - _TOL)
 
 
 def single_contact_roll(tip_radius: float, base_radius: float, base_pitch: float, contact_ratio: float) -> float:
@@ -67,6 +68,6 @@ def nominal_root_stress(tangential_force: float, face_width: float, module: floa
 def crack_path(m_b: float) -> str:
     """What Lewicki & Ballarini's tests and FE give at backup ratio ``m_b``: 'tooth' (m_B >= 1),
     'rim' (m_B < 0.5) or 'mixed' (between: tooth or rim, by where the crack starts)."""
-    if m_b >= LEWICKI_TOOTH:
+    if m_b >= LEWICKI_TOOTH * (1 - _TOL):
         return "tooth"
-    return "rim" if m_b < LEWICKI_RIM else "mixed"
+    return "rim" if m_b < LEWICKI_RIM * (1 - _TOL) else "mixed"

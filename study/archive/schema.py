@@ -122,9 +122,17 @@ RUN_VARIABLES: dict[str, Var] = {
                                "Method B at the HPSTC", {"source": "solver.peers.iso6336 (Y_F, Y_S of the basic rack "
                                                                    "generating a fillet of the tool tip radius), "
                                                                    "solver.peers.iso6336_strength (Y_B)"}),
+    "tooth_form_factor_iso6336": Var(("gear",), "1", "tooth form factor Y_F of ISO 6336-3 Method B, load at the HPSTC",
+                                     {"source": "solver.peers.iso6336.root_form_factors"}),
+    "stress_correction_factor_iso6336": Var(("gear",), "1", "stress correction factor Y_S of ISO 6336-3 Method B, load at "
+                                            "the HPSTC", {"source": "solver.peers.iso6336.root_form_factors"}),
     "failure_mode": Var(("gear",), "1", "where the first crack is expected: 'tooth', 'rim' or 'web'", {
         "source": "solver.strength.failure_mode: m_B with the thresholds of Lewicki & Ballarini 1997 (1.0 tooth, "
                   "0.5 mixed, 0.3 rim fracture) and the FE's rim-to-root and web-to-root ratios of bending_stress_static"}),
+    "gear_material": Var(("gear",), "1", "gear steel of the bending rating (scene gearN.material; solver.materials)"),
+    "bending_limit_stress": Var(("gear",), "MPa", "tooth-root limit stress sigma_FG = sigma_Flim Y_ST Y_NT Y_delta_rel_T "
+                                "Y_R_rel_T Y_X", {"comment": "Y_ST = 2, Y_NT = Y_delta_rel_T = Y_R_rel_T = Y_X = 1; sigma_Flim "
+                                                             "of ISO 6336-5 grade MQ (solver.materials)"}),
     "bending_safety": Var(("gear", "location"), "1", "bending safety factor S_F = sigma_FG / bending_stress", {
         "comment": "sigma_FG = sigma_Flim Y_ST Y_NT Y_delta_rel_T Y_R_rel_T Y_X with Y_ST = 2 and the others 1 "
                    "(solver.materials); the rim and web of a surface-hardened gear are core material, weaker than the "

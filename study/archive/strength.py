@@ -56,8 +56,8 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
     pos = np.full((2, nl, 2), np.nan)
     site = ["", ""]
     lig_w, lig_s = np.full((2, nk), np.nan), np.full((2, nk), np.nan)
-    s_r, m_b, y_b, hp, iso = (np.full(2, np.nan) for _ in range(5))
-    mode = ["", ""]
+    s_r, m_b, y_b, hp, iso, y_f, y_s = (np.full(2, np.nan) for _ in range(7))
+    mode, names, limits = ["", ""], ["", ""], np.full(2, np.nan)
     safety, safety_static = np.full((2, nl), np.nan), np.full((2, nl), np.nan)
     notes, iso_notes, yb_notes, mode_notes, mat_notes = [], [], [], [], []
     scale = dynamic_scale if math.isfinite(dynamic_scale) else 1.0
@@ -106,7 +106,8 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
         iso[i] = nominal_root_stress(f_t, b, m, f["Y_F"], f["Y_S"], y_b[i]) / units.MPA
         hp[i] = res.hpstc / units.MPA
         iso_notes.append(f"gear {s.gear}: F_t {f_t:.1f} N, b {b * 1e3:g} mm, m {m * 1e3:g} mm, d_HPSTC {d * 1e3:.3f} mm, "
-                         f"Y_F {f['Y_F']:.3f}, Y_S {f['Y_S']:.3f}, Y_B {y_b[i]:.3f}; FE/ISO {hp[i] / iso[i]:.3f}")
+                         f"Y_F {f['Y_F']:.3f}, Y_S {f['Y_S']:.3f}, Y_B {y_b[i]:.3f}, FE/ISO {hp[i] / iso[i]:.3f}")
+        y_f[i], y_s[i] = f["Y_F"], f["Y_S"]
         rim_ratio = static[i, 1] / static[i, 0]
         web_ratio = static[i, 2] / static[i, 0]
         mode[i] = failure_mode(m_b[i], rim_ratio, web_ratio)
@@ -114,6 +115,7 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
                           f"{rim_ratio:.3f}, web/root {web_ratio:.3f} -> {mode[i]}")
         mat = gear_material(scene.gear(s.gear).material)
         limit = mat.limit_stress() / units.MPA
+        names[i], limits[i] = mat.name, limit
         mat_notes.append(f"gear {s.gear}: {mat.name} ({mat.treatment}), sigma_Flim {mat.sigma_f_lim / units.MPA:g} MPa "
                          f"({mat.source}), sigma_FG {limit:g} MPa")
         for k in range(nl):
@@ -145,7 +147,11 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
         "rim_thickness_factor_iso6336": variable("rim_thickness_factor_iso6336", y_b, comment="; ".join(yb_notes)),
         "root_stress_hpstc": variable("root_stress_hpstc", hp, stress=stress_kind),
         "root_stress_iso6336": variable("root_stress_iso6336", iso, comment="; ".join(iso_notes)),
+        "tooth_form_factor_iso6336": variable("tooth_form_factor_iso6336", y_f),
+        "stress_correction_factor_iso6336": variable("stress_correction_factor_iso6336", y_s),
         "failure_mode": variable("failure_mode", np.array(mode), comment="; ".join(mode_notes)),
+        "gear_material": variable("gear_material", np.array(names), comment="; ".join(mat_notes)),
+        "bending_limit_stress": variable("bending_limit_stress", limits, comment="; ".join(mat_notes)),
         "bending_safety": variable("bending_safety", safety, material="; ".join(mat_notes),
                                    loads="with K_v" if math.isfinite(dynamic_scale) else "static (no dynamic run)"),
         "bending_safety_static": variable("bending_safety_static", safety_static, material="; ".join(mat_notes)),
