@@ -213,29 +213,30 @@ def _ligaments(points, triangles, region, openings, rim_radius, inner_radius, h)
     r = np.hypot(points[:, 0], points[:, 1])
     out = []
 
-    def section(kind, i, a, b):
+    def section(kind, i, ends, b=None):
+        """The ligament from node ends[0] to the point b (or to node ends[1])."""
+        a = points[ends[0]]
+        b = points[ends[1]] if b is None else b
         length = float(np.hypot(*(b - a)))
         nodes = web_nodes[tree.query_ball_point(0.5 * (a + b), 0.5 * length + h)]
         p = points[nodes]
         d = b - a
         s = np.clip(((p - a) @ d) / max(length**2, 1e-30), 0.0, 1.0)
         near = np.hypot(*(p - (a + s[:, None] * d)).T) <= 0.6 * h
-        out.append(Ligament(kind, i, a, b, nodes[near]))
+        out.append(Ligament(kind, i, a, b, np.union1d(nodes[near], ends)))    # its ends on the edges always
 
     for i, o in enumerate(openings):
         top = o[np.argmax(r[o])]
-        a = points[top]
-        section("hole-rim", i, a, a * rim_radius / r[top])
+        section("hole-rim", i, [top], points[top] * rim_radius / r[top])
         low = o[np.argmin(r[o])]
-        a = points[low]
-        section("hole-hub", i, a, a * inner_radius / r[low])
+        section("hole-hub", i, [low], points[low] * inner_radius / r[low])
         if len(openings) > 1:
             nxt = openings[(i + 1) % len(openings)]
             if len(openings) == 2 and i == 1:
                 continue        # two openings: one pair
             d, j = cKDTree(points[nxt]).query(points[o])
             k = int(np.argmin(d))
-            section("hole-hole", i, points[o[k]], points[nxt[j[k]]])
+            section("hole-hole", i, [o[k], nxt[j[k]]])
     return out
 
 

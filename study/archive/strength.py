@@ -151,7 +151,7 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
         "stress_correction_factor_iso6336": variable("stress_correction_factor_iso6336", y_s),
         "failure_mode": variable("failure_mode", np.array(mode), comment="; ".join(mode_notes)),
         "gear_material": variable("gear_material", np.array(names), comment="; ".join(mat_notes)),
-        "bending_limit_stress": variable("bending_limit_stress", limits, comment="; ".join(mat_notes)),
+        "bending_limit_stress": variable("bending_limit_stress", limits, material="; ".join(mat_notes)),
         "bending_safety": variable("bending_safety", safety, material="; ".join(mat_notes),
                                    loads="with K_v" if math.isfinite(dynamic_scale) else "static (no dynamic run)"),
         "bending_safety_static": variable("bending_safety_static", safety_static, material="; ".join(mat_notes)),

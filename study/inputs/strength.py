@@ -29,7 +29,7 @@ import numpy as np
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup
 
-STRENGTH_VERSION = "2"      # bump when the sites or the load cases change (in every key)
+STRENGTH_VERSION = "3"      # bump when the sites or the load cases change (in every key)
 LOCATIONS = ("root", "rim", "web")
 
 
