@@ -58,6 +58,9 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
     lig_w, lig_s = np.full((2, nk), np.nan), np.full((2, nk), np.nan)
     s_r, m_b, y_b, hp, iso, y_f, y_s = (np.full(2, np.nan) for _ in range(7))
     mode, names, limits = ["", ""], ["", ""], np.full(2, np.nan)
+    n_site = max((r.body.points.shape[0] for r in results if r is not None), default=0)
+    site_s, site_p = np.full((2, n_site), np.nan), np.full((2, n_site, 2), np.nan)
+    site_loc = np.full((2, n_site), -1, np.int8)
     safety, safety_static = np.full((2, nl), np.nan), np.full((2, nl), np.nan)
     notes, iso_notes, yb_notes, mode_notes, mat_notes = [], [], [], [], []
     scale = dynamic_scale if math.isfinite(dynamic_scale) else 1.0
@@ -67,6 +70,8 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
             continue
         bs, peak = res.body, res.peak
         mp = peak["max_principal"]
+        n = mp.size
+        site_s[i, :n], site_p[i, :n], site_loc[i, :n] = mp / units.MPA * max(scale, 1.0), bs.points * units.MM_PER_M, bs.location
         for k in range(nl):
             sel = bs.location == k
             if not sel.any():
@@ -129,7 +134,7 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
            "averaged over the elements of the location's region) for a load on each loaded tooth at five roll parameters, "
            f"superposed with {load}")
     coords = {"location": variable("location", np.array(LOCATIONS)), "ligament": variable("ligament", np.array(LIGAMENT_KINDS)),
-              "axis": variable("axis", np.array(["x", "y"]))}
+              "axis": variable("axis", np.array(["x", "y"])), "site": variable("site", np.arange(n_site))}
     nan_reason = "; ".join(notes) if notes else "none"
     data = {
         "bending_stress": variable("bending_stress", stress, stress=stress_kind, source=how, not_computed=nan_reason),
@@ -137,6 +142,9 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
                                           not_computed=nan_reason),
         "von_mises_max": variable("von_mises_max", vm, source=how, not_computed=nan_reason),
         "stress_position": variable("stress_position", pos),
+        "site_stress": variable("site_stress", site_s, stress=stress_kind, source=how),
+        "site_position": variable("site_position", site_p),
+        "site_location": variable("site_location", site_loc),
         "web_stress_max": variable("web_stress_max", stress[:, 2], stress=stress_kind, source=how, not_computed=nan_reason),
         "rim_stress_max": variable("rim_stress_max", stress[:, 1], stress=stress_kind, source=how, not_computed=nan_reason),
         "web_stress_site": variable("web_stress_site", np.array(site)),

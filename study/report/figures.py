@@ -39,6 +39,7 @@ def run_plots() -> tuple:
     here, not at the top: building the command line loads no matplotlib."""
     from study.report.campbell import campbell_plot, order_map_plot
     from study.report.stiffness_plot import stiffness_plot
+    from study.report.strength_plot import strength_plot
     from study.report.te_plots import dte_plot, spectrum_plot, ste_plot
     return (
         (("ste",), "ste", ste_plot, "STE plot", "the archive has no quasi-static analysis (ste)"),
@@ -48,6 +49,7 @@ def run_plots() -> tuple:
         (("tooth_stiffness",), "tooth_stiffness", stiffness_plot, "stiffness plot", "no tooth_stiffness in the archive"),
         (("mode_frequency",), "campbell", campbell_plot, "Campbell diagram", "no modes in the archive"),
         (("order_amplitude",), "order_map", order_map_plot, "order map", order_map_missing),
+        (("site_stress",), "strength", strength_plot, "strength map", "no strength in the archive (no static analysis)"),
     )
 
 
