@@ -25,7 +25,8 @@ import xarray as xr
 
 # dimensions of a single run archive; any other dimension is a swept parameter
 RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "driven_tooth", "contact_slot", "ste_order", "ste_peak", "dte_peak",
-            "mode", "mesh_position", "excitation", "runup_speed", "tracked_order"}
+            "mode", "mesh_position", "excitation", "runup_speed", "tracked_order",
+            "location", "ligament", "axis", "site"}      # the strength's (study.archive.strength)
 TABLE_DIMS = {"output", "term"}          # the study's sensitivity table (`study.report.effects`)
 
 
