@@ -173,6 +173,12 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
             out.append(sensitivity_figure(ds, table, name("sensitivity")))
         else:
             skip("sensitivity ranking", "every output is constant over the points that are ok")
+    if any(f"{v}_gear2" in ds for v in ("web_stress_max", "rim_stress_max", "bending_stress_root")):
+        from study.report.study_views import strength_figure
+        if swept == ["point"]:
+            skip("strength view", "explicit study points (no factorial grid to average over)")
+        else:
+            out.append(strength_figure(ds, swept, name("strength_gear2")))
     pareto = pareto_table(ds, skip=skip)
     if pareto.data_vars:
         tables.append(pareto)
