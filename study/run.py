@@ -346,10 +346,13 @@ def strength_fields(scene: Scene, model: Model, st, data: dict) -> tuple[dict, d
 
     setups = gear_setups(scene)
     pair = pair_geometry(setups[0].geometry, setups[1].geometry)
-    loads = static_loads(model, st)
     torque = scene.quasi_static.torque
-    results = [gear_strength(s, pair, ld, st.angle.size, abs(torque) / s.geometry.base_radius if torque else s.force)
-               for s, ld in zip(setups, loads)]
+    loads = static_loads(model, st) if torque > 0 else None
+    if loads is None or not loads[0][0].size:     # nothing to rate: each gear's variables NaN, with the reason
+        why = ("quasi_static.torque <= 0: the coast flanks' loads are not rated" if loads is None
+               else "no converged static contact force")
+        return strength_variables(setups, pair, [why, why], scene, math.nan, "")
+    results = [gear_strength(s, pair, ld, st.angle.size, torque / s.geometry.base_radius) for s, ld in zip(setups, loads)]
     scale, note = math.nan, ""
     if "dynamic_factor" in data and torque:
         kv = float(data["dynamic_factor"].values)

@@ -48,7 +48,7 @@ def rim_thickness(setup, bs) -> tuple[float, str]:
 
 def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynamic_note: str) -> tuple[dict, dict]:
     """Coordinates and variables (see the module) of both gears from their
-    `study.inputs.strength.GearStrength` ``results`` (None: not computed), the static torque's
+    `study.inputs.strength.GearStrength` ``results`` (a text: why not computed), the static torque's
     results scaled by ``dynamic_scale`` [1] (the dynamic torque over the static one times K_v;
     NaN without a dynamic run) for the stresses with K_v."""
     nl, nk = len(LOCATIONS), len(LIGAMENT_KINDS)
@@ -58,6 +58,8 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
     lig_w, lig_s = np.full((2, nk), np.nan), np.full((2, nk), np.nan)
     s_r, m_b, y_b, hp, iso, y_f, y_s = (np.full(2, np.nan) for _ in range(7))
     mode, names, limits = ["", ""], ["", ""], np.full(2, np.nan)
+    reasons = list(results)
+    results = [r if hasattr(r, "body") else None for r in reasons]
     n_site = max((r.body.points.shape[0] for r in results if r is not None), default=0)
     site_s, site_p = np.full((2, n_site), np.nan), np.full((2, n_site, 2), np.nan)
     site_loc = np.full((2, n_site), -1, np.int8)
@@ -66,7 +68,7 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
     scale = dynamic_scale if math.isfinite(dynamic_scale) else 1.0
     for i, (s, res) in enumerate(zip(setups, results)):
         if res is None:
-            notes.append(f"gear {s.gear}: not computed (no static analysis)")
+            notes.append(f"gear {s.gear}: not computed ({reasons[i] if isinstance(reasons[i], str) else 'no static analysis'})")
             continue
         bs, peak = res.body, res.peak
         mp = peak["max_principal"]
@@ -113,9 +115,9 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
         iso_notes.append(f"gear {s.gear}: F_t {f_t:.1f} N, b {b * 1e3:g} mm, m {m * 1e3:g} mm, d_HPSTC {d * 1e3:.3f} mm, "
                          f"Y_F {f['Y_F']:.3f}, Y_S {f['Y_S']:.3f}, Y_B {y_b[i]:.3f}, FE/ISO {hp[i] / iso[i]:.3f}")
         y_f[i], y_s[i] = f["Y_F"], f["Y_S"]
-        rim_ratio = static[i, 1] / static[i, 0]
-        web_ratio = static[i, 2] / static[i, 0]
-        mode[i] = failure_mode(m_b[i], rim_ratio, web_ratio)
+        rim_ratio = static[i, 1] / static[i, 0] if static[i, 0] > 0 else math.nan
+        web_ratio = static[i, 2] / static[i, 0] if static[i, 0] > 0 else math.nan
+        mode[i] = failure_mode(m_b[i], rim_ratio, web_ratio) if math.isfinite(rim_ratio) else ""
         mode_notes.append(f"gear {s.gear}: m_B {m_b[i]:.3f} (Lewicki & Ballarini: {crack_path(m_b[i])}), rim/root "
                           f"{rim_ratio:.3f}, web/root {web_ratio:.3f} -> {mode[i]}")
         mat = gear_material(scene.gear(s.gear).material)

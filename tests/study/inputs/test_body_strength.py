@@ -133,3 +133,14 @@ def test_a_material_the_table_does_not_hold_is_refused_by_name():
         small(**{"gear2.material": "unobtainium"})
     ds_scene = small(**{"gear2.material": "42CrMo4"})
     assert ds_scene.gear2.material == "42CrMo4"
+
+
+def test_a_coast_side_load_is_not_rated_and_says_why():
+    """A negative static torque loads the coast flanks, which the load cases do not hold: every
+    strength variable NaN (the failure mode empty) with the reason, and the summary NaN."""
+    from study.run import run_fields
+    r = run_fields(small(**{"quasi_static.torque": -50.0, "quasi_static.rotation": 5.0}), modal=False,
+                   mesh_outputs=False)
+    assert np.isnan(r["bending_stress"].values).all() and list(r["failure_mode"].values) == ["", ""]
+    assert "coast flanks" in r["bending_stress"].attrs["not_computed"]
+    assert math.isnan(study.summarize(r.dataset())["failure_mode_gear2"])
