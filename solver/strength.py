@@ -23,6 +23,7 @@ import math
 from solver.peers.iso6336_strength import crack_path
 
 FAILURE_MODES = ("tooth", "rim", "web")
+LOCATIONS = ("root", "rim", "web")      # where a gear's strength is read (solver.fe.stress.strength_sites)
 RIM_RATIO_MIXED = 0.5   # rim-to-root stress ratio from which a mixed-band rim (0.5 <= m_B < 1) counts as 'rim'
 
 

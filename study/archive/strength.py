@@ -26,9 +26,8 @@ from solver.fe.stress import LIGAMENT_KINDS
 from solver.materials import gear_material
 from solver.peers import iso6336
 from solver.peers.iso6336_strength import backup_ratio, crack_path, nominal_root_stress, rim_thickness_factor
-from solver.strength import bending_safety, failure_mode
+from solver.strength import LOCATIONS, bending_safety, failure_mode
 from study.archive.schema import variable
-from study.inputs.strength import LOCATIONS
 
 WEB_SITES = ("opening edge", *(f"{k} ligament" for k in LIGAMENT_KINDS))
 

@@ -26,11 +26,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from solver.strength import LOCATIONS  # noqa: F401  (BodyStress.location indexes it; imported from here too)
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup
 
 STRENGTH_VERSION = "3"      # bump when the sites or the load cases change (in every key)
-LOCATIONS = ("root", "rim", "web")
 
 
 @dataclass
