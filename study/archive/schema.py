@@ -96,8 +96,7 @@ RUN_VARIABLES: dict[str, Var] = {
     "site_stress": Var(("gear", "site"), "MPa", "largest tensile (max principal) stress at each strength site under the "
                        "run's loads", {"comment": "the field the location maxima are read from; NaN past a gear's sites"}),
     "site_position": Var(("gear", "site", "axis"), "mm", "position of each strength site (gear frame)"),
-    "site_location": Var(("gear", "site"), "1", "location of each strength site: 0 root, 1 rim, 2 web, -1 none", {
-        "flag_values": "0 1 2 -1", "flag_meanings": "root rim web none"}),
+    "site_location": Var(("gear", "site"), "1", "location of each strength site: 0 root, 1 rim, 2 web, -1 none"),
     "bending_stress": Var(("gear", "location"), "MPa", "largest tensile (max principal) stress at the location under the "
                           "run's loads", {"comment": "the stress S_F divides; static, or with K_v when that is larger"}),
     "bending_stress_static": Var(("gear", "location"), "MPa", "largest tensile (max principal) stress at the location "
