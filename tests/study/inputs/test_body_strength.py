@@ -144,3 +144,32 @@ def test_a_coast_side_load_is_not_rated_and_says_why():
     assert np.isnan(r["bending_stress"].values).all() and list(r["failure_mode"].values) == ["", ""]
     assert "coast flanks" in r["bending_stress"].attrs["not_computed"]
     assert math.isnan(study.summarize(r.dataset())["failure_mode_gear2"])
+
+
+def test_a_dynamic_run_scales_the_static_stresses_by_its_torque_and_k_v():
+    """With a dynamic run the rated stress is the static one times (dynamic torque / static
+    torque) K_v where that is larger; S_F follows, and the static S_F is kept beside it."""
+    sc = small(**{"dynamic.enabled": True, "dynamic.duration": 0.006, "dynamic.ramp_time": 0.001,
+                  "dynamic.torque": 120.0, "quasi_static.torque": 100.0})
+    ds = study.run_scene(sc)
+    kv = float(ds["dynamic_factor"])
+    scale = max(1.0, 120.0 / 100.0 * kv)
+    np.testing.assert_allclose(ds["bending_stress"].values, scale * ds["bending_stress_static"].values, rtol=1e-12)
+    np.testing.assert_allclose(ds["bending_safety"].values * scale, ds["bending_safety_static"].values, rtol=1e-12)
+    assert ds["bending_safety"].attrs["loads"] == "with K_v" and f"K_v {kv:.4f}" in ds["bending_stress"].attrs["source"]
+
+
+def test_a_study_point_reads_the_strength_of_its_run():
+    """The strength outputs of a study point are the run archive's summary (same numbers), and
+    asking for them runs the strength; a study without them does not."""
+    from study.sweep.engine import run_point
+    from study.sweep.outputs import Outputs
+    sc = small()
+    names = ("web_stress_max_gear2", "rim_stress_max_gear2", "failure_mode_gear2", "bending_safety_gear2",
+             "bending_safety_web_gear2", "backup_ratio_gear2", "root_stress_iso6336_gear2")
+    r = run_point(sc, Outputs(names))
+    s = study.summarize(study.run_scene(sc, static=True, dynamic=False))
+    assert r["status"] == "ok"
+    for k in names:
+        assert r["scalars"][k] == pytest.approx(s[k], rel=1e-12, nan_ok=True), k
+    assert math.isnan(run_point(sc, Outputs(("ste_p2p",)))["scalars"].get("web_stress_max_gear2", math.nan))
