@@ -118,3 +118,67 @@ def test_hole_edge_stress_of_kirschs_plate_is_three_times_the_tension(kirsch_run
         assert float(von_mises(s).max()) / SIGMA == pytest.approx(3.0, rel=0.05)
     assert err[96] < 0.03 and err[96] < 0.75 * err[48]
     print({n: round(e, 4) for n, e in err.items()})
+
+
+def window_body(h: float = 0.4e-3) -> BodyMesh:
+    """A plain disc body (no teeth): rim 24-30 mm, web 10-24 mm with four rectangular windows
+    (radial 14-20 mm, 6 mm wide) at 0, 90, 180, 270 degrees, hub 6-10 mm; element size h."""
+    import gmsh
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("windows")
+        geo = gmsh.model.geo
+        c = geo.addPoint(0, 0, 0, h)
+
+        def circle(r):
+            p = [geo.addPoint(r * math.cos(t), r * math.sin(t), 0, h) for t in np.arange(4) * math.pi / 2]
+            return geo.addCurveLoop([geo.addCircleArc(p[i], c, p[(i + 1) % 4]) for i in range(4)])
+
+        def window(t):
+            cs, sn = math.cos(t), math.sin(t)
+            corners = [(14e-3, -3e-3), (20e-3, -3e-3), (20e-3, 3e-3), (14e-3, 3e-3)]
+            p = [geo.addPoint(x * cs - y * sn, x * sn + y * cs, 0, h) for x, y in corners]
+            return geo.addCurveLoop([geo.addLine(p[i], p[(i + 1) % 4]) for i in range(4)])
+        outer, rim_in, hub_out, bore = circle(30e-3), circle(24e-3), circle(10e-3), circle(6e-3)
+        from solver.fe.mesh import REGION_HUB, REGION_WEB
+        surf = {REGION_RIM: geo.addPlaneSurface([outer, rim_in]),
+                REGION_WEB: geo.addPlaneSurface([rim_in, *(window(k * math.pi / 2) for k in range(4)), hub_out]),
+                REGION_HUB: geo.addPlaneSurface([hub_out, bore])}
+        geo.synchronize()
+        gmsh.model.mesh.generate(2)
+        tags, xyz, _ = gmsh.model.mesh.getNodes()
+        index = {int(t): i for i, t in enumerate(tags)}
+        tris, regions = [], []
+        for reg, s in surf.items():
+            _, _, nodes = gmsh.model.mesh.getElements(2, s)
+            t = np.array([index[int(n)] for n in nodes[0]]).reshape(-1, 3)
+            tris.append(t)
+            regions.append(np.full(t.shape[0], reg, np.int8))
+        tri = np.concatenate(tris)
+        used, tri = np.unique(tri, return_inverse=True)
+        return BodyMesh(xyz.reshape(-1, 3)[used, :2], tri.reshape(-1, 3), np.concatenate(regions), 6e-3, h)
+    finally:
+        gmsh.finalize()
+
+
+def test_openings_of_any_shape_and_their_ligaments_come_from_the_mesh():
+    """Four rectangular windows: four openings found from the web's free edges (the bore and the
+    web's inner interfaces are not openings), ligaments to the rim 24 - |corner| =
+    24 - hypot(20, 3) mm, to the hub 14 - 10 = 4 mm, between windows sqrt(2) (14 - 3) mm corner
+    to corner, within the element size's chord error."""
+    from solver.fe.stress import LIGAMENT_KINDS, strength_sites
+    m = window_body()
+    sites = strength_sites(m.points, m.triangles, m.region, 29.999e-3, 30.001e-3, 24e-3, 10e-3, 6e-3, 4)
+    assert len(sites.openings) == 4
+    for o in sites.openings:                       # each loop lies on its window's edges
+        r = np.hypot(*m.points[o].T)
+        assert r.min() >= 14e-3 - 1e-9 and r.max() <= math.hypot(20e-3, 3e-3) + 1e-9
+    want = {"hole-rim": 24.0 - math.hypot(20.0, 3.0), "hole-hub": 4.0, "hole-hole": math.sqrt(2) * 11.0}
+    for kind, w in want.items():
+        got = [lg.width * 1e3 for lg in sites.ligaments if lg.kind == kind]
+        assert len(got) == 4 and np.allclose(got, w, atol=0.01), (kind, got)
+    assert {lg.kind for lg in sites.ligaments} == set(LIGAMENT_KINDS)
+    # the root nodes are the outline's (the outer circle here), the rim nodes its inner half
+    assert np.allclose(np.hypot(*m.points[sites.root].T), 30e-3, rtol=1e-6)
+    assert np.hypot(*m.points[sites.rim].T).max() <= 27e-3 + 1e-9
