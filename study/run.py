@@ -194,7 +194,7 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
 def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
                max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True,
                warn: bool = True, keep_model: bool = False, archive: bool = True,
-               gear_variables: bool = True, modal: bool = True) -> RunFields:
+               gear_variables: bool = True, modal: bool = True, strength: bool | None = None) -> RunFields:
     """Run the analyses a scene asks for (or those forced by static/dynamic) -> the run
     archive's variables and attributes (`RunFields`; `run_scene` makes the archive of them).
 
@@ -214,7 +214,9 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     archive (the scene's TOML, the provenance) and, without ``mesh_outputs``, the loaded
     contacts of the dynamic run and each tooth's largest force, ``gear_variables=False`` the per-gear mass,
     inertia and root stress, ``modal=False`` the modal variables (mesh mode, critical speeds,
-    free decay) and the critical-speed warning they give."""
+    free decay) and the critical-speed warning they give. ``strength``: the bending strength of
+    both gears under the STE's contact forces, with K_v when the run has a dynamic factor
+    (`strength_fields`; default: with the statics and the per-gear variables)."""
     static = scene.quasi_static.enabled if static is None else static
     dynamic = scene.dynamic.enabled if dynamic is None else dynamic
     warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
@@ -364,4 +366,34 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
         attrs["dynamic_method"] = choice.method
         attrs["dynamic_method_reason"] = choice.reason
         attrs["hht_alpha"] = d.alpha if choice.method == "implicit" else float("nan")
+    if (static and gear_variables) if strength is None else (strength and static):
+        t0 = time.perf_counter()
+        c, v = strength_fields(scene, model, st, data)
+        coords.update(c); data.update(v)
+        attrs["wall_time_strength_s"] = time.perf_counter() - t0
     return RunFields(coords, data, attrs)
+
+
+def strength_fields(scene: Scene, model: Model, st, data: dict) -> tuple[dict, dict]:
+    """The strength variables (`study.archive.strength`) of both gears under the static
+    result's contact forces ``st`` and, when ``data`` holds a dynamic factor K_v, the dynamic
+    run's: the static stresses times (dynamic torque / static torque) K_v."""
+    from solver.geometry import pair_geometry
+    from study.archive.strength import strength_variables
+    from study.inputs.strength import gear_strength, static_loads
+
+    setups = gear_setups(scene)
+    pair = pair_geometry(setups[0].geometry, setups[1].geometry)
+    torque = scene.quasi_static.torque
+    loads = static_loads(model, st) if torque > 0 else None
+    if loads is None or not loads[0][0].size:     # nothing to rate: each gear's variables NaN, with the reason
+        why = ("quasi_static.torque <= 0: the coast flanks' loads are not rated" if loads is None
+               else "no converged static contact force")
+        return strength_variables(setups, pair, [why, why], scene, math.nan, "")
+    results = [gear_strength(s, pair, ld, st.angle.size, torque / s.geometry.base_radius) for s, ld in zip(setups, loads)]
+    scale, note = math.nan, ""
+    if "dynamic_factor" in data and torque:
+        kv = float(data["dynamic_factor"].values)
+        scale = scene.dynamic.torque / torque * kv
+        note = f"dynamic torque {scene.dynamic.torque:g} N·m over static {torque:g} N·m, K_v {kv:.4f}"
+    return strength_variables(setups, pair, results, scene, scale, note)

@@ -33,6 +33,7 @@ from solver.geometry import (
     pair_geometry,
     validate_body,
 )
+from solver.materials import DEFAULT_MATERIAL, MATERIALS
 from study.damping import MESH_DAMPING_RATIO, NOT_GIVEN, TOOTH_DAMPING_RATIO, check_damping, damping_partner, resolve_exclusive
 from study.errors import SceneError
 from study.modification import ModificationSection, modification_spec
@@ -128,6 +129,10 @@ class GearSection:
     fillet_radius: float = _f(0.45, "mm", "root fillet radius", 0.0)
     face_width: float = _f(17.0, "mm", "face width t2", 0, lo_open=True)
     pivot_radius: float = _f(0.0, "mm", "radius of the tooth pivot on the tooth axis; 0 = root circle", 0.0)
+    # the bending rating's steel (solver.materials); the elastic constants stay those of [material]
+    material: str = _f(DEFAULT_MATERIAL, "", "gear steel of the bending rating: its sigma_Flim (ISO 6336-5, grade MQ) "
+                       "sets the safety factors S_F; one of " + ", ".join(f"{k} ({m.treatment}, sigma_Flim "
+                       f"{m.sigma_f_lim / 1e6:g} MPa)" for k, m in MATERIALS.items()), choices=tuple(MATERIALS))
     body: BodySection = field(default_factory=BodySection)
     spring: SpringSection = field(default_factory=SpringSection)
     modification: ModificationSection = field(default_factory=ModificationSection)

@@ -1,13 +1,16 @@
-"""The lightest driven-gear body whose transmission error and root stress stay within limits.
+"""The lightest driven-gear body whose transmission error and strength stay within limits.
 
 Among driven-gear bodies (hole count, hole radius, rim and web thickness), the one that saves
 the most mass while its STE peak-to-peak and its DTE RMS at the given speed stay within given
-factors of the solid gear's (no holes, web as thick as the face) and its largest root stress
-within a limit (relative to the solid gear's, and optionally in MPa):
+factors of the solid gear's (no holes, web as thick as the face), its largest root stress
+within a limit (relative to the solid gear's, and optionally in MPa) and its bending safety
+factor S_F at the root, in the rim and in the web (under the STE's contact forces, against the
+scene's gear2.material) at least ``--safety-min``:
 
     python -m workflows.lightest_gear [SCENE.toml] [--ste-factor 2.0] [--dte-factor 4.0]
-        [--stress-ratio 1.15] [--stress-max MPA] [--speed 100] [--grid gear2.body.holes=3,6,9 ...]
-        [--shapes round,slot,window] [--refine 2] [-o results/lightest_gear] [--workers N]
+        [--stress-ratio 1.15] [--stress-max MPA] [--safety-min 1.4] [--speed 100]
+        [--grid gear2.body.holes=3,6,9 ...] [--shapes round,slot,window] [--refine 2] [-o results/lightest_gear]
+        [--workers N]
 
 1. the solid gear, at the same speed: the reference of the factors;
 2. a coarse grid over the four body fields (full factorial, `study.make_study` + `study.run_sweep`
@@ -22,7 +25,8 @@ within a limit (relative to the solid gear's, and optionally in MPa):
    wider is lighter; a window's spokes, narrower is lighter), and all compete for the answer;
 4. ``tradeoff.png``: mass saved against STE p2p and DTE RMS over every body run, coloured by root
    stress, the Pareto set, the TE limits and the chosen body; ``lightest.txt``: the answer, also
-   printed.
+   printed; ``candidates.csv``: every body run, its S_F, the location that limits it (root, rim or
+   web: the smallest S_F), its failure mode and whether it meets the limits.
 
 The default factors are wide because the solid paper gear's STE is small (0.33 um peak-to-peak):
 every body of the default grid raises it by at least 45 % (its web, 10 mm or less of the 17 mm
@@ -81,7 +85,10 @@ def fields_of(opening: str) -> dict:
     return {(size if path == "gear2.body.hole_radius" else path): (SIZE_NAMES[size] if path == "gear2.body.hole_radius"
                                                                   else name) for path, name in FIELDS.items()}
 SCALARS = ["ste_p2p", "dte_rms", "mass_gear2", "mass_saving_gear2", "inertia_gear2",
-           "root_stress_max_gear2", "root_stress_ratio_gear2"]
+           "root_stress_max_gear2", "root_stress_ratio_gear2", "bending_safety_gear2", "bending_safety_root_gear2",
+           "bending_safety_rim_gear2", "bending_safety_web_gear2", "failure_mode_gear2"]
+LOCATIONS = ("root", "rim", "web")
+MODES = ("tooth", "rim", "web")        # failure_mode_gear2's codes (solver.strength.FAILURE_MODES)
 
 
 @dataclass(frozen=True)
@@ -90,6 +97,7 @@ class Limits:
     dte_factor: float = 4.0           # DTE RMS over the solid gear's [1]
     stress_ratio: float = 1.15        # largest root stress over the solid gear's [1]
     stress_max: float = math.inf      # largest root stress [MPa]
+    safety_min: float = 1.4           # smallest bending safety factor S_F at the root, rim and web [1]
 
 
 # ---------------------------------------------------------------- selection (any candidate table)
@@ -125,7 +133,34 @@ def feasible(table: xr.Dataset, solid: dict, limits: Limits) -> xr.DataArray:
     ok &= table["root_stress_ratio_gear2"] <= limits.stress_ratio
     if math.isfinite(limits.stress_max):
         ok &= table["root_stress_max_gear2"] <= limits.stress_max
+    if limits.safety_min > 0:
+        ok &= table["bending_safety_gear2"] >= limits.safety_min
     return ok
+
+
+def limiting_location(table: xr.Dataset) -> np.ndarray:
+    """The location (root, rim, web) with the smallest S_F of each candidate ('' where none is known)."""
+    sf = np.stack([table[f"bending_safety_{loc}_gear2"].values for loc in LOCATIONS], axis=1)
+    known = np.isfinite(sf).any(axis=1)
+    idx = np.argmin(np.where(np.isfinite(sf), sf, np.inf), axis=1)
+    return np.where(known, np.array(LOCATIONS)[idx], "")
+
+
+def candidate_rows(table: xr.Dataset, mask: xr.DataArray) -> str:
+    """Every candidate as CSV: body, mass saved, TE, S_F and the location that limits it, failure mode, feasible."""
+    where = limiting_location(table)
+    lines = ["n_holes,opening,hole_radius_mm,slot_width_mm,spoke_width_mm,rim_thickness_mm,web_thickness_mm,"
+             "mass_saving_pct,ste_p2p_um,dte_rms_um,"
+             "root_stress_ratio,bending_safety,limiting_location,failure_mode,feasible"]
+    for i in range(table.sizes["candidate"]):
+        v = {k: table[k].values[i] for k in table.data_vars}
+        mode = v["failure_mode_gear2"]
+        lines.append(f"{int(v['n_holes'])},{v['opening']},{v['hole_radius']:g},{v['slot_width']:g},{v['spoke_width']:g},"
+                     f"{v['rim_thickness']:g},{v['web_thickness']:g},"
+                     f"{v['mass_saving_gear2']:.2f},{v['ste_p2p']:.4f},{v['dte_rms']:.4f},{v['root_stress_ratio_gear2']:.4f},"
+                     f"{v['bending_safety_gear2']:.3f},{where[i]},{MODES[int(mode)] if np.isfinite(mode) else ''},"
+                     f"{int(bool(mask.values[i]))}")
+    return "\n".join(lines) + "\n"
 
 
 def ranked(table: xr.Dataset, mask: xr.DataArray) -> list[int]:
@@ -215,7 +250,19 @@ def answer(best: dict, solid: dict, speed: float) -> str:
             f"{best['inertia_gear2']:.0f} against {solid['inertia_gear2']:.0f} kg mm2) for {ste:+.1f} % STE p2p "
             f"({best['ste_p2p']:.3f} against {solid['ste_p2p']:.3f} um) and {dte:+.1f} % DTE RMS at {speed:g} rad/s "
             f"({best['dte_rms']:.3f} against {solid['dte_rms']:.3f} um), root stress {best['root_stress_max_gear2']:.1f} MPa "
-            f"(x {best['root_stress_ratio_gear2']:.2f} of solid).")
+            f"(x {best['root_stress_ratio_gear2']:.2f} of solid); bending safety S_F {best['bending_safety_gear2']:.2f}, "
+            f"limited by the {_limit(best)}, failure mode {_mode(best)}.")
+
+
+def _limit(row: dict) -> str:
+    sf = [row.get(f"bending_safety_{loc}_gear2", math.nan) for loc in LOCATIONS]
+    known = [(v, loc) for v, loc in zip(sf, LOCATIONS) if np.isfinite(v)]
+    return min(known)[1] if known else "(unknown)"
+
+
+def _mode(row: dict) -> str:
+    m = row.get("failure_mode_gear2", math.nan)
+    return MODES[int(m)] if np.isfinite(m) else "unknown"
 
 
 def _row(table, i) -> dict:
@@ -240,7 +287,7 @@ def parse_grid(items: list[str]) -> dict:
 def run(args) -> int:
     """The workflow for the parsed command line ``args`` (its options checked first) -> exit code."""
     check_options(args)
-    limits = Limits(args.ste_factor, args.dte_factor, args.stress_ratio, args.stress_max)
+    limits = Limits(args.ste_factor, args.dte_factor, args.stress_ratio, args.stress_max, args.safety_min)
     scene = base_scene(args.scene, args.set, args.speed, args.duration, args.angle_step)
     grid = parse_grid(args.grid)
     shapes = parse_shapes(args.shapes)
@@ -260,6 +307,7 @@ def run(args) -> int:
     print(f"lightest driven gear at {args.speed:g} rad/s: STE p2p <= {limits.ste_factor:g} x solid, DTE RMS <= "
           f"{limits.dte_factor:g} x solid, root stress <= {limits.stress_ratio:g} x solid"
           + (f" and <= {limits.stress_max:g} MPa" if math.isfinite(limits.stress_max) else "")
+          + (f", S_F >= {limits.safety_min:g} at the root, rim and web" if limits.safety_min > 0 else "")
           + f"; DTE over {scene.dynamic.duration:g} s; coarse grid {n} bodies"
           + (f" ({', '.join(shapes)})" if shapes != ["round"] else "") + f" -> {out}", flush=True)
     lost = 0
@@ -303,6 +351,10 @@ def run(args) -> int:
         text = "No body of the grid meets the limits." + (
             f" The nearest miss: {answer(_row(table, near), solid, args.speed)}" if near is not None else "")
     (out / "lightest.txt").write_text(text + "\n")
+    (out / "candidates.csv").write_text(candidate_rows(table, mask))
+    where = limiting_location(table)
+    print("  S_F limited by: " + ", ".join(f"{loc} {int((where == loc).sum())}" for loc in LOCATIONS)
+          + f" of {table.sizes['candidate']} bodies (each in candidates.csv)")
     print(f"\n{text}\n  figure: {figure}")
     if lost:
         print(f"  {lost} analyses lost (worker failures): run the same command again", file=sys.stderr)
@@ -341,6 +393,8 @@ def main(argv=None) -> int:
     p.add_argument("--stress-ratio", type=float, default=Limits.stress_ratio,
                    help="root stress limit over the solid gear's [1]")
     p.add_argument("--stress-max", type=float, default=math.inf, help="root stress limit [MPa] (default: none)")
+    p.add_argument("--safety-min", type=float, default=Limits.safety_min,
+                   help="smallest bending safety factor S_F at the root, rim and web [1] (0: no limit)")
     p.add_argument("--speed", type=float, default=100.0, help="driver speed of the DTE [rad/s]")
     p.add_argument("--duration", type=float, default=None,
                    help="DTE run [s] (default: twice the ramp, then one revolution of the driven gear)")
@@ -370,6 +424,8 @@ def check_options(args) -> None:
             raise SceneError(f"--{name.replace('_', '-')}", f"must be positive, got {v:g}")
     if args.duration is not None and not args.duration > 0:
         raise SceneError("--duration", f"must be positive, got {args.duration:g}")
+    if not args.safety_min >= 0:
+        raise SceneError("--safety-min", f"must be >= 0 (0: no limit), got {args.safety_min:g}")
     if args.refine < 0:
         raise SceneError("--refine", f"must be >= 0, got {args.refine}")
     if args.workers is not None and args.workers < 0:

@@ -36,6 +36,15 @@ PEAK_NAMES = ("peak name: N hole order, Z mesh order, kZ+-N sidebands, R1 and R2
 
 # per-gear scalars a study archives as ``{name}_gear{g}`` (`study.sweep.outputs`)
 GEAR_VARIABLES = ("mass", "mass_saving", "inertia", "root_stress_max", "root_stress_ratio")
+# per-gear strength scalars a study archives as ``{name}_gear{g}`` (`study.archive.strength`); besides
+# them ``failure_mode_gear{g}`` (its index in solver.strength.FAILURE_MODES) and ``bending_safety_gear{g}``
+# (the smallest over the locations) with ``bending_safety_{location}_gear{g}``
+STRENGTH_VARIABLES = ("web_stress_max", "rim_stress_max", "backup_ratio", "rim_thickness_factor_iso6336",
+                      "root_stress_hpstc", "root_stress_iso6336")
+STRENGTH_SOURCE = ("FE plane-stress body (study.inputs.strength): its stress per unit load at the strength sites "
+                   "(solver.fe.stress.strength_sites) for a load on each loaded tooth at five roll parameters, superposed "
+                   "with the STE's static contact forces at every angle; with a dynamic run, times the dynamic torque over "
+                   "the static torque times K_v when that is larger")
 
 
 def _peaks(prefix: str, frequency: bool) -> dict:
@@ -77,6 +86,63 @@ RUN_VARIABLES: dict[str, Var] = {
                               "stiffness ratio)",
         "comment": "1 by definition for a solid gear (no holes, web as thick as the face: its own reference, no FE "
                    "needed); NaN for a lightened gear whose springs need no FE"}),
+    # ---- strength under the run's loads: `study.archive.strength`
+    "location": Var(("location",), "1", "where a gear's strength is read: root (fillets and root lands), rim (inner half "
+                                        "of the rim under the roots), web (edges of its openings and its ligaments)"),
+    "ligament": Var(("ligament",), "1", "ligament of the web: between an opening and the rim, the next opening, the hub "
+                                        "(the bore without a hub)"),
+    "axis": Var(("axis",), "1", "coordinate in the gear frame: x along tooth 0's axis, y 90 degrees ahead"),
+    "site": Var(("site",), "1", "a mesh node where a gear's strength is read (root, rim or web; padded per gear)"),
+    "site_stress": Var(("gear", "site"), "MPa", "largest tensile (max principal) stress at each strength site under the "
+                       "run's loads", {"comment": "the field the location maxima are read from; NaN past a gear's sites"}),
+    "site_position": Var(("gear", "site", "axis"), "mm", "position of each strength site (gear frame)"),
+    "site_location": Var(("gear", "site"), "1", "location of each strength site: 0 root, 1 rim, 2 web, -1 none"),
+    "bending_stress": Var(("gear", "location"), "MPa", "largest tensile (max principal) stress at the location under the "
+                          "run's loads", {"comment": "the stress S_F divides; static, or with K_v when that is larger"}),
+    "bending_stress_static": Var(("gear", "location"), "MPa", "largest tensile (max principal) stress at the location "
+                                 "under the STE's static contact forces"),
+    "von_mises_max": Var(("gear", "location"), "MPa", "largest von Mises stress at the location under the run's loads"),
+    "stress_position": Var(("gear", "location", "axis"), "mm", "position of the largest tensile stress of the location "
+                           "(gear frame)", {"source": STRENGTH_SOURCE}),
+    "web_stress_max": Var(("gear",), "MPa", "largest tensile stress at the web's opening edges and ligaments under the "
+                          "run's loads", {"comment": "bending_stress at the web; NaN for a web without openings"}),
+    "rim_stress_max": Var(("gear",), "MPa", "largest tensile stress in the inner half of the rim under the run's loads",
+                          {"comment": "bending_stress in the rim"}),
+    "web_stress_site": Var(("gear",), "1", "where the web's largest tensile stress is: an opening's edge or a ligament "
+                           "(hole-rim, hole-hole, hole-hub)"),
+    "ligament_width": Var(("gear", "ligament"), "mm", "width of the narrowest ligament of each kind (from the mesh: "
+                          "opening edge to the rim circle, to the next opening, to the hub circle)"),
+    "ligament_stress_max": Var(("gear", "ligament"), "MPa", "largest tensile stress on the ligaments of each kind under "
+                               "the run's loads"),
+    "rim_thickness": Var(("gear",), "mm", "rim thickness s_R under the root circle"),
+    "backup_ratio": Var(("gear",), "1", "backup ratio m_B = s_R / h_t (rim thickness over tooth height)",
+                        {"source": "ISO 6336-3:2019, AGMA 2001-D04"}),
+    "rim_thickness_factor_iso6336": Var(("gear",), "1", "rim thickness factor Y_B of ISO 6336-3 (= K_B of AGMA 2001)", {
+        "source": "Y_B = 1.6 ln(2.242 / m_B) for 0.5 <= m_B < 1.2, 1 for m_B >= 1.2 (solver.peers.iso6336_strength)"}),
+    "root_stress_hpstc": Var(("gear",), "MPa", "FE root stress (largest max principal on the tooth's root) with the tooth "
+                             "loaded alone by F = T/rb at the outer point of single tooth contact (HPSTC)", {
+                                 "comment": "largest over the loaded teeth; the load position and the load of "
+                                            "root_stress_iso6336, for their comparison"}),
+    "root_stress_iso6336": Var(("gear",), "MPa", "nominal tooth root stress sigma_F0 = F_t/(b m) Y_F Y_S Y_B of ISO 6336-3 "
+                               "Method B at the HPSTC", {"source": "solver.peers.iso6336 (Y_F, Y_S of the basic rack "
+                                                                   "generating a fillet of the tool tip radius), "
+                                                                   "solver.peers.iso6336_strength (Y_B)"}),
+    "tooth_form_factor_iso6336": Var(("gear",), "1", "tooth form factor Y_F of ISO 6336-3 Method B, load at the HPSTC",
+                                     {"source": "solver.peers.iso6336.root_form_factors"}),
+    "stress_correction_factor_iso6336": Var(("gear",), "1", "stress correction factor Y_S of ISO 6336-3 Method B, load at "
+                                            "the HPSTC", {"source": "solver.peers.iso6336.root_form_factors"}),
+    "failure_mode": Var(("gear",), "1", "where the first crack is expected: 'tooth', 'rim' or 'web'", {
+        "source": "solver.strength.failure_mode: m_B with the thresholds of Lewicki & Ballarini 1997 (1.0 tooth, "
+                  "0.5 mixed, 0.3 rim fracture) and the FE's rim-to-root and web-to-root ratios of bending_stress_static"}),
+    "gear_material": Var(("gear",), "1", "gear steel of the bending rating (scene gearN.material; solver.materials)"),
+    "bending_limit_stress": Var(("gear",), "MPa", "tooth-root limit stress sigma_FG = sigma_Flim Y_ST Y_NT Y_delta_rel_T "
+                                "Y_R_rel_T Y_X", {"comment": "Y_ST = 2, Y_NT = Y_delta_rel_T = Y_R_rel_T = Y_X = 1; sigma_Flim "
+                                                             "of ISO 6336-5 grade MQ (solver.materials)"}),
+    "bending_safety": Var(("gear", "location"), "1", "bending safety factor S_F = sigma_FG / bending_stress", {
+        "comment": "sigma_FG = sigma_Flim Y_ST Y_NT Y_delta_rel_T Y_R_rel_T Y_X with Y_ST = 2 and the others 1 "
+                   "(solver.materials); the rim and web of a surface-hardened gear are core material, weaker than the "
+                   "root's case: their S_F is optimistic for those"}),
+    "bending_safety_static": Var(("gear", "location"), "1", "bending safety factor S_F under the static loads alone"),
     # ---- modes and critical speeds: `study.archive.modes`
     "mode": Var(("mode",), "1", "mode number: 0 the mesh mode, then the tooth modes by frequency"),
     "mode_kind": Var(("mode",), "1", "what the mode is: the mesh mode (largest share of kinetic energy on the driven "

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from study.archive.schema import GEAR_VARIABLES
+from study.archive.schema import GEAR_VARIABLES, STRENGTH_VARIABLES
 
 
 def summarize(ds: xr.Dataset) -> dict:
@@ -56,11 +56,33 @@ def summarize(ds: xr.Dataset) -> dict:
         for g in (1, 2):
             for name in GEAR_VARIABLES:
                 out[f"{name}_gear{g}"] = float(_at(ds, name, gear=g)) if name in ds else nan
+    if "bending_stress" in ds:
+        out.update(strength_scalars(ds))
     for k in ("wall_time_springs_s", "wall_time_static_s", "wall_time_dynamic_s"):
         if k in ds.attrs:
             out[k] = float(ds.attrs[k])
     return out
 
+
+
+def strength_scalars(ds) -> dict:
+    """The per-gear strength scalars of a run (`study.archive.strength`): `STRENGTH_VARIABLES`
+    as ``{name}_gear{g}``, the failure mode as its index in `solver.strength.FAILURE_MODES`, the
+    root's tensile stress, and S_F at each location and the smallest of them."""
+    from solver.strength import FAILURE_MODES
+    out = {}
+    locations = [str(x) for x in ds["location"].values]
+    for g in (1, 2):
+        for name in STRENGTH_VARIABLES:
+            out[f"{name}_gear{g}"] = float(_at(ds, name, gear=g))
+        mode = str(_at(ds, "failure_mode", gear=g))
+        out[f"failure_mode_gear{g}"] = float(FAILURE_MODES.index(mode)) if mode in FAILURE_MODES else float("nan")
+        out[f"bending_stress_root_gear{g}"] = float(_at(ds, "bending_stress", gear=g, location="root"))
+        sf = np.asarray(_at(ds, "bending_safety", gear=g), float)
+        for loc, v in zip(locations, sf):
+            out[f"bending_safety_{loc}_gear{g}"] = float(v)
+        out[f"bending_safety_gear{g}"] = float(np.nanmin(sf)) if np.isfinite(sf).any() else float("nan")
+    return out
 
 
 def _at(ds: xr.Dataset, name: str, **where):

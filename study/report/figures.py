@@ -25,7 +25,8 @@ import xarray as xr
 
 # dimensions of a single run archive; any other dimension is a swept parameter
 RUN_DIMS = {"angle", "time", "frequency", "gear", "tooth", "driver_tooth", "driven_tooth", "contact_slot", "ste_order", "ste_peak", "dte_peak",
-            "mode", "mesh_position", "excitation", "runup_speed", "tracked_order"}
+            "mode", "mesh_position", "excitation", "runup_speed", "tracked_order",
+            "location", "ligament", "axis", "site"}      # the strength's (study.archive.strength)
 TABLE_DIMS = {"output", "term"}          # the study's sensitivity table (`study.report.effects`)
 
 
@@ -39,6 +40,7 @@ def run_plots() -> tuple:
     here, not at the top: building the command line loads no matplotlib."""
     from study.report.campbell import campbell_plot, order_map_plot
     from study.report.stiffness_plot import stiffness_plot
+    from study.report.strength_plot import strength_plot
     from study.report.te_plots import dte_plot, spectrum_plot, ste_plot
     return (
         (("ste",), "ste", ste_plot, "STE plot", "the archive has no quasi-static analysis (ste)"),
@@ -48,6 +50,7 @@ def run_plots() -> tuple:
         (("tooth_stiffness",), "tooth_stiffness", stiffness_plot, "stiffness plot", "no tooth_stiffness in the archive"),
         (("mode_frequency",), "campbell", campbell_plot, "Campbell diagram", "no modes in the archive"),
         (("order_amplitude",), "order_map", order_map_plot, "order map", order_map_missing),
+        (("site_stress",), "strength", strength_plot, "strength map", "no strength in the archive (no static analysis)"),
     )
 
 
@@ -170,6 +173,12 @@ def _study_views(ds, swept, name, skip) -> list[Path]:
             out.append(sensitivity_figure(ds, table, name("sensitivity")))
         else:
             skip("sensitivity ranking", "every output is constant over the points that are ok")
+    if any(f"{v}_gear2" in ds for v in ("web_stress_max", "rim_stress_max", "bending_stress_root")):
+        from study.report.study_views import strength_figure
+        if swept == ["point"]:
+            skip("strength view", "explicit study points (no factorial grid to average over)")
+        else:
+            out.append(strength_figure(ds, swept, name("strength_gear2")))
     pareto = pareto_table(ds, skip=skip)
     if pareto.data_vars:
         tables.append(pareto)

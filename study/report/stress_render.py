@@ -107,6 +107,10 @@ def fe_stress_render(ds: xr.Dataset, path, g: int, fields: list) -> RenderResult
         z = sc.gear(g).face_width
         p.add_mesh(pv.Arrow(start=(lp[0] - L * d[0], lp[1] - L * d[1], z), direction=(d[0], d[1], 0), scale=L,
                             tip_length=0.3, tip_radius=0.12, shaft_radius=0.04), color="#00b4ff", lighting=False)
+        hot = hot_spots(ds, g, rot, corners, z)
+        for name, xy, _ in hot:
+            p.add_mesh(pv.Sphere(radius=0.5 * geo.spec.module / units.MM, center=(xy[0], xy[1], z + 0.1)),
+                       color=HOT_COLOURS[name], lighting=False)
         fit_parallel(p, corners, vw, vh, margin=1.03, bottom_margin=0.3 if last else 0.0, top_margin=0.16)
         where = ""
         if n_holes:
@@ -116,7 +120,9 @@ def fe_stress_render(ds: xr.Dataset, path, g: int, fields: list) -> RenderResult
         p.add_text(f"gear {g}: {f.load_N:.0f} N on tooth {f.tooth}{where}\n"
                    f"k_phi {k[f.tooth]:.4g} N·mm/rad^{sc.gear(g).spring.n_k:g}; fillet stress (root_stress, largest at "
                    f"the fillet vertices) {archived}\n"
-                   f"colour: von Mises stress [MPa], element means (largest in the fillet {peaks[j]:.0f} MPa)",
+                   f"colour: von Mises stress [MPa], element means (largest in the fillet {peaks[j]:.0f} MPa)"
+                   + ("\nhot spots under the run's loads (strength.png), in view: "
+                      + ", ".join(f"{name} ({HOT_NAMES[name]}) {v:.1f} MPa" for name, _, v in hot) if hot else ""),
                    position="upper_left", font_size=10, color="black")
         # displacement on the magnified shape, undeformed outline in grey
         p.subplot(j, 1)
@@ -136,6 +142,29 @@ def fe_stress_render(ds: xr.Dataset, path, g: int, fields: list) -> RenderResult
                    position="upper_left", font_size=10, color="black")
     title = f"FE stress and displacement of gear {g} under a tooth load / {archive_title(ds)}"
     return RenderResult(write_png(p, path, title), (lo, hi), "von_mises", "MPa")
+
+
+HOT_COLOURS = {"root": "#ff2d2d", "rim": "#b44bff", "web": "#ffffff"}
+HOT_NAMES = {"root": "red dot", "rim": "violet dot", "web": "white dot"}
+
+
+def hot_spots(ds: xr.Dataset, g: int, rot: float, corners: np.ndarray, z: float) -> list:
+    """[(location, (x, y) [mm] in the view's frame, largest tensile stress [MPa])] of the
+    archive's strength hot spots of gear g (``stress_position``, ``bending_stress``) that lie in
+    the view (the box of ``corners``); [] without them."""
+    if "stress_position" not in ds or "bending_stress" not in ds:
+        return []
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    out = []
+    for k, name in enumerate(ds["location"].values):
+        v = float(ds["bending_stress"].sel(gear=g).values[k])
+        xy = ds["stress_position"].sel(gear=g).values[k]
+        if not (np.isfinite(v) and np.isfinite(xy).all()):
+            continue
+        q = transform(np.asarray(xy, float)[None, :], rot, np.zeros(2))[0]
+        if np.all(q >= lo) and np.all(q <= hi):
+            out.append((str(name), q, v))
+    return out
 
 
 def below_cut(mesh, y_cut: float):

@@ -224,3 +224,53 @@ def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path, te_limits: dict | 
     figure_title(fig, ds, f"Trade-off: mass saved against transmission error ({n_ok} points ok)",
                  width=int(9 * (5.6 * len(te) + 1.4)))
     return save_figure(fig, path)
+
+
+STRENGTH_LINES = (("bending_stress_root_gear{g}", "root", "v", "#d62728"), ("rim_stress_max_gear{g}", "rim", "s", "#9467bd"),
+                  ("web_stress_max_gear{g}", "web", "D", "#111111"))
+
+
+def strength_figure(ds: xr.Dataset, swept: list[str], path, g: int = 2):
+    """Gear g's largest tensile stress at the root, in the rim and in the web against each swept
+    parameter (mean over the others, min-max band), with its smallest S_F on a second axis where
+    the study has it; writes ``path``."""
+    lines = [(v.format(g=g), lab, m, c) for v, lab, m, c in STRENGTH_LINES if v.format(g=g) in ds]
+    if not lines:
+        raise KeyError(f"the study has none of gear {g}'s strength outputs")
+    n = len(swept)
+    ncol = min(n, 3)
+    nrow = -(-n // ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol + 0.6, 3.2 * nrow + 1.3), sharey=True,
+                             squeeze=False, constrained_layout=True)
+    sf = f"bending_safety_gear{g}"
+    for k, dim in enumerate(swept):
+        ax = axes[k // ncol, k % ncol]
+        x, labels = _positions(ds, dim)
+        for var, lab, m, c in lines:
+            me = main_effect(ds, var, dim)
+            if not np.isfinite(me["mean"].values).any():
+                continue
+            ax.fill_between(x, me["min"].values, me["max"].values, color=c, alpha=0.12, lw=0)
+            ax.plot(x, me["mean"].values, marker=m, ms=5, color=c, label=lab)
+        if sf in ds:
+            tw = ax.twinx()
+            tw.plot(x, main_effect(ds, sf, dim)["min"].values, ls=":", color="#2ca02c", marker=".",
+                    label="smallest S_F (right)")
+            tw.set_ylabel("bending safety S_F [1]", color="#2ca02c")
+            if k == 0:
+                tw.legend(loc="center right", fontsize=8)
+        if labels:
+            ax.set_xticks(x, labels)
+        elif ds[dim].values.dtype.kind in "iu":
+            integer_ticks(ax, x)
+        ax.set_xlabel(_param_label(ds, dim))
+        ax.grid(alpha=0.3)
+        if k % ncol == 0:
+            ax.set_ylabel("largest tensile stress [MPa]")
+        if k == 0:
+            ax.legend(loc="upper left", fontsize=8, title="mean over the others", title_fontsize=8)
+    for k in range(n, nrow * ncol):
+        axes[k // ncol, k % ncol].set_visible(False)
+    figure_title(fig, ds, f"Gear {g}: largest tensile stress at the root, in the rim and in the web over the study "
+                          "(static contact forces; band: min-max over the other parameters)", width=int(30 * ncol + 20))
+    return save_figure(fig, path)

@@ -159,6 +159,9 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
             else:
                 line += ", root stress not computed (its springs need no FE)"
             w(line + "\n")
+    if "bending_stress" in ds:
+        for line in strength_lines(ds):
+            w(line + "\n")
     for what in ("dte", "ste"):
         if f"{what}_peak_amplitude" in ds:
             named = [(str(n), float(a)) for n, a in zip(ds[f"{what}_peak"].values, ds[f"{what}_peak_amplitude"].values)
@@ -176,3 +179,28 @@ def _range(k: xr.DataArray) -> str:
     """'lo-hi' of the finite values of ``k`` with one decimal (one value when they are equal)."""
     lo, hi = float(k.min()), float(k.max())
     return f"{lo:.1f}" if f"{lo:.1f}" == f"{hi:.1f}" else f"{lo:.1f}-{hi:.1f}"
+
+
+def strength_lines(ds: xr.Dataset) -> list[str]:
+    """The printed strength of each gear: largest tensile stress at the root, rim and web, m_B,
+    Y_B, the failure mode and S_F; the FE root stress beside ISO 6336-3's at the HPSTC."""
+    out = []
+    kv = ds["bending_safety"].attrs.get("loads", "")
+    for g in (1, 2):
+        b = ds["bending_stress"].sel(gear=g).values
+        if not np.isfinite(b[0]):
+            continue
+        sf = ds["bending_safety"].sel(gear=g).values
+        site = str(ds["web_stress_site"].sel(gear=g).values)
+        web = f"web {b[2]:.1f} MPa ({site})" if np.isfinite(b[2]) else "web: no openings"
+        mat = f"{ds['gear_material'].sel(gear=g).values}, sigma_FG {float(ds['bending_limit_stress'].sel(gear=g)):g} MPa"
+        out.append(f"  gear {g} strength: largest tensile stress root {b[0]:.1f} MPa, rim {b[1]:.1f} MPa, {web}; "
+                   f"m_B {float(ds['backup_ratio'].sel(gear=g)):.2f}, Y_B {float(ds['rim_thickness_factor_iso6336'].sel(gear=g)):.3f}; "
+                   f"failure mode {ds['failure_mode'].sel(gear=g).values}; S_F ({mat}, {kv}) "
+                   + ", ".join(f"{loc} {v:.2f}" for loc, v in zip(ds["location"].values, sf) if np.isfinite(v)))
+        fe, iso = float(ds["root_stress_hpstc"].sel(gear=g)), float(ds["root_stress_iso6336"].sel(gear=g))
+        y_f, y_s = (float(ds[f"{n}_iso6336"].sel(gear=g)) for n in ("tooth_form_factor", "stress_correction_factor"))
+        out.append(f"    root stress at the HPSTC (one tooth, F = T/rb): FE {fe:.1f} MPa, ISO 6336-3 sigma_F0 {iso:.1f} MPa "
+                   f"(Y_F {y_f:.3f}, Y_S {y_s:.3f}): FE/ISO {fe / iso:.3f}")
+    return out
+

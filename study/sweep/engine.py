@@ -64,7 +64,7 @@ from study.errors import BudgetError
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
-from study.sweep.outputs import CURVES, MESH_SCALARS, Outputs, analysis_of
+from study.sweep.outputs import CURVES, MESH_SCALARS, STRENGTH_SCALARS, Outputs, analysis_of
 from study.sweep.tasks import plan, point_result
 
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
@@ -99,7 +99,8 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
                              mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)),
                              warn=False, keep_model=True,    # the sweep warns once; a body's points share its model
                              archive=False, gear_variables=outputs.needs("geometry") or outputs.needs("fe"),
-                             modal=outputs.modes or "mesh_mode_damping_decay" in outputs.scalars)
+                             modal=outputs.modes or "mesh_mode_damping_decay" in outputs.scalars,
+                             strength=bool(set(outputs.scalars) & set(STRENGTH_SCALARS)))
         else:   # geometry (and root stress) only: no model, no solve
             from study.inputs.springs import lightening_dataset
             run = lightening_dataset(scene, stress=outputs.fe)

@@ -91,6 +91,32 @@ for _g, _which in ((1, "driver"), (2, "driven gear")):
         f"root_stress_ratio_gear{_g}": Scalar("1", f"largest fillet stress of the {_which} relative to the same gear solid "
                                                    "(FE; NaN when its springs need no FE)", "fe"),
     })
+# the strength of each gear under the STE's contact forces (`study.archive.strength`; static: no K_v in a
+# study): asked for by name, not among the default outputs (each body's strength costs its FE solves)
+STRENGTH_SCALARS = ()
+for _g, _which in ((1, "driver"), (2, "driven gear")):
+    _s = {
+        f"web_stress_max_gear{_g}": Scalar("MPa", f"largest tensile stress at the {_which}'s web openings and ligaments "
+                                                  "under the STE's contact forces (FE; NaN without openings)", "static"),
+        f"rim_stress_max_gear{_g}": Scalar("MPa", f"largest tensile stress in the inner half of the {_which}'s rim under "
+                                                  "the STE's contact forces (FE)", "static"),
+        f"bending_stress_root_gear{_g}": Scalar("MPa", f"largest tensile stress at the {_which}'s tooth roots under the "
+                                                       "STE's contact forces (FE)", "static"),
+        f"backup_ratio_gear{_g}": Scalar("1", f"backup ratio m_B = s_R/h_t of the {_which}", "static"),
+        f"rim_thickness_factor_iso6336_gear{_g}": Scalar("1", f"rim thickness factor Y_B (ISO 6336-3; AGMA K_B) of the "
+                                                              f"{_which}", "static"),
+        f"root_stress_hpstc_gear{_g}": Scalar("MPa", f"FE root stress of the {_which}, one tooth loaded by T/rb at the "
+                                                     "HPSTC", "static"),
+        f"root_stress_iso6336_gear{_g}": Scalar("MPa", f"ISO 6336-3 nominal root stress sigma_F0 of the {_which} at the "
+                                                       "HPSTC, Y_B included", "static"),
+        f"failure_mode_gear{_g}": Scalar("1", f"where the {_which}'s first crack is expected: 0 tooth, 1 rim, 2 web", "static"),
+        f"bending_safety_gear{_g}": Scalar("1", f"smallest bending safety factor S_F of the {_which} (root, rim, web; "
+                                                "static loads)", "static"),
+        **{f"bending_safety_{_loc}_gear{_g}": Scalar("1", f"bending safety factor S_F of the {_which} at the {_loc} "
+                                                          "(static loads)", "static") for _loc in ("root", "rim", "web")},
+    }
+    SCALARS.update(_s)
+    STRENGTH_SCALARS += tuple(_s)
 # the outputs of the linearised mesh and the tooth loads (`study.run.run_scene`'s mesh_outputs):
 # a study that asks for none of them skips that part
 MESH_SCALARS = ("mesh_stiffness", "mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha",
@@ -120,9 +146,10 @@ CURVES = {
 #             when it runs (study.scene_model.mean_load reads dynamic.enabled and dynamic.torque)
 #   dynamic   DTE: every field
 ERRORS = ("gear1.errors", "gear2.errors")    # pitch errors and runout: no part of a gear's mass or FE body
+RATING = ("gear1.material", "gear2.material")  # the bending rating's steel: read by the strength outputs (static) only
 ANALYSIS_FIELDS = {
-    "geometry": (("gear1", "gear2", "pair", "material.density"), ("gear1.spring", "gear2.spring", *ERRORS)),
-    "fe": (("gear1", "gear2", "pair", "material", "fe", "quasi_static.torque"), ERRORS),
+    "geometry": (("gear1", "gear2", "pair", "material.density"), ("gear1.spring", "gear2.spring", *ERRORS, *RATING)),
+    "fe": (("gear1", "gear2", "pair", "material", "fe", "quasi_static.torque"), (*ERRORS, *RATING)),
     "static": (("",), ("dynamic", "title")),
     "modes": (("", "dynamic.enabled", "dynamic.torque"), ("dynamic", "title")),
     "dynamic": (("",), ("title",)),
@@ -197,7 +224,8 @@ class Outputs:
 
 def outputs_from_table(table) -> Outputs:
     """The [outputs] table of a study ({scalars = [...], curves = [...]}) checked: unknown names
-    and an empty selection are SceneErrors. Scalars default to all of `SCALARS`, curves to none.
+    and an empty selection are SceneErrors. Scalars default to all of `SCALARS` but the strength
+    outputs (`STRENGTH_SCALARS`), curves to none.
     A plain list of names (``["ste_p2p", "dte"]``) is split into its scalars and curves."""
     if isinstance(table, Outputs):
         table = {"scalars": list(table.scalars), "curves": list(table.curves)}
@@ -214,7 +242,7 @@ def outputs_from_table(table) -> Outputs:
     for k in table:
         if k not in ("scalars", "curves"):
             raise SceneError(f"outputs.{k}", "unknown key (expected scalars, curves)")
-    scalars = table.get("scalars", list(SCALARS))
+    scalars = table.get("scalars", [x for x in SCALARS if x not in STRENGTH_SCALARS])
     curves = table.get("curves", [])
     for name, items, known in (("scalars", scalars, tuple(SCALARS)), ("curves", curves, tuple(CURVES))):
         if not isinstance(items, (list, tuple)):

@@ -12,8 +12,10 @@ from workflows.lightest_gear import (
     Limits,
     answer,
     body_of,
+    candidate_rows,
     candidates,
     feasible,
+    limiting_location,
     main,
     ranked,
     refine_points,
@@ -39,8 +41,14 @@ def synthetic_grid():
     ds = xr.Dataset({"status": (dims, status), "ste_p2p": (dims, ste), "dte_rms": (dims, dte),
                      "mass_saving_gear2": (dims, saving), "mass_gear2": (dims, 2.0 * (1 - saving / 100)),
                      "inertia_gear2": (dims, 900.0 * (1 - saving / 100)),
-                     "root_stress_ratio_gear2": (dims, ratio), "root_stress_max_gear2": (dims, 300.0 * ratio)},
+                     "root_stress_ratio_gear2": (dims, ratio), "root_stress_max_gear2": (dims, 300.0 * ratio),
+                     # S_F: the root's falls with the root stress, the web's with the hole radius
+                     "bending_safety_root_gear2": (dims, 3.0 / ratio), "bending_safety_rim_gear2": (dims, np.full(ratio.shape, 9.0)),
+                     "bending_safety_web_gear2": (dims, np.broadcast_to((9.0 - r)[:, :, None, :], ratio.shape).copy()),
+                     "failure_mode_gear2": (dims, np.zeros(ratio.shape))},
                     coords=coords)
+    sf = np.fmin(ds["bending_safety_root_gear2"], np.fmin(ds["bending_safety_rim_gear2"], ds["bending_safety_web_gear2"]))
+    ds["bending_safety_gear2"] = sf
     # the static outputs of a sweep lie over fewer dimensions: the table broadcasts them
     return ds.assign(mass_gear2=ds["mass_gear2"].isel(rim_thickness=0, drop=True))
 
@@ -70,6 +78,34 @@ def test_the_lightest_feasible_body_within_every_limit():
     assert not feasible(table, SOLID, Limits(1.0, 1.0, 1.2)).values.any()   # nothing as quiet as solid
 
 
+def test_a_minimum_safety_factor_removes_bodies_and_says_which_location_limits_each():
+    """Synthetic S_F: the web's 9 - hole radius (4 with 5 mm holes, 2 with 7 mm), the root's
+    3 / stress ratio (2.6-2.9), the rim's 9. The web limits the 7 mm holes (and the body whose
+    root is unknown), the root the 5 mm ones; S_F >= 2.5 removes the 7 mm holes."""
+    table = candidates(synthetic_grid())
+    where = limiting_location(table)
+    r, sf_root = table["hole_radius"].values, table["bending_safety_root_gear2"].values
+    assert list(where) == ["web" if (x == 7.0 or np.isnan(y)) else "root" for x, y in zip(r, sf_root)]
+    loose = feasible(table, SOLID, Limits(1.36, 1.2, 1.2, safety_min=0.0))
+    assert (feasible(table, SOLID, Limits(1.36, 1.2, 1.2, safety_min=1.4)) == loose).all()
+    strict = feasible(table, SOLID, Limits(1.36, 1.2, 1.2, safety_min=2.5))
+    kept = np.flatnonzero(strict.values)
+    assert kept.size and set(kept) < set(np.flatnonzero(loose.values))
+    assert np.all(r[kept] == 5.0) and np.all(table["bending_safety_gear2"].values[kept] >= 2.5)
+    best = ranked(table, strict)[0]
+    assert r[best] == 5.0 and saving_of(table, best) <= saving_of(table, ranked(table, loose)[0])
+    # a body whose S_F is unknown (no strength computed) never passes a minimum
+    table["bending_safety_gear2"].values[kept[0]] = np.nan
+    assert not feasible(table, SOLID, Limits(1.36, 1.2, 1.2, safety_min=2.5)).values[kept[0]]
+    csv = candidate_rows(table, strict).splitlines()
+    assert csv[0].split(",")[9] == "limiting_location" and len(csv) == table.sizes["candidate"] + 1
+    assert [line.split(",")[9] for line in csv[1:]] == list(where)
+
+
+def saving_of(table, i):
+    return float(table["mass_saving_gear2"].values[i])
+
+
 def test_refinement_moves_half_a_step_towards_the_lighter_side_within_the_grid():
     grid = {**COARSE, "gear2.body.hole_radius": [5.0, 7.0], "gear2.body.rim_height": [5.0, 7.0],
             "gear2.body.web_thickness": [6.0, 10.0, 14.0]}
@@ -94,16 +130,19 @@ def test_refinement_moves_half_a_step_towards_the_lighter_side_within_the_grid()
 def test_the_answer_gives_saving_te_and_stress_against_the_solid_gear():
     row = {"n_holes": 6, "hole_radius": 7.0, "rim_thickness": 5.0, "web_thickness": 6.0, "mass_saving_gear2": 25.0,
            "mass_gear2": 1.5, "inertia_gear2": 700.0, "ste_p2p": 1.1, "dte_rms": 2.5,
-           "root_stress_max_gear2": 330.0, "root_stress_ratio_gear2": 1.1}
+           "root_stress_max_gear2": 330.0, "root_stress_ratio_gear2": 1.1, "bending_safety_gear2": 2.5,
+           "bending_safety_root_gear2": 3.0, "bending_safety_rim_gear2": 9.0, "bending_safety_web_gear2": 2.5,
+           "failure_mode_gear2": 2.0}
     text = answer(row, SOLID, 100.0)
     assert text.startswith("6 holes of 7 mm radius, a 5 mm rim and a 6 mm web save 25.0 % mass")
     assert "+10.0 % STE p2p" in text and "+25.0 % DTE RMS at 100 rad/s" in text
     assert "root stress 330.0 MPa (x 1.10 of solid)" in text
+    assert "bending safety S_F 2.50, limited by the web, failure mode web" in text
 
 
 @pytest.mark.parametrize("argv, field", [
     (["--ste-factor", "0"], "--ste-factor"), (["--speed", "-5"], "--speed"), (["--refine", "-1"], "--refine"),
-    (["--workers", "-2"], "--workers"), (["--grid", "gear2.body.teeth=20,30"], "gear2.body.teeth"),
+    (["--workers", "-2"], "--workers"), (["--safety-min", "-1"], "--safety-min"), (["--grid", "gear2.body.teeth=20,30"], "gear2.body.teeth"),
     (["--grid", "gear2.body.holes=2.5"], "gear2.body.holes"),
     (["--duration", "0.02", "--set", "dynamic.ramp_time=0.5"], "dynamic.duration"),
 ])
@@ -150,6 +189,10 @@ def test_small_pair_end_to_end_gives_the_lightest_body_its_figure_and_archives(t
         assert f"save {float(best['mass_saving_gear2']):.1f} % mass" in said
         assert f"root stress {float(best['root_stress_max_gear2']):.1f} MPa" in said
     assert (out / "tradeoff.png").stat().st_size > 10_000
+    rows = (out / "candidates.csv").read_text().splitlines()
+    where = rows[0].split(",").index("limiting_location")
+    assert len(rows) == 1 + 3 and all(r.split(",")[where] in ("root", "rim", "web") for r in rows[1:])
+    assert "S_F limited by: " in text and "limited by the " in said
 
 
 def test_other_shapes_are_sized_by_their_own_field_and_refined_towards_less_mass():

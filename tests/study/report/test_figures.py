@@ -54,7 +54,7 @@ def test_every_supported_figure_is_written_and_not_blank(tiny):
     ds, out, paths = tiny
     names = sorted(p.name for p in paths)
     assert names == sorted(["ste.png", "dte.png", "spectrum.png", "tooth_stiffness.png", "campbell.png", "gear_pair.png",
-                            "fe_stress_gear2.png"])
+                            "fe_stress_gear2.png", "strength.png"])
     for p in paths:
         img = _png(p)
         white = np.all(img > 0.97, axis=-1).mean()
@@ -67,7 +67,7 @@ def test_archive_without_dynamics_skips_what_it_cannot_draw(tiny, tmp_path, caps
     static_only = ds.drop_vars([v for v in ds.variables if "time" in ds[v].dims or "frequency" in ds[v].dims
                                 or v.startswith("dte_peak")])
     paths = make_figures(static_only, tmp_path, renders=False)
-    assert sorted(p.name for p in paths) == ["campbell.png", "spectrum.png", "ste.png", "tooth_stiffness.png"]
+    assert sorted(p.name for p in paths) == ["campbell.png", "spectrum.png", "ste.png", "strength.png", "tooth_stiffness.png"]
     said = capsys.readouterr().out
     assert "skip DTE plot" in said and "skip renders" in said
 
@@ -185,10 +185,10 @@ def test_render_cli_writes_plots_beside_the_archive(tiny, tmp_path):
     assert main(["render", str(path), "--no-renders"]) == 0
     # named after the archive: two archives rendered into one folder keep their own figures
     assert {p.name for p in tmp_path.glob("*.png")} == {f"run_{n}.png" for n in ("ste", "dte", "spectrum", "tooth_stiffness",
-                                                                              "campbell")}
+                                                                              "campbell", "strength")}
     write_netcdf(ds, tmp_path / "other.nc")
     assert main(["render", str(tmp_path / "other.nc"), "--no-renders"]) == 0
-    assert len(list(tmp_path.glob("run_*.png"))) == len(list(tmp_path.glob("other_*.png"))) == 5
+    assert len(list(tmp_path.glob("run_*.png"))) == len(list(tmp_path.glob("other_*.png"))) == 6
 
 
 def test_hole_passes_on_the_ste_axis_follow_the_gear_ratio():

@@ -100,3 +100,22 @@ def test_main_effects_count_points_of_an_output_stored_over_fewer_dimensions(tmp
     ds["status"][:] = 1
     study_views.main_effects_figure(ds, "ste_p2p", ["n_holes", "speed"], tmp_path / "me.png")
     assert "points ok" not in titles[1]
+
+
+def test_strength_over_the_hole_pattern_is_drawn_from_the_studys_strength_outputs(tmp_path):
+    """The root, rim and web stress of gear 2 and its smallest S_F over two swept parameters:
+    strength_gear2.png among the study's figures, something drawn; without the outputs, no view."""
+    from study.report.study_views import strength_figure
+    ds = synthetic_study().isel(rim_thickness=0, web_thickness=0, speed=0, drop=True)
+    n, r = ds["n_holes"], ds["hole_radius"]
+    web = (20.0 + 0.5 * n * r).where(n > 0).broadcast_like(ds["ste_p2p"])
+    for name, v in (("bending_stress_root_gear2", 310.0 + 0 * web), ("rim_stress_max_gear2", 40.0 + 0 * web),
+                    ("web_stress_max_gear2", web), ("bending_safety_gear2", 1000.0 / np.fmax(310.0, web))):
+        ds[name] = v.assign_attrs(units="MPa" if "stress" in name else "1", long_name=name)
+    paths = make_figures(ds, tmp_path, renders=False)
+    assert "strength_gear2.png" in [p.name for p in paths]
+    img = imread(tmp_path / "strength_gear2.png")[..., :3]
+    assert img.std() > 0.05
+    with pytest.raises(KeyError):
+        strength_figure(synthetic_study(), ["n_holes"], tmp_path / "none.png")
+    plt.close("all")
