@@ -510,9 +510,21 @@ def scene_path(name: str | Path, what: str = "scene") -> Path:
                      f"`lightgear scenes` lists them){hint}")
 
 
-def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] = ()) -> Scene:
-    """Read a scene file or an embedded scene by name (default: the embedded paper example),
-    apply ``key=value`` overrides."""
+def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] | dict = ()) -> Scene:
+    """A scene -> Scene: ``path`` a TOML file or the name of an embedded scene (``"runup"``;
+    `embedded_scenes` lists them; None: the paper example), with ``overrides`` as
+    ``["key=value", ...]`` or ``{"dotted.key": value}``. SceneError names the offending field."""
+    from collections.abc import Mapping
+
+    from study.errors import check_argument, is_path
+    check_argument(path is None or is_path(path), "load_scene", "path",
+                   "a scene file's path or an embedded scene's name (str or os.PathLike; None: the paper example); "
+                   "for fields given in Python use study.default_scene().replace(**{...})", path)
+    if isinstance(overrides, Mapping):
+        scene = load_scene(path)
+        return scene.replace(**dict(overrides)) if overrides else scene
+    check_argument(not isinstance(overrides, str | bytes) and all(isinstance(o, str) for o in overrides), "load_scene",
+                   "overrides", 'a list of "key=value" strings or a dict {dotted key: value}', overrides)
     text = default_scene_text() if path is None else read_text(scene_path(path))
     data = _tables(text, str(path or "scene"))
     items = [parse_override(item) for item in overrides]
@@ -545,6 +557,21 @@ def parse_override(item: str):
         return key.strip(), tomllib.loads(f"v = {raw.strip()}")["v"]
     except tomllib.TOMLDecodeError:
         return key.strip(), raw.strip()
+
+
+def parse_overrides(items) -> dict:
+    """``["gear2.body.holes=3", ...]`` -> {"gear2.body.holes": 3, ...} (values parse as TOML, else
+    as text), for `Scene.replace` or `study.make_study`."""
+    from study.errors import check_argument
+    check_argument(not isinstance(items, str | bytes), "parse_overrides", "items", 'a list of "key=value" strings', items)
+    return dict(parse_override(str(item)) for item in items)
+
+
+def solid_scene(scene: Scene, gears=(1, 2)) -> Scene:
+    """The scene with the bodies of ``gears`` made solid (no holes, the web as thick as the face) -> Scene."""
+    from study.errors import check_scene_argument
+    check_scene_argument("solid_scene", scene)
+    return scene.solid(gears=tuple(gears))
 
 
 def set_dotted(data: dict, path: str, value) -> None:

@@ -73,3 +73,17 @@ def export_csv(ds: xr.Dataset, outdir) -> list[Path]:
             w.writerow([k, " ".join(_fmt(x) for x in np.ravel(v)) if isinstance(v, np.ndarray) else _fmt(v)])
     paths.append(path)
     return paths
+
+
+def export(archive, outdir=None) -> list[Path]:
+    """The variables of an archive (path or Dataset) as CSV files in ``outdir`` (default: beside
+    the archive, ``NAME_csv``), one per dimension group, with units in the headers -> their paths."""
+    from study.errors import check_argument, is_path
+    if isinstance(archive, xr.Dataset):
+        check_argument(outdir is not None, "export", "outdir", "a folder (needed for a Dataset)", outdir)
+        return export_csv(archive, Path(outdir))
+    check_argument(is_path(archive), "export", "archive", "a NetCDF path or a Dataset", archive)
+    path = Path(archive)
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        return export_csv(ds, Path(outdir) if outdir is not None else path.with_name(f"{path.stem}_csv"))
+
