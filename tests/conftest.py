@@ -20,12 +20,12 @@ def pytest_collection_modifyitems(config, items):
 def private_fe_cache(tmp_path, monkeypatch):
     """FE results of the test go to a fresh disk cache, and nothing the process holds in memory
     (the shelves of `solver.store.STORE`: spring maps, compliances, factorised bodies, rims,
-    coupling fits, models, equilibria, model-only analyses) leaks in or out."""
+    coupling fits, models, equilibria, model-only analyses) leaks in or out. Yields the store:
+    ``private_fe_cache.clear()`` drops what memory holds, the disk cache stays."""
     from solver.store import STORE
-    from study.inputs.cache import FE_CACHE
     monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
     STORE.clear()
-    yield FE_CACHE
+    yield STORE
     STORE.clear()
 
 
