@@ -9,6 +9,7 @@ import tiers
 
 import study
 from solver.mbs.statics import solve_static
+from study.cli import main
 from study.scene import load_scene
 
 
@@ -30,6 +31,10 @@ def _calls_helper():
 
 def _starts_a_process():
     return subprocess.run(["true"])
+
+
+def _command_line():
+    return main(["scenes"])
 
 
 def _fe_fixture():
@@ -56,6 +61,7 @@ class _Item:
     (_runs, None, ["solver"]),                            # study.run_scene -> study.run
     (_calls_helper, None, ["solver"]),                    # through a helper of the test file
     (_starts_a_process, None, ["process"]),
+    (_command_line, None, ["solver"]),                    # the command line runs whatever it is given
     (_pure, {"bodies": _fe_fixture}, ["fe"]),             # through a fixture
     (_pure, {"private_fe_cache": _pure}, ["fe"]),
 ])

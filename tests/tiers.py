@@ -9,7 +9,8 @@ call refer to, each resolved to the module that defines it (``study.X`` through 
 - ``fe``: the FE (`solver.fe`, the FE-derived inputs `study.inputs`, the FE reference and the
   model checks `study.verify`, the FE commands), or the ``private_fe_cache`` fixture;
 - ``solver``: the multibody model or its kernels (`solver.mbs`, `solver.peers`, a run, a
-  sweep, the scene's model, the estimates that build one);
+  sweep, the scene's model, the estimates that build one, the command line and the scripts,
+  which run whatever they are given: the first run of a fresh clone compiles the kernels);
 - ``process``: another process (``subprocess``, a dask cluster, ``multiprocessing``);
 - ``slow``: marked by hand (`pytest.mark.slow`): the longest of the others.
 """
@@ -27,7 +28,7 @@ REACHES = (
     ("solver.mbs", "solver"), ("solver.peers", "solver"), ("study.run", "solver"), ("study.sweep.engine", "solver"),
     ("study.sweep.tasks", "solver"), ("study.scene_model", "solver"), ("study.estimate", "solver"),
     ("study.report.figures", "solver"), ("study.archive.modes", "solver"), ("study.archive.mesh", "solver"),
-    ("workflows", "solver"),
+    ("workflows", "solver"), ("study.cli", "solver"), ("study.process", "solver"),
     ("subprocess", "process"), ("multiprocessing", "process"), ("distributed", "process"), ("dask", "process"),
     ("concurrent.futures", "process"),
 )

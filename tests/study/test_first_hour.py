@@ -1,7 +1,6 @@
 """What a new user meets first on the command line: scenes by name, the field and output
 listings, hints for the usual slips, and warnings for values that are valid but almost
 certainly a unit slip (stderr and the archive, not a refusal)."""
-import pytest
 import xarray as xr
 
 import study
@@ -22,7 +21,6 @@ def test_scenes_lists_the_embedded_scenes_and_studies_with_their_titles(capsys):
     assert "runup" in out and "sensitivity" in out
 
 
-@pytest.mark.slow      # a run and a sweep through the command line
 def test_run_and_sweep_take_an_embedded_name(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     # by name, from a folder without scene files: refused for its output path, i.e. the scene was found

@@ -77,7 +77,6 @@ def test_a_material_too_soft_for_weber_is_named_by_fit_contact(capsys):
 
 # ---------------------------------------------------------------- estimates and their levers
 
-@pytest.mark.slow      # the command line runs the paper pair's FE and model first
 def test_static_angles_that_do_not_fit_in_memory_are_refused_before_they_are_built(tmp_path, capsys):
     code, _, err = run_cli(capsys, "reference", "--step", "1e-9", "-o", tmp_path / "r.nc")
     assert code == 2 and "--step: the static analysis needs about" in err and "TiB" in err
@@ -86,7 +85,6 @@ def test_static_angles_that_do_not_fit_in_memory_are_refused_before_they_are_bui
     assert code == 2 and "quasi_static.angle_step: the static analysis needs" in err
 
 
-@pytest.mark.slow      # the command line runs the paper pair's FE and model first
 def test_a_refusal_names_the_lever_of_its_largest_part(tmp_path, capsys):
     # 6e6 angles: some 10 GiB (fits), minutes of statics and hours of mesh linearisations
     code, _, err = run_cli(capsys, "run", "--no-dynamic", "--set", "quasi_static.angle_step=2e-5", "--max-time", "100",
@@ -207,7 +205,6 @@ def test_a_run_up_without_one_whole_driven_revolution_is_refused(tmp_path, capsy
     assert code == 2 and "dynamic.speed_end: the driven gear turns" in err and "needs at least 2" in err
 
 
-@pytest.mark.slow      # the command line runs the paper pair's FE and model first
 def test_render_draws_a_run_at_standstill_or_says_what_it_skips(tmp_path, capsys):
     import study
     ds = study.run_scene(small_scene(**{"dynamic.speed": 0.0}), static=True, dynamic=True)
@@ -339,7 +336,6 @@ def test_a_face_width_that_only_changes_the_inertia_is_said(tmp_path, capsys):
     assert code == 0 and "face width acts on masses and inertias only" in out
 
 
-@pytest.mark.slow      # the command line runs the paper pair's FE and model first
 def test_precision_gets_an_estimate_and_max_time(tmp_path, capsys):
     """A 10 s window is some 2e7 stability steps of plain-Python scipy integration: refused
     before any run with the lever (--duration); a 1 deg static study alone is cheap and says

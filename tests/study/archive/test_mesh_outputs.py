@@ -45,7 +45,6 @@ def eight_holes(tmp_path_factory):
     return out
 
 
-@pytest.mark.slow      # runs the command line on a lightened pair
 def test_set_holes_puts_the_count_run_in_the_archive_and_figure_titles(eight_holes):
     import xarray as xr
     with xr.open_dataset(eight_holes / "h8.nc") as ds:
