@@ -1,4 +1,5 @@
-# lightgear: `make run` sets up .venv and runs the paper example; `make test` runs the suite.
+# lightgear: `make run` sets up .venv and runs the paper example; `make test` runs the suite (what
+# CI runs), `make test-fast` the tests that run no FE, no solver and no other process (the inner loop).
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -6,15 +7,23 @@ STAMP  := $(VENV)/.installed
 export VTK_DEFAULT_OPENGL_WINDOW ?= vtkEGLRenderWindow
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.lightgear-cache/numba
 export MPLBACKEND ?= Agg
+# test processes (pytest-xdist): the suite's two halves on the two cores of a small machine, each
+# test file on one process (its module fixtures, built scenes and runs, made once)
+JOBS   ?= 2
+# the fast tier: tests/tiers.py marks each test by what it reaches (FE, solver, processes)
+FAST   := not (fe or solver or process or slow)
 
-.PHONY: run test lint bench venv sysdeps clean
+.PHONY: run test test-fast lint bench venv sysdeps clean
 
 run: $(STAMP)
 	$(PY) -m workflows.paper_example -o results/paper_example/paper_example.nc
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check --quiet .
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(JOBS) --dist loadscope
+
+test-fast: $(STAMP)
+	$(PY) -m pytest -q -m "$(FAST)"
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .

@@ -1,7 +1,7 @@
-"""The work of the commands besides run, sweep and render, as functions of a Scene: the FE
-stiffness map (`lightgear stiffness`), the contact law's Weber fit (`fit-contact`), the FE
-reference STE (`reference`) and the work-precision study (`precision`). The command line
-prints what these return; the Python API (`study`) exposes them.
+"""The work of the commands besides run and sweep: the FE stiffness map of a scene (`lightgear
+stiffness`), the contact law's Weber fit (`fit-contact`), the FE reference STE (`reference`),
+the work-precision study (`precision`) and the pictures of an archive (`render`). The command
+line prints what these return; the Python API (`study`) offers them.
 """
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from study import estimate
+from study.errors import check_argument, check_scene_argument, is_number, is_path
 from study.scene import Scene, SceneError
 
 
@@ -18,6 +19,7 @@ def stiffness(scene: Scene, max_time: float | None = None, progress: bool = Fals
     ``stiffness_ratio`` [1] over gear and tooth). ``max_time`` [s]: refuse (BudgetError) a map
     estimated to take longer, before any work; ``progress``: a bar on stderr for a long one."""
     from study.inputs.springs import stiffness_dataset
+    check_scene_argument("stiffness", scene)
     est = estimate.Estimate({"FE bodies": estimate.fe_seconds(scene)})
     estimate.check_time(est, max_time)
     estimate.run_fe_bodies(scene, progress)
@@ -39,6 +41,7 @@ def identify_spring(scene: Scene, gear: int) -> SpringIdentification:
     radii along its profile (`study.inputs.springs.identify_spring`)."""
     from study.inputs.springs import identify_spring as fit
     from study.scene_model import gear_setup
+    check_scene_argument("identify_spring", scene)
     if gear not in (1, 2):
         raise ValueError(f"identify_spring: gear takes 1 (driver) or 2 (driven), got {gear!r}")
     f, u, _c = fit(gear_setup(scene, gear))
@@ -65,6 +68,7 @@ def fit_contact(scene: Scene, depth_fraction: float = 0.5) -> ContactFit:
     from solver import units
     from solver.identify.weber import fit_contact as weber_fit
     from study.scene_model import gear_setups
+    check_scene_argument("fit_contact", scene)
     if not 0 < depth_fraction <= 1:
         raise ValueError(f"fit_contact: depth_fraction takes a number in (0, 1], got {depth_fraction!r}")
     if not scene.quasi_static.torque > 0:
@@ -83,6 +87,8 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
     a run estimated to take longer (BudgetError, before any work)."""
     from study.scene_model import static_angles
     from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, reference_dataset
+    check_scene_argument("reference", scene)
+    check_argument(step is None or is_number(step), "reference", "step", "a number of degrees or None", step)
     if step is not None and not step > 0:
         raise SceneError("--step", f"must be positive, got {step}")
     angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
@@ -123,6 +129,9 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
     from study.archive.netcdf import write_netcdf
     from study.scene_model import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
+    check_scene_argument("precision", scene)
+    check_argument(output is None or is_path(output), "precision", "output", "an archive base name ending in .nc, or None",
+                   output)
     for name, value, ok, what in (("duration", duration, lambda v: v > 0, "a positive number of seconds"),
                                   ("ramp_fraction", ramp_fraction, lambda v: 0 < v < 1, "a number in (0, 1)"),
                                   ("rotation", rotation, lambda v: v > 0, "a positive number of degrees"),
@@ -148,3 +157,69 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
             ds.attrs["archive"] = str(path)
         out[kind] = ds
     return out
+
+
+def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None, prefix: str = "") -> list:
+    """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
+    files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a
+    path or an xarray.Dataset; ``limits`` ({output: value}, sampled studies): the probability
+    of exceeding each; ``prefix``: put before every file name (`lightgear render` gives the
+    archive's stem, ``h3_ste.png``). The renders of a lightened body draw its FE fields from
+    the FE cache (solved and cached once when missing)."""
+    from study.archive.netcdf import read_netcdf
+    from study.report.figures import make_figures
+    check_argument(isinstance(prefix, str), "render", "prefix", "a string put before every file name", prefix)
+    if not hasattr(archive, "data_vars"):
+        check_argument(is_path(archive), "render", "archive", "an archive's path or an xarray.Dataset", archive)
+        path = Path(archive)
+        if not path.is_file():
+            raise FileNotFoundError(f"no such archive: {path}")
+        out_dir = path.parent if out_dir is None else out_dir
+        archive = read_netcdf(path)
+    elif out_dir is None:
+        raise ValueError("render: out_dir is needed for a dataset")
+    fields = None
+    if renders and "scene" in archive.attrs and "tooth_stiffness" in archive and "status" not in archive:
+        from study.inputs.springs import archive_body_fields
+        fields = archive_body_fields(archive)      # what the renders of a lightened body draw: FE cache, else solved
+    return make_figures(archive, Path(out_dir), prefix=prefix, renders=renders, limits=limits, fields=fields)
+
+
+def write_report(archive, out_dir=None, renders: bool = True) -> list:
+    """A report to hand on of a run, study or tolerance-study archive (path): one self-contained
+    HTML page (figures embedded as base64 PNG) and its Markdown twin, with the scene or study as
+    run, the summary table with units, the validation status of the model used and the figures,
+    written into ``out_dir`` (default: beside the archive) as ``STEM_report.html`` and
+    ``STEM_report.md`` (the figures beside them, ``STEM_*.png``) -> [html, md] paths."""
+    from study.archive.netcdf import read_netcdf
+    from study.report.report_page import write_report as write
+    from study.sweep.outputs import report_rows
+    check_argument(is_path(archive), "write_report", "archive", "an archive's path", archive)
+    path = Path(archive)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such archive: {path}")
+    out_dir = Path(out_dir) if out_dir is not None else path.parent
+    ds = read_netcdf(path)
+    figures = [p for p in render(ds, out_dir, renders=renders, prefix=f"{path.stem}_") if p.suffix == ".png"]
+    summary, extra = report_rows(ds)
+    return write(ds, path.stem, out_dir, figures, summary, extra)
+
+
+def export(archive, outdir=None) -> list:
+    """The variables of an archive (path or Dataset) as CSV files in ``outdir`` (default: beside
+    the archive, ``NAME_csv``), one per dimension group, with units in the headers, and the
+    summary scalars (STE peak-to-peak, DTE RMS and mean, ...) in ``scalars.csv`` -> their paths
+    (`study.report.export`)."""
+    import xarray as xr
+
+    from study.report.export import export_csv
+    from study.sweep.outputs import summary_rows
+    if isinstance(archive, xr.Dataset):
+        check_argument(outdir is not None, "export", "outdir", "a folder (needed for a Dataset)", outdir)
+        return export_csv(archive, Path(outdir), summary_rows(archive))
+    check_argument(is_path(archive), "export", "archive", "a NetCDF path or a Dataset", archive)
+    path = Path(archive)
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        return export_csv(ds, Path(outdir) if outdir is not None else path.with_name(f"{path.stem}_csv"),
+                          summary_rows(ds))
+

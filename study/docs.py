@@ -70,8 +70,9 @@ def field_rows(prefix: str = "") -> list[FieldRow]:
     """Every value field of a scene whose dotted path starts with ``prefix`` (a section such as
     ``gear2.body`` or ``dynamic``, or a field), in declaration order. SceneError when no field
     matches."""
-    from study.errors import SceneError
+    from study.errors import SceneError, check_argument
     from study.scene import Scene
+    check_argument(isinstance(prefix, str), "fields", "prefix", "a dotted path such as 'gear2.body'", prefix)
 
     def walk(cls, path: str):
         hints = typing.get_type_hints(cls)

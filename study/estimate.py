@@ -19,6 +19,8 @@ import numpy as np
 
 from solver.mbs.kernels import layout as L
 from study.errors import BudgetError
+from study.memory import available_memory, bytes_text
+from study.scene_model import static_angle_count
 
 DEFAULT_MAX_TIME_S = 3600.0       # --max-time default [s]
 PROGRESS_AFTER_S = 5.0            # runs expected to take longer than this show a progress bar [s]
@@ -107,29 +109,6 @@ def duration_text(s: float) -> str:
     return f"{s / 86400:.3g} days"
 
 
-def bytes_text(b: float) -> str:
-    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20)):
-        if b >= size:
-            return f"{b / size:.3g} {unit}"
-    return f"{b / 1024:.3g} KiB"
-
-
-def available_memory() -> float:
-    """Memory the machine can give a run now [bytes]: MemAvailable of /proc/meminfo, else the
-    physical memory."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return math.inf
-
-
 # ---------------------------------------------------------------- parts
 
 def dynamic_records(scene) -> int:
@@ -165,38 +144,6 @@ def dynamic_seconds(model, choice, duration: float, scene=None) -> float:
     return (DYNAMIC_S_PER_RUN + steps * per_step) * (RUNUP_RUNS if runup else 1.0) * load_factor()
 
 
-def static_angle_count(scene, step_deg: float | None = None) -> float:
-    """Driver angles of the quasi-static analysis (`study.scene_model.static_angles`) at
-    quasi_static.angle_step or ``step_deg`` [deg], counted without building them."""
-    from study.scene_model import static_rotation
-    step = scene.quasi_static.angle_step if step_deg is None else step_deg
-    return math.floor(static_rotation(scene) / step + 1e-9) + 1.0
-
-
-# bytes a driver angle holds in a static analysis: the kernel's results (S_* columns and the
-# force on each gear-1 tooth), the result's and the archive's copies; the FE reference holds
-# about four times that (contacts and load sharing per angle)
-STATIC_BYTES_PER_ANGLE_TOOTH = 3 * 8.0
-STATIC_BYTES_PER_ANGLE = 3 * 8.0 * (L.N_S_OUT + 8)
-
-
-def check_static_memory(scene, step_deg: float | None = None, factor: float = 1.0,
-                        field: str = "quasi_static.angle_step") -> float:
-    """Refuse, before the angles are built, a static analysis whose arrays do not fit in memory
-    (BudgetError naming ``field``, the lever); returns the number of angles."""
-    n = static_angle_count(scene, step_deg)
-    need = factor * n * (STATIC_BYTES_PER_ANGLE + STATIC_BYTES_PER_ANGLE_TOOTH * scene.gear1.teeth)
-    have = available_memory()
-    if need > 0.8 * have:
-        from study.scene_model import static_rotation
-        step = scene.quasi_static.angle_step if step_deg is None else step_deg
-        raise BudgetError(field, f"the static analysis needs about {bytes_text(need)} for its {n:.3g} driver angles "
-                                 f"({static_rotation(scene):.4g} deg at {step:.3g} deg), more than the "
-                                 f"{bytes_text(have)} of memory available; raise the angle step or shorten "
-                                 "quasi_static.rotation")
-    return n
-
-
 def static_seconds(scene, model) -> float:
     """Estimated run time [s] of the quasi-static analysis."""
     qs = scene.quasi_static
@@ -228,7 +175,7 @@ def mesh_seconds(scene) -> float:
 def error_period_note(scene) -> str | None:
     """A line for the user when pitch errors or an eccentricity stretch the quasi-static range
     beyond quasi_static.rotation (`study.scene_model.static_rotation`) by more than 1.5 times; None otherwise."""
-    from study.scene_model import static_rotation
+    from study.scene import static_rotation
     qs = scene.quasi_static
     rot = static_rotation(scene)
     if not qs.enabled or rot <= 1.5 * qs.rotation:
@@ -342,12 +289,12 @@ TEETH_SEARCH_ANGLES = 20000      # more angles than this: the cache is not searc
 def reference_parts(scene, angles, teeth=None) -> dict:
     """Estimated seconds of the FE reference's parts: each body's influence coefficients (0 when
     cached) and the contact sweep. ``teeth``: (teeth of gear 1, of gear 2, spread) in mesh over
-    ``angles`` (`study.verify.fe_reference.teeth_in_mesh`; None: found here, from the geometry)."""
+    ``angles`` (`solver.fe.ltca.teeth_in_mesh`; None: found here, from the geometry)."""
     from study.inputs.compliance import compliance_cached
     from study.inputs.gearsetup import gear_setups
     if teeth is None and len(angles) <= TEETH_SEARCH_ANGLES:
+        from solver.fe.ltca import teeth_in_mesh
         from study.scene_model import geometry_model
-        from study.verify.fe_reference import teeth_in_mesh
         teeth = teeth_in_mesh(geometry_model(scene), angles)
     parts = {}
     for i, (g, s) in enumerate(zip((1, 2), gear_setups(scene))):
@@ -514,7 +461,7 @@ def sweep_estimate(tasks) -> Estimate:
     distinct body the cache lacks), statics (per static task, by its angles) and dynamics
     (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
     from study.inputs.cache import FE_CACHE
-    from study.run import dynamic_choice
+    from study.scene_model import dynamic_choice
     est = Estimate()
     bodies, body_s = {}, {}
     static_s = 0.0

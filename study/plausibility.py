@@ -92,7 +92,10 @@ RUNUP_REVOLUTIONS = 2.0       # driven revolutions a run-up must give its order 
 
 
 def check_dynamic_window(scene) -> None:
-    """The run must leave a steady part after the ramps for the DTE summary and spectrum."""
+    """SceneError when the scene's dynamic run leaves no steady part after its ramps for the DTE
+    summary and spectrum (`lightgear run` checks it; integrator studies end with the ramps on purpose)."""
+    from study.errors import check_scene_argument
+    check_scene_argument("check_dynamic_window", scene)
     d = scene.dynamic
     if not d.enabled:
         return
@@ -234,7 +237,10 @@ def scene_warnings(scene) -> list[str]:
     """Values that pass the checks but are almost certainly a unit slip, each as one line naming
     the field: a lightening hole smaller than the FE mesh size (metres typed for millimetres), a
     pitch-line velocity above PITCH_LINE_VELOCITY_MAX (rpm typed for rad/s), a spring field the
-    coupled model does not read (`unread_spring_warnings`)."""
+    coupled model does not read (`unread_spring_warnings`). `run_scene` prints them on stderr and
+    keeps them in the archive's ``plausibility_warnings`` attribute."""
+    from study.errors import check_scene_argument
+    check_scene_argument("plausibility_warnings", scene)
     out = []
     for g in (1, 2):
         b, h = scene.gear(g).body, mesh_size_mm(scene, g)

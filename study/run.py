@@ -12,35 +12,35 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import run_loads, simulate
+from solver.mbs.dynamics import simulate
 from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels.layout import R_PV
 from solver.mbs.kernels.status import COMPLETED
 from solver.mbs.mesh_stiffness import mesh_states
-from solver.mbs.method import choose_method
 from solver.mbs.model import Model
 from solver.mbs.statics import solve_static
+from solver.store import STORE, digest
 from study import estimate
 from study.archive import run_variables
 from study.archive.lightening import lightening_variables
 from study.archive.mesh import dynamic_factor_reason, dynamic_force_variables, mesh_variables, steady_window
 from study.archive.modes import modal_variables
 from study.archive.netcdf import provenance
+from study.errors import check_argument, check_scene_argument, is_number
 from study.inputs.coupling import plain_windup
 from study.inputs.gearsetup import gear_setups
 from study.inputs.springs import root_stresses
 from study.plausibility import critical_speed_warning, report_warnings, scene_warnings
-from study.scene import Scene
+from study.scene import Scene, error_period, static_rotation
 from study.scene_model import (
     build_scene_model,
     damping_ratios,
-    error_period,
+    dynamic_choice,
     kept_scene_model,
     load_table,
     mean_load,
     scene_springs,
     static_angles,
-    static_rotation,
 )
 
 
@@ -66,13 +66,6 @@ def run_static(scene: Scene, model: Model):
     te, th2, nc = at_driver_angles(dyn, qs.speed, qs.ramp_time, angles)
     it = np.where(np.isfinite(te), 1, -1)
     return StaticResult(angles, te, th2, nc, np.full((angles.size, model.teeth[0]), np.nan), it, qs.torque, np.full(model.n_teeth, np.nan))
-
-
-def dynamic_choice(scene: Scene, model: Model):
-    """Integrator and step of the scene's dynamic run (`solver.mbs.method.choose_method`)."""
-    d = scene.dynamic
-    step_torque = run_loads(load_table(scene), d.torque)[1]
-    return choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
 
 
 def run_dynamic(scene: Scene, model: Model, choice=None, progress: bool = False):
@@ -132,8 +125,8 @@ def contact_loss_attrs(res, d) -> dict:
     return out
 
 
-# the springs and model of the last scene run with keep_model: (what they depend on, springs, model)
-_LAST_MODEL: list = [None, None, None]
+# the springs and model of the last scene run with keep_model
+LAST_MODEL = STORE.shelf("last springs and model", 1)
 
 
 def kept_springs_and_model(scene: Scene):
@@ -144,13 +137,12 @@ def kept_springs_and_model(scene: Scene):
     whole scene) are then made once, not once per point. The objects are shared: not to be
     changed in place."""
     from study.inputs.cache import FE_CACHE
-    # the FE cache's folder and generation: springs read from another cache, or from one
-    # cleared since, are made again
-    key = (scene.model_sections(), mean_load(scene), str(FE_CACHE.folder), FE_CACHE.generation)
-    if _LAST_MODEL[0] != key:
+
+    def make():
         springs = scene_springs(scene)
-        _LAST_MODEL[:] = [key, springs, kept_scene_model(scene, springs)]
-    return _LAST_MODEL[1], _LAST_MODEL[2]
+        return springs, kept_scene_model(scene, springs)
+    # the FE cache's folder: springs read from another cache are made again
+    return LAST_MODEL.kept(digest(scene.model_sections(), mean_load(scene), str(FE_CACHE.folder)), make)
 
 
 class RunFields:
@@ -183,12 +175,23 @@ class RunFields:
         return xr.Dataset(self.data, coords=self.coords, attrs=self.attrs)
 
 
-def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,
-              max_time: float | None = None, progress: bool = False, mesh_outputs: bool = True,
-              warn: bool = True, keep_model: bool = False) -> xr.Dataset:
-    """Run the analyses a scene asks for (or those forced by static/dynamic) -> run archive
-    (`run_fields`, assembled into its xarray.Dataset)."""
-    return run_fields(scene, static, dynamic, springs, max_time, progress, mesh_outputs, warn, keep_model).dataset()
+def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, max_time: float | None = None,
+              progress: bool = False, springs=None, mesh_outputs: bool = True, warn: bool = True,
+              keep_model: bool = False) -> xr.Dataset:
+    """Run a scene -> run archive (xarray.Dataset): tooth springs, then the quasi-static STE and
+    the dynamic DTE with their spectra. ``static``/``dynamic`` force an analysis on or off
+    (None: as the scene's ``quasi_static.enabled`` / ``dynamic.enabled``). Output arrays that
+    would not fit in memory, or with ``max_time`` [s] an estimated run time beyond it, raise
+    `BudgetError` before any work; ``progress``: bars on stderr for long parts. Plausibility
+    warnings (see `study.plausibility_warnings`, and a speed far above the highest critical
+    speed of the mesh orders) go to stderr (unless ``warn`` is False) and the archive's
+    ``plausibility_warnings`` attribute. The other arguments are those of `run_fields`."""
+    check_scene_argument("run_scene", scene)
+    for name, v in (("static", static), ("dynamic", dynamic)):
+        check_argument(v is None or isinstance(v, bool), "run_scene", name, "True, False or None (as the scene says)", v)
+    check_argument(max_time is None or (is_number(max_time) and max_time > 0), "run_scene", "max_time",
+                   "a positive number of seconds or None", max_time)
+    return run_fields(scene, static, dynamic, springs, max_time, bool(progress), mesh_outputs, warn, keep_model).dataset()
 
 
 def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = None, springs=None,

@@ -449,11 +449,46 @@ def check_scene(scene: Scene) -> None:
     if d.spectrum_start >= d.duration:
         raise SceneError("dynamic.spectrum_start", f"must be before the end of the run ({d.duration} s)")
     if scene.quasi_static.enabled:
-        from study.scene_model import check_two_angles
         check_two_angles(scene, scene.quasi_static.angle_step)
     check_integrator_model(scene)
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
+
+
+# ---------------------------------------------------------------- the static analysis's angles
+
+def error_period(scene: Scene) -> float:
+    """Driver rotation [deg] after which the TE of a scene with pitch errors or eccentricity
+    repeats: one revolution of the gear that has them (gear 2: Z2/Z1 driver revolutions), the
+    hunting period lcm(Z1, Z2)/Z1 driver revolutions when both have them; 0 without errors."""
+    z1, z2 = scene.gear1.teeth, scene.gear2.teeth
+    on = (not scene.gear1.errors.is_zero, not scene.gear2.errors.is_zero)
+    if on == (False, False):
+        return 0.0
+    if on == (True, True):
+        return 360.0 * math.lcm(z1, z2) / z1
+    return 360.0 if on[0] else 360.0 * z2 / z1
+
+
+def static_rotation(scene: Scene) -> float:
+    """Driver rotation [deg] of the quasi-static analysis: quasi_static.rotation, or with errors
+    whole periods of them (`error_period`, at least one) at the same angle step, so that the STE
+    and its spectrum hold every tooth pair."""
+    rot = scene.quasi_static.rotation
+    period = error_period(scene)
+    if period > 0:
+        rot = period * max(1, math.ceil(rot / period - 1e-9))
+    return rot
+
+
+def check_two_angles(scene: Scene, step_deg: float, field: str = "quasi_static.angle_step") -> None:
+    """SceneError naming ``field`` when an angle step of ``step_deg`` [deg] leaves one driver
+    angle over the static rotation: an STE needs two at least (its peak-to-peak over one angle
+    would read 0)."""
+    rot = static_rotation(scene)
+    if step_deg > rot * (1 + 1e-9):
+        raise SceneError(field, f"a step of {step_deg:g} deg leaves one driver angle over the rotation of {rot:g} deg "
+                                "(quasi_static.rotation): the STE needs two at least; give a step no larger than the rotation")
 
 
 def check_integrator_model(scene: Scene) -> None:
@@ -574,9 +609,21 @@ def scene_path(name: str | Path, what: str = "scene") -> Path:
                      f"`lightgear scenes` lists them){hint}")
 
 
-def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] = ()) -> Scene:
-    """Read a scene file or an embedded scene by name (default: the embedded paper example),
-    apply ``key=value`` overrides."""
+def load_scene(path: str | Path | None = None, overrides: typing.Iterable[str] | dict = ()) -> Scene:
+    """A scene -> Scene: ``path`` a TOML file or the name of an embedded scene (``"runup"``;
+    `embedded_scenes` lists them; None: the paper example), with ``overrides`` as
+    ``["key=value", ...]`` or ``{"dotted.key": value}``. SceneError names the offending field."""
+    from collections.abc import Mapping
+
+    from study.errors import check_argument, is_path
+    check_argument(path is None or is_path(path), "load_scene", "path",
+                   "a scene file's path or an embedded scene's name (str or os.PathLike; None: the paper example); "
+                   "for fields given in Python use study.default_scene().replace(**{...})", path)
+    if isinstance(overrides, Mapping):
+        scene = load_scene(path)
+        return scene.replace(**dict(overrides)) if overrides else scene
+    check_argument(not isinstance(overrides, str | bytes) and all(isinstance(o, str) for o in overrides), "load_scene",
+                   "overrides", 'a list of "key=value" strings or a dict {dotted key: value}', overrides)
     text = default_scene_text() if path is None else read_text(scene_path(path))
     data = _tables(text, str(path or "scene"))
     if is_study_table(data):
@@ -639,6 +686,21 @@ def parse_override(item: str):
         return key.strip(), tomllib.loads(f"v = {raw.strip()}")["v"]
     except tomllib.TOMLDecodeError:
         return key.strip(), raw.strip()
+
+
+def parse_overrides(items) -> dict:
+    """``["gear2.body.holes=3", ...]`` -> {"gear2.body.holes": 3, ...} (values parse as TOML, else
+    as text), for `Scene.replace` or `study.make_study`."""
+    from study.errors import check_argument
+    check_argument(not isinstance(items, str | bytes), "parse_overrides", "items", 'a list of "key=value" strings', items)
+    return dict(parse_override(str(item)) for item in items)
+
+
+def solid_scene(scene: Scene, gears=(1, 2)) -> Scene:
+    """The scene with the bodies of ``gears`` made solid (no holes, the web as thick as the face) -> Scene."""
+    from study.errors import check_scene_argument
+    check_scene_argument("solid_scene", scene)
+    return scene.solid(gears=tuple(gears))
 
 
 def set_dotted(data: dict, path: str, value) -> None:

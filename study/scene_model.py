@@ -8,24 +8,32 @@ inputs (`study.inputs`) take those setups and the model is assembled from them.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
 import math
-from collections import OrderedDict
 
 import numpy as np
 
 from solver import units
 from solver.mbs.kernels import layout as L
 from solver.mbs.model import ContactLaw, GearInput, Model, build_model
+from solver.store import STORE, digest
+from study.errors import BudgetError
 from study.inputs import coupling
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup, gear_setup, gear_setups
 from study.inputs.springs import tooth_springs
-from study.scene import MESH_DAMPING_RATIO, TOOTH_DAMPING_RATIO, Scene, SceneError
+from study.memory import available_memory, bytes_text
+from study.scene import (
+    MESH_DAMPING_RATIO,
+    TOOTH_DAMPING_RATIO,
+    Scene,
+    SceneError,
+    check_two_angles,
+    static_rotation,
+)
 
 __all__ = ["GearSetup", "gear_setup", "gear_setups", "coupling_fit", "scene_springs",
-           "build_scene_model", "kept_scene_model", "geometry_model", "static_angles", "load_table", "damping_ratios", "mean_load"]
+           "build_scene_model", "kept_scene_model", "geometry_model", "static_angles", "static_angle_count",
+           "check_static_memory", "dynamic_choice", "load_table", "damping_ratios", "mean_load"]
 
 
 def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple | None = None):
@@ -66,7 +74,7 @@ def scene_springs(scene: Scene, setups: tuple | None = None):
 
 
 MODEL_SLOTS = 4     # built models kept in a process: a study's worker runs many points of one body
-_MODELS: OrderedDict = OrderedDict()
+MODELS = STORE.shelf("scene models", MODEL_SLOTS)
 
 
 def model_key(scene: Scene, springs, convert_damping: bool) -> str:
@@ -79,14 +87,7 @@ def model_key(scene: Scene, springs, convert_damping: bool) -> str:
     data["convert_damping"] = convert_damping
     if springs is not None:
         data["springs"] = [[np.asarray(a, float).tolist() for a in pair] for pair in springs]
-    return hashlib.sha256(json.dumps(data, sort_keys=True, default=_plain).encode()).hexdigest()
-
-
-def _plain(value):
-    """A scene value JSON does not take, in full (arrays as lists, not numpy's shortened repr)."""
-    if isinstance(value, np.ndarray | np.generic):
-        return value.tolist()
-    return repr(value)
+    return digest(data)
 
 
 def kept_scene_model(scene: Scene, springs=None) -> Model:
@@ -94,15 +95,7 @@ def kept_scene_model(scene: Scene, springs=None) -> Model:
     point that differs from an earlier one of the process only in ``dynamic.*`` builds nothing,
     its damping conversion (dozens of modal analyses) included. For callers that never change
     a model in place (the solver does not; the sweep's tasks do not): the object is shared."""
-    key = model_key(scene, springs, True)
-    if key in _MODELS:
-        _MODELS.move_to_end(key)
-        return _MODELS[key]
-    model = build_scene_model(scene, springs)
-    _MODELS[key] = model
-    while len(_MODELS) > MODEL_SLOTS:
-        _MODELS.popitem(last=False)
-    return model
+    return MODELS.kept(model_key(scene, springs, True), lambda: build_scene_model(scene, springs))
 
 
 def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) -> Model:
@@ -223,38 +216,34 @@ def geometry_model(scene: Scene) -> Model:
                                              (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2))), convert_damping=False)
 
 
-def error_period(scene: Scene) -> float:
-    """Driver rotation [deg] after which the TE of a scene with pitch errors or eccentricity
-    repeats: one revolution of the gear that has them (gear 2: Z2/Z1 driver revolutions), the
-    hunting period lcm(Z1, Z2)/Z1 driver revolutions when both have them; 0 without errors."""
-    z1, z2 = scene.gear1.teeth, scene.gear2.teeth
-    on = (not scene.gear1.errors.is_zero, not scene.gear2.errors.is_zero)
-    if on == (False, False):
-        return 0.0
-    if on == (True, True):
-        return 360.0 * math.lcm(z1, z2) / z1
-    return 360.0 if on[0] else 360.0 * z2 / z1
+def static_angle_count(scene: Scene, step_deg: float | None = None) -> float:
+    """Driver angles of the quasi-static analysis (`static_angles`) at quasi_static.angle_step
+    or ``step_deg`` [deg], counted without building them."""
+    step = scene.quasi_static.angle_step if step_deg is None else step_deg
+    return math.floor(static_rotation(scene) / step + 1e-9) + 1.0
 
 
-def static_rotation(scene: Scene) -> float:
-    """Driver rotation [deg] of the quasi-static analysis: quasi_static.rotation, or with errors
-    whole periods of them (`error_period`, at least one) at the same angle step, so that the STE
-    and its spectrum hold every tooth pair."""
-    rot = scene.quasi_static.rotation
-    period = error_period(scene)
-    if period > 0:
-        rot = period * max(1, math.ceil(rot / period - 1e-9))
-    return rot
+# bytes a driver angle holds in a static analysis: the kernel's results (S_* columns and the
+# force on each gear-1 tooth), the result's and the archive's copies; the FE reference holds
+# about four times that (contacts and load sharing per angle)
+STATIC_BYTES_PER_ANGLE_TOOTH = 3 * 8.0
+STATIC_BYTES_PER_ANGLE = 3 * 8.0 * (L.N_S_OUT + 8)
 
 
-def check_two_angles(scene: Scene, step_deg: float, field: str = "quasi_static.angle_step") -> None:
-    """SceneError naming ``field`` when an angle step of ``step_deg`` [deg] leaves one driver
-    angle over the static rotation: an STE needs two at least (its peak-to-peak over one angle
-    would read 0)."""
-    rot = static_rotation(scene)
-    if step_deg > rot * (1 + 1e-9):
-        raise SceneError(field, f"a step of {step_deg:g} deg leaves one driver angle over the rotation of {rot:g} deg "
-                                "(quasi_static.rotation): the STE needs two at least; give a step no larger than the rotation")
+def check_static_memory(scene: Scene, step_deg: float | None = None, factor: float = 1.0,
+                        field: str = "quasi_static.angle_step") -> float:
+    """Refuse, before the angles are built, a static analysis whose arrays do not fit in memory
+    (`study.errors.BudgetError` naming ``field``, the lever); returns the number of angles."""
+    n = static_angle_count(scene, step_deg)
+    need = factor * n * (STATIC_BYTES_PER_ANGLE + STATIC_BYTES_PER_ANGLE_TOOTH * scene.gear1.teeth)
+    have = available_memory()
+    if need > 0.8 * have:
+        step = scene.quasi_static.angle_step if step_deg is None else step_deg
+        raise BudgetError(field, f"the static analysis needs about {bytes_text(need)} for its {n:.3g} driver angles "
+                                 f"({static_rotation(scene):.4g} deg at {step:.3g} deg), more than the "
+                                 f"{bytes_text(have)} of memory available; raise the angle step or shorten "
+                                 "quasi_static.rotation")
+    return n
 
 
 def static_angles(scene: Scene, step_deg: float | None = None, memory_factor: float = 1.0) -> np.ndarray:
@@ -263,7 +252,6 @@ def static_angles(scene: Scene, step_deg: float | None = None, memory_factor: fl
     ``--step`` of a command). `study.errors.BudgetError` before they are built when
     ``memory_factor`` times a static analysis's arrays would not fit in memory (the FE
     reference holds about `study.verify.fe_reference.REFERENCE_MEMORY_FACTOR` times that)."""
-    from study.estimate import check_static_memory
     step = scene.quasi_static.angle_step if step_deg is None else step_deg
     if not (math.isfinite(step) and step > 0):
         raise SceneError("--step", f"the driver angle step must be a positive number of degrees, got {step}")
@@ -271,6 +259,15 @@ def static_angles(scene: Scene, step_deg: float | None = None, memory_factor: fl
     check_two_angles(scene, step, field)
     n = int(check_static_memory(scene, step, factor=memory_factor, field=field))
     return np.radians(np.arange(n) * step)
+
+
+def dynamic_choice(scene: Scene, model: Model):
+    """Integrator and step of the scene's dynamic run (`solver.mbs.method.choose_method`)."""
+    from solver.mbs.dynamics import run_loads  # the integrators load numba: not for `lightgear --help`
+    from solver.mbs.method import choose_method
+    d = scene.dynamic
+    step_torque = run_loads(load_table(scene), d.torque)[1]
+    return choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
 
 
 def load_table(scene: Scene) -> np.ndarray | None:

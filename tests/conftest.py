@@ -7,18 +7,26 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 import pytest  # noqa: E402
+import tiers  # noqa: E402
 from helpers import solid_scene  # noqa: E402
+
+
+def pytest_collection_modifyitems(config, items):
+    """Markers of what each test reaches (FE, solver, processes): `tiers`, which ``make test-fast`` leaves out."""
+    tiers.mark(items, pytest)
 
 
 @pytest.fixture
 def private_fe_cache(tmp_path, monkeypatch):
-    """FE results of the test go to a fresh disk cache, and nothing the FE cache holds in
-    memory (spring maps, influence coefficients, factorised bodies, coupling fits) leaks in or out."""
-    from study.inputs.cache import FE_CACHE
+    """FE results of the test go to a fresh disk cache, and nothing the process holds in memory
+    (the shelves of `solver.store.STORE`: spring maps, compliances, factorised bodies, rims,
+    coupling fits, models, equilibria, model-only analyses) leaks in or out. Yields the store:
+    ``private_fe_cache.clear()`` drops what memory holds, the disk cache stays."""
+    from solver.store import STORE
     monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "cache"))
-    FE_CACHE.clear()
-    yield FE_CACHE
-    FE_CACHE.clear()
+    STORE.clear()
+    yield STORE
+    STORE.clear()
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,11 @@
   and start no run, sweep or FE solve;
 - the run archive (`study/archive/`) imports only the solver, the scene and itself;
 - no cycle between packages (a subpackage or a top-level module of `solver`/`study`) through
-  the imports a module runs when it is loaded.
+  the imports a module runs when it is loaded;
+- no cycle between modules through any import, those inside functions included (a deferred
+  import hides a cycle from the interpreter, not from the design), and the names `study`
+  offers through its table ``_OFFERED`` (imported on first use). Only imports under
+  ``if TYPE_CHECKING:`` never run and do not count.
 
 The workflows' rule (only `study`'s public API) is tests/workflows/test_imports.py.
 """
@@ -32,20 +36,26 @@ ARCHIVE = ("study.archive",)
 KNOWN: set = set()
 
 
-def _module(path: Path) -> str:
-    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+def _module(path: Path, root: Path = ROOT) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-FILES = {_module(p): p for top in ("solver", "study") for p in sorted((ROOT / top).rglob("*.py"))}
+def _files(root: Path, tops=("solver", "study")) -> dict:
+    """module name -> source file of every module under the packages ``tops`` of ``root``."""
+    return {_module(p, root): p for top in tops for p in sorted((root / top).rglob("*.py"))}
 
 
-def _imports(path: Path, loaded_only: bool = False):
+FILES = _files(ROOT)
+
+
+def _imports(path: Path, loaded_only: bool = False, files: dict = FILES, root: Path = ROOT):
     """(line, imported module) of each import in the file; ``from a import b`` gives ``a.b`` when
     that is a module of the project, else ``a``. ``loaded_only``: the imports run when the
-    module is loaded (not those in functions or under TYPE_CHECKING)."""
+    module is loaded (not those in functions or under TYPE_CHECKING); else every import that can
+    run (those under TYPE_CHECKING left out)."""
     tree = ast.parse(path.read_text())
-    me = _module(path)
+    me = _module(path, root)
     package = me if path.name == "__init__.py" else me.rpartition(".")[0]
 
     def statements(body):
@@ -59,7 +69,16 @@ def _imports(path: Path, loaded_only: bool = False):
             elif isinstance(node, ast.With):
                 yield from statements(node.body)
 
-    nodes = statements(tree.body) if loaded_only else (n for n in ast.walk(tree) if isinstance(n, ast.Import | ast.ImportFrom))
+    def every(node):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.Import | ast.ImportFrom):
+                yield child
+            elif not (isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test)):
+                yield from every(child)
+
+    nodes = statements(tree.body) if loaded_only else every(tree)
+    if not loaded_only:
+        yield from _offered(tree, files)
     for node in nodes:
         if isinstance(node, ast.Import):
             yield from ((node.lineno, a.name) for a in node.names)
@@ -69,7 +88,18 @@ def _imports(path: Path, loaded_only: bool = False):
             up = package.split(".")[: len(package.split(".")) - node.level + 1]
             base = ".".join(up + ([node.module] if node.module else []))
         for a in node.names:
-            yield node.lineno, f"{base}.{a.name}" if f"{base}.{a.name}" in FILES else base
+            yield node.lineno, f"{base}.{a.name}" if f"{base}.{a.name}" in files else base
+
+
+def _offered(tree, files: dict):
+    """(line, module) of each entry of a module-level table ``_OFFERED = {name: (module,
+    attribute)}``: the names a package offers and imports on first use (`study`'s API)."""
+    for node in tree.body:
+        if (isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "_OFFERED" for t in node.targets)
+                and isinstance(node.value, ast.Dict)):
+            for value in node.value.values:
+                module, attribute = ast.literal_eval(value)
+                yield value.lineno, f"{module}.{attribute}" if f"{module}.{attribute}" in files else module
 
 
 def _under(name: str, *prefixes: str) -> bool:
@@ -166,3 +196,80 @@ def test_no_import_cycle_between_packages():
         if cycle:
             pytest.fail("import cycle between packages:\n" + "\n".join(
                 edges[(u, v)] for u, v in zip(cycle, cycle[1:], strict=False)), pytrace=False)
+
+
+def _module_graph(files: dict, root: Path) -> dict:
+    """module -> {imported module of ``files``: 'file:line' of the first import of it}, every
+    import counted (deferred ones too); a name inside a module counts as that module."""
+    graph: dict = {}
+    for module, path in files.items():
+        for line, name in _imports(path, files=files, root=root):
+            while name not in files and "." in name:
+                name = name.rpartition(".")[0]
+            if name in files and name != module:
+                graph.setdefault(module, {}).setdefault(name, f"{path.relative_to(root)}:{line} imports {name}")
+    return graph
+
+
+def _module_cycles(graph: dict) -> list:
+    """The strongly connected groups of more than one module (Tarjan), each as a sorted list."""
+    index: dict = {}
+    low: dict = {}
+    stack: list = []
+    found = []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while not group or group[-1] != v:
+                group.append(stack.pop())
+            if len(group) > 1:
+                found.append(sorted(group))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def _cycle_report(graph: dict, group: list) -> str:
+    inside = set(group)
+    return "import cycle between modules (deferred imports included):\n" + "\n".join(
+        f"  {where}" for a in group for b, where in sorted(graph.get(a, {}).items()) if b in inside)
+
+
+def test_no_import_cycle_between_modules():
+    graph = _module_graph(FILES, ROOT)
+    cycles = _module_cycles(graph)
+    if cycles:
+        pytest.fail("\n".join(_cycle_report(graph, g) for g in cycles), pytrace=False)
+
+
+def test_a_planted_deferred_import_cycle_is_found(tmp_path):
+    """The cycle check sees a cycle made only of imports inside functions or through an
+    ``_OFFERED`` table, and not one that lies under TYPE_CHECKING."""
+    pkg = tmp_path / "study"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("def f():\n    from study.b import g\n    return g()\n")
+    (pkg / "b.py").write_text("from study import c\n\ndef g():\n    return c.h()\n")
+    (pkg / "c.py").write_text("def h():\n    from . import a\n    return a\n")
+    (pkg / "d.py").write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from study.a import f\n")
+    (pkg / "e.py").write_text("from study.d import TYPE_CHECKING\n")
+    (pkg / "f.py").write_text("_OFFERED = {'g': ('study.g', 'g')}\n")
+    (pkg / "g.py").write_text("def g():\n    import study.f\n    return study.f\n")
+    files = _files(tmp_path, ("study",))
+    graph = _module_graph(files, tmp_path)
+    assert _module_cycles(graph) == [["study.a", "study.b", "study.c"], ["study.f", "study.g"]]
+    assert "study/c.py:2 imports study.a" in _cycle_report(graph, ["study.a", "study.b", "study.c"])
+    (pkg / "c.py").write_text("def h():\n    return 1\n")
+    (pkg / "g.py").write_text("def g():\n    return 1\n")
+    assert _module_cycles(_module_graph(_files(tmp_path, ("study",)), tmp_path)) == []

@@ -40,6 +40,7 @@ from solver.fe.body import BodyModel, plane_stress_lame, plane_stress_p2_stiffne
 from solver.fe.factor import blas1_solver, congruence, factorise, influence, one_blas_thread
 from solver.fe.mesh import REGION_RIM, REGION_WEB, BodyMesh
 from solver.geometry import Material
+from solver.store import Shelf, digest
 
 MATCH_TOL = 1e-9        # m: two DOF locations closer than this are the same node
 SOLVES_KEPT = 2         # rim solves and column-read sets kept for reuse (`RimBlock.rim_solve`, `RimBlock.read_set`)
@@ -119,8 +120,9 @@ class RimBlock:
     blocks: tuple = field(default=(), repr=False)          # (K_rr CSC, K_ii^R CSC) [N/m], for `make_split`
     split: dict | None = field(default=None, repr=False)   # factors of the interface-last factorisation
     key: str = ""                                          # the cache's name for this rim, if any
-    solves: dict = field(default_factory=dict, repr=False)  # kept K_rr^-1 f (`rim_solve`)
-    read_sets: dict = field(default_factory=dict, repr=False)  # kept `ReadSet`s (`read_set`)
+    # kept K_rr^-1 f (`rim_solve`) and `ReadSet`s (`read_set`): shelves of the rim itself, gone with it
+    solves: Shelf = field(default_factory=lambda: Shelf("rim solves", SOLVES_KEPT), repr=False)
+    read_sets: Shelf = field(default_factory=lambda: Shelf("rim read sets", SOLVES_KEPT), repr=False)
 
     @property
     def n_interface(self) -> int:
@@ -158,30 +160,14 @@ class RimBlock:
         j's reads), made by restricted triangular solves of the interface-last factorisation;
         the last `SOLVES_KEPT` are kept by the loads' and reads' bytes (every web of the rim
         reads the same teeth under the same loads)."""
-        import hashlib
-        h = hashlib.sha1(F.data.tobytes() + b"|" + F.indices.astype(np.int64).tobytes() + b"|"
-                         + F.indptr.astype(np.int64).tobytes())
-        for r in reads:
-            h.update(np.asarray(r, np.int64).tobytes() + b"|")
-        return _kept(self.read_sets, h.hexdigest() + str(F.shape), lambda: _read_set(self, F, reads))
+        key = digest(F.shape, F.data, F.indices.astype(np.int64), F.indptr.astype(np.int64),
+                     *(np.asarray(r, np.int64) for r in reads))
+        return self.read_sets.kept(key, lambda: _read_set(self, F, reads))
 
     def rim_solve(self, f: np.ndarray) -> np.ndarray:
         """K_rr^-1 f [m] for loads f (n_interior, k) [N]; the last `SOLVES_KEPT` results are
         kept by the loads' bytes (every web of the rim solves its teeth's reference loads)."""
-        import hashlib
-        return _kept(self.solves, hashlib.sha1(f.tobytes()).hexdigest() + str(f.shape), lambda: self.model.solve(f))
-
-
-def _kept(store: dict, key: str, make):
-    """``store[key]``, made by ``make()`` when it is not among the last `SOLVES_KEPT` used (the
-    least recently used goes first: a dict keeps its insertion order, most recently used last)."""
-    value = store.pop(key, None)
-    if value is None:
-        while len(store) >= SOLVES_KEPT:
-            store.pop(next(iter(store)))
-        value = make()
-    store[key] = value
-    return value
+        return self.solves.kept(digest(f), lambda: self.model.solve(f))
 
 
 @dataclass

@@ -454,3 +454,19 @@ def ltca_sweep(model: Model, compliance: tuple, angles, torque: float, k_con: fl
         np.add.at(f1[a], mp.tooth1 % z1, F)
         ext[a] = F[mp.kind != 1].sum()
     return LTCAResult(angles, te, w_out, nc, f1, ext, float(torque), jn2)
+
+
+def teeth_in_mesh(model, angles) -> tuple[list, list, int]:
+    """Teeth of each gear that meet the mesh at ``angles`` [rad], and the largest index spread
+    between simultaneous candidates (for the solid body's symmetric columns)."""
+    s1, s2, spread = set(), set(), 1
+    z = model.teeth
+    for th in angles:
+        mp = mesh_points(model, float(th))
+        s1.update(int(t) % z[0] for t in mp.tooth1)
+        s2.update(int(t) % z[1] for t in mp.tooth2)
+        for t, zz in ((mp.tooth1, z[0]), (mp.tooth2, z[1])):
+            if t.size > 1:
+                d = (t[:, None] - t[None, :] + zz // 2) % zz - zz // 2
+                spread = max(spread, int(np.abs(d).max()))
+    return sorted(s1), sorted(s2), spread

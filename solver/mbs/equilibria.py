@@ -8,17 +8,16 @@ dampers (`solver.mbs.modes.with_damping`) shares them.
 """
 from __future__ import annotations
 
-import hashlib
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.model import Model
+from solver.store import STORE, digest
 
-_KEPT: OrderedDict = OrderedDict()
 KEEP = 32           # equilibrium sets kept (a study point asks for one or two)
+KEPT = STORE.shelf("loaded equilibria", KEEP)
 
 
 @dataclass
@@ -37,11 +36,8 @@ def statics_key(model: Model, torque: float, positions: int) -> str:
     gp[:, [L.C_PHI, L.N_C, L.C_BODY]] = 0.0
     lp = model.law_par.copy()
     lp[[L.C_CON, L.M2, L.M3]] = 0.0
-    h = hashlib.blake2b(digest_size=16)
-    for a in (gp, model.pair_par, lp, model.k_phi, model.tooth_compliance, np.array([torque, positions], float)):
-        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
-        h.update(str(np.shape(a)).encode())
-    return h.hexdigest()
+    return digest(*(np.asarray(a, dtype=float) for a in (
+        gp, model.pair_par, lp, model.k_phi, model.tooth_compliance, np.array([torque, positions], float))))
 
 
 def loaded_equilibria(model: Model, torque: float, positions: int = 12) -> list[Equilibrium]:
@@ -49,14 +45,8 @@ def loaded_equilibria(model: Model, torque: float, positions: int = 12) -> list[
     across one angular pitch, by one sweep with continuation; positions that do not converge
     are left out. Solved once per `statics_key` (the last KEEP sets are kept); the caller
     gets copies of the tooth rotations."""
-    key = statics_key(model, torque, positions)
-    if key in _KEPT:
-        _KEPT.move_to_end(key)
-    else:
-        _KEPT[key] = _solve(model, torque, positions)
-        while len(_KEPT) > KEEP:
-            _KEPT.popitem(last=False)
-    return [Equilibrium(e.theta1, e.rim1, e.rim2, e.phi.copy()) for e in _KEPT[key]]
+    kept = KEPT.kept(statics_key(model, torque, positions), lambda: _solve(model, torque, positions))
+    return [Equilibrium(e.theta1, e.rim1, e.rim2, e.phi.copy()) for e in kept]
 
 
 def _solve(model: Model, torque: float, positions: int) -> list[Equilibrium]:

@@ -135,8 +135,9 @@ def clean_stale_temporaries(path) -> list[Path]:
     return removed
 
 
-def write_netcdf(ds: xr.Dataset, path) -> None:
-    """Write compressed CF NetCDF4 (`cf_ready`) atomically (temporary file, then rename).
+def write_netcdf(ds: xr.Dataset, path) -> Path:
+    """Write a run or study archive as compressed CF NetCDF4 (`cf_ready`) atomically (temporary
+    file, then rename) -> its path.
 
     The temporary name is unique per process and call, so concurrent writers of the same path
     (dask workers filling the FE spring cache) never share a half-written file; the last
@@ -145,6 +146,10 @@ def write_netcdf(ds: xr.Dataset, path) -> None:
     """
     import os
     import uuid
+
+    from study.errors import check_argument, is_path
+    check_argument(hasattr(ds, "data_vars"), "write", "ds", "an xarray.Dataset", ds)
+    check_argument(is_path(path), "write", "path", "a file path ending in .nc", path)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     clean_stale_temporaries(path)
@@ -161,6 +166,7 @@ def write_netcdf(ds: xr.Dataset, path) -> None:
     finally:
         if tmp.exists():
             tmp.unlink()
+    return path
 
 
 # room a write needs beyond the data [bytes]: NetCDF4/HDF5 headers, chunk indexes
@@ -183,3 +189,11 @@ def disk_full(error: Exception, folder: Path, data_bytes: float) -> OSError | No
     left = f"{free / 2 ** 20:.1f} MiB" if free is not None else "no room"
     return OSError(errno.ENOSPC, f"no space left on device: {left} free in {folder} for an archive of about "
                                  f"{data_bytes / 2 ** 20:.1f} MiB of data; free some space or write elsewhere (-o)")
+
+
+def read_netcdf(path) -> xr.Dataset:
+    """A run or study archive (NetCDF) read into memory -> xarray.Dataset (the file is closed)."""
+    from study.errors import check_argument, is_path
+    check_argument(is_path(path), "read", "path", "a NetCDF file's path", path)
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        return ds.load()

@@ -120,6 +120,9 @@ def add_default_model(ds: xr.Dataset, default: xr.Dataset) -> xr.Dataset:
     of the same scene (the paper example runs the paper's model): ``ste_default(angle)`` and
     ``dte_default(time)`` [um] and its modes as attributes (``default_coupling_model``,
     ``default_mesh_mode_frequency_hz``, ``default_critical_speed_1z_rad_s``). Returns ``ds``."""
+    from study.errors import check_argument
+    check_argument(hasattr(ds, "data_vars") and hasattr(default, "data_vars"), "add_default_model", "ds, default",
+                   "two run archives (xarray.Dataset)", (ds, default))
     name = str(default.attrs.get("coupling_model", "default"))
     ds.attrs["default_coupling_model"] = name
     if "ste" in ds and "ste" in default and default.sizes["angle"] == ds.sizes["angle"]:

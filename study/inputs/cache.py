@@ -14,11 +14,13 @@ named by `FECache.key` of everything the result depends on:
   (`solver.fe.condense`: the condensed stiffness and the DOF positions it belongs to), and
   ``rim-{key}-{load set}.npz`` its products of a compliance load set.
 
-In memory: the same results once read or computed, the last `BODY_SLOTS` factorised bodies (a
-reference and the coupling fits of both gears reuse them), the last `RIM_SLOTS` condensed rims
-(every body of one rim height reuses one) and the coupling fits. `FE_CACHE` is
-the process-wide instance; `FECache.clear` forgets everything held in memory (the disk stays).
-A missing or unreadable file is recomputed; a read-only folder only costs recomputation.
+In memory, on shelves of the process's one store (`solver.store.STORE`, which
+`STORE.clear()` empties; the disk stays): the maps and compliances once read or computed (the
+last `MAP_SLOTS` and `COMPLIANCE_SLOTS`), the last `BODY_SLOTS` factorised bodies (a reference
+and the coupling fits of both gears reuse them), the last `RIM_SLOTS` condensed rims (every
+body of one rim height reuses one) and the last `FIT_SLOTS` coupling fits. `FE_CACHE` is the
+process-wide instance. A missing or unreadable file is recomputed; a read-only folder only
+costs recomputation.
 """
 from __future__ import annotations
 
@@ -32,9 +34,13 @@ from pathlib import Path
 
 import numpy as np
 
+from solver.store import STORE
+
 BODY_SLOTS = 2      # factorised bodies kept: one per gear (each up to ~0.5 GB)
 RIM_SLOTS = 2       # condensed teeth-and-rim blocks kept (each up to ~0.4 GB with its factors)
 FIT_SLOTS = 16      # coupling fits kept (small: a few arrays of the tooth count)
+MAP_SLOTS = 512     # tooth stiffness maps and fillet stresses kept (an array of the tooth count each)
+COMPLIANCE_SLOTS = 16   # bulk compliances kept (a few MB each)
 # what reading a damaged cache file raises: truncated or empty (zip, zlib, end of file), an
 # array or a variable missing or of another shape, a NetCDF file HDF cannot read
 UNREADABLE = (OSError, EOFError, zipfile.BadZipFile, zlib.error, KeyError, IndexError, ValueError, TypeError)
@@ -44,13 +50,12 @@ class FECache:
     """FE results in memory and on disk, keyed by the hash of their settings."""
 
     def __init__(self):
-        self.stiffness: dict[str, np.ndarray] = {}   # key -> tooth stiffness map [N·m/rad]
-        self.root_stress: dict[str, np.ndarray] = {}  # key -> largest fillet stress of each tooth [Pa]
-        self.compliance: dict = {}                   # key -> BodyCompliance
-        self.bodies: dict = {}                       # body key -> factorised BodyModel (least recently used first)
-        self.fits: dict = {}                         # fit key -> coupling fit (least recently used first)
-        self.rims: dict = {}                         # rim key -> condensed teeth and rim (`solver.fe.condense.RimBlock`)
-        self.generation = 0                          # counts `clear`: what was made from the held results is stale
+        self.stiffness = STORE.shelf("FE tooth stiffness maps", MAP_SLOTS)     # key -> [N·m/rad] per tooth
+        self.root_stress = STORE.shelf("FE fillet stresses", MAP_SLOTS)        # key -> largest stress of each tooth [Pa]
+        self.compliance = STORE.shelf("FE bulk compliances", COMPLIANCE_SLOTS)  # key -> BodyCompliance
+        self.bodies = STORE.shelf("FE factorised bodies", BODY_SLOTS)          # body key -> factorised BodyModel
+        self.fits = STORE.shelf("coupling fits", FIT_SLOTS)                    # fit key -> coupling fit
+        self.rims = STORE.shelf("FE condensed rims", RIM_SLOTS)                # rim key -> `solver.fe.condense.RimBlock`
 
     @property
     def folder(self) -> Path:
@@ -61,12 +66,6 @@ class FECache:
     def key(settings: dict) -> str:
         """20 hex digits of the SHA-256 of the settings as sorted JSON (numbers as floats)."""
         return hashlib.sha256(json.dumps(settings, sort_keys=True, default=float).encode()).hexdigest()[:20]
-
-    def clear(self) -> None:
-        """Forget every result held in memory (maps, compliances, factorised bodies, fits)."""
-        for held in (self.stiffness, self.root_stress, self.compliance, self.bodies, self.fits, self.rims):
-            held.clear()
-        self.generation += 1
 
     def _read(self, held: dict, key: str, name: str, load):
         """The result of ``key`` from ``held``, else loaded from the file ``name`` by
@@ -184,12 +183,12 @@ class FECache:
     def body(self, key: str, build):
         """The factorised body of ``key``, made by ``build()`` when it is not among the last
         `BODY_SLOTS` used."""
-        return _held(self.bodies, BODY_SLOTS, key, build)
+        return self.bodies.kept(key, build)
 
     def rim(self, key: str, build):
         """The condensed teeth and rim of ``key``, made by ``build()`` when it is not among the
         last `RIM_SLOTS` used."""
-        return _held(self.rims, RIM_SLOTS, key, build)
+        return self.rims.kept(key, build)
 
     # ---- arrays of a condensed rim (its condensed stiffness, the products of a load set)
     def read_arrays(self, name: str) -> dict | None:
@@ -213,19 +212,7 @@ class FECache:
 
     def fit(self, key, build):
         """The coupling fit of ``key`` (any hashable), made by ``build()`` when not held."""
-        return _held(self.fits, FIT_SLOTS, key, build)
-
-
-def _held(store: dict, slots: int, key, build):
-    """``store[key]``, made by ``build()`` when it is not among the last ``slots`` used: the
-    least recently used goes first (a dict keeps its insertion order: most recently used last)."""
-    value = store.pop(key, None)
-    if value is None:
-        while len(store) >= slots:
-            store.pop(next(iter(store)))
-        value = build()
-    store[key] = value
-    return value
+        return self.fits.kept(key, build)
 
 
 FE_CACHE = FECache()

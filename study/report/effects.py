@@ -153,10 +153,10 @@ def pareto_mask(gain: np.ndarray, cost: np.ndarray, feasible: np.ndarray) -> np.
     return out
 
 
-def pareto_table(ds: xr.Dataset, stress_limit: float = STRESS_LIMIT, skip=None) -> xr.Dataset:
+def pareto_table(ds: xr.Dataset, stress_ratio: float = STRESS_LIMIT, skip=None) -> xr.Dataset:
     """``pareto_<te>`` for each TE measure of ``TE_MEASURES`` in ``ds``: 1 where the point is in
     the Pareto set of most mass saved (``mass_saving_gear2``) for least TE, among the ok points
-    with ``root_stress_ratio_gear2 <= stress_limit`` (a point whose ratio is NaN, a lightened gear on
+    with ``root_stress_ratio_gear2 <= stress_ratio`` (a point whose ratio is NaN, a lightened gear on
     uniform springs say, is left out); int8 CF flags over the study's dims.
     ``skip(what, why)`` is told what cannot be computed."""
     skip = skip or (lambda what, why: None)
@@ -172,13 +172,13 @@ def pareto_table(ds: xr.Dataset, stress_limit: float = STRESS_LIMIT, skip=None) 
         cost = kept(ds, t)
         g, c, r = xr.broadcast(gain, cost, ratio)
         c, r = c.transpose(*g.dims), r.transpose(*g.dims)
-        mask = pareto_mask(g.values, c.values, (r <= stress_limit).values).reshape(g.shape)
+        mask = pareto_mask(g.values, c.values, (r <= stress_ratio).values).reshape(g.shape)
         out[f"pareto_{t}"] = xr.Variable(g.dims, mask.astype(np.int8), {
             "units": "1", "long_name": f"in the Pareto set of mass saving against {t}",
             "flag_values": np.array([0, 1], np.int8), "flag_meanings": "not_pareto pareto",
             "comment": f"most {MASS_SAVING} for least {t} among the ok points with {STRESS_RATIO} <= "
-                       f"{stress_limit:g}; 0 also for points not ok, NaN or over the stress limit",
-            "stress_limit": float(stress_limit)})
+                       f"{stress_ratio:g}; 0 also for points not ok, NaN or over the stress limit",
+            "stress_limit": float(stress_ratio)})
     return xr.Dataset(out, coords={d: ds[d] for d in gain.dims if d in ds.coords})
 
 

@@ -154,19 +154,19 @@ def point_labels(arrays, dims) -> np.ndarray:
                      for vals in zip(*cols)] if cols else [""] * st.size, dtype=object)
 
 
-def tradeoff_figure(ds: xr.Dataset, pareto: xr.Dataset, path, te_limits: dict | None = None, chosen: int | None = None):
-    """Mass saving against each TE measure with a ``pareto_<te>`` flag in ``pareto``; colour:
+def tradeoff_figure(ds: xr.Dataset, pareto_flags: xr.Dataset, path, te_limits: dict | None = None, chosen: int | None = None):
+    """Mass saving against each TE measure with a ``pareto_<te>`` flag in ``pareto_flags``; colour:
     root stress [MPa] when archived; hollow: over the stress limit; the Pareto set joined.
     ``te_limits``: {TE measure: limit [its units]} drawn as dashed lines; ``chosen``: the index of
     a point (in the points flattened in the order of the dims) marked by a star."""
-    te = [str(v)[len("pareto_"):] for v in pareto.data_vars]
+    te = [str(v)[len("pareto_"):] for v in pareto_flags.data_vars]
     fig, axes = plt.subplots(1, len(te), figsize=(5.6 * len(te) + 1.4, 5.0), squeeze=False, constrained_layout=True)
     gain = kept(ds, MASS_SAVING)
     stress = kept(ds, STRESS) if STRESS in ds else None
     ratio = kept(ds, STRESS_RATIO)
     sc = None
     for ax, t in zip(axes[0], te):
-        flag = pareto[f"pareto_{t}"]
+        flag = pareto_flags[f"pareto_{t}"]
         limit = float(flag.attrs.get("stress_limit", np.nan))
         g, c, r, f = (a.values.ravel() for a in xr.broadcast(gain, kept(ds, t), ratio, flag.astype(bool)))
         s = xr.broadcast(stress, gain)[0].values.ravel() if stress is not None else np.full(g.shape, np.nan)

@@ -61,7 +61,9 @@ def critical_speed_line(ds: xr.Dataset) -> str:
             f"{top:g} rad/s); the lowest {names[low]} {cs[low]:.0f}\n")
 
 
-def print_summary(ds: xr.Dataset, path, wall: float) -> None:
+def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
+    """The one-screen summary `lightgear run` prints for a run archive written to ``path`` after
+    ``wall_time`` [s]."""
     s = summarize(ds)
     w = sys.stdout.write
     w(f"{ds.attrs.get('title', '')}\n  archive: {path}\n")
@@ -172,7 +174,7 @@ def print_summary(ds: xr.Dataset, path, wall: float) -> None:
                 if len(shown) < len(named) else ""
             w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in shown) + more + "\n")
     w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
-      + f", total {wall:.2f} s\n")
+      + f", total {wall_time:.2f} s\n")
 
 
 def _range(k: xr.DataArray) -> str:

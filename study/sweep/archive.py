@@ -37,7 +37,7 @@ from study.archive.netcdf import provenance
 from study.scene import field_doc, field_unit
 from study.sweep.grid import Point, Study, coupling_models, dim_name
 from study.sweep.outputs import CURVES, SCALARS, STATUS, analysis_of, reads
-from study.sweep.sample import sample_attrs, sample_variables
+from study.sweep.sample import Sample
 from study.sweep.tasks import point_task_keys
 
 CF_UNITS = {"": "1", "deg": "degree", "N*m": "N m", "rad/s": "rad s-1", "kg/m^3": "kg m-3",
@@ -60,6 +60,30 @@ def _coord_values(values, path: str):
     else:
         arr = np.array(vals, dtype=np.float64)
     return arr, {"units": cf_units(field_unit(path)), "long_name": field_doc(path), "scene_field": path}
+
+
+def sample_variables(sample: Sample) -> dict:
+    """The archive's variables over ``sample``: the drawn values of each field (named like a grid
+    dimension, `grid.dim_name`), and for the Saltelli design ``sample_block`` and ``sample_row``."""
+    out = {}
+    for f in sample.fields:
+        vals = sample.values[f.path]
+        out[dim_name(f.path)] = xr.Variable("sample", vals, {
+            "units": cf_units(field_unit(f.path)), "long_name": field_doc(f.path), "scene_field": f.path,
+            "distribution": f.describe()})
+    if sample.design == "saltelli":
+        out["sample_block"] = xr.Variable("sample", sample.block, {
+            "units": "1", "long_name": "matrix of the Saltelli design",
+            "comment": "0: A, 1: B, 2 + i: A with drawn field i (in the order of sample_fields) from B"})
+        out["sample_row"] = xr.Variable("sample", sample.row, {
+            "units": "1", "long_name": "row of the build in its matrix of the Saltelli design"})
+    return out
+
+
+def sample_attrs(sample: Sample) -> dict:
+    """Global attributes of a sampled study's archive."""
+    return {"sample_method": sample.method, "sample_size": sample.size, "sample_seed": sample.seed,
+            "sample_design": sample.design, "sample_fields": " ".join(sample.paths)}
 
 
 def study_layout(study: Study, points: list[Point]) -> tuple[tuple[str, ...], dict]:

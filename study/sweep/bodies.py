@@ -24,6 +24,7 @@ condensed rim from the disk instead of each worker condensing it again.
 """
 from __future__ import annotations
 
+from solver.store import STORE
 from study.scene import Scene
 
 
@@ -58,7 +59,8 @@ def _map_missing(setup, teeth) -> tuple[str, bool]:
     return key, key not in FE_CACHE.stiffness and not (FE_CACHE.folder / f"{key}.nc").exists()
 
 
-_REACH: dict = {}       # (gear 1 key, gear 2 key, gear) -> coupling reach [teeth]: one geometry per pair
+REACH_SLOTS = 256   # coupling reaches kept [teeth]: one per gear of a pair (a few integers)
+REACH = STORE.shelf("coupling reach", REACH_SLOTS)
 
 
 def _reach(scene: Scene, setups: tuple, g: int) -> int:
@@ -66,10 +68,8 @@ def _reach(scene: Scene, setups: tuple, g: int) -> int:
     of a solid body's compliance."""
     from study.inputs.coupling import mesh_samples
     from study.scene_model import geometry_model
-    key = (setups[0].key, setups[1].key, g)
-    if key not in _REACH:
-        _REACH[key] = max(abs(d) for d in mesh_samples(geometry_model(scene), g))
-    return _REACH[key]
+    return REACH.kept((setups[0].key, setups[1].key, g),
+                      lambda: max(abs(d) for d in mesh_samples(geometry_model(scene), g)))
 
 
 def fe_jobs(scene: Scene) -> list[tuple[str, object, tuple]]:

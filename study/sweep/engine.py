@@ -60,7 +60,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from study.errors import BudgetError
+from study.errors import BudgetError, check_argument, checked_workers, is_path
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
@@ -274,6 +274,20 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
     with cluster, Client(cluster) as client:
         client.register_plugin(stop_kernels_plugin(), name="lightgear-stop-kernels")
         yield client
+
+
+@contextlib.contextmanager
+def local_cluster(workers: int | None = None):
+    """A dask LocalCluster for several sweeps in a row, as a context manager that yields its
+    scheduler address (give it to `run_sweep` as ``scheduler``); ``workers``: processes (None:
+    one per core; 0: yields None, the sweeps then run in this process)."""
+    workers = checked_workers("local_cluster", workers)
+    if workers == 0:
+        yield None
+        return
+    check_main_guard()
+    with dask_client(None, workers) as client:
+        yield client.scheduler.address
 
 
 def stop_kernels_plugin():
@@ -553,11 +567,23 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     dask cluster. The part files are removed once the archive holds every point (unless
     ``keep_parts``). ``max_time`` [s]: refuse (`study.errors.BudgetError`, before any work) a
     study too large to list or whose missing tasks are estimated to take longer in all
-    (`study.estimate.sweep_estimate`, CPU seconds summed over the tasks).
+    (`study.estimate.sweep_estimate`, CPU seconds summed over the tasks). The returned
+    SweepResult has ``.dataset`` (the archive as written, its curves read from the file when
+    used), ``.computed``, ``.reused``, ``.invalid``, ``.pending`` and ``.wall_time`` [s]. Finished
+    points are kept on disk, so the same call after an interruption computes only the missing
+    ones. Worker processes import the calling script again: a script needs
+    ``if __name__ == "__main__":``.
     """
     from study import estimate
     from study.archive.netcdf import write_netcdf
 
+    check_argument(isinstance(study, Study), "run_sweep", "study", "a Study (study.make_study(scene, grid={...}) or "
+                   "study.load_study(path or name))", study)
+    check_argument(is_path(output), "run_sweep", "output", "the archive's path ending in .nc (str or os.PathLike)", output)
+    workers = checked_workers("run_sweep", workers)
+    check_argument(scheduler is None or isinstance(scheduler, str), "run_sweep", "scheduler",
+                   "a dask scheduler address such as 'tcp://host:8786', or None", scheduler)
+    progress, keep_parts = bool(progress), bool(keep_parts)
     t0 = time.perf_counter()
     estimate.check_study_size(study, max_time)
     points = check_points(study)

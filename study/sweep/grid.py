@@ -49,7 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
-from study.errors import StudyError
+from study.errors import StudyError, check_argument, is_path
 from study.plausibility import check_dynamic_window
 from study.scene import (
     Scene,
@@ -394,12 +394,23 @@ def check_swept_together(groups, outputs: Outputs) -> None:
 
 
 def load_study(path: str | Path) -> Study:
-    """A study file, or an embedded study by name (``"sensitivity"``), read and checked."""
+    """A study file, or an embedded study by name (``"sensitivity"``; `study.scenes` lists them):
+    base scene, [grid] and/or [[points]], [sample], [outputs], read and checked -> Study
+    (StudyError names the field)."""
+    check_argument(is_path(path), "load_study", "path",
+                   "a study file's path or an embedded study's name (str or os.PathLike)", path)
     try:
         p = scene_path(path, "study")
     except SceneError as e:
         raise StudyError(e.field, e.reason) from None
     return loads_study(read_text(p, "study"), p.parent)
+
+
+def study_from_dict(raw: dict, folder: str | Path | None = None) -> Study:
+    """A study from the tables of a study file as a dict (title, scene, grid, points, sample,
+    outputs), checked like the file; relative scene paths are read from ``folder``."""
+    check_argument(isinstance(raw, dict), "study_from_dict", "raw", "a dict of study tables", raw)
+    return loads_study(dumps_study(raw), folder)
 
 
 def dumps_study(raw: dict) -> str:

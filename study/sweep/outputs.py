@@ -305,3 +305,18 @@ def summarize_sweep(ds) -> dict:
     the point's status is not ok (an output not over every swept dimension is broadcast)."""
     ok = ds["status"] == STATUS.index("ok")
     return {k: ds[k].where(ok) for k in SCALARS if k in ds.data_vars}
+
+
+def archive_summary(ds) -> dict:
+    """The summary scalars of an archive. A run archive: {name: float} (STE mean and
+    peak-to-peak [um], DTE RMS [um], amplitudes at the mesh and hole orders [um], largest tooth
+    force [N], ...; `study.archive.summary.summarize`). A sweep archive: {name:
+    xarray.DataArray} of its scalars over the swept dimensions, NaN where a point is not ok
+    (`summarize_sweep`)."""
+    from study.archive.summary import summarize
+    from study.errors import check_argument
+    check_argument(hasattr(ds, "data_vars"), "summarize", "ds", "a run or sweep archive (xarray.Dataset; study.read(path))", ds)
+    if "status" in ds.data_vars and "study_key" in ds.attrs:
+        return summarize_sweep(ds)
+    return summarize(ds)
+

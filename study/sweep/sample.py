@@ -311,32 +311,3 @@ def parse_sample(table, base: dict, taken: tuple[str, ...] = ()) -> Sample:
     if not fields:
         raise SceneError("sample", "draws no field: give at least one \"dotted.field\" = {distribution}")
     return Sample(size, method, seed, design, tuple(fields))
-
-
-def sample_variables(sample: Sample) -> dict:
-    """The archive's variables over ``sample``: the drawn values of each field (named like a grid
-    dimension, `grid.dim_name`), and for the Saltelli design ``sample_block`` and ``sample_row``."""
-    import xarray as xr
-
-    from study.scene import field_doc, field_unit
-    from study.sweep.archive import cf_units
-    from study.sweep.grid import dim_name
-    out = {}
-    for f in sample.fields:
-        vals = sample.values[f.path]
-        out[dim_name(f.path)] = xr.Variable("sample", vals, {
-            "units": cf_units(field_unit(f.path)), "long_name": field_doc(f.path), "scene_field": f.path,
-            "distribution": f.describe()})
-    if sample.design == "saltelli":
-        out["sample_block"] = xr.Variable("sample", sample.block, {
-            "units": "1", "long_name": "matrix of the Saltelli design",
-            "comment": "0: A, 1: B, 2 + i: A with drawn field i (in the order of sample_fields) from B"})
-        out["sample_row"] = xr.Variable("sample", sample.row, {
-            "units": "1", "long_name": "row of the build in its matrix of the Saltelli design"})
-    return out
-
-
-def sample_attrs(sample: Sample) -> dict:
-    """Global attributes of a sampled study's archive."""
-    return {"sample_method": sample.method, "sample_size": sample.size, "sample_seed": sample.seed,
-            "sample_design": sample.design, "sample_fields": " ".join(sample.paths)}

@@ -16,12 +16,12 @@ point's share of the compute time (a shared task's time split equally over its p
 from __future__ import annotations
 
 import dataclasses
-import functools
 import hashlib
 import json
 from collections import Counter
 from dataclasses import dataclass
 
+from solver.store import STORE
 from study.scene import Scene
 from study.sweep.grid import Point, Study
 from study.sweep.outputs import Outputs, reads
@@ -69,9 +69,11 @@ class _Box:
     v: object
 
 
-@functools.lru_cache(maxsize=4096)
+READS = STORE.shelf("fields an analysis reads", 4096)     # (analysis, dotted field) -> whether it reads it
+
+
 def _reads(analysis: str, path: str) -> bool:
-    return reads(analysis, path)
+    return READS.kept((analysis, path), lambda: reads(analysis, path))
 
 
 def task_key(scene: Scene, outputs: Outputs) -> str:

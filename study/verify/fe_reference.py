@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.fe.ltca import ltca_sweep, mesh_points
+from solver.fe.ltca import ltca_sweep, teeth_in_mesh
 from study.archive.run_variables import opening_attrs
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
@@ -28,22 +28,6 @@ from study.scene_model import geometry_model, static_angles
 # the reference holds about four times the arrays of a static analysis an angle (contacts and
 # load sharing per angle): its angles are checked against memory with this factor
 REFERENCE_MEMORY_FACTOR = 4.0
-
-
-def teeth_in_mesh(model, angles) -> tuple[list, list, int]:
-    """Teeth of each gear that meet the mesh at ``angles`` [rad], and the largest index spread
-    between simultaneous candidates (for the solid body's symmetric columns)."""
-    s1, s2, spread = set(), set(), 1
-    z = model.teeth
-    for th in angles:
-        mp = mesh_points(model, float(th))
-        s1.update(int(t) % z[0] for t in mp.tooth1)
-        s2.update(int(t) % z[1] for t in mp.tooth2)
-        for t, zz in ((mp.tooth1, z[0]), (mp.tooth2, z[1])):
-            if t.size > 1:
-                d = (t[:, None] - t[None, :] + zz // 2) % zz - zz // 2
-                spread = max(spread, int(np.abs(d).max()))
-    return sorted(s1), sorted(s2), spread
 
 
 def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS, progress: bool = False):

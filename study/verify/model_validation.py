@@ -26,6 +26,7 @@ import xarray as xr
 from solver import units
 from solver.mbs.statics import solve_static
 from study.archive.netcdf import cf_variable, provenance
+from study.errors import check_scene_argument
 from study.scene import Scene
 from study.scene_model import build_scene_model
 from study.verify.fe_reference import reference
@@ -114,18 +115,21 @@ def _angles(rotation_deg: float, step_deg: float) -> np.ndarray:
     return np.radians(np.arange(int(math.floor(rotation_deg / step_deg + 1e-9)) + 1) * step_deg)
 
 
-def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), rims=(5.0, 7.0),
-                         rotation: float = 120.0, step: float = 0.1, models=MODELS, log=None) -> xr.Dataset:
-    """STE figures of every model over gear 2's body grid at the base scene's quasi-static torque,
+def design_space_dataset(scene: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), rims=(5.0, 7.0),
+                         rotation: float = 120.0, step: float = 0.1, log=None, models=MODELS) -> xr.Dataset:
+    """STE of every model (paper, body-torsion, compliance) and the FE reference over gear 2's
+    body: hole counts x web thickness [mm] x rim height [mm], at the scene's quasi-static torque,
     over ``rotation`` [deg] of the driver at ``step`` [deg] (a whole number of hole periods for
-    every hole count: 120 deg for 3, 6, 9 and 12 holes). ``log``: called with a line per body."""
+    every hole count: 120 deg for 3, 6, 9 and 12 holes) -> Dataset (mean, elastic mean and p2p
+    [um], hole-order amplitude [um], wall time [s]). ``log``: called with a line per body."""
+    check_scene_argument("validate_design_space", scene)
     shape = (len(holes), len(webs), len(rims), len(models))
     figs = {k: np.full(shape, np.nan) for k in ("mean", "elastic_mean", "p2p", "hole", "wall")}
     angles = _angles(rotation, step)
     for i, n in enumerate(holes):
         for j, web in enumerate(webs):
             for k, rim in enumerate(rims):
-                f = ste_figures(body_scene(base, n, web, rim), angles, models)
+                f = ste_figures(body_scene(scene, n, web, rim), angles, models)
                 for m, name in enumerate(models):
                     for key in figs:
                         figs[key][i, j, k, m] = f[name][key]
@@ -142,9 +146,21 @@ def design_space_dataset(base: Scene, holes=(0, 3, 6, 9, 12), webs=(6.0, 10.0), 
             "hole_amplitude": v(dims, figs["hole"], "um", "STE amplitude at the hole order of gear 2"),
             "wall_time": v(dims, figs["wall"], "s", "wall time of the model's STE (its FE included unless cached)")}
     attrs = {"title": "STE of the models against the FE reference over gear 2's body",
-             "static_torque_N_m": base.quasi_static.torque, "rotation_deg": rotation, "angle_step_deg": step,
-             "base_scene": base.to_toml(), **_target_attrs(), **provenance()}
+             "static_torque_N_m": scene.quasi_static.torque, "rotation_deg": rotation, "angle_step_deg": step,
+             "base_scene": scene.to_toml(), **_target_attrs(), **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def validate_bodies(scenes: dict, step: float = 0.1, models=("fe-reference", "compliance"), log=None) -> xr.Dataset:
+    """STE of ``models`` and the FE reference for named scenes ({name: Scene}, bodies of any
+    opening shape), each over two periods of its driven gear's openings at ``step`` [deg] ->
+    Dataset over (body, model): mean, elastic mean and p2p [um], opening-order amplitude [um]
+    (`bodies_dataset`); errors with `relative_errors`."""
+    from study.errors import check_argument, check_scene_argument
+    check_argument(isinstance(scenes, dict), "validate_bodies", "scenes", "a dict {name: Scene}", scenes)
+    for sc in scenes.values():
+        check_scene_argument("validate_bodies", sc)
+    return bodies_dataset(dict(scenes), step=step, models=tuple(models), log=log)
 
 
 def bodies_dataset(scenes: dict, step: float = 0.1, models=MODELS, log=None) -> xr.Dataset:
@@ -264,6 +280,16 @@ def relief_dataset(pairs: dict, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def validate_relief(scene: Scene, reliefs=(0.0, 1.0, 2.0, 3.0, 4.0, 6.0), torques=(25.0, 50.0, 100.0),
+                    step: float = 0.1, log=None) -> xr.Dataset:
+    """STE peak-to-peak of every model and the FE reference for the scene's pair with its driven
+    gear solid and as given, with a linear tip relief [um] of each amount on both gears at each
+    torque [N·m], and the relief that minimises it -> Dataset (`relief_dataset`)."""
+    check_scene_argument("validate_relief", scene)
+    return relief_dataset({"solid": scene.solid(), "paper": scene}, reliefs=reliefs, torques=torques,
+                          rotations={"solid": 30.0, "paper": 60.0}, step=step, log=log)
+
+
 def _target_attrs() -> dict:
     return {f"target_{k}": v for k, v in TARGETS.items()}
 
@@ -278,8 +304,9 @@ def relative_errors(ds: xr.Dataset) -> xr.Dataset:
     return xr.Dataset(out).drop_sel(model="fe-reference")
 
 
-def check_targets(ds: xr.Dataset, model: str) -> list[str]:
-    """The points where ``model`` misses a target of `TARGETS`, as text (empty: all met)."""
+def check_targets(ds: xr.Dataset, model: str = "compliance") -> list[str]:
+    """The points of a validation dataset where ``model`` misses a target of `TARGETS`, as text
+    (empty: all met)."""
     miss = []
     err = relative_errors(ds).sel(model=model)
     for key in ("elastic_mean", "p2p", "hole"):

@@ -122,10 +122,14 @@ def run_one(model, scene, method: str, duration: float, scipy_wall: float):
                              load_table=table), choice.dt
 
 
-def run_suite(scene, duration: float = 0.002, methods=METHODS, scipy_wall: float = 20.0, names=None,
+def run_suite(scene, duration: float = 0.002, methods=None, scipy_wall: float = 20.0, names=None,
               mesh_size: float = 1.0, progress=print) -> xr.Dataset:
-    """Run the suite -> dataset with dims (scene, method): status, message, TE range [um],
-    largest contact force [N], step [s], wall time [s]."""
+    """Stiff and extreme variants of a scene (`suite`), each run with every integrator of
+    ``methods`` (None: `METHODS`) -> Dataset over (scene, method): status, message, TE range
+    [um], largest contact force [N], step [s], wall time [s]."""
+    from study.errors import check_scene_argument
+    check_scene_argument("stability_suite", scene)
+    methods = tuple(methods or METHODS)
     scenes = [(n, o) for n, o in suite(scene) if names is None or n in names]
     shape = (len(scenes), len(methods))
     status = np.full(shape, "", dtype=object)

@@ -30,8 +30,9 @@ from solver import units
 from solver.fe.ltca import mesh_points
 from solver.mbs.statics import solve_static
 from study.archive.netcdf import cf_variable, provenance
-from study.scene_model import build_scene_model, coupling_fit, gear_setup
-from study.verify.fe_reference import reference
+from study.errors import check_argument, check_scene_argument, is_number
+from study.scene_model import build_scene_model, coupling_fit, gear_setup, static_angles
+from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, reference
 from study.verify.model_validation import order_amplitude, order_unresolved
 
 MODELS = ("fe-reference", "plain", "plain-fe", "coupled", "compliance")
@@ -122,6 +123,21 @@ METRIC_DOC = {
     "error_rms_double": ("um", "RMS STE error in double contact"),
     "load_share_error_max": ("1", "largest error in the load share of one driver tooth through the mesh"),
 }
+
+
+def validation(scene, step: float | None = None) -> xr.Dataset:
+    """STE of the pseudo-rigid models (plain, plain-fe, coupled, compliance) against the FE
+    reference for the scene's pair with its driven gear solid and lightened -> Dataset over
+    (pair, model, angle [degree]) with the error figures [um]; ``step`` [deg]: the driver angle
+    step (None: quasi_static.angle_step)."""
+    check_scene_argument("validation", scene)
+    check_argument(step is None or is_number(step), "validation", "step", "a number of degrees or None", step)
+    if scene.coupling.model != "none":       # the plain model is the scene's own; the coupled ones are built from it
+        scene = scene.replace(**{"coupling.model": "none"})
+    t0 = time.perf_counter()
+    ds = validation_dataset(scene, static_angles(scene, step, REFERENCE_MEMORY_FACTOR))
+    ds.attrs["wall_time_s"] = time.perf_counter() - t0
+    return ds
 
 
 def validation_dataset(scene, angles) -> xr.Dataset:

@@ -20,6 +20,13 @@ def small():
     return study.load_study("example_study").base_scene()
 
 
+@pytest.fixture(scope="module")
+def api_loaded():
+    """Every function the API offers, imported: the time of a refused call is then its check."""
+    for name in study.__all__:
+        getattr(study, name)
+
+
 @pytest.mark.parametrize("call, words", [
     (lambda s: study.load_scene({"gear2.body.holes": 3}), ["load_scene", "path", "dict"]),
     (lambda s: study.load_scene(5), ["load_scene", "path", "int"]),
@@ -37,7 +44,7 @@ def small():
     (lambda s: study.stiffness(None), ["stiffness", "scene", "NoneType"]),
     (lambda s: study.reference("paper"), ["reference", "scene", "str"]),
 ])
-def test_a_wrong_argument_type_raises_at_once_naming_it(call, words, small, tmp_path, monkeypatch):
+def test_a_wrong_argument_type_raises_at_once_naming_it(call, words, small, api_loaded, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     t0 = time.perf_counter()
     with pytest.raises(TypeError) as e:
@@ -154,3 +161,28 @@ def test_a_script_without_main_guard_stops_at_once_saying_what_to_add(guarded, t
         assert len(lines) == 1, r.stderr[-2000:]
         assert 'if __name__ == "__main__":' in lines[0] and "sweep_script.py" in lines[0]
         assert not (tmp_path / "s.nc").exists()
+
+
+def test_make_study_takes_the_sample_table_the_tolerance_page_documents():
+    """docs/tolerance.md: ``make_study(..., sample={...})`` draws scene fields like a study
+    file's [sample] table: the same draws as the file, within the distribution's range."""
+    sample = {"size": 8, "method": "sobol", "seed": 1, "gear1.errors.eccentricity": {"uniform": [0.0, 5.0]}}
+    st = study.make_study(None, {"gear1.errors.grade": [5, 7]}, outputs=["ste_p2p"], sample=sample)
+    assert st.sample.paths == ("gear1.errors.eccentricity",) and st.sample.builds == 8
+    drawn = st.sample.values["gear1.errors.eccentricity"]
+    assert drawn.shape == (8,) and (drawn >= 0.0).all() and (drawn <= 5.0).all() and np.unique(drawn).size == 8
+    same = study.study_from_dict({"grid": {"gear1.errors.grade": [5, 7]}, "sample": sample,
+                                  "outputs": {"scalars": ["ste_p2p"]}})
+    np.testing.assert_array_equal(same.sample.values["gear1.errors.eccentricity"], drawn)
+    with pytest.raises(study.StudyError, match="size"):
+        study.make_study(None, sample={**sample, "size": 0})
+
+
+def test_the_api_offers_each_function_itself_with_one_docstring():
+    """`study.NAME` is the function of the module that does the work (no wrapper repeating its
+    docstring), and each documents itself."""
+    import importlib
+    for name, (module, attribute) in study._OFFERED.items():
+        value = getattr(study, name)
+        assert value is getattr(importlib.import_module(module), attribute), name
+        assert value.__doc__ and len(value.__doc__) > 20, name

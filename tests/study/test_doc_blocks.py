@@ -82,7 +82,6 @@ def options_of(cmd: str) -> list[str]:
 # Python blocks that another test runs with checks of its results
 RUN_ELSEWHERE = {"README.md": "tests/study/test_api.py runs the README's first study and checks its numbers"}
 # Python blocks that wait for a fix of the code they document: strict xfail, so the fix shows up as a failure here
-AWAITING_FIX = {"docs/tolerance.md": "study.make_study takes no `sample` yet (TypeError)"}
 # the blocks cheap enough to run on every test run (seconds); the others are slow
 CHEAP_PYTHON = {"docs/tolerance.md"}
 
@@ -97,8 +96,6 @@ def python_params():
     out = []
     for b in blocks("python"):
         marks = []
-        if b.page in AWAITING_FIX:
-            marks.append(pytest.mark.xfail(strict=True, reason=AWAITING_FIX[b.page]))
         if b.page not in CHEAP_PYTHON:
             marks.append(pytest.mark.slow)
         out.append(pytest.param(b, id=str(b), marks=marks))

@@ -26,7 +26,7 @@ def test_points_that_differ_only_in_speed_share_the_model_and_the_rest_do_not():
 
 
 def test_the_kept_model_equals_one_built_afresh_and_gives_the_same_run():
-    scene_model._MODELS.clear()
+    scene_model.MODELS.clear()
     a = solid_scene(**SHORT)
     b = a.replace(**{"dynamic.speed": 1.5 * a.dynamic.speed})
     kept = kept_scene_model(a)
@@ -35,10 +35,10 @@ def test_the_kept_model_equals_one_built_afresh_and_gives_the_same_run():
     for name in ("gear_par", "pair_par", "law_par", "k_phi"):
         np.testing.assert_array_equal(getattr(kept, name), getattr(fresh, name))
     # a run after one at another speed: its model kept from that run, its numbers unchanged
-    scene_model._MODELS.clear()
+    scene_model.MODELS.clear()
     run_scene(a, warn=False, keep_model=True)
     ds_kept = run_scene(b, warn=False, keep_model=True)
-    assert len(scene_model._MODELS) == 1
+    assert len(scene_model.MODELS) == 1
     ds_fresh = run_scene(b, warn=False)
     for name in ("ste", "dte"):
         np.testing.assert_array_equal(ds_kept[name].values, ds_fresh[name].values)

@@ -8,8 +8,8 @@ import pytest
 from solver.mbs.kernels import layout as L
 from solver.pitch_errors import iso1328_pitch_tolerances
 from study.estimate import error_period_note
-from study.scene import SceneError, default_scene, loads_scene
-from study.scene_model import error_period, geometry_model, static_angles, static_rotation
+from study.scene import SceneError, default_scene, error_period, loads_scene, static_rotation
+from study.scene_model import geometry_model, static_angles
 
 E = "gear1.errors."
 E2 = "gear2.errors."

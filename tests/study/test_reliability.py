@@ -60,7 +60,7 @@ def test_precision_options_are_checked_before_any_work(tmp_path, capsys, option,
 
 
 def test_workflow_scripts_options_give_exit_2_not_a_traceback(tmp_path, capsys):
-    from study.cli import script_main
+    from study.process import script_main
     from workflows import sensitivity_sweep, validation
     assert script_main("validation", lambda: validation.main(["--step", "0", "-o", str(tmp_path / "v.nc")])) == 2
     assert "--step: the driver angle step must be a positive number" in capsys.readouterr().err

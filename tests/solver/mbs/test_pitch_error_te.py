@@ -9,7 +9,8 @@ from test_relief import RELIEF, RIGID, first_order_shift, kinematic_te, small
 from solver.mbs.kernels import layout as L
 from solver.mbs.statics import solve_static
 from solver.pitch_errors import iso1328_pitch_tolerances
-from study.scene_model import error_period, geometry_model, static_angles
+from study.scene import error_period
+from study.scene_model import geometry_model, static_angles
 
 PITCH = 15.0        # deg: one mesh pitch of the 24-tooth pair
 STIFF = {"gear1.spring.k_phi": 1e8, "gear2.spring.k_phi": 1e8, "gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0,

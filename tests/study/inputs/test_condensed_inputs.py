@@ -4,6 +4,7 @@ of its rim height (in memory and from the disk cache), and another rim height ge
 import numpy as np
 import pytest
 
+from solver.store import STORE
 from study.inputs import compliance, springs
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import gear_setup
@@ -58,7 +59,7 @@ def test_a_rim_read_from_disk_gives_the_same_inputs_and_another_rim_height_its_o
             f.unlink()
     for a, b in zip(first, _inputs(setup)):
         assert np.array_equal(a, b)
-    FE_CACHE.clear()                                        # a new process: the rim from disk
+    STORE.clear()                                        # a new process: the rim from disk
     for f in (tmp_path / "cache" / "fe").glob("*"):
         if not f.name.startswith("rim-"):
             f.unlink()
@@ -81,7 +82,7 @@ def test_a_body_gets_the_same_bits_whichever_body_of_its_rim_condensed_it(tmp_pa
     first, other = (gear_setup(small_scene(**kw), 2) for kw in ({}, {"gear2.body.holes": 0, "gear2.body.web_thickness": 5.0}))
     _inputs(first)                                          # condenses the rim from the first body's mesh
     kept = _inputs(other)                                   # the rim in memory
-    FE_CACHE.clear()                                        # a new process: the rim from disk
+    STORE.clear()                                        # a new process: the rim from disk
     for f in (tmp_path / "cache" / "fe").glob("*"):
         if not f.name.startswith("rim-"):
             f.unlink()

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from solver.geometry import gear_geometry
+from solver.store import STORE
 from study.inputs.cache import BODY_SLOTS, FECache
 from study.inputs.gearsetup import gear_setup, gear_setups
 from study.scene import default_scene
@@ -53,7 +54,7 @@ def test_fe_cache_reads_back_from_disk_and_forgets_memory_on_clear(tmp_path, mon
     got = cache.read_stiffness("k")
     got[0] = 99.0                                   # callers get copies
     assert np.array_equal(cache.read_stiffness("k"), k)
-    cache.clear()
+    STORE.clear()
     assert not cache.stiffness and np.array_equal(cache.read_stiffness("k"), k)    # from disk
     (tmp_path / "fe" / "bad.nc").write_text("not NetCDF")
     assert cache.read_stiffness("bad") is None      # unreadable: recomputed by the caller
@@ -67,5 +68,5 @@ def test_fe_cache_keeps_the_last_bodies_and_fits():
     # "a" stays the most recently used: "b" was dropped for "c", then "c" for "b"
     assert built == ["a", "b", "c", "b"] and len(cache.bodies) == BODY_SLOTS
     assert cache.fit(("x", 1), lambda: [1]) is cache.fit(("x", 1), lambda: [2])
-    cache.clear()
+    STORE.clear()
     assert not cache.bodies and not cache.fits

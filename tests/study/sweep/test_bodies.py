@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from helpers import scene_overrides
 
+from solver.store import STORE
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import gear_setup
 from study.inputs.springs import tooth_springs
@@ -81,7 +82,7 @@ def test_a_dask_sweep_computes_each_map_once_before_the_tasks_that_read_it(tmp_p
     # once and joins each later web to it; on dask the rim's first job condenses it and the
     # other jobs read it, its nodes included, from the disk
     monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "another cache"))
-    FE_CACHE.clear()
+    STORE.clear()
     alone = run_sweep(st, tmp_path / "alone.nc", workers=0, progress=False)
     for name in ("ste_p2p", "dte_rms", "root_stress_max_gear2"):
         np.testing.assert_array_equal(res.dataset[name].values, alone.dataset[name].values, err_msg=name)
@@ -120,7 +121,7 @@ def test_the_compliance_model_lists_one_body_job_per_gear_body_and_the_solid_ref
     for _key, func, args in fe_jobs(scene):
         func(*args)
     assert fe_jobs(scene) == []
-    FE_CACHE.clear()                      # and it is on disk, not only in this process
+    STORE.clear()                      # and it is on disk, not only in this process
     assert fe_jobs(scene) == []
 
 
@@ -146,7 +147,7 @@ def test_a_compliance_sweep_on_dask_equals_the_one_that_computes_its_fe_in_the_t
     assert first and all(set(after) <= first and len(after) == 1 for after in fe.values() if after)
     assert (res.dataset["status"] == STATUS.index("ok")).all()
     monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "another cache"))
-    FE_CACHE.clear()
+    STORE.clear()
     alone = run_sweep(st, tmp_path / "alone.nc", workers=0, progress=False)
     # equal to round-off: the compliance comes from another process (and the disk) in one, the
     # same factorisation in the other: they differ in the last digits (2e-10 relative measured)

@@ -151,7 +151,7 @@ def test_points_of_one_model_share_its_springs_and_model_only():
     other = kept_springs_and_model(base.replace(**{"gear2.body.holes": 0}))
     assert other[1] is not model and other[1].body_inertia[1] > model.body_inertia[1]     # no holes: heavier
     # the FE cache cleared (or another one): the springs are read again, not kept from before
-    from study.inputs.cache import FE_CACHE
-    FE_CACHE.clear()
+    from solver.store import STORE
+    STORE.clear()
     again = kept_springs_and_model(base.replace(**{"gear2.body.holes": 0}))
     assert again[0] is not other[0]

@@ -1,0 +1,71 @@
+"""The test tiers (`tiers`): a test is marked by what its code, its fixtures and the helpers it
+calls reach, so that ``make test-fast`` leaves out exactly the tests that run the FE, the solver
+or other processes."""
+import subprocess
+import types
+
+import pytest
+import tiers
+
+import study
+from solver.mbs.statics import solve_static
+from study.cli import main
+from study.scene import load_scene
+
+
+def _pure():
+    return load_scene("small_pair").gear1.teeth
+
+
+def _runs():
+    return study.run_scene(load_scene("small_pair"))
+
+
+def _helper_solves(model):
+    return solve_static(model, [0.0], 1.0)
+
+
+def _calls_helper():
+    return _helper_solves(None)
+
+
+def _starts_a_process():
+    return subprocess.run(["true"])
+
+
+def _command_line():
+    return main(["scenes"])
+
+
+def _fe_fixture():
+    from study.inputs.springs import tooth_springs
+    return tooth_springs
+
+
+class _Item:
+    """What `tiers.mark` reads of a collected test: its function, its fixture closure and defs."""
+
+    def __init__(self, function, fixtures=None):
+        self.function = function
+        self.fixturenames = list(fixtures or {})
+        defs = {name: [types.SimpleNamespace(func=f)] for name, f in (fixtures or {}).items()}
+        self._fixtureinfo = types.SimpleNamespace(name2fixturedefs=defs)
+        self.markers = []
+
+    def add_marker(self, marker):
+        self.markers.append(marker.name)
+
+
+@pytest.mark.parametrize("function, fixtures, markers", [
+    (_pure, None, []),
+    (_runs, None, ["solver"]),                            # study.run_scene -> study.run
+    (_calls_helper, None, ["solver"]),                    # through a helper of the test file
+    (_starts_a_process, None, ["process"]),
+    (_command_line, None, ["solver"]),                    # the command line runs whatever it is given
+    (_pure, {"bodies": _fe_fixture}, ["fe"]),             # through a fixture
+    (_pure, {"private_fe_cache": _pure}, ["fe"]),
+])
+def test_a_test_is_marked_by_what_it_reaches(function, fixtures, markers):
+    item = _Item(function, fixtures)
+    tiers.mark([item], pytest)
+    assert sorted(item.markers) == markers
