@@ -129,9 +129,12 @@ def flankless_model(scene: Scene, springs=None) -> Model:
     """The scene's model with perfect involutes and no pitch errors, its dampers as given (the
     ratios not converted): what the builds of a tolerance study, which draw the reliefs, pitch
     deviations and runout, have in common (geometry, inertia, FE springs and body coupling,
-    contact law). Kept for the last `FLANKLESS_SLOTS` scenes by `model_key` without the flanks;
-    shared, never changed in place (`with_flank_deviations` copies the arrays it writes)."""
-    key = model_key(scene, springs, False, flanks=False)
+    contact law). Kept for the last `FLANKLESS_SLOTS` scenes by `model_key` without the flanks
+    and the FE cache it read; shared, never changed in place (`build_scene_model` hands out
+    `with_flank_deviations`' copies)."""
+    # the FE cache's folder and generation: springs read from another cache, or from one cleared
+    # since, are made again (as `study.run.kept_springs_and_model`)
+    key = (model_key(scene, springs, False, flanks=False), str(FE_CACHE.folder), FE_CACHE.generation)
     if key in _FLANKLESS:
         _FLANKLESS.move_to_end(key)
         return _FLANKLESS[key]

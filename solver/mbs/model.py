@@ -244,8 +244,9 @@ def with_flank_deviations(model: Model, modifications, errors) -> Model:
     """A copy of ``model`` with the gears' profile modifications ((ProfileModification |
     None) x 2) and pitch errors ((GearErrors | None) x 2) in place of its own: the deviation
     columns DEV_* of gear_par and the errors block E_* of pair_par written anew (`build_model`
-    writes them the same way), the other arrays shared. What a sampled build of a tolerance
-    study changes: its model is the study's one with these rewritten, not built again."""
+    writes them the same way), its other arrays copied (the caller may change the copy in place;
+    the geometry objects are shared). What a sampled build of a tolerance study changes: its
+    model is the study's one with these rewritten, not built again."""
     geos = model.geometry
     gp = model.gear_par.copy()
     for i, (name, mod, g) in enumerate(zip(("gear1", "gear2"), modifications, geos)):
@@ -261,7 +262,8 @@ def with_flank_deviations(model: Model, modifications, errors) -> Model:
     if inputs:
         inputs = tuple(dataclasses.replace(gi, modification=mod, errors=e)
                        for gi, mod, e in zip(inputs[:2], modifications, errors)) + tuple(inputs[2:])
-    return dataclasses.replace(model, gear_par=gp, pair_par=pp, inputs=inputs)
+    return dataclasses.replace(model, gear_par=gp, pair_par=pp, law_par=model.law_par.copy(), k_phi=model.k_phi.copy(),
+                               tooth_compliance=model.tooth_compliance.copy(), inputs=inputs)
 
 
 def _check_compliance(gi: GearInput, z: int, name: str) -> None:

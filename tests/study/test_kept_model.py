@@ -110,3 +110,16 @@ def test_a_tolerance_study_builds_its_model_once_and_archives_what_a_model_per_b
     drop = ["wall_time"]
     xr.testing.assert_identical(once.drop_vars(drop).load().assign_attrs(created="", history=""),
                                 each.drop_vars(drop).load().assign_attrs(created="", history=""))
+
+
+def test_a_model_changed_in_place_leaves_the_kept_flankless_one_and_the_next_build_alone():
+    _clear()
+    a = solid_scene(**SHORT, **RELIEF)
+    first = build_scene_model(a)
+    for name in ("gear_par", "pair_par", "law_par", "k_phi"):
+        getattr(first, name)[...] *= 2.0
+    again = build_scene_model(a)
+    scene_model._FLANKLESS.clear()
+    fresh = build_scene_model(a)
+    for name in ("gear_par", "pair_par", "law_par", "k_phi"):
+        np.testing.assert_array_equal(getattr(again, name), getattr(fresh, name))
