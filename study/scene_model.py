@@ -99,15 +99,19 @@ def kept_scene_model(scene: Scene, springs=None) -> Model:
     point that differs from an earlier one of the process only in ``dynamic.*`` builds nothing,
     its damping conversion (dozens of modal analyses) included. For callers that never change
     a model in place (the solver does not; the sweep's tasks do not): the object is shared."""
-    key = model_key(scene, springs, True)
-    if key in _MODELS:
-        _MODELS.move_to_end(key)
-        return _MODELS[key]
-    model = build_scene_model(scene, springs)
-    _MODELS[key] = model
-    while len(_MODELS) > MODEL_SLOTS:
-        _MODELS.popitem(last=False)
-    return model
+    return _kept(_MODELS, model_key(scene, springs, True), MODEL_SLOTS, lambda: build_scene_model(scene, springs))
+
+
+def _kept(store: OrderedDict, key, slots: int, make):
+    """``make()`` kept in ``store`` by ``key``, the last ``slots`` entries (least recently used out)."""
+    if key in store:
+        store.move_to_end(key)
+        return store[key]
+    value = make()
+    store[key] = value
+    while len(store) > slots:
+        store.popitem(last=False)
+    return value
 
 
 def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) -> Model:
@@ -135,14 +139,7 @@ def flankless_model(scene: Scene, springs=None) -> Model:
     # the FE cache's folder and generation: springs read from another cache, or from one cleared
     # since, are made again (as `study.run.kept_springs_and_model`)
     key = (model_key(scene, springs, False, flanks=False), str(FE_CACHE.folder), FE_CACHE.generation)
-    if key in _FLANKLESS:
-        _FLANKLESS.move_to_end(key)
-        return _FLANKLESS[key]
-    model = _build_flankless(scene, springs)
-    _FLANKLESS[key] = model
-    while len(_FLANKLESS) > FLANKLESS_SLOTS:
-        _FLANKLESS.popitem(last=False)
-    return model
+    return _kept(_FLANKLESS, key, FLANKLESS_SLOTS, lambda: _build_flankless(scene, springs))
 
 
 def _build_flankless(scene: Scene, springs) -> Model:
