@@ -14,7 +14,7 @@ import numpy as np
 
 from solver import units
 from solver.mbs.kernels import layout as L
-from solver.mbs.model import ContactLaw, GearInput, Model, build_model
+from solver.mbs.model import ContactLaw, GearInput, Model, build_model, with_flank_deviations
 from solver.store import STORE, digest
 from study.errors import BudgetError
 from study.inputs import coupling
@@ -77,12 +77,17 @@ MODEL_SLOTS = 4     # built models kept in a process: a study's worker runs many
 MODELS = STORE.shelf("scene models", MODEL_SLOTS)
 
 
-def model_key(scene: Scene, springs, convert_damping: bool) -> str:
+def model_key(scene: Scene, springs, convert_damping: bool, flanks: bool = True) -> str:
     """What a scene's model depends on: every field but ``dynamic.*`` (the run, not the model)
     except the mean load the damping ratios are converted at, the springs given and whether the
-    ratios are converted. Points of a study that differ only in speed share it."""
+    ratios are converted. Points of a study that differ only in speed share it. Without
+    ``flanks``, the gears' ``modification`` and ``errors`` are left out too (`flankless_model`)."""
     data = dataclasses.asdict(scene)
     data.pop("dynamic", None)
+    if not flanks:
+        for g in ("gear1", "gear2"):
+            data[g].pop("modification", None)
+            data[g].pop("errors", None)
     data["mean_load"] = mean_load(scene)
     data["convert_damping"] = convert_damping
     if springs is not None:
@@ -101,7 +106,32 @@ def kept_scene_model(scene: Scene, springs=None) -> Model:
 def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) -> Model:
     """The solver model of a scene (SI). ``springs`` = ((k1, r1), (k2, r2)) skips the FE of
     the tooth springs (a coupled model still takes its body springs from the FE).
-    ``convert_damping=False`` leaves the dampers given as ratios at zero (`damping_from_ratios`)."""
+    ``convert_damping=False`` leaves the dampers given as ratios at zero (`damping_from_ratios`).
+    The model without the flank deviations and pitch errors is made once for the scenes that
+    differ only in those (`flankless_model`); the scene's own are written into a copy."""
+    flanks = tuple(scene.modification_spec(g) for g in (1, 2)), tuple(scene.errors_spec(g) for g in (1, 2))
+    model = with_flank_deviations(flankless_model(scene, springs), *flanks)
+    return damping_from_ratios(scene, model) if convert_damping else model
+
+
+FLANKLESS_SLOTS = 2     # a tolerance study's builds share one; its geometry model a second
+FLANKLESS = STORE.shelf("flankless models", FLANKLESS_SLOTS)
+
+
+def flankless_model(scene: Scene, springs=None) -> Model:
+    """The scene's model with perfect involutes and no pitch errors, its dampers as given (the
+    ratios not converted): what the builds of a tolerance study, which draw the reliefs, pitch
+    deviations and runout, have in common (geometry, inertia, FE springs and body coupling,
+    contact law). Kept for the last `FLANKLESS_SLOTS` scenes by `model_key` without the flanks
+    and the FE cache it read; shared, never changed in place (`build_scene_model` hands out
+    `with_flank_deviations`' copies)."""
+    # the FE cache's folder: springs read from another cache are made again (as
+    # `study.run.kept_springs_and_model`; `solver.store.STORE.clear` empties this shelf too)
+    key = digest(model_key(scene, springs, False, flanks=False), str(FE_CACHE.folder))
+    return FLANKLESS.kept(key, lambda: _build_flankless(scene, springs))
+
+
+def _build_flankless(scene: Scene, springs) -> Model:
     setups = gear_setups(scene)
     springs = springs or scene_springs(scene, setups)
     gears = []
@@ -121,14 +151,12 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
                                k_phi=units.spring_stiffness_to_si(np.asarray(k_phi, float)),
                                n_k=n_k, c_phi=units.spring_damping_to_si(0.0 if math.isnan(sp.c_phi) else sp.c_phi),
                                n_c=sp.n_c, body_stiffness=k_body, tooth_compliance=cmat,
-                               modification=scene.modification_spec(setup.gear),
-                               errors=scene.errors_spec(setup.gear), contact_compliance=cloc))
+                               contact_compliance=cloc))
     c = scene.contact
     law = ContactLaw(units.contact_stiffness_to_si(c.k_con, c.m1), c.m1,
                      units.contact_damping_to_si(0.0 if math.isnan(c.c_con) else c.c_con, c.m2, c.m3), c.m2, c.m3,
                      mu=c.friction, friction_velocity=c.friction_velocity * units.MM)
-    model = build_model(gears[0], gears[1], law, setups[0].material)
-    return damping_from_ratios(scene, model) if convert_damping else model
+    return build_model(gears[0], gears[1], law, setups[0].material)
 
 
 def damping_ratios(scene: Scene) -> dict:

@@ -10,6 +10,7 @@ Gear 1 turns counter-clockwise and drives with the "+" flanks; gear 2 turns cloc
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -207,9 +208,6 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
         gp[i, L.N_C] = gi.n_c
         gp[i, L.TOOTH0] = tooth0[i]
         gp[i, L.NZ] = g.teeth
-        if gi.modification is not None:
-            gi.modification.check(g.u_form, g.u_tip, ("gear1", "gear2")[i])
-        sample_deviation(gi.modification, g.u_form, g.u_tip, gp[i])
         if gi.contact_compliance is not None:
             sample_local_compliance(gi.contact_compliance, g.u_form, g.u_tip, gp[i], ("gear1", "gear2")[i])
         if gi.body_stiffness != math.inf:
@@ -223,11 +221,6 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
     pp[L.JN_HALF] = 0.5 * pair.normal_backlash
     pp[L.ALPHA] = pair.pressure_angle
     pp[L.MARGIN] = presearch_margin * max(geos[0].pitch_angle, geos[1].pitch_angle)
-    for name, gi, g in (("gear1", gear1, geos[0]), ("gear2", gear2, geos[1])):
-        if gi.errors is not None:
-            # limited to 0.1 module: a few % of a pitch, well inside the pre-search margin
-            gi.errors.check(g.teeth, g.spec.module, name)
-    pp = np.concatenate([pp, error_block((gear1.errors, gear2.errors), geos)])
     lp = np.zeros(L.N_LAW_PAR)
     lp[[L.K_CON, L.M1, L.C_CON, L.M2, L.M3, L.MU, L.V_REG]] = law.k, law.m1, law.c, law.m2, law.m3, law.mu, law.friction_velocity
     kphi = np.concatenate(own)
@@ -243,7 +236,34 @@ def build_model(gear1: GearInput, gear2: GearInput, law: ContactLaw, material: M
         ctooth = np.zeros((kphi.size, kphi.size))
         ctooth[:n1, :n1] = blocks[0]
         ctooth[n1:, n1:] = blocks[1]
-    return Model(gp, pp, lp, kphi, tuple(geos), pair, tuple(inert), tuple(bodies), (gear1, gear2, law, material), ctooth)
+    model = Model(gp, pp, lp, kphi, tuple(geos), pair, tuple(inert), tuple(bodies), (gear1, gear2, law, material), ctooth)
+    return with_flank_deviations(model, (gear1.modification, gear2.modification), (gear1.errors, gear2.errors))
+
+
+def with_flank_deviations(model: Model, modifications, errors) -> Model:
+    """A copy of ``model`` with the gears' profile modifications ((ProfileModification |
+    None) x 2) and pitch errors ((GearErrors | None) x 2) in place of its own: the deviation
+    columns DEV_* of gear_par and the errors block E_* of pair_par written anew (`build_model`
+    writes them the same way), its other arrays copied (the caller may change the copy in place;
+    the geometry objects are shared). What a sampled build of a tolerance study changes: its
+    model is the study's one with these rewritten, not built again."""
+    geos = model.geometry
+    gp = model.gear_par.copy()
+    for i, (name, mod, g) in enumerate(zip(("gear1", "gear2"), modifications, geos)):
+        if mod is not None:
+            mod.check(g.u_form, g.u_tip, name)
+        sample_deviation(mod, g.u_form, g.u_tip, gp[i])
+    for name, e, g in zip(("gear1", "gear2"), errors, geos):
+        if e is not None:
+            # limited to 0.1 module: a few % of a pitch, well inside the pre-search margin
+            e.check(g.teeth, g.spec.module, name)
+    pp = np.concatenate([model.pair_par[:L.N_PAIR_PAR], error_block(errors, geos)])
+    inputs = model.inputs
+    if inputs:
+        inputs = tuple(dataclasses.replace(gi, modification=mod, errors=e)
+                       for gi, mod, e in zip(inputs[:2], modifications, errors)) + tuple(inputs[2:])
+    return dataclasses.replace(model, gear_par=gp, pair_par=pp, law_par=model.law_par.copy(), k_phi=model.k_phi.copy(),
+                               tooth_compliance=model.tooth_compliance.copy(), inputs=inputs)
 
 
 def _check_compliance(gi: GearInput, z: int, name: str) -> None:

@@ -84,7 +84,14 @@ def te_participation(M, C, lam, u, te, mesh) -> np.ndarray:
     return np.abs((te @ u) * (mesh @ u)) / np.maximum(np.abs(a * lam), 1e-300)
 
 
-def _damped_modes(sy: LinearSystem, C):
+def _state_parts(sy: LinearSystem) -> tuple:
+    """(M^-1, -M^-1 K) of ``sy``: the parts of the state-space matrix of `_damped_modes` that do
+    not depend on the damping, made once for the many dampings a ratio search tries on it."""
+    mi = np.linalg.inv(sy.M)
+    return mi, -mi @ sy.K
+
+
+def _damped_modes(sy: LinearSystem, C, parts: tuple | None = None):
     """(natural frequency |lambda| [rad/s], damping ratio -Re(lambda)/|lambda| [1], kinetic-energy
     shares (dof, mode), index of the mesh mode) of the oscillating modes of
     M x'' + C x' + K x = 0 (the state-space eigenproblem: exact for non-proportional damping,
@@ -92,11 +99,12 @@ def _damped_modes(sy: LinearSystem, C):
     modes are left out. The mesh mode is the one whose resonance puts the most into the TE at
     the hubs under a force at the mesh: `te_participation` over the damping ratio (the peak of
     a lightly damped mode; at least 1e-3 counted, so that an undamped pair falls back on the
-    static share), the resonance a run-up shows."""
+    static share), the resonance a run-up shows. ``parts``: `_state_parts` of ``sy`` when
+    already made."""
     M, K = sy.M, sy.K
     n = M.shape[0]
-    mi = np.linalg.inv(M)
-    lam, v = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [-mi @ K, -mi @ C]]))
+    mi, mik = parts or _state_parts(sy)
+    lam, v = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [mik, -mi @ C]]))
     wn = np.abs(lam)
     # rigid-like modes (unloaded teeth on their regularised springs) are left out by comparison
     # with the driven hub on its own stiffness, not with the highest mode: with very stiff
@@ -111,8 +119,8 @@ def _damped_modes(sy: LinearSystem, C):
     return np.abs(lam), zeta, share, mesh
 
 
-def _mesh_damping(sy: LinearSystem, C) -> float:
-    w, z, share, i = _damped_modes(sy, C)
+def _mesh_damping(sy: LinearSystem, C, parts: tuple | None = None) -> float:
+    w, z, share, i = _damped_modes(sy, C, parts)
     return float(z[i])
 
 
@@ -191,8 +199,10 @@ def _solve_scale(parts, zeta: float, what: str) -> float:
     mean over the positions ``parts`` [(LinearSystem, C0, C1)], is ``zeta``. The ratio grows
     with s from that of C0 up to a largest value (a very stiff damper locks its joint) and
     falls after it: the root below that largest value is taken."""
+    state = [_state_parts(sy) for sy, _, _ in parts]
+
     def mean(s):
-        return float(np.mean([_mesh_damping(sy, C0 + s * C1) for sy, C0, C1 in parts]))
+        return float(np.mean([_mesh_damping(sy, C0 + s * C1, st) for (sy, C0, C1), st in zip(parts, state)]))
     z0 = mean(0.0)
     if z0 > zeta:
         raise ValueError(f"the other dampers alone give the mesh mode {z0:.4g} of critical, more than {zeta:.4g}")
@@ -201,9 +211,9 @@ def _solve_scale(parts, zeta: float, what: str) -> float:
     # first guess: the proportional-damping estimate x^T C1 x / (2 w), linear in s, on the
     # undamped mode nearest the damped mesh mode
     est = []
-    for sy, C0, C1 in parts:
+    for (sy, C0, C1), st in zip(parts, state):
         w, x = _modes(sy.M, sy.K)
-        wd, _z, _share, i = _damped_modes(sy, C0)
+        wd, _z, _share, i = _damped_modes(sy, C0, st)
         j = int(np.argmin(np.abs(w - wd[i])))
         est.append(0.5 * x[:, j] @ C1 @ x[:, j] / w[j])
     unit = float(np.mean(est))

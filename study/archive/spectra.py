@@ -133,6 +133,20 @@ def named_orders(hole_order: float, mesh_order: float, mesh_harmonics: int = 5, 
     return out
 
 
+def _lobe_window(order: np.ndarray):
+    """``window(o, w)`` -> (lo, hi): a slice of ``order`` that holds every bin within ``w`` of
+    ``o`` (a few bins more on each side, the exact test is the caller's), found by bisection on
+    an increasing axis; the whole axis when it is not increasing (NaN orders)."""
+    if order.size < 2 or not np.all(np.diff(order) > 0):
+        return lambda o, w: (0, order.size)
+
+    def window(o, w):
+        lo = int(np.searchsorted(order, o - w, "left")) - 2
+        hi = int(np.searchsorted(order, o + w, "right")) + 2
+        return max(lo, 0), min(hi, order.size)
+    return window
+
+
 def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resolution: float,
                 mesh_harmonics: int = 5, hole_harmonics: int = 2, unexplained: int = 4,
                 min_order: float = 0.5, revolution_orders: tuple | None = None) -> list[Peak]:
@@ -159,15 +173,18 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
     is_peak[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
     peaks = []
     nominal = []
+    window = _lobe_window(order)
     for name, o in table:
-        sel = np.zeros(order.size, bool)
+        i = None
         if np.isfinite(o):
             # search the main lobe, but no closer to another named order (or to 0) than half way
             d = np.abs(finite - o)
             w = min(tol, 0.5 * d[d > 1e-9].min()) if np.any(d > 1e-9) else tol
-            sel = np.abs(order - o) <= w
+            lo, hi = window(o, w)
+            sel = np.abs(order[lo:hi] - o) <= w
+            if sel.any():
+                i = lo + np.flatnonzero(sel)[np.argmax(amp[lo:hi][sel])]
             nominal.append(o)
-        i = np.flatnonzero(sel)[np.argmax(amp[sel])] if sel.any() else None
         if no_holes and name.endswith("N"):
             i = None
         if i is not None and is_peak[i]:
@@ -189,9 +206,9 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
         side = hole_order if np.isfinite(hole_order) and hole_order > 0 else 0.0
         j = np.arange(-sidebands, sidebands + 1) * side
         nominal = np.concatenate([nominal, (k[:, None] * mesh_order + j[None, :]).ravel()])
-    if nominal.size:
-        is_max &= np.min(np.abs(order[:, None] - nominal[None, :]), axis=1) > tol
     idx = np.flatnonzero(is_max)
+    if nominal.size and idx.size:    # the distances at the candidate maxima only (not every bin)
+        idx = idx[np.min(np.abs(order[idx, None] - nominal[None, :]), axis=1) > tol]
     idx = idx[np.argsort(-amp[idx])]
     chosen: list[int] = []
     for i in idx:   # one maximum per main lobe (zero padding makes side-by-side maxima)

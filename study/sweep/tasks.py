@@ -22,7 +22,7 @@ from collections import Counter
 from dataclasses import dataclass
 
 from solver.store import STORE
-from study.scene import Scene
+from study.scene import GearSection, Scene
 from study.sweep.grid import Point, Study
 from study.sweep.outputs import Outputs, reads
 
@@ -125,9 +125,12 @@ BATCHES_PER_WORKER = 4
 
 
 def model_group(scene: Scene) -> tuple:
-    """What a task's model depends on: every scene field but ``dynamic.*`` (the points of one
-    group share the model a worker keeps)."""
-    return scene.model_sections()
+    """What a task's model depends on: every scene field but ``dynamic.*`` and the gears'
+    ``modification`` and ``errors`` (the points of one group share the model a worker keeps,
+    the sampled builds of a tolerance study its model without those:
+    `study.scene_model.flankless_model`)."""
+    return tuple(dataclasses.replace(s, modification=None, errors=None) if isinstance(s, GearSection) else s
+                 for s in scene.model_sections())
 
 
 def batches(tasks: list[Task], workers: int) -> list[tuple[Task, ...]]:
