@@ -362,14 +362,21 @@ def fit_contact(scene, depth_fraction: float = 0.5):
     return fit(scene, depth_fraction)
 
 
-def reference(scene, step: float | None = None, max_time: float | None = None, progress: bool = False):
-    """FE reference STE by loaded-tooth-contact analysis (`lightgear reference`) -> xarray.Dataset
-    (``ste`` [um] over ``angle`` [degree], ``ste_tooth_force`` [N]); ``step`` [deg]: driver angle
-    step (None: quasi_static.angle_step); ``max_time`` [s]: refuse a longer estimate (BudgetError)."""
+def reference(scene, step: float | None = None, max_time: float | None = None, progress: bool = False,
+              solver: str = "ltca", flank_size: float | None = None, contact_stiffness: float | None = None):
+    """FE reference STE (`lightgear reference`) -> xarray.Dataset (``ste`` [um] over ``angle``
+    [degree], attribute ``backlash_offset_um``); ``step`` [deg]: driver angle step (None:
+    quasi_static.angle_step); ``max_time`` [s]: refuse a longer estimate (BudgetError).
+    ``solver``: "ltca" (default: loaded-tooth-contact analysis, also ``ste_tooth_force`` [N]) or
+    "calculix" (the independent FE contact peer; needs ccx) with ``flank_size`` [mm] and
+    ``contact_stiffness`` [MPa/mm] (None: the defaults)."""
     from study.commands import reference as run
     _check_scene("reference", scene)
     _check(step is None or _number(step), "reference", "step", "a number of degrees or None", step)
-    return run(scene, step, max_time, progress)
+    _check(solver in ("ltca", "calculix"), "reference", "solver", "'ltca' or 'calculix'", solver)
+    for name, v in (("flank_size", flank_size), ("contact_stiffness", contact_stiffness)):
+        _check(v is None or _number(v), "reference", name, "a number or None", v)
+    return run(scene, step, max_time, progress, solver, flank_size, contact_stiffness)
 
 
 def precision(scene, output=None, duration: float = 0.002, ramp_fraction: float = 0.5, rotation: float = 6.0,
