@@ -152,14 +152,17 @@ class Outline:
     bore_radius: float      # m
 
 
-def build_outline(gmsh, g: GearGeometry, body: BodySpec, h: float, rim: bool = True, deviation=None) -> Outline:
+def build_outline(gmsh, g: GearGeometry, body: BodySpec, h: float, rim: bool = True, deviation=None,
+                  n_flank: int = 12) -> Outline:
     """Add the gear body to the current gmsh model (gear frame, tooth k's axis at 2*pi*k/z):
     the outline of all teeth with points of size ``h`` [m] (``h/2`` on the fillets), the
     rim, web (pierced by the holes) and hub as plane surfaces; ``rim=False``: web and hub only
-    (see `mesh_body`); ``deviation``: the flanks' profile modification (`tooth_pieces`)."""
+    (see `mesh_body`); ``deviation``: the flanks' profile modification (`tooth_pieces`);
+    ``n_flank``: points of each flank's spline (12: the involute within a few um, enough for a
+    body loaded at given points; a contact analysis needs ~150, within 0.01 um)."""
     geo = gmsh.model.geo
     h_body = 5.0 * h
-    pieces = tooth_pieces(g, deviation=deviation)
+    pieces = tooth_pieces(g, n=n_flank, deviation=deviation)
     # ---- outline: one spline per piece, shared end points between pieces and teeth
     first_tag = None
     prev_tag = None
