@@ -17,9 +17,18 @@ from solver.peers.calculix import CalculixSettings, PeerGear, default_settings, 
 from study.scene import Scene, SceneError
 from study.scene_model import geometry_model
 
-# ccx CPU seconds per 1000 nodes of a deck (paper pair, 0.05 mm flanks: ~100k nodes, 30-100 s);
-# used only for the estimate printed before a run
-CPU_S_PER_KNODE = 0.6
+# wall time [s] of one deck at the default flank size (module/30) on a quiet machine (the paper
+# pair: 30-100 s); the nodes, and the time, grow about as flank_size**-1.5 (only the estimate
+# printed before a run and checked against --max-time uses it)
+DECK_S = 60.0
+
+
+def peer_estimate(n_decks: int, settings: CalculixSettings, module: float):
+    """`study.estimate.Estimate` of a peer run: ``n_decks`` decks at ``settings``, module [m]."""
+    from study.estimate import Estimate
+    per = DECK_S * (module / 30.0 / settings.sizes.flank) ** 1.5
+    return Estimate(seconds={"CalculiX decks": n_decks * per},
+                    levers={"CalculiX decks": "fewer angles (a larger --step) or a larger --flank-size"})
 
 
 def peer_gears(scene: Scene) -> tuple:
@@ -51,9 +60,10 @@ def settings_for(scene: Scene, flank_size_mm: float | None = None, contact_stiff
 
 
 def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | None = None, progress: bool = False,
-                     keep: str | None = None) -> xr.Dataset:
+                     keep: str | None = None, starts=None) -> xr.Dataset:
     """Peer reference archive of the scene at driver ``angles`` [rad] (default: the quasi-static
-    angles) under quasi_static.torque; ``progress``: a line per deck on stderr."""
+    angles) under quasi_static.torque; ``progress``: a line per deck on stderr; ``starts``: each
+    deck's start approach [m] (`solver.peers.calculix.ste_sweep`)."""
     from study.archive.netcdf import cf_variable, provenance
     from study.scene_model import static_angles
 
@@ -72,7 +82,8 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
                   f"{(te - model.backlash_offset) * units.UM_PER_M:.4f} um ({wall:.0f} s; about "
                   f"{done / (i + 1) * (n - i - 1):.0f} s left)", file=sys.stderr, flush=True)
 
-    res = ste_sweep(gears, model.pair, scene.material_spec(), angles, torque, settings, progress=report, keep=keep)
+    res = ste_sweep(gears, model.pair, scene.material_spec(), angles, torque, settings, progress=report, keep=keep,
+                    starts=starts)
     nodes = sum(m.n_nodes for m in res.meshes)
     coords = {"angle": cf_variable("angle", np.degrees(res.angle), "degree", "driver rotation from the nominal position")}
     off = res.backlash_offset

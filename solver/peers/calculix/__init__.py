@@ -103,11 +103,13 @@ def start_approach(gears: tuple, material: Material, torque: float) -> float:
 
 
 def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torque: float,
-              settings: CalculixSettings, progress=None, keep: str | None = None) -> PeerResult:
+              settings: CalculixSettings, progress=None, keep: str | None = None, starts=None) -> PeerResult:
     """STE at every driver angle [rad] under the resisting ``torque`` [N·m] on gear 2, one deck
-    an angle. ``progress(i, n, te_m, wall_s)``: called after each deck. Each deck starts from the
-    previous deck's approach (the first from `start_approach`); a deck that does not converge is
-    retried with smaller load increments and a smaller start."""
+    an angle. ``progress(i, n, te_m, wall_s)``: called after each deck. Each deck starts from
+    ``starts[i]`` [m] (an approach near the loaded one, e.g. a model's elastic STE: fewer Newton
+    iterations; the result does not depend on it) or else from the previous deck's approach (the
+    first from `start_approach`); a deck that does not converge is retried with smaller load
+    increments and a smaller, then larger start."""
     ccx_path()
     angles = np.asarray(angles, float)
     meshes = pair_meshes(gears, pair, angles, settings)
@@ -119,6 +121,8 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
     start = start_approach(gears, material, torque)
     for a, th1 in enumerate(angles):
         t0 = time.perf_counter()
+        if starts is not None:
+            start = float(starts[a])
         th2 = (jn2 - rb1 * th1) / rb2
         last = None
         for frac, inc in ((1.0, (1.0, 1.0)), (1.0, (0.25, 0.5)), (0.5, (0.1, 0.25)), (1.5, (0.1, 0.25))):

@@ -173,16 +173,19 @@ def test_solver_options_need_the_peer(capsys, tmp_path):
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed: make sysdeps installs it")
 def test_default_model_ste_within_tolerance_of_the_peer():
-    """Small pair at 100 N·m, a coarse peer mesh (0.4 mm flanks), at a double-contact and a
-    single-contact position: the compliance model's elastic STE within the documented tolerance,
-    and the STE higher in single contact in both."""
+    """Small pair at 100 N·m, the peer at 0.3 mm on the flanks (two decks, ~30 s each on a quiet
+    machine), at a double-contact (0 deg) and a single-contact position (11 deg): the default
+    (compliance) model's elastic STE within the documented tolerance at both, and so the jump
+    from double to single contact within 10 %."""
     import study
     from study.verify.model_validation import model_ste
-    scene = small_scene(**{"quasi_static.rotation": 7.5, "quasi_static.angle_step": 7.5})
-    peer = study.reference(scene, solver="calculix", flank_size=0.4)
+    scene = small_scene(**{"quasi_static.rotation": 11.0})
+    peer = study.reference(scene, step=11.0, solver="calculix", flank_size=0.3)
+    assert peer.attrs["solver"] == "calculix" and peer["ste"].attrs["units"] == "um"
+    np.testing.assert_allclose(peer["angle"].values, [0.0, 11.0])
     ste_peer = peer["ste"].values - peer.attrs["backlash_offset_um"]
     te, off = model_ste(scene, "compliance", np.radians(peer["angle"].values))
     ste_model = (te - off) * units.UM_PER_M
-    assert peer.attrs["solver"] == "calculix" and peer["ste"].attrs["units"] == "um"
     assert ste_model == pytest.approx(ste_peer, rel=STE_TOLERANCE)
-    assert np.all(ste_peer > 5.0) and np.all(ste_peer < 30.0)
+    assert np.diff(ste_model)[0] == pytest.approx(np.diff(ste_peer)[0], rel=0.10)
+    assert np.diff(ste_peer)[0] > 2.0          # um: one pair carries the load at 11 deg
