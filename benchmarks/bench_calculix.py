@@ -16,7 +16,7 @@ figures: elastic mean STE and STE peak-to-peak of each model against the peer [%
 Run:  .venv/bin/python benchmarks/bench_calculix.py [--cases solid,paper] [--torques 50]
       [--angles 0,1.34,4.0] [--flank-size MM] [--quick]
 Prints the table and writes results/benchmarks/calculix.csv. A deck of the paper pair at the
-default mesh (0.05 mm at the flanks, ~100k nodes) takes 30-100 s of one core.
+default mesh (0.05 mm at the flanks, ~140k nodes) takes 200-250 s of one core.
 """
 from __future__ import annotations
 

@@ -17,16 +17,17 @@ from solver.peers.calculix import CalculixSettings, PeerGear, default_settings, 
 from study.scene import Scene, SceneError
 from study.scene_model import geometry_model
 
-# wall time [s] of one deck at the default flank size (module/30) on a quiet machine (the paper
-# pair: 30-100 s); the nodes, and the time, grow about as flank_size**-1.5 (only the estimate
-# printed before a run and checked against --max-time uses it)
-DECK_S = 60.0
+# CPU time [s] of one deck at the default flank size (module/30): the paper pair, ~140,000 nodes,
+# 5-10 Newton iterations of ~25 s; a deck's nodes, and its time, grow about as 1/flank_size
+# (the small pair at 0.15 mm: 106 s). Only the estimate printed before a run and checked
+# against --max-time uses it.
+DECK_S = 200.0
 
 
 def peer_estimate(n_decks: int, settings: CalculixSettings, module: float):
     """`study.estimate.Estimate` of a peer run: ``n_decks`` decks at ``settings``, module [m]."""
     from study.estimate import Estimate
-    per = DECK_S * (module / 30.0 / settings.sizes.flank) ** 1.5
+    per = DECK_S * (module / 30.0 / settings.sizes.flank)
     return Estimate(seconds={"CalculiX decks": n_decks * per},
                     levers={"CalculiX decks": "fewer angles (a larger --step) or a larger --flank-size"})
 
