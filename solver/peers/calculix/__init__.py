@@ -31,6 +31,10 @@ __all__ = ["CalculixFailed", "CalculixMissing", "CalculixSettings", "PeerGear", 
            "ccx_version", "default_settings", "pair_meshes", "ste_sweep"]
 
 
+# stiffness of the driven gear's ground spring over the mesh's (`deck.write_deck`)
+GROUND_FRACTION = 1e-4
+
+
 @dataclass(frozen=True)
 class CalculixSettings:
     """Mesh and contact settings of the peer (SI)."""
@@ -130,7 +134,10 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
             placed = (GearPlacement(meshes[0], g1.spec.face_width, gears[0].body.web_thickness, (0.0, 0.0), th1),
                       GearPlacement(meshes[1], g2.spec.face_width, gears[1].body.web_thickness, (pair.center_distance, 0.0),
                                     th2 + s / rb2 + math.pi + math.pi / g2.teeth))
-            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, inc)
+            # a ground spring of 1e-4 of the mesh's torsional stiffness (about torque / start angle):
+            # it takes 1e-4 of the torque per start error of the size of the approach
+            ground = GROUND_FRACTION * torque * rb2 / max(s, 1e-9)
+            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, inc, ground)
             try:
                 res = run_deck(text, nums.rot_node, nums.ref_node, keep=keep and f"{keep}/deck{a:03d}")
                 break
@@ -138,7 +145,9 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
                 last = e
         else:
             raise CalculixFailed(f"{last} at driver angle {math.degrees(th1):.4f} deg")
-        te[a] = jn2 + s + rb2 * res.rotation
+        # the ground spring took ground * U3 of the torque: back to the full torque along the
+        # pair's secant stiffness (a correction of order 1e-4 of the start error)
+        te[a] = jn2 + s + rb2 * res.rotation * (1.0 + GROUND_FRACTION)
         wall[a], cpu[a] = time.perf_counter() - t0, res.cpu_time_s
         start = te[a] - jn2
         if progress is not None:

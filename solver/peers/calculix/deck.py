@@ -59,10 +59,13 @@ def placed_points(p: GearPlacement) -> np.ndarray:
 
 
 def write_deck(gears: tuple, material: Material, torque: float, contact_stiffness: float,
-               increments: tuple = (1.0, 1.0)) -> tuple[str, DeckNumbers]:
+               increments: tuple = (1.0, 1.0), ground_stiffness: float = 0.0) -> tuple[str, DeckNumbers]:
     """The .inp text and its numbering. ``gears``: (GearPlacement of gear 1, of gear 2);
     ``torque`` [N·m] resisting on gear 2 (> 0); ``contact_stiffness`` [Pa/m] slope of the linear
-    pressure-overclosure law; ``increments``: (initial, maximum) fraction of the step's load."""
+    pressure-overclosure law; ``increments``: (initial, maximum) fraction of the step's load;
+    ``ground_stiffness`` [N·m/rad]: a torsion spring from the driven gear to the ground (SPRING1 on
+    the rotation node; 0: none) that keeps the system regular when a Newton iteration opens every
+    contact: it carries ground_stiffness * U3 of the torque, U3 the rotation from the start."""
     if not torque > 0:
         raise ValueError(f"quasi_static.torque: the contact peer needs a positive (drive-side) torque, got {torque}")
     if not contact_stiffness > 0:
@@ -108,6 +111,8 @@ def write_deck(gears: tuple, material: Material, torque: float, contact_stiffnes
     w(f"*NSET, NSET=REF\n{ref}\n*NSET, NSET=ROT\n{rot}\n")
     w(f"*RIGID BODY, NSET=BORE2, REF NODE={ref}, ROT NODE={rot}\n")
     w(f"*BOUNDARY\nBORE1,1,2\n{ref},1,3\n{rot},1,2\n")
+    if ground_stiffness > 0:
+        w(f"*ELEMENT, TYPE=SPRING1, ELSET=GROUND\n{e + 1},{rot}\n*SPRING, ELSET=GROUND\n3\n{ground_stiffness / units.NMM:.9g}\n")
     w("*SURFACE INTERACTION, NAME=FLANK\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n")
     # slope [MPa/mm]; a small tension (0.1 MPa) for clearances below 0.1 um keeps the slave
     # nodes next to the contact from chattering in and out between iterations

@@ -79,6 +79,11 @@ def test_deck_counts_sets_units_and_torque_sign(small_light_meshes):
         assert np.hypot(*(xy - c).T).min() > 3e-3 * (1 - 1e-6)
     with pytest.raises(ValueError, match="positive"):
         _deck(scene, gears, model, meshes, torque=-1.0)
+    # the driven gear's ground spring: on the rotation node's z rotation, N·mm/rad
+    assert "GROUND" not in text
+    placed = (GearPlacement(meshes[0], 0.02, 0.02, (0.0, 0.0), 0.0), GearPlacement(meshes[1], 0.02, 0.008, (0.07, 0.0), 0.0))
+    grounded, nums = write_deck(placed, scene.material_spec(), 100.0, 2e16, ground_stiffness=1e3)
+    assert f"*ELEMENT, TYPE=SPRING1, ELSET=GROUND\n{nums.n_elements + 1},{nums.rot_node}\n*SPRING, ELSET=GROUND\n3\n1000000\n" in grounded
 
 
 def test_contact_faces_are_the_drive_flanks_and_tips_of_the_teeth_at_the_mesh(small_light_meshes):
