@@ -43,6 +43,7 @@ class CalculixSettings:
     contact_stiffness: float     # Pa/m, slope of the linear pressure-overclosure law
     fine_teeth: int = 3          # teeth each side of the line of centres meshed fine (at every angle)
     contact_teeth: int = 2       # teeth each side whose drive flanks and tips are contact faces
+    both_ways: bool = False      # a second contact pair, gear 1 the slave (`deck.write_deck`)
 
 
 def default_settings(module: float, flank_size: float | None = None) -> CalculixSettings:
@@ -137,7 +138,7 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
             # a ground spring of 1e-4 of the mesh's torsional stiffness (about torque / start angle):
             # it takes 1e-4 of the torque per start error of the size of the approach
             ground = GROUND_FRACTION * torque * rb2 / max(s, 1e-9)
-            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, inc, ground)
+            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, inc, ground, settings.both_ways)
             try:
                 res = run_deck(text, nums.rot_node, nums.ref_node, keep=keep and f"{keep}/deck{a:03d}")
                 break

@@ -59,13 +59,15 @@ def placed_points(p: GearPlacement) -> np.ndarray:
 
 
 def write_deck(gears: tuple, material: Material, torque: float, contact_stiffness: float,
-               increments: tuple = (1.0, 1.0), ground_stiffness: float = 0.0) -> tuple[str, DeckNumbers]:
+               increments: tuple = (1.0, 1.0), ground_stiffness: float = 0.0,
+               both_ways: bool = False) -> tuple[str, DeckNumbers]:
     """The .inp text and its numbering. ``gears``: (GearPlacement of gear 1, of gear 2);
     ``torque`` [N·m] resisting on gear 2 (> 0); ``contact_stiffness`` [Pa/m] slope of the linear
     pressure-overclosure law; ``increments``: (initial, maximum) fraction of the step's load;
     ``ground_stiffness`` [N·m/rad]: a torsion spring from the driven gear to the ground (SPRING1 on
     the rotation node; 0: none) that keeps the system regular when a Newton iteration opens every
-    contact: it carries ground_stiffness * U3 of the torque, U3 the rotation from the start."""
+    contact: it carries ground_stiffness * U3 of the torque, U3 the rotation from the start;
+    ``both_ways``: a second contact pair with gear 1's faces as the slave surface."""
     if not torque > 0:
         raise ValueError(f"quasi_static.torque: the contact peer needs a positive (drive-side) torque, got {torque}")
     if not contact_stiffness > 0:
@@ -117,7 +119,11 @@ def write_deck(gears: tuple, material: Material, torque: float, contact_stiffnes
     # slope [MPa/mm]; a small tension (0.1 MPa) for clearances below 0.1 um keeps the slave
     # nodes next to the contact from chattering in and out between iterations
     w(f"{contact_stiffness / units.MPA / mm:.9g},0.1,1.e-4\n")
+    # both ways round: each gear's tip corner is then a slave node on the other's flank (a
+    # master corner pokes between the slave nodes and carries too little of the tip contact)
     w("*CONTACT PAIR, INTERACTION=FLANK, TYPE=NODE TO SURFACE\nFLANKS2,FLANKS1\n")
+    if both_ways:
+        w("*CONTACT PAIR, INTERACTION=FLANK, TYPE=NODE TO SURFACE\nFLANKS1,FLANKS2\n")
     w(f"*STEP, INC=200\n*STATIC\n{increments[0]:.6g},1.,1.e-5,{increments[1]:.6g}\n")
     w(f"*CLOAD\n{rot},3,{torque / units.NMM:.9g}\n")
     w("*NODE PRINT, NSET=ROT\nU\n*NODE PRINT, NSET=REF, TOTALS=ONLY\nRF\n*END STEP\n")
