@@ -43,7 +43,7 @@ class CalculixSettings:
     contact_stiffness: float     # Pa/m, slope of the linear pressure-overclosure law
     fine_teeth: int = 3          # teeth each side of the line of centres meshed fine (at every angle)
     contact_teeth: int = 2       # teeth each side whose drive flanks and tips are contact faces
-    both_ways: bool = False      # a second contact pair, gear 1 the slave (`deck.write_deck`)
+    both_ways: bool = True       # a second contact pair, gear 1 the slave (`deck.write_deck`)
 
 
 def default_settings(module: float, flank_size: float | None = None) -> CalculixSettings:
