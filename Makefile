@@ -41,13 +41,15 @@ $(STAMP): pyproject.toml requirements.lock | sysdeps
 	$(PY) -m pip install -qq --no-deps -e .
 	touch $(STAMP)
 
-# Off-screen rendering (pyvista/VTK) and gmsh need a few shared libraries from the OS.
+# Off-screen rendering (pyvista/VTK) and gmsh need a few shared libraries from the OS; the FE
+# contact peer (`lightgear reference --solver calculix`) needs CalculiX (ccx).
 SYSLIBS := libGL.so.1 libGLU.so.1 libEGL.so.1 libXcursor.so.1 libXft.so.2 libXinerama.so.1 libgomp.so.1
-DEBPKGS := libgl1 libglu1-mesa libegl1 libegl-mesa0 libgl1-mesa-dri libxcursor1 libxft2 libxinerama1 libgomp1
+DEBPKGS := libgl1 libglu1-mesa libegl1 libegl-mesa0 libgl1-mesa-dri libxcursor1 libxft2 libxinerama1 libgomp1 calculix-ccx
 sysdeps:
 	@missing=""; for lib in $(SYSLIBS); do ldconfig -p | grep -q "$$lib" || missing="$$missing $$lib"; done; \
+	command -v ccx >/dev/null || missing="$$missing ccx(calculix-ccx)"; \
 	if [ -n "$$missing" ]; then \
-	  echo "Missing system libraries:$$missing"; \
+	  echo "Missing system libraries and programs:$$missing"; \
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
 	    echo "Installing: $(DEBPKGS)"; apt-get update -qq && apt-get install -y -qq $(DEBPKGS) >/dev/null; \
 	  else \

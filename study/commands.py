@@ -6,6 +6,7 @@ line prints what these return; the Python API (`study`) offers them.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -80,18 +81,31 @@ def fit_contact(scene: Scene, depth_fraction: float = 0.5) -> ContactFit:
                       tuple(float(x) for x in f.force_range), f.radius * 1e3, f.rms_log_error, f_ref)
 
 
-def reference(scene: Scene, step: float | None = None, max_time: float | None = None, progress: bool = False):
-    """FE reference STE (loaded-tooth-contact analysis with FE influence coefficients of both
-    bodies) -> xarray.Dataset (``ste`` [um] over ``angle`` [degree], ``ste_tooth_force`` [N], ...).
-    ``step`` [deg]: the driver angle step (None: quasi_static.angle_step); ``max_time`` [s]: refuse
-    a run estimated to take longer (BudgetError, before any work)."""
+def reference(scene: Scene, step: float | None = None, max_time: float | None = None, progress: bool = False,
+              solver: str = "ltca", flank_size: float | None = None, contact_stiffness: float | None = None):
+    """FE reference STE -> xarray.Dataset (``ste`` [um] over ``angle`` [degree]). ``solver``:
+    "ltca" (loaded-tooth-contact analysis with FE influence coefficients of both bodies) or
+    "calculix" (the independent FE contact peer, `study.verify.calculix_reference`, with
+    ``flank_size`` [mm] and ``contact_stiffness`` [MPa/mm]); ``max_time`` [s]: refuse a run
+    estimated to take longer (BudgetError, before any work)."""
     from study.scene_model import static_angles
     from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, reference_dataset
     check_scene_argument("reference", scene)
     check_argument(step is None or is_number(step), "reference", "step", "a number of degrees or None", step)
     if step is not None and not step > 0:
         raise SceneError("--step", f"must be positive, got {step}")
+    if solver not in ("ltca", "calculix"):
+        raise SceneError("--solver", f"one of ltca, calculix, got {solver!r}")
     angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
+    if solver == "calculix":
+        from study.verify.calculix_reference import calculix_dataset, peer_estimate, settings_for
+        settings = settings_for(scene, flank_size, contact_stiffness)
+        est = peer_estimate(angles.size, settings, scene.gear1.module * 1e-3)
+        estimate.check_time(est, max_time)
+        if progress:
+            print(f"CalculiX contact peer: {angles.size} decks, about {estimate.duration_text(est.total_s)} "
+                  f"({est.total_s / angles.size:.0f} s a deck)", file=sys.stderr, flush=True)
+        return calculix_dataset(scene, angles, settings, progress=progress)
     estimate.check_time(estimate.reference_estimate(scene, angles), max_time)
     from study.inputs.gearsetup import gear_setups
     line = estimate.check_fe_memory(scene, estimate.REFERENCE_BODY_MEMORY, gear_setups(scene))

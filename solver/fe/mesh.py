@@ -61,7 +61,7 @@ class BodyMesh:
     """Triangle mesh of a gear body, gear frame (tooth k's axis at polar angle 2*pi*k/z)."""
 
     points: np.ndarray      # (n, 2) node coordinates [m]
-    triangles: np.ndarray   # (m, 3) node indices, counter-clockwise
+    triangles: np.ndarray   # (m, 3) node indices, counter-clockwise ((m, 6) quadratic: `_collect`)
     region: np.ndarray      # (m,) REGION_RIM / REGION_WEB / REGION_HUB
     bore_radius: float      # m
     size: float             # element size at the outline [m]
@@ -82,17 +82,26 @@ def _arc(r: float, a0: float, a1: float, n: int):
     return np.column_stack([r * np.cos(a), r * np.sin(a)])
 
 
-def tooth_pieces(g: GearGeometry, n: int = 12) -> list[tuple[np.ndarray, bool]]:
+def tooth_pieces(g: GearGeometry, n: int = 12, deviation=None) -> list[tuple[np.ndarray, bool]]:
     """One tooth's outline as pieces from mid-space -pi/z to +pi/z, counter-clockwise.
 
     Returns a list of (points (k, 2) [m], is_fillet). Consecutive pieces share end points; the
     last point of a tooth is the first of the next tooth rotated by the pitch angle.
+    ``deviation``: None (perfect involutes) or a function of the roll parameter u [-] giving the
+    flank's deviation along its normal [m], positive where material is removed (a profile
+    modification, `solver.modification.ProfileModification.deviation`); the tip arc then ends at
+    the modified tip corners.
     """
     rf, ra = g.root_radius, g.tip_radius
     half_pitch = math.pi / g.teeth
     plus = []  # + half from the tip corner down to mid-space, as (points, is_fillet)
     u = np.linspace(g.u_tip, g.u_form, n)
-    plus.append((np.column_stack(g.flank_point(u, 1)), False))
+    flank = np.column_stack(g.flank_point(u, 1))
+    if deviation is not None:
+        t = g.psi_base - u   # the + flank's outward normal is (-sin t, cos t)
+        d = np.asarray(deviation(u), float)
+        flank = flank - d[:, None] * np.column_stack([-np.sin(t), np.cos(t)])
+    plus.append((flank, False))
     if g.radial_flank:
         rho = g.spec.fillet_radius
         r_tan = math.sqrt((rf + rho) ** 2 - rho**2)
@@ -109,8 +118,9 @@ def tooth_pieces(g: GearGeometry, n: int = 12) -> list[tuple[np.ndarray, bool]]:
         plus.append((np.column_stack([cx + rho * np.cos(a), cy + rho * np.sin(a)]), True))
     plus.append((_arc(rf, g.fillet_root_angle, half_pitch, 4), False))
     minus = [(p[::-1] * np.array([1.0, -1.0]), f) for p, f in reversed(plus)]
-    tip = (_arc(ra, -g.tip_half_angle, g.tip_half_angle, 5), False)
-    return minus + [tip] + plus
+    tip = _arc(ra, -g.tip_half_angle, g.tip_half_angle, 5)
+    tip[0], tip[-1] = minus[-1][0][-1], plus[0][0][0]   # the (modified) tip corners
+    return minus + [(tip, False)] + plus
 
 
 def _rotate(p: np.ndarray, a: float) -> np.ndarray:
@@ -142,9 +152,37 @@ def mesh_body(g: GearGeometry, body: BodySpec, size: float | None = None, prefix
 
 
 def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str, rim: bool = True) -> BodyMesh:
+    outline = build_outline(gmsh, g, body, h, rim)
+    corners = outline.corners
+    corner_size = opening_edge_sizes(body, h)[1] if any(corners) else None
+    _size_field(gmsh, g, outline.curves, outline.fillets, h, 5.0 * h, GRADINGS[grading], corners, corner_size)
+    generate(gmsh)
+    return _collect(gmsh, outline.surfaces, outline.bore_radius, h)
+
+
+@dataclass(frozen=True)
+class Outline:
+    """The gmsh geometry of a gear body (`build_outline`): the tags of its surfaces and curves."""
+
+    surfaces: dict          # REGION_* -> plane surface tag
+    curves: list            # outline curve tags, ``pieces`` per tooth, tooth by tooth
+    fillets: list           # the fillet curves among them
+    pieces: list            # (points [m], is_fillet) of one tooth in its frame (`tooth_pieces`)
+    bore_radius: float      # m
+    corners: tuple = ((), ())   # a window's fillet curves and sharp corner points (refined by the size field)
+
+
+def build_outline(gmsh, g: GearGeometry, body: BodySpec, h: float, rim: bool = True, deviation=None,
+                  n_flank: int = 12) -> Outline:
+    """Add the gear body to the current gmsh model (gear frame, tooth k's axis at 2*pi*k/z):
+    the outline of all teeth with points of size ``h`` [m] (``h/2`` on the fillets), the
+    rim, web (pierced by the holes) and hub as plane surfaces; ``rim=False``: web and hub only
+    (see `mesh_body`); ``deviation``: the flanks' profile modification (`tooth_pieces`);
+    ``n_flank``: points of each flank's spline (12: the involute within a few um, enough for a
+    body loaded at given points; a contact analysis needs ~150, within 0.01 um)."""
     geo = gmsh.model.geo
     h_body = 5.0 * h
-    pieces = tooth_pieces(g)
+    pieces = tooth_pieces(g, n=n_flank, deviation=deviation)
     # ---- outline: one spline per piece, shared end points between pieces and teeth
     first_tag = None
     prev_tag = None
@@ -207,16 +245,19 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str, rim: b
     if has_hub:
         surfaces[REGION_HUB] = geo.addPlaneSurface([hub_out if hub_out is not None else rim_in, bore])
     geo.synchronize()
+    return Outline(surfaces, curves, fillets, pieces, r_bore, corners)
 
-    corner_size = opening_edge_sizes(body, h)[1] if any(corners) else None
-    _size_field(gmsh, g, curves, fillets, h, h_body, GRADINGS[grading], corners, corner_size)
+
+def generate(gmsh, order: int = 1) -> None:
+    """Mesh the current gmsh model's surfaces by its size field and point sizes (``order`` 2:
+    6-node triangles whose mid-side nodes lie on the curves)."""
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 1)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
     gmsh.option.setNumber("Mesh.Algorithm", 5)  # Delaunay: fast and robust for large planar meshes
     gmsh.model.mesh.generate(2)
-
-    return _collect(gmsh, surfaces, r_bore, h)
+    if order > 1:
+        gmsh.model.mesh.setOrder(order)
 
 
 def _is_round_slot(body: BodySpec) -> bool:
@@ -321,8 +362,10 @@ def _size_field(gmsh, g: GearGeometry, curves: list, fillets: list, h: float, h_
     f.setAsBackgroundMesh(fm)
 
 
-def _collect(gmsh, surfaces: dict, r_bore: float, h: float) -> BodyMesh:
-    """Nodes and 3-node triangles of the meshed surfaces, tagged by region, counter-clockwise."""
+def _collect(gmsh, surfaces: dict, r_bore: float, h: float, order: int = 1) -> BodyMesh:
+    """Nodes and triangles (``order`` 1: 3 nodes; 2: 6 nodes, corners then the mid-sides of
+    edges 1-2, 2-3, 3-1) of the meshed surfaces, tagged by region, counter-clockwise."""
+    gmsh_type, nodes_per = {1: (2, 3), 2: (9, 6)}[order]
     tags, xyz, _ = gmsh.model.mesh.getNodes()
     index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
     index[tags.astype(np.int64)] = np.arange(tags.size)
@@ -331,9 +374,9 @@ def _collect(gmsh, surfaces: dict, r_bore: float, h: float) -> BodyMesh:
     for reg, s in surfaces.items():
         types, _, nodes = gmsh.model.mesh.getElements(2, s)
         for ty, nd in zip(types, nodes):
-            if ty != 2:
-                raise RuntimeError(f"gmsh returned element type {ty}, expected 3-node triangles")
-            t = index[nd.astype(np.int64)].reshape(-1, 3)
+            if ty != gmsh_type:
+                raise RuntimeError(f"gmsh returned element type {ty}, expected {nodes_per}-node triangles")
+            t = index[nd.astype(np.int64)].reshape(-1, nodes_per)
             tris.append(t)
             regions.append(np.full(t.shape[0], reg, dtype=np.int8))
     tri = np.concatenate(tris)
@@ -347,7 +390,7 @@ def _collect(gmsh, surfaces: dict, r_bore: float, h: float) -> BodyMesh:
     a = points[tri]
     area2 = (a[:, 1, 0] - a[:, 0, 0]) * (a[:, 2, 1] - a[:, 0, 1]) - (a[:, 2, 0] - a[:, 0, 0]) * (a[:, 1, 1] - a[:, 0, 1])
     flip = area2 < 0
-    tri[flip] = tri[flip][:, [0, 2, 1]]
+    tri[flip] = tri[flip][:, [0, 2, 1, 5, 4, 3][:nodes_per]]
     return BodyMesh(points, tri, region, r_bore, h)
 
 
