@@ -408,7 +408,7 @@ def precision_command(args) -> int:
     from study import estimate
     from study.commands import precision as run_precision
     from study.commands import precision_scene
-    from study.scene_model import build_scene_model
+    from study.scene_model import build_scene_model, check_static_memory
     from study.verify.precision import setting_label
     check_precision_options(args)
     scene = precision_scene(args_scene(args))
@@ -416,7 +416,7 @@ def precision_command(args) -> int:
     if args.only != "static":
         estimate.check_dynamic_memory(scene.replace(**{"dynamic.duration": args.duration}), "--duration")
     if args.only != "dynamic":
-        estimate.check_static_memory(scene.replace(**{"quasi_static.rotation": args.rotation}), field="--rotation")
+        check_static_memory(scene.replace(**{"quasi_static.rotation": args.rotation}), field="--rotation")
     base = checked_output(args.output)
     max_time = checked_max_time(args)
     model = build_scene_model(scene)

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from study.cli import main
+from study.inputs.cache import FE_CACHE
 
 
 def run_cli(capsys, *argv):
@@ -541,7 +542,7 @@ def test_a_sweep_point_with_a_tiny_time_step_is_estimated_and_refused_like_a_run
 def test_a_load_too_small_to_resolve_is_refused_before_the_fe_naming_the_torque(tmp_path, capsys, private_fe_cache):
     code, _, err = run_cli(capsys, "run", "small_pair", "--set", "dynamic.torque=1e-6", "-o", tmp_path / "r.nc")
     assert code == 2 and "dynamic.torque: a load too small to resolve: 1e-06 N*m" in err
-    assert "damping_ratio" not in err and not private_fe_cache.folder.exists()      # no FE body made
+    assert "damping_ratio" not in err and not FE_CACHE.folder.exists()      # no FE body made
     from study.plausibility import MIN_APPROACH_MM, approach_estimate_mm, smallest_torque
     from tests.helpers import small_scene
     t = smallest_torque(small_scene())
@@ -592,8 +593,8 @@ def test_the_study_tables_render_writes_are_an_archive_export_takes(tmp_path, ca
     with xr.open_dataset(tmp_path / "s.nc") as ds:
         assert np.isfinite(ds["dte_rms"].values).all()
     code, _, err = run_cli(capsys, "render", tmp_path / "s.nc", "-o", tmp_path / "fig", "--no-renders")
-    assert code == 0 and (tmp_path / "fig" / "study_tables.nc").is_file(), err
-    code, out, err = run_cli(capsys, "export", tmp_path / "fig" / "study_tables.nc", "-o", tmp_path / "csv")
+    assert code == 0 and (tmp_path / "fig" / "s_study_tables.nc").is_file(), err      # named after the archive
+    code, out, err = run_cli(capsys, "export", tmp_path / "fig" / "s_study_tables.nc", "-o", tmp_path / "csv")
     assert code == 0 and "csv:" in out, err
 
 
@@ -660,14 +661,14 @@ def test_fe_bodies_beyond_the_memory_are_refused_before_any_fe_work(tmp_path, ca
     code, _, err = run_cli(capsys, "run", "small_pair", "--set", "gear2.teeth=10000", "--max-time", "1e9",
                            "-o", tmp_path / "r.nc")
     assert code == 2 and "fe.mesh_size: the FE bodies need about" in err and "GiB" in err
-    assert "a coarser fe.mesh_size" in err and not private_fe_cache.folder.exists()
+    assert "a coarser fe.mesh_size" in err and not FE_CACHE.folder.exists()
     code, _, err = run_cli(capsys, "reference", "small_pair", "--set", "gear2.teeth=10000", "--max-time", "1e9",
                            "-o", tmp_path / "f.nc")
     assert code == 2 and "fe.mesh_size: the FE bodies need about" in err
     st = tmp_path / "big.toml"
     st.write_text('scene = "small_pair"\n[grid]\n"gear2.teeth" = [24, 10000]\n[outputs]\nscalars = ["ste_p2p"]\n')
     code, _, err = run_cli(capsys, "sweep", st, "-o", tmp_path / "s.nc", "--workers", 0, "--max-time", "1e9")
-    assert code == 2 and "fe.mesh_size: the FE bodies need about" in err and not private_fe_cache.folder.exists()
+    assert code == 2 and "fe.mesh_size: the FE bodies need about" in err and not FE_CACHE.folder.exists()
     # the small pair's bodies (some 80 MB each) pass; with 200 MB available they are warned of
     from study.inputs.gearsetup import gear_setups
     from tests.helpers import small_scene

@@ -169,7 +169,10 @@ def test_validation_workflow_writes_archive_and_figures(tmp_path):
         assert list(ds["model"].values) == list(MODELS)
         assert ds["error_mean"].sel(model="fe-reference").values.tolist() == [0.0, 0.0]
         assert np.isnan(ds["hole_amplitude"].sel(pair="solid", model="fe-reference"))
-        assert ds["hole_amplitude"].sel(pair="lightened", model="fe-reference") > 0
+        # 15 deg of the driver turn the driven gear through less than one period of its 4 holes
+        # (90 deg): the hole order is not resolved, and the archive says so instead of a fit
+        assert np.isnan(ds["hole_amplitude"].sel(pair="lightened", model="fe-reference"))
+        assert "undefined (NaN)" in ds["hole_amplitude"].attrs["comment"]
         assert ds["ste"].attrs["units"] == "um"
         root = s.gear2.module * (s.gear2.teeth / 2 - s.gear2.dedendum)
         piv = ds["compliance_pivot_radius"].values

@@ -7,6 +7,7 @@ import pytest
 
 from solver.fe.body import BodyField
 from solver.fe.ltca import BodyCompliance
+from study.inputs.cache import FE_CACHE
 
 
 def _fields():
@@ -29,9 +30,9 @@ def _read_each_kind(cache):
 
 @pytest.mark.parametrize("damage", ["truncated", "empty"])
 def test_a_damaged_cache_file_of_any_kind_is_computed_again_with_a_warning(private_fe_cache, damage):
-    cache = private_fe_cache
+    cache = FE_CACHE
     _write_each_kind(cache)
-    cache.clear()
+    private_fe_cache.clear()      # memory dropped: the files answer
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert all(v is not None for v in _read_each_kind(cache).values())      # the round trip
@@ -40,7 +41,7 @@ def test_a_damaged_cache_file_of_any_kind_is_computed_again_with_a_warning(priva
         path = cache.folder / name
         data = path.read_bytes()
         path.write_bytes(data[: len(data) // 2] if damage == "truncated" else b"")
-    cache.clear()
+    private_fe_cache.clear()      # memory dropped: the files answer
     with pytest.warns(RuntimeWarning) as caught:
         read = _read_each_kind(cache)
     assert all(v is None for v in read.values()), read
@@ -50,9 +51,9 @@ def test_a_damaged_cache_file_of_any_kind_is_computed_again_with_a_warning(priva
 
 
 def test_a_map_without_its_stresses_is_no_damage(private_fe_cache):
-    cache = private_fe_cache
+    cache = FE_CACHE
     cache.write_stiffness("k2", np.array([1.0]), {"a": 2})
-    cache.clear()
+    private_fe_cache.clear()      # memory dropped: the files answer
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert cache.read_root_stress("k2") is None and cache.read_stiffness("k2") is not None
