@@ -34,6 +34,7 @@ from study.plausibility import critical_speed_warning, report_warnings, scene_wa
 from study.scene import Scene, error_period, static_rotation
 from study.scene_model import (
     build_scene_model,
+    check_static_memory,
     damping_ratios,
     dynamic_choice,
     kept_scene_model,
@@ -226,6 +227,8 @@ def run_fields(scene: Scene, static: bool | None = None, dynamic: bool | None = 
     report_warnings(warnings, warn)
     if dynamic:
         estimate.check_dynamic_memory(scene)
+    if static and scene.quasi_static.method == "static":
+        check_static_memory(scene)      # the angles' arrays, before the FE bodies are made
     est = estimate.Estimate()
     bounded = max_time is not None      # the estimates serve only the bound
     if springs is None and bounded:
