@@ -199,7 +199,8 @@ def tracked_files() -> list[Path]:
 
 
 def test_nothing_in_the_repository_points_outside_it():
-    pattern = re.compile(r"/work/|\.\./shared/|shared/design\.md")
+    # (spelled in pieces, so that this file does not hold the paths it looks for)
+    pattern = re.compile("|".join(["/" + "work/", r"\.\./" + "shared/", "shared/" + r"design\.md"]))
     here = Path(__file__).resolve()
     hits = []
     for path in tracked_files():
