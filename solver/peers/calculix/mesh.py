@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.fe.mesh import REGION_WEB, _collect, build_outline, generate
+from solver.fe.mesh import REGION_WEB, _collect, build_outline, generate, start_gmsh
 from solver.geometry import BodySpec, GearGeometry, validate_body
 
 # points of each flank's spline: the mesh nodes then lie within 0.01 um of the involute (12, the
@@ -71,9 +71,7 @@ def mesh_gear(g: GearGeometry, body: BodySpec, sizes: MeshSizes, fine_teeth, con
     and tip arcs of ``contact_teeth`` become contact faces; ``deviation`` is the flanks' profile
     modification u -> m (`solver.fe.mesh.tooth_pieces`)."""
     validate_body(g, body, prefix)
-    import gmsh
-
-    gmsh.initialize(interruptible=False)
+    gmsh = start_gmsh()     # the process's SIGINT/SIGTERM handlers kept (gmsh's library replaces them)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("gear_peer")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from solver.fe.body import plane_stress_lame, plane_stress_p2_stiffness
-from solver.fe.mesh import REGION_RIM, BodyMesh
+from solver.fe.mesh import REGION_RIM, BodyMesh, start_gmsh
 from solver.fe.stress import boundary_edges, max_principal, stress_operator, von_mises
 
 A, R, SIGMA = 1.0e-3, 12.0e-3, 100.0e6       # hole radius, outer radius [m], remote tension [Pa]
@@ -30,9 +30,8 @@ def plate_with_hole(n_hole: int) -> BodyMesh:
     """Annulus A..R meshed by gmsh with ``n_hole`` elements around the hole, growing to the
     outer circle (a disc with a hole: Kirsch's traction on the outer circle makes it the
     infinite plate exactly)."""
-    import gmsh
     h_in, h_out = 2 * math.pi * A / n_hole, 2 * math.pi * R / 48
-    gmsh.initialize(interruptible=False)
+    gmsh = start_gmsh()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("kirsch")
@@ -123,8 +122,7 @@ def test_hole_edge_stress_of_kirschs_plate_is_three_times_the_tension(kirsch_run
 def window_body(h: float = 0.4e-3) -> BodyMesh:
     """A plain disc body (no teeth): rim 24-30 mm, web 10-24 mm with four rectangular windows
     (radial 14-20 mm, 6 mm wide) at 0, 90, 180, 270 degrees, hub 6-10 mm; element size h."""
-    import gmsh
-    gmsh.initialize(interruptible=False)
+    gmsh = start_gmsh()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("windows")
