@@ -1,6 +1,6 @@
 """Time integration of the pair under the prescribed speed ramp and the load-torque ramp.
 
-`simulate` runs the explicit velocity-Verlet kernel (`kernels/explicit.py`, or
+`ExplicitIntegrator` (its settings; `simulate` in one call) runs the explicit velocity-Verlet kernel (`kernels/explicit.py`, or
 `kernels/explicit_coupled.py` for a body-torsion coupled model) with a fixed step, by default
 the stability bound of `solver.mbs.stability`. Shared by every fixed-step integrator (the
 implicit one and the peers too): the step grid (`step_grid`), the load inputs
@@ -292,15 +292,28 @@ def slow_ramp_window(angles, angle_step: float, speed: float, ramp: float) -> tu
     return dt_out, ramp / 2 + angles[-1] / speed + 2 * dt_out
 
 
-def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
-             duration: float, dt: float | None = None, output_step: float = 1e-5,
-             safety: float | None = None, delta_max: float | None = None, raise_on_failure: bool = False,
-             phi_quiet: float | None = None, energy_tol: float = ENERGY_TOL, load_table=None,
-             all_teeth: bool = False, progress=None, implicit_dampers: bool | None = None) -> DynamicResult:
-    """Integrate from rest with the driver speed ramp 0 -> speed [rad/s] over speed_ramp [s]
-    and the resisting torque ramp 0 -> torque [N·m] over torque_ramp [s], for duration [s].
+@dataclass(frozen=True)
+class Drive:
+    """What a run is driven by, from rest: the driver speed ramp 0 -> ``speed`` [rad/s] over
+    ``speed_ramp`` [s] and the resisting torque ramp 0 -> ``torque`` [N·m] over
+    ``torque_ramp`` [s], for ``duration`` [s]. ``load_table``: a resisting-torque profile (rows
+    of time [s], torque [N·m], from 0 N·m at t = 0; `load_profile`) instead of the ramp to
+    ``torque``; the step estimate then uses the profile's largest torque in magnitude, and the
+    initial flank side its first nonzero torque."""
+    speed: float
+    speed_ramp: float
+    torque: float
+    torque_ramp: float
+    duration: float
+    load_table: object = None
 
-    ``dt`` defaults to ``safety`` times the stability bound (`solver.mbs.stability`; safety
+
+@dataclass(frozen=True)
+class ExplicitIntegrator:
+    """The explicit velocity-Verlet integrator and its settings; `run` integrates a model
+    under a `Drive`.
+
+    ``dt`` [s] defaults to ``safety`` times the stability bound (`solver.mbs.stability`; safety
     None: 0.5, or 0.9 with implicit dampers); it is rounded down so that output_step [s] is a
     whole number of steps. A step of the default is checked after the run against the largest
     contact force reached (`solver.mbs.stability.load_covered`): where that force makes the
@@ -312,20 +325,50 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     ``phi_quiet`` [rad]: a tooth outside the mesh window is frozen once its rotation is below
     this (1e-9 rad moves the flank by about 3e-6 um) and its rate below phi_quiet times its
     natural frequency; None: `default_phi_quiet` (1e-7 rad with well-damped tooth joints).
-    ``load_table``: a resisting-torque profile (rows of time [s], torque [N·m], from 0 N·m at
-    t = 0; `load_profile`) instead of the ramp to ``torque``; the step estimate then uses the
-    profile's largest torque in magnitude, and the initial flank side its first nonzero torque.
     ``energy_tol`` [-]: the run stops ("energy growth") when the energy balance shows more
     energy in the pair than the work put in, by more than this fraction of the larger of the
     work and the stored energy: the signature of an unstable step.
     ``all_teeth``: integrate every tooth from the start and never freeze one (the model of
     the scipy peer `solver.peers.scipy_dynamics`, for like-for-like error figures).
-    ``progress``: a callable taking the time reached [s] while the run goes (`run_kernel`).
     ``implicit_dampers``: take the tooth-root dampers implicitly in the Verlet kicks (IMEX,
     `solver.mbs.kernels.explicit`), so that they no longer limit the step; None (default):
     wherever they can be (`solver.mbs.stability.implicit_dampers_apply`: linear dampers);
     False: every force explicit (the scheme before, kept as the reference).
+    ``raise_on_failure``: a run stopped by a guard raises `DivergenceError` instead of
+    returning its status.
     """
+    dt: float | None = None
+    output_step: float = 1e-5
+    safety: float | None = None
+    delta_max: float | None = None
+    raise_on_failure: bool = False
+    phi_quiet: float | None = None
+    energy_tol: float = ENERGY_TOL
+    all_teeth: bool = False
+    implicit_dampers: bool | None = None
+
+    def run(self, model: Model, drive: Drive, progress=None) -> DynamicResult:
+        """Integrate ``model`` from rest under ``drive``. ``progress``: a callable taking the
+        time reached [s] while the run goes (`run_kernel`)."""
+        return _run_explicit(self, model, drive, progress)
+
+
+def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
+             duration: float, *, progress=None, **settings) -> DynamicResult:
+    """The explicit integrator in one call: ``ExplicitIntegrator(**settings).run(model,
+    Drive(speed, speed_ramp, torque, torque_ramp, duration, load_table), progress)``, with
+    ``load_table`` taken from ``settings`` (see `Drive` and `ExplicitIntegrator`)."""
+    drive = Drive(speed, speed_ramp, torque, torque_ramp, duration, settings.pop("load_table", None))
+    return ExplicitIntegrator(**settings).run(model, drive, progress)
+
+
+def _run_explicit(settings: ExplicitIntegrator, model: Model, drive: Drive, progress) -> DynamicResult:
+    """`ExplicitIntegrator.run`."""
+    speed, speed_ramp, torque, torque_ramp = drive.speed, drive.speed_ramp, drive.torque, drive.torque_ramp
+    duration, load_table = drive.duration, drive.load_table
+    dt, output_step, safety, delta_max = settings.dt, settings.output_step, settings.safety, settings.delta_max
+    phi_quiet, energy_tol, all_teeth = settings.phi_quiet, settings.energy_tol, settings.all_teeth
+    implicit_dampers, raise_on_failure = settings.implicit_dampers, settings.raise_on_failure
     check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step)
     table, torque, side = run_loads(load_table, torque)
     applies = implicit_dampers_apply(model)
