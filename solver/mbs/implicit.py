@@ -1,8 +1,9 @@
 """Implicit time integration (HHT-alpha, Newton on the analytic tangent).
 
-`simulate_implicit` has the arguments and the `DynamicResult` contract of
-`solver.mbs.dynamics.simulate`, plus the HHT parameter alpha (0: trapezoidal rule, no numerical
-damping; down to -1/3: more damping of the high frequencies) and the Newton controls. Its
+`ImplicitIntegrator` (`simulate_implicit` in one call) has the settings and the `DynamicResult`
+contract of `solver.mbs.dynamics.ExplicitIntegrator`, plus the HHT parameter alpha (0:
+trapezoidal rule, no numerical damping; down to -1/3: more damping of the high frequencies)
+and the Newton controls. Its
 result also carries the Newton counts and the numerical dissipation of the scheme.
 The choice between this integrator and the explicit one is `solver.mbs.method.choose_method`.
 """
@@ -14,6 +15,7 @@ import numpy as np
 
 from solver.mbs.dynamics import (
     ENERGY_TOL,
+    Drive,
     DynamicResult,
     accuracy_check,
     check_positive,
@@ -48,13 +50,10 @@ class ImplicitResult(DynamicResult):
         return self.energy_error
 
 
-def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
-                      duration: float, dt: float | None = None, output_step: float = 1e-5,
-                      alpha: float = 0.0, newton_tol: float = 1e-13, max_iter: int = 12,
-                      delta_max: float | None = None, raise_on_failure: bool = False,
-                      phi_quiet: float = 1e-9, energy_tol: float = ENERGY_TOL,
-                      all_teeth: bool = False, load_table=None, progress=None) -> ImplicitResult:
-    """Integrate from rest with HHT-alpha; loads, outputs and guards as `integrate.simulate`.
+@dataclass(frozen=True)
+class ImplicitIntegrator:
+    """The HHT-alpha integrator and its settings; `run` integrates a model under a `Drive`
+    (loads, outputs and guards as `solver.mbs.dynamics.ExplicitIntegrator`).
 
     ``dt`` [s] defaults to four times the explicit stability step; it is rounded down so that
     output_step [s] is a whole number of steps (then the end of a ramp that is a multiple of
@@ -64,6 +63,40 @@ def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: flo
     ``all_teeth``: integrate every tooth from the start and never freeze one (the model of
     the scipy peer `solver.peers.scipy_dynamics`, for like-for-like error figures).
     """
+    dt: float | None = None
+    output_step: float = 1e-5
+    alpha: float = 0.0
+    newton_tol: float = 1e-13
+    max_iter: int = 12
+    delta_max: float | None = None
+    raise_on_failure: bool = False
+    phi_quiet: float = 1e-9
+    energy_tol: float = ENERGY_TOL
+    all_teeth: bool = False
+
+    def run(self, model: Model, drive: Drive, progress=None) -> ImplicitResult:
+        """Integrate ``model`` from rest under ``drive``. ``progress``: a callable taking the
+        time reached [s] while the run goes (`run_kernel`)."""
+        return _run_implicit(self, model, drive, progress)
+
+
+def simulate_implicit(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
+                      duration: float, *, progress=None, **settings) -> ImplicitResult:
+    """The implicit integrator in one call: ``ImplicitIntegrator(**settings).run(model,
+    Drive(speed, speed_ramp, torque, torque_ramp, duration, load_table), progress)``, with
+    ``load_table`` taken from ``settings``."""
+    drive = Drive(speed, speed_ramp, torque, torque_ramp, duration, settings.pop("load_table", None))
+    return ImplicitIntegrator(**settings).run(model, drive, progress)
+
+
+def _run_implicit(settings: ImplicitIntegrator, model: Model, drive: Drive, progress) -> ImplicitResult:
+    """`ImplicitIntegrator.run`."""
+    speed, speed_ramp, torque, torque_ramp = drive.speed, drive.speed_ramp, drive.torque, drive.torque_ramp
+    duration, load_table = drive.duration, drive.load_table
+    dt, output_step, alpha, newton_tol, max_iter = (settings.dt, settings.output_step, settings.alpha,
+                                                    settings.newton_tol, settings.max_iter)
+    delta_max, raise_on_failure, phi_quiet = settings.delta_max, settings.raise_on_failure, settings.phi_quiet
+    energy_tol, all_teeth = settings.energy_tol, settings.all_teeth
     check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step,
                    newton_tol=newton_tol)
     if not -1.0 / 3.0 <= alpha <= 0.0:
