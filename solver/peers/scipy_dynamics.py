@@ -17,7 +17,7 @@ idle driver teeth (I_cpl * theta1'' on k_phi). The resulting TE difference is of
 1e-4 um on the paper pair; `simulate_explicit_all_teeth` runs the explicit kernel on this
 model for like-for-like comparisons.
 
-SI units throughout. Entry point: `simulate_scipy`.
+SI units throughout. Entry point: `ScipyIntegrator` (`simulate_scipy` in one call).
 """
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate
 
-from solver.mbs.dynamics import DivergenceError, DynamicResult, check_positive, run_loads, simulate
+from solver.mbs.dynamics import DivergenceError, Drive, DynamicResult, check_positive, run_loads, simulate
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.status import INTERRUPTED, NONFINITE, OK, PENETRATION
 from solver.mbs.model import Model
@@ -54,87 +54,123 @@ class ScipyResult(DynamicResult):
     wall_time: float = float("nan")     # s, integration only
 
 
-def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
-                   duration: float, method: str = "LSODA", rtol: float = 1e-6, atol: float | None = None,
-                   output_step: float = 1e-5, max_step: float | None = None, delta_max: float | None = None,
-                   raise_on_failure: bool = False, max_wall_time: float | None = None,
-                   load_table=None) -> ScipyResult:
-    """Integrate the pair from rest with a `scipy.integrate` ODE solver (all teeth free).
+@dataclass(frozen=True)
+class ScipyIntegrator:
+    """A `scipy.integrate` ODE solver on the pair (all teeth free) and its settings; `run`
+    integrates a model from rest under a `solver.mbs.dynamics.Drive` (the loads of the
+    explicit integrator), TE [m] and the energies sampled every output_step [s].
 
-    Same loads as `solver.mbs.dynamics.simulate`: driver speed ramp 0 -> speed [rad/s] over
-    speed_ramp [s], resisting torque ramp 0 -> torque [N·m] over torque_ramp [s], for
-    duration [s]; TE [m] and the energies are sampled every output_step [s].
     ``method``: one of RK45, DOP853 (non-stiff; use DOP853 for tight references), Radau, BDF,
     LSODA (stiff; analytic Jacobian). ``rtol`` [-]; ``atol`` absolute tolerance on angles
     [rad] and rates [rad/s] (default rtol * 1e-6, i.e. rtol times about a micrometre of flank
-    motion; rates get atol scaled by the highest tooth frequency). ``delta_max`` [m]
-    (default a tenth of the module) bounds the penetration.
+    motion; rates get atol scaled by the highest tooth frequency). ``max_step`` [s]: the
+    solver's largest step (None: its own). ``delta_max`` [m] (default a tenth of the module)
+    bounds the penetration.
     A failure of the solver or a guard gives a status other than OK (`solver.mbs.kernels.status`)
     and a message (or raises `DivergenceError` with ``raise_on_failure``). ``max_wall_time`` [s]
-    stops a run that takes longer (status INTERRUPTED, "wall-time limit"). ``load_table``: a torque profile instead of the
-    torque ramp, as in `solver.mbs.dynamics.simulate`.
+    stops a run that takes longer (status INTERRUPTED, "wall-time limit").
     """
-    if method not in METHODS:
-        raise ValueError(f"method: must be one of {', '.join(METHODS)}, got {method!r}")
-    check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step, rtol=rtol)
-    table, _step_torque, side = run_loads(load_table, torque)
-    eq = PairEquations(model, speed, speed_ramp, torque, torque_ramp, table)
-    n = eq.n
-    if atol is None:
-        atol = rtol * 1e-6
-    omega_tooth = math.sqrt(float(np.max(model.k_phi)) / float(np.min(model.gear_par[:, L.I_P])))
-    atol_vec = np.r_[np.full(n, atol), np.full(n, atol * omega_tooth), 1e-3 * atol, 1e-3 * atol]
-    if delta_max is None:
-        delta_max = 0.1 * model.geometry[0].spec.module
-    y = np.zeros(2 * n + 2)
-    y[0] = model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset)
-    n_out = int(math.floor(duration / output_step + 1e-9)) + 1
-    t_out = np.arange(n_out) * output_step
-    kinks = (speed_ramp, *table[:, 0]) if table.shape[0] else (speed_ramp, torque_ramp)
-    breaks = sorted({0.0, duration, *(float(b) for b in kinks if 0 < b < duration)})
-    kw = {"rtol": rtol, "atol": atol_vec}
-    if max_step is not None:
-        kw["max_step"] = max_step
-    if method in STIFF_METHODS:
-        kw["jac"] = eq.jac
-    ys = np.full((n_out, y.size), np.nan)
-    status, msg = OK, "ok"
-    nfev = njev = nlu = steps = 0
-    t_reached = 0.0
-    cls = getattr(integrate, method)
-    ys[0] = y
-    t0 = _time.perf_counter()
-    for a, b in zip(breaks[:-1], breaks[1:]):
-        solver = cls(eq.rhs, a, y, b, **kw)
-        while solver.status == "running":
-            t_old = solver.t
-            err = solver.step()
-            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                status = NONFINITE
-                msg = (f"{method} failed at t = {t_old:.6g} s (step {steps + 1}): "
-                       f"{err or 'non-finite state'}")
+    method: str = "LSODA"
+    rtol: float = 1e-6
+    atol: float | None = None
+    output_step: float = 1e-5
+    max_step: float | None = None
+    delta_max: float | None = None
+    raise_on_failure: bool = False
+    max_wall_time: float | None = None
+
+    def run(self, model: Model, drive: Drive) -> ScipyResult:
+        """Integrate ``model`` from rest under ``drive``."""
+        method, rtol, atol, output_step = self.method, self.rtol, self.atol, self.output_step
+        speed, speed_ramp, torque, torque_ramp = drive.speed, drive.speed_ramp, drive.torque, drive.torque_ramp
+        duration = drive.duration
+        if method not in METHODS:
+            raise ValueError(f"method: must be one of {', '.join(METHODS)}, got {method!r}")
+        check_positive(duration=duration, speed_ramp=speed_ramp, torque_ramp=torque_ramp, output_step=output_step,
+                       rtol=rtol)
+        table, _step_torque, side = run_loads(drive.load_table, torque)
+        eq = PairEquations(model, speed, speed_ramp, torque, torque_ramp, table)
+        n = eq.n
+        if atol is None:
+            atol = rtol * 1e-6
+        omega_tooth = math.sqrt(float(np.max(model.k_phi)) / float(np.min(model.gear_par[:, L.I_P])))
+        atol_vec = np.r_[np.full(n, atol), np.full(n, atol * omega_tooth), 1e-3 * atol, 1e-3 * atol]
+        delta_max = self.delta_max
+        if delta_max is None:
+            delta_max = 0.1 * model.geometry[0].spec.module
+        y = np.zeros(2 * n + 2)
+        y[0] = model.theta2_for_te(0.0, (1.0 if side >= 0 else -1.0) * model.backlash_offset)
+        n_out = int(math.floor(duration / output_step + 1e-9)) + 1
+        t_out = np.arange(n_out) * output_step
+        kinks = (speed_ramp, *table[:, 0]) if table.shape[0] else (speed_ramp, torque_ramp)
+        breaks = sorted({0.0, duration, *(float(b) for b in kinks if 0 < b < duration)})
+        kw = {"rtol": rtol, "atol": atol_vec}
+        if self.max_step is not None:
+            kw["max_step"] = self.max_step
+        if method in STIFF_METHODS:
+            kw["jac"] = eq.jac
+        ys, status, msg, counts = self._step(eq, y, t_out, breaks, kw)
+        steps, t_reached, wall = counts["steps"], counts["t_reached"], counts["wall"]
+        good = np.all(np.isfinite(ys), axis=1)
+        m = int(np.argmin(good)) if not good.all() else n_out
+        t_out, ys = t_out[:m], ys[:m]
+        status, msg, (te, fmax, ncon, react, ke, pe) = _sampled(model, eq, drive, t_out, ys, status, msg, delta_max)
+        if status and self.raise_on_failure:
+            raise DivergenceError(msg)
+        mean_dt = t_reached / steps if steps else float("nan")
+        return ScipyResult(t_out, te, ys[:, 0], fmax, ncon, react, ke, pe, ys[:, 2 * n], ys[:, 2 * n + 1],
+                           np.zeros_like(t_out), mean_dt, steps, status, msg, float("nan"), eq.nt,
+                           method=method, rtol=rtol, atol=float(atol), nfev=counts["nfev"], njev=counts["njev"],
+                           nlu=counts["nlu"], wall_time=wall)
+
+    def _step(self, eq: PairEquations, y: np.ndarray, t_out: np.ndarray, breaks: list, kw: dict):
+        """Step the solver from one break (ramp end) to the next, reading the state at the
+        output instants t_out [s] from its dense output: (states, status, message, counters:
+        steps, nfev, njev, nlu, t_reached [s], wall [s] of the integration)."""
+        method, max_wall_time = self.method, self.max_wall_time
+        ys = np.full((t_out.size, y.size), np.nan)
+        status, msg = OK, "ok"
+        nfev = njev = nlu = steps = 0
+        t_reached = 0.0
+        cls = getattr(integrate, method)
+        ys[0] = y
+        t0 = _time.perf_counter()
+        for a, b in zip(breaks[:-1], breaks[1:]):
+            solver = cls(eq.rhs, a, y, b, **kw)
+            while solver.status == "running":
+                t_old = solver.t
+                err = solver.step()
+                if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                    status = NONFINITE
+                    msg = (f"{method} failed at t = {t_old:.6g} s (step {steps + 1}): "
+                           f"{err or 'non-finite state'}")
+                    break
+                steps += 1
+                if max_wall_time is not None and _time.perf_counter() - t0 > max_wall_time:
+                    status = INTERRUPTED
+                    msg = (f"{method}: wall-time limit {max_wall_time:g} s reached at t = {solver.t:.6g} s "
+                           f"(step {steps})")
+                    solver.status = "failed"
+                sel = np.flatnonzero((t_out > t_old) & (t_out <= solver.t))
+                if sel.size:
+                    ys[sel] = solver.dense_output()(t_out[sel]).T
+                t_reached = solver.t
+            nfev += solver.nfev
+            njev += solver.njev
+            nlu += solver.nlu
+            if status:
                 break
-            steps += 1
-            if max_wall_time is not None and _time.perf_counter() - t0 > max_wall_time:
-                status = INTERRUPTED
-                msg = (f"{method}: wall-time limit {max_wall_time:g} s reached at t = {solver.t:.6g} s "
-                       f"(step {steps})")
-                solver.status = "failed"
-            sel = np.flatnonzero((t_out > t_old) & (t_out <= solver.t))
-            if sel.size:
-                ys[sel] = solver.dense_output()(t_out[sel]).T
-            t_reached = solver.t
-        nfev += solver.nfev
-        njev += solver.njev
-        nlu += solver.nlu
-        if status:
-            break
-        y = solver.y
-    wall = _time.perf_counter() - t0
-    # post-processing at the output instants
-    good = np.all(np.isfinite(ys), axis=1)
-    m = int(np.argmin(good)) if not good.all() else n_out
-    t_out, ys = t_out[:m], ys[:m]
+            y = solver.y
+        wall = _time.perf_counter() - t0
+        return ys, status, msg, dict(steps=steps, nfev=nfev, njev=njev, nlu=nlu, t_reached=t_reached, wall=wall)
+
+
+def _sampled(model: Model, eq: PairEquations, drive: Drive, t_out: np.ndarray, ys: np.ndarray, status: int,
+             msg: str, delta_max: float):
+    """The outputs at the instants t_out [s] of the states ys: (status, message, (TE [m],
+    largest contact force [N], contacts in force, driver torque [N·m], kinetic and potential
+    energy [J])); a penetration beyond delta_max [m] sets the status where none was set."""
+    n, m = eq.n, t_out.size
     rb1, rb2 = model.base_radii
     te = np.empty(m)
     fmax = np.zeros(m)
@@ -146,7 +182,7 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
         x, v = yy[:n], yy[n:2 * n]
         q, q1, cons, a1 = eq.forces(t, x, v)
         acc = eq.solve_mass(q, a1)
-        th1 = driver_motion(t, speed, speed_ramp)[0]
+        th1 = driver_motion(t, drive.speed, drive.speed_ramp)[0]
         te[i] = rb1 * th1 + rb2 * x[0]
         fmax[i] = max((c.force for c in cons), default=0.0)
         ncon[i] = sum(1 for c in cons if c.force > 0.0)
@@ -154,26 +190,30 @@ def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float,
         ke[i], pe[i] = eq.energies(t, x, v, cons)
         if status == OK and max((c.delta for c in cons), default=0.0) > delta_max:
             status, msg = PENETRATION, f"penetration beyond the bound {delta_max * 1e6:.4g} um at t = {t:.6g} s"
-    if status and raise_on_failure:
-        raise DivergenceError(msg)
-    mean_dt = t_reached / steps if steps else float("nan")
-    return ScipyResult(t_out, te, ys[:, 0], fmax, ncon, react, ke, pe, ys[:, 2 * n], ys[:, 2 * n + 1],
-                       np.zeros_like(t_out), mean_dt, steps, status, msg, float("nan"), eq.nt,
-                       method=method, rtol=rtol, atol=float(atol), nfev=nfev, njev=njev, nlu=nlu, wall_time=wall)
+    return status, msg, (te, fmax, ncon, react, ke, pe)
+
+
+def simulate_scipy(model: Model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
+                   duration: float, **settings) -> ScipyResult:
+    """The scipy peer in one call: ``ScipyIntegrator(**settings).run(model, Drive(speed,
+    speed_ramp, torque, torque_ramp, duration, load_table))``, with ``load_table`` (a torque
+    profile instead of the torque ramp, as in `solver.mbs.dynamics.Drive`) taken from
+    ``settings``."""
+    drive = Drive(speed, speed_ramp, torque, torque_ramp, duration, settings.pop("load_table", None))
+    return ScipyIntegrator(**settings).run(model, drive)
 
 
 def simulate_explicit_all_teeth(model: Model, speed: float, speed_ramp: float, torque: float,
-                                torque_ramp: float, duration: float, dt: float,
-                                output_step: float = 1e-5, load_table=None,
-                                implicit_dampers: bool = False) -> DynamicResult:
+                                torque_ramp: float, duration: float, dt: float, **settings) -> DynamicResult:
     """The explicit Verlet kernel on the same model as the scipy peer: every tooth free.
 
     `solver.mbs.dynamics.simulate` freezes idle teeth rigid to their hub (its active set); here
     all teeth start active (phi = 1e-300 rad, numerically zero) and none is ever frozen, so
     the two solvers integrate identical equations and can be compared step against
-    tolerance. ``dt`` [s] is rounded down to divide ``output_step`` [s]; ``load_table`` as in
+    tolerance. ``dt`` [s] is rounded down to divide ``output_step`` [s] (default 1e-5 s);
+    ``settings``: those of `solver.mbs.dynamics.ExplicitIntegrator` and ``load_table``, as in
     `solver.mbs.dynamics.simulate`. Every force explicit by default (the scheme the reference
     runs have always used); ``implicit_dampers``: the IMEX kicks of `simulate`.
     """
-    return simulate(model, speed, speed_ramp, torque, torque_ramp, duration, dt=dt, output_step=output_step,
-                    load_table=load_table, all_teeth=True, implicit_dampers=implicit_dampers)
+    settings.setdefault("implicit_dampers", False)
+    return simulate(model, speed, speed_ramp, torque, torque_ramp, duration, dt=dt, all_teeth=True, **settings)
