@@ -26,6 +26,7 @@ REACHES = (
     ("solver.fe", "fe"), ("solver.identify", "fe"), ("study.inputs", "fe"), ("study.verify", "fe"),
     ("study.commands", "fe"), ("study.sweep.bodies", "fe"),
     ("solver.mbs", "solver"), ("solver.peers", "solver"), ("study.run", "solver"), ("study.sweep.engine", "solver"),
+    ("study.sweep.point", "solver"), ("study.sweep.cluster", "solver"),
     ("study.sweep.tasks", "solver"), ("study.scene_model", "solver"), ("study.estimate", "solver"),
     ("study.report.figures", "solver"), ("study.archive.modes", "solver"), ("study.archive.mesh", "solver"),
     ("workflows", "solver"), ("study.cli", "solver"), ("study.process", "solver"),

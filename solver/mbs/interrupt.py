@@ -11,7 +11,7 @@ before its next driver angle (statics), and the KeyboardInterrupt goes on up: no
 caller's ``finally`` blocks run, and the command line exits 130.
 
 A dask worker has no Ctrl-C of its own: when its cluster closes, `stop_all` (called from the
-worker plugin `study.sweep.engine.StopKernels`) aborts the kernels running in that process and
+worker plugin `study.sweep.cluster.stop_kernels_plugin`) aborts the kernels running in that process and
 those started after, which then raise `Interrupted`, so the worker closes at once instead of
 waiting for the point to finish.
 """

@@ -65,8 +65,8 @@ def test_unwritable_output_folder_is_refused(capsys, example_scene_file):
 def test_sweep_refuses_negative_workers_and_an_unreachable_scheduler(tmp_path, capsys, monkeypatch):
     assert main(["sweep", STUDY, "-o", str(tmp_path / "s.nc"), "--workers", "-1"]) == 2
     assert "--workers: must be >= 0" in capsys.readouterr().err
-    from study.sweep import engine
-    monkeypatch.setattr(engine, "CONNECT_TIMEOUT_S", 1.0)
+    from study.sweep import cluster
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 1.0)
     assert main(["sweep", STUDY, "-o", str(tmp_path / "s.nc"), "--scheduler", "tcp://127.0.0.1:1", "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "--scheduler: no dask scheduler answered at tcp://127.0.0.1:1 within 1 s" in err and "Traceback" not in err

@@ -100,7 +100,7 @@ def test_an_interrupt_stops_the_statics_before_the_next_angle(paper_solid_model)
 
 
 def test_stop_all_ends_a_running_kernel_and_refuses_new_ones(paper_solid_model, monkeypatch):
-    """What a closing dask worker does (`study.sweep.engine.stop_kernels_plugin`)."""
+    """What a closing dask worker does (`study.sweep.cluster.stop_kernels_plugin`)."""
     from solver.mbs.dynamics import simulate
     monkeypatch.setattr(interrupt, "_stopping", threading.Event())
     threading.Timer(1.0, interrupt.stop_all).start()

@@ -45,9 +45,11 @@ def swept(tmp_path_factory):
 
 
 def count_points(monkeypatch, stop_after: int | None = None) -> list:
-    """Patch `study.sweep.engine.run_point` to record each point's scene in the returned list,
-    and, with ``stop_after``, to raise KeyboardInterrupt (a Ctrl-C mid-study) when that many
-    points have run."""
+    """Patch `run_point` where the sweep calls it (`study.sweep.engine` in process,
+    `study.sweep.cluster.run_after` in a batch) to record each point's scene in the returned
+    list, and, with ``stop_after``, to raise KeyboardInterrupt (a Ctrl-C mid-study) when that
+    many points have run."""
+    import study.sweep.cluster as cluster
     import study.sweep.engine as engine
     real = engine.run_point
     calls = []
@@ -59,6 +61,7 @@ def count_points(monkeypatch, stop_after: int | None = None) -> list:
         return real(scene, outputs)
 
     monkeypatch.setattr(engine, "run_point", run)
+    monkeypatch.setattr(cluster, "run_point", run)
     return calls
 
 

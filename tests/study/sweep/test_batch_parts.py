@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 from sweep_cases import count_points, swept, tiny_study  # noqa: F401  (swept: the sweep, run once per session)
 
-import study.sweep.engine as engine
+import study.sweep.cluster as cluster
 from study.sweep.engine import PartStore, parts_folder, run_after, run_sweep
 from study.sweep.grid import check_points
 from study.sweep.outputs import STATUS
@@ -53,10 +53,10 @@ def test_a_closing_worker_stores_nothing_and_a_remote_batch_leaves_the_store_to_
     t = next(iter(plan(st, check_points(st))[0].values()))
     folder = tmp_path / "parts"
     # a worker whose cluster closes: its kernels were stopped, what it returns is no result to keep
-    monkeypatch.setattr(engine, "_CLOSING", True)
+    monkeypatch.setattr(cluster, "_CLOSING", True)
     [(key, r)] = run_after(((t.key, t.scene, t.outputs),), parts=str(folder))
     assert key == t.key and "stored" not in r and not folder.exists()
-    monkeypatch.setattr(engine, "_CLOSING", False)
+    monkeypatch.setattr(cluster, "_CLOSING", False)
     # no part folder given (a scheduler elsewhere, whose workers may not share this disk)
     [(_, r)] = run_after(((t.key, t.scene, t.outputs),))
     assert "stored" not in r and not folder.exists()
@@ -82,7 +82,7 @@ def test_on_a_local_cluster_the_workers_store_the_tasks_of_their_batches(tmp_pat
     by_client = []
     real_put = PartStore.put
     monkeypatch.setattr(PartStore, "put", lambda self, key, result: by_client.append(key) or real_put(self, key, result))
-    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)     # no pilot task: the batches above
+    monkeypatch.setattr(cluster, "kernels_cached", lambda coupled=None: True)     # no pilot task: the batches above
     out = tmp_path / "dask.nc"
     res = run_sweep(st, out, workers=2, progress=False, keep_parts=True)
     assert (res.dataset["status"] == STATUS.index("ok")).all()

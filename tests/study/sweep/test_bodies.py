@@ -8,7 +8,7 @@ from solver.store import STORE
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import gear_setup
 from study.inputs.springs import tooth_springs
-from study.sweep import engine
+from study.sweep import cluster, engine
 from study.sweep.bodies import compute_body, compute_map, fe_jobs, job_rim, spring_maps
 from study.sweep.engine import run_sweep
 from study.sweep.grid import loads_study
@@ -69,7 +69,7 @@ def test_a_dask_sweep_computes_each_map_once_before_the_tasks_that_read_it(tmp_p
         submitted.append((func.__name__, future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
-    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)     # no pilot task (test_pilot)
+    monkeypatch.setattr(cluster, "kernels_cached", lambda coupled=None: True)     # no pilot task (test_pilot)
     res = run_sweep(st, tmp_path / "dask.nc", workers=2, progress=False)
     maps = [key for name, key, _ in submitted if name == "compute_map"]
     assert len(maps) == len(set(maps)) == 4
@@ -136,7 +136,7 @@ def test_a_compliance_sweep_on_dask_equals_the_one_that_computes_its_fe_in_the_t
         submitted.append((func.__name__, future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
-    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)     # no pilot task (test_pilot)
+    monkeypatch.setattr(cluster, "kernels_cached", lambda coupled=None: True)     # no pilot task (test_pilot)
     res = run_sweep(st, tmp_path / "dask.nc", workers=2, progress=False)
     names = [name for name, _, _ in submitted]
     assert names.count("compute_body") == 4 and names.count("compute_map") == 1

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from helpers import scene_overrides
 
-from study.sweep import engine
+from study.sweep import cluster
 from study.sweep.engine import kernel_cache_folder, kernels_cached, run_sweep
 from study.sweep.grid import loads_study
 from study.sweep.outputs import STATUS
@@ -66,7 +66,7 @@ def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, mon
         batches.append(args[0])
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
-    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: False)
+    monkeypatch.setattr(cluster, "kernels_cached", lambda coupled=None: False)
     res = run_sweep(st, tmp_path / "cold.nc", workers=2, progress=False)
     (pilot, before), *rest = submitted
     assert before == [] and len(rest) == len(submitted) - 1 >= 2
@@ -77,7 +77,7 @@ def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, mon
     assert (res.dataset["status"] == STATUS.index("ok")).all()
     # a warm cache: no pilot, no waiting, the same numbers
     submitted.clear()
-    monkeypatch.setattr(engine, "kernels_cached", lambda coupled=None: True)
+    monkeypatch.setattr(cluster, "kernels_cached", lambda coupled=None: True)
     warm = run_sweep(st, tmp_path / "warm.nc", workers=2, progress=False)
     assert all(after == [] for _, after in submitted)
     for name in ("ste_p2p", "dte_rms"):
