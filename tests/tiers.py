@@ -24,7 +24,7 @@ import types
 # module prefixes -> marker; the first that matches wins
 REACHES = (
     ("solver.fe", "fe"), ("solver.identify", "fe"), ("study.inputs", "fe"), ("study.verify", "fe"),
-    ("study.commands", "fe"), ("study.sweep.bodies", "fe"),
+    ("study.commands", "fe"), ("study.cli_fe", "fe"), ("study.sweep.bodies", "fe"),
     ("solver.mbs", "solver"), ("solver.peers", "solver"), ("study.run", "solver"), ("study.sweep.engine", "solver"),
     ("study.sweep.point", "solver"), ("study.sweep.cluster", "solver"),
     ("study.sweep.tasks", "solver"), ("study.scene_model", "solver"), ("study.estimate", "solver"),
