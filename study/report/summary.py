@@ -66,6 +66,19 @@ def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
     ``wall_time`` [s]."""
     s = summarize(ds)
     w = sys.stdout.write
+    _head(ds, s, w, path)
+    _stiffness(ds, s, w)
+    _dynamics(ds, s, w)
+    _runup(ds, w)
+    _gears(ds, s, w)
+    _named_orders(ds, w)
+    w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
+      + f", total {wall_time:.2f} s\n")
+
+
+def _head(ds: xr.Dataset, s: dict, w, path) -> None:
+    """The title, the archive, the comparison, the contact ratio, the model and the STE (``w``: the
+    writer, ``s``: `summarize`'s scalars)."""
     w(f"{ds.attrs.get('title', '')}\n  archive: {path}\n")
     for line in comparison_lines(ds):
         w(line + "\n")
@@ -78,6 +91,10 @@ def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
     if "ste" in s or "ste_mean" in s:
         w(f"  STE: mean {s['ste_mean']:.3f} um (elastic part {s['ste_elastic_mean']:.3f} um), "
           f"peak-to-peak {s['ste_p2p']:.3f} um over {float(ds['angle'][-1]):.4g} deg\n")
+
+
+def _stiffness(ds: xr.Dataset, s: dict, w) -> None:
+    """The mesh stiffness against ISO 6336-1 and the tooth stiffness at the pitch point."""
     if "mesh_stiffness_mean" in s:
         w(f"  mesh stiffness (tangent, along the line of action): pair {s['mesh_stiffness_mean']:.1f} N/um mean (both "
           f"bodies' wind-up from the bore in it), peak-to-peak {s['mesh_stiffness_p2p']:.1f} N/um")
@@ -101,6 +118,10 @@ def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
             kb = ds["tooth_stiffness_pitch_bore"]
             line += "; with the wind-up from the bore: " + ", ".join(f"gear {g} {_range(kb.sel(gear=g))}" for g in (1, 2))
         w(line + "\n")
+
+
+def _dynamics(ds: xr.Dataset, s: dict, w) -> None:
+    """The DTE, its largest peaks, the dynamic tooth force and the mesh mode with its critical speeds."""
     runup = "order_amplitude" in ds
     if "dte_rms" in s and not runup:
         short = ds.attrs.get("steady_window_note")
@@ -128,6 +149,10 @@ def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
             line += f", {a['mesh_mode_damping_decay']:.4f} from the free decay ({a['mesh_mode_damping_at_decay']:.4f} modal there)"
         w(line + "\n")
         w(critical_speed_line(ds))
+
+
+def _runup(ds: xr.Dataset, w) -> None:
+    """A run-up's resonance peaks, and where its teeth lost contact."""
     if "order_amplitude" in ds:
         sp, order, amp = ds["runup_speed"].values, ds["tracked_order"].values, ds["order_amplitude"].values
         z = ds.attrs["mesh_order"]
@@ -151,6 +176,10 @@ def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
                     peaks.append(f"{k}Z measured {at:.0f} rad/s, modal {modal:.0f} ({100 * (at / modal - 1):+.1f} %)")
             w(f"    the teeth lost contact between {lost[0]:.0f} and {lost[1]:.0f} rad/s: the response left the linear "
               "range, and the critical speeds are linear estimates" + (": " + ", ".join(peaks) if peaks else "") + "\n")
+
+
+def _gears(ds: xr.Dataset, s: dict, w) -> None:
+    """Each gear's mass, inertia and root stress, and the strength lines."""
     if "mass" in ds:
         for g in (1, 2):
             line = (f"  gear {g}: mass {s[f'mass_gear{g}']:.4f} kg ({s[f'mass_saving_gear{g}']:.1f} % saved against "
@@ -164,6 +193,10 @@ def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
     if "bending_stress" in ds:
         for line in strength_lines(ds):
             w(line + "\n")
+
+
+def _named_orders(ds: xr.Dataset, w) -> None:
+    """The DTE and STE at the named orders."""
     for what in ("dte", "ste"):
         if f"{what}_peak_amplitude" in ds:
             named = [(str(n), float(a)) for n, a in zip(ds[f"{what}_peak"].values, ds[f"{what}_peak_amplitude"].values)
@@ -173,8 +206,6 @@ def print_summary(ds: xr.Dataset, path, wall_time: float) -> None:
             more = f" (and {len(named) - len(shown)} below {NAMED_SHOWN:.0%} of the largest: {what}_peak_*)" \
                 if len(shown) < len(named) else ""
             w(f"  {what.upper()} at named orders [um]: " + ", ".join(f"{n} {a:.3g}" for n, a in shown) + more + "\n")
-    w("  wall time: " + ", ".join(f"{k[10:-2]} {ds.attrs[k]:.3f} s" for k in ds.attrs if k.startswith("wall_time_"))
-      + f", total {wall_time:.2f} s\n")
 
 
 def _range(k: xr.DataArray) -> str:
