@@ -329,6 +329,48 @@ def sample_tables(ds: xr.Dataset, outputs: list[str] | None = None, limits: dict
     for name in limits:
         if name not in ds.data_vars or "sample" not in ds[name].dims:
             raise ValueError(f"limit {name!r}: no sampled output of that name (outputs: {', '.join(sample_outputs(ds))})")
+    r = _statistics(ds, outputs, limits, level)
+    mean, pct, count, exc, free = r["mean"], r["pct"], r["count"], r["exc"], r["free"]
+    bound = {"bound": xr.DataArray(list(BOUNDS), dims="bound")}
+    out_c = {"output": xr.DataArray(outputs, dims="output")}
+    note = f"bound: the estimate and the ends of its {100 * level:g} % confidence interval"
+    arrays = _over_grid(ds, {"sample_mean": mean}, ("output", "bound"), {**out_c, **bound},
+                        {"sample_mean": {"long_name": "mean of the output over the builds", "comment": note}})
+    arrays |= _over_grid(ds, {"sample_percentile": pct}, ("output", "quantile", "bound"),
+                         {**out_c, "quantile": xr.DataArray(list(QUANTILES), dims="quantile",
+                                                            attrs={"units": "1", "long_name": "probability"}), **bound},
+                         {"sample_percentile": {"long_name": "percentile of the output over the builds",
+                                                "comment": note + " (order statistics of the independent builds, "
+                                                "binomial coverage; NaN where the sample cannot support one)"}})
+    arrays |= _over_grid(ds, {"sample_count": count}, ("output",), out_c,
+                         {"sample_count": {"units": "1", "long_name": "builds ok with a finite value"}})
+    if limits:
+        arrays |= _over_grid(ds, {"exceedance_probability": exc}, ("limit", "bound"),
+                             {"limit": xr.DataArray(list(limits), dims="limit"),
+                              "limit_value": xr.DataArray([float(v) for v in limits.values()], dims="limit",
+                                                          attrs={"comment": "in the units of the output named by limit"}),
+                              **bound},
+                             {"exceedance_probability": {"units": "1", "long_name": "probability that the output "
+                                                         "exceeds limit_value", "comment": note + " (Clopper-Pearson)"}})
+    if r["conv"] is not None:
+        arrays |= _convergence_arrays(ds, r, out_c, bound, note)
+    if r["saltelli"]:
+        arrays |= _sobol_arrays(ds, r, out_c, bound, note)
+    # each output's units on its statistics
+    units = {v: ds[v].attrs.get("units", "") for v in outputs}
+    tab = xr.Dataset(arrays)
+    tab["output_units"] = xr.DataArray([units[v] for v in outputs], dims="output",
+                                       attrs={"long_name": "units of the output (and of its mean and percentiles)"})
+    tab["sample_percentile"].attrs["min_independent_builds"] = np.array([min_builds(q, level) for q in QUANTILES])
+    return tab.assign_attrs(confidence_level=level, bootstrap_resamples=N_BOOT, independent_builds=int(free.sum()))
+
+
+def _statistics(ds: xr.Dataset, outputs: list[str], limits: dict, level: float) -> dict:
+    """The statistics of `sample_tables` as arrays over (grid..., output, ...): ``mean``,
+    ``pct``, ``count``, ``exc`` (per limit), ``conv`` (the convergence of the mean and P95; None
+    without points) with ``conv_builds``, ``conv_rows`` and ``conv_time`` [s], ``s1`` and ``st``
+    (Sobol indices, with the Saltelli design: ``saltelli``) over the drawn ``fields``; ``free``:
+    the independent builds."""
     points = grid_points(ds)
     gshape = tuple(ds.sizes[d] for d in grid_dims(ds))
     rows = rows_of(ds)
@@ -338,7 +380,7 @@ def sample_tables(ds: xr.Dataset, outputs: list[str] | None = None, limits: dict
     pct = np.full(gshape + (no, nq, nb), np.nan)
     count = np.zeros(gshape + (no,), np.int64)
     exc = np.full(gshape + (len(limits), nb), np.nan)
-    conv = None
+    conv = conv_builds = conv_rows = conv_time = None
     saltelli = "sample_block" in ds
     fields = drawn_fields(ds)
     s1 = np.full(gshape + (no, len(fields), nb), np.nan)
@@ -370,51 +412,34 @@ def sample_tables(ds: xr.Dataset, outputs: list[str] | None = None, limits: dict
                 st[pos + (j,)] = ind["total"]
         for k, (var, lim) in enumerate(limits.items()):
             exc[pos + (k,)] = exceedance(output_at(ds, var, at), lim, rows, level)
-    bound = {"bound": xr.DataArray(list(BOUNDS), dims="bound")}
-    out_c = {"output": xr.DataArray(outputs, dims="output")}
-    note = f"bound: the estimate and the ends of its {100 * level:g} % confidence interval"
-    arrays = _over_grid(ds, {"sample_mean": mean}, ("output", "bound"), {**out_c, **bound},
-                        {"sample_mean": {"long_name": "mean of the output over the builds", "comment": note}})
-    arrays |= _over_grid(ds, {"sample_percentile": pct}, ("output", "quantile", "bound"),
-                         {**out_c, "quantile": xr.DataArray(list(QUANTILES), dims="quantile",
-                                                            attrs={"units": "1", "long_name": "probability"}), **bound},
-                         {"sample_percentile": {"long_name": "percentile of the output over the builds",
-                                                "comment": note + " (order statistics of the independent builds, "
-                                                "binomial coverage; NaN where the sample cannot support one)"}})
-    arrays |= _over_grid(ds, {"sample_count": count}, ("output",), out_c,
-                         {"sample_count": {"units": "1", "long_name": "builds ok with a finite value"}})
-    if limits:
-        arrays |= _over_grid(ds, {"exceedance_probability": exc}, ("limit", "bound"),
-                             {"limit": xr.DataArray(list(limits), dims="limit"),
-                              "limit_value": xr.DataArray([float(v) for v in limits.values()], dims="limit",
-                                                          attrs={"comment": "in the units of the output named by limit"}),
-                              **bound},
-                             {"exceedance_probability": {"units": "1", "long_name": "probability that the output "
-                                                         "exceeds limit_value", "comment": note + " (Clopper-Pearson)"}})
-    if conv is not None:
-        rows_c = {"rows": xr.DataArray(conv_rows, dims="rows", attrs={"units": "1", "long_name": "first rows of the sample used"})}
-        arrays |= _over_grid(ds, {"convergence_mean": conv["mean"], "convergence_p95": conv["quantile"]},
-                             ("output", "rows", "bound"), {**out_c, **rows_c, **bound},
-                             {"convergence_mean": {"long_name": "mean of the output over the first rows", "comment": note},
-                              "convergence_p95": {"long_name": "95th percentile of the output over the first rows",
-                                                  "comment": note}})
-        arrays |= _over_grid(ds, {"convergence_time": conv_time}, ("rows",), rows_c,
-                             {"convergence_time": {"units": "s", "long_name": "compute time of the builds of the "
-                                                                             "first rows (sum of their wall_time)"}})
-        arrays["convergence_builds"] = xr.DataArray(conv_builds, dims="rows", coords=rows_c,
-                                                    attrs={"units": "1", "long_name": "builds in the first rows"})
-    if saltelli:
-        f_c = {"field": xr.DataArray([ds[f].attrs["scene_field"] for f in fields], dims="field")}
-        arrays |= _over_grid(ds, {"sobol_first": s1, "sobol_total": st}, ("output", "field", "bound"),
-                             {**out_c, **f_c, **bound},
-                             {"sobol_first": {"units": "1", "long_name": "first-order Sobol index of the drawn field",
-                                              "comment": note + " (bootstrap over the rows)"},
-                              "sobol_total": {"units": "1", "long_name": "total Sobol index of the drawn field",
-                                              "comment": note + " (bootstrap over the rows)"}})
-    # each output's units on its statistics
-    units = {v: ds[v].attrs.get("units", "") for v in outputs}
-    tab = xr.Dataset(arrays)
-    tab["output_units"] = xr.DataArray([units[v] for v in outputs], dims="output",
-                                       attrs={"long_name": "units of the output (and of its mean and percentiles)"})
-    tab["sample_percentile"].attrs["min_independent_builds"] = np.array([min_builds(q, level) for q in QUANTILES])
-    return tab.assign_attrs(confidence_level=level, bootstrap_resamples=N_BOOT, independent_builds=int(free.sum()))
+    return dict(mean=mean, pct=pct, count=count, exc=exc, conv=conv, conv_builds=conv_builds, conv_rows=conv_rows,
+                conv_time=conv_time, s1=s1, st=st, saltelli=saltelli, fields=fields, free=free)
+
+
+def _convergence_arrays(ds: xr.Dataset, r: dict, out_c: dict, bound: dict, note: str) -> dict:
+    """The convergence tables of `sample_tables` (over ``rows``) from `_statistics`' ``r``."""
+    conv, conv_rows, conv_time, conv_builds = r["conv"], r["conv_rows"], r["conv_time"], r["conv_builds"]
+    rows_c = {"rows": xr.DataArray(conv_rows, dims="rows", attrs={"units": "1", "long_name": "first rows of the sample used"})}
+    arrays = _over_grid(ds, {"convergence_mean": conv["mean"], "convergence_p95": conv["quantile"]},
+                         ("output", "rows", "bound"), {**out_c, **rows_c, **bound},
+                         {"convergence_mean": {"long_name": "mean of the output over the first rows", "comment": note},
+                          "convergence_p95": {"long_name": "95th percentile of the output over the first rows",
+                                              "comment": note}})
+    arrays |= _over_grid(ds, {"convergence_time": conv_time}, ("rows",), rows_c,
+                         {"convergence_time": {"units": "s", "long_name": "compute time of the builds of the "
+                                                                         "first rows (sum of their wall_time)"}})
+    arrays["convergence_builds"] = xr.DataArray(conv_builds, dims="rows", coords=rows_c,
+                                                attrs={"units": "1", "long_name": "builds in the first rows"})
+    return arrays
+
+
+def _sobol_arrays(ds: xr.Dataset, r: dict, out_c: dict, bound: dict, note: str) -> dict:
+    """The Sobol tables of `sample_tables` (over ``field``) from `_statistics`' ``r``."""
+    fields, s1, st = r["fields"], r["s1"], r["st"]
+    f_c = {"field": xr.DataArray([ds[f].attrs["scene_field"] for f in fields], dims="field")}
+    return _over_grid(ds, {"sobol_first": s1, "sobol_total": st}, ("output", "field", "bound"),
+                         {**out_c, **f_c, **bound},
+                         {"sobol_first": {"units": "1", "long_name": "first-order Sobol index of the drawn field",
+                                          "comment": note + " (bootstrap over the rows)"},
+                          "sobol_total": {"units": "1", "long_name": "total Sobol index of the drawn field",
+                                          "comment": note + " (bootstrap over the rows)"}})
