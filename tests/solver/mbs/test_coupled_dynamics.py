@@ -12,7 +12,7 @@ from solver.mbs.dynamics import energy_error_limit, simulate
 from solver.mbs.kernels import layout as L
 from solver.mbs.modes import modal_analysis
 from solver.mbs.ringdown import ring_down
-from study.archive.order_tracking import order_cut, order_map
+from study.archive.order_tracking import OrderBlocks, order_cut, order_map
 from study.scene_model import build_scene_model
 
 MODELS = ("none", "body-torsion", "compliance")
@@ -68,8 +68,8 @@ def test_mesh_mode_critical_speed_is_the_runup_peak(cm, models, modes, runups):
     assert r.status in (0, 6) and r.time[-1] == pytest.approx(RUNUP_S)
     z1, z2 = m.teeth
     crit = critical_1z(m, modes[cm])
-    speed, order, amp = order_map(r.time, r.te * 1e6, w_end, RUNUP_S, z1, z2, revs=0.5, speed_min=0.5 * crit,
-                                  hop=1 / 32)
+    speed, order, amp = order_map(r.time, r.te * 1e6, w_end, RUNUP_S, z1, z2,
+                                  OrderBlocks(revs=0.5, speed_min=0.5 * crit, hop=1 / 32))
     cut = order_cut(speed, order, amp, float(z2), 1.0)
     peak = speed[int(np.argmax(cut))]
     assert peak == pytest.approx(crit, rel=0.03)

@@ -8,7 +8,7 @@ from helpers import solid_scene
 
 from solver.mbs.dynamics import simulate
 from study.archive.modes import critical_speeds
-from study.archive.order_tracking import driver_angle, order_cut, order_map
+from study.archive.order_tracking import OrderBlocks, driver_angle, order_cut, order_map
 from study.archive.spectra import amplitude_spectrum
 from study.scene_model import build_scene_model
 
@@ -21,7 +21,7 @@ def test_order_map_recovers_the_orders_of_a_synthetic_run_up():
     t = np.arange(0.0, 1.0, 2e-5)
     rev = driver_angle(t, 300.0, 1.0) * 60 / 67 / (2 * math.pi)
     x = 0.3 * np.cos(2 * math.pi * 67 * rev) + 0.1 * np.sin(2 * math.pi * 6 * rev + 0.4)
-    speed, order, amp = order_map(t, x, 300.0, 1.0, 60, 67, speed_min=20.0)
+    speed, order, amp = order_map(t, x, 300.0, 1.0, 60, 67, OrderBlocks(speed_min=20.0))
     assert speed.min() >= 20 and np.all(np.diff(speed) > 0) and speed.max() < 300
     np.testing.assert_allclose(order_cut(speed, order, amp, 67), 0.3, rtol=0.02)
     np.testing.assert_allclose(order_cut(speed, order, amp, 6), 0.1, rtol=0.01)
@@ -38,7 +38,7 @@ def test_run_up_tracks_the_steady_mesh_order_and_peaks_at_the_critical_speed():
     m = build_scene_model(solid_scene())
     run = simulate(m, 400.0, 0.5, 50.0, 0.01, 0.5)
     assert run.status == 0
-    speed, order, amp = order_map(run.time, run.te * 1e6, 400.0, 0.5, 67, 67, speed_min=20.0)
+    speed, order, amp = order_map(run.time, run.te * 1e6, 400.0, 0.5, 67, 67, OrderBlocks(speed_min=20.0))
     z = order_cut(speed, order, amp, 67)
     for w in (100.0, 150.0, 200.0):
         st = simulate(m, w, 0.01, 50.0, 0.01, 0.05)
