@@ -23,10 +23,21 @@ class MethodChoice:
     estimated: bool = False     # explicit at the estimated stability step: `simulate` may check it
 
 
+@dataclass(frozen=True)
+class MethodLimits:
+    """What `choose_method` weighs: the most explicit steps a run may take before 'auto' goes
+    implicit (``max_explicit_steps``), the implicit step as a multiple of the explicit bound
+    (``implicit_factor``), and the fraction of the stability bound (``safety``; None: the
+    default of `solver.mbs.stability`)."""
+    max_explicit_steps: float = math.inf
+    implicit_factor: float = 4.0
+    safety: float | None = None
+
+
 def choose_method(model: Model, torque: float, duration: float, method: str = "auto",
-                  dt: float | None = None, alpha: float = 0.0, max_explicit_steps: float = math.inf,
-                  implicit_factor: float = 4.0, safety: float | None = None) -> MethodChoice:
-    """Method and step [s] for a run of ``duration`` [s] under ``torque`` [N·m].
+                  dt: float | None = None, alpha: float = 0.0, limits: MethodLimits = MethodLimits()) -> MethodChoice:
+    """Method and step [s] for a run of ``duration`` [s] under ``torque`` [N·m] (``alpha``, the
+    HHT parameter of an implicit run, does not change its step).
 
     'explicit' and 'implicit' are kept; a given ``dt`` [s] > 0 is kept. 'auto' computes the
     explicit stability step safety*2/omega_max and takes explicit when duration/step is at
@@ -41,6 +52,7 @@ def choose_method(model: Model, torque: float, duration: float, method: str = "a
     (`solver.mbs.stability.implicit_dampers_apply`; ``safety`` None: that default); the
     implicit step is a multiple of the all-explicit bound (safety 0.5 by default), as before.
     """
+    max_explicit_steps, implicit_factor, safety = limits.max_explicit_steps, limits.implicit_factor, limits.safety
     if method not in ("explicit", "implicit", "auto"):
         raise ValueError(f"method: must be 'explicit', 'implicit' or 'auto', got {method!r}")
     given = dt is not None and dt > 0

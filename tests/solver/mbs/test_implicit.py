@@ -16,7 +16,7 @@ from solver.mbs.kernels.laws import (
     spring_damping_tangent,
     spring_torque,
 )
-from solver.mbs.method import choose_method
+from solver.mbs.method import MethodLimits, choose_method
 from solver.mbs.stability import highest_frequency, linearized_system, stable_time_step
 from study.run import run_scene
 from study.scene import SceneError
@@ -152,7 +152,7 @@ def test_scene_selects_the_integrator():
     auto = run_scene(sc.replace(**{"dynamic.method": "auto", "dynamic.time_step": 0.0}), static=False)
     assert auto.attrs["dynamic_method"] == "explicit" and "auto: explicit" in auto.attrs["dynamic_method_reason"]
     m = build_scene_model(sc)
-    ch = choose_method(m, 50.0, 10.0, "auto", max_explicit_steps=1e5)
+    ch = choose_method(m, 50.0, 10.0, "auto", limits=MethodLimits(max_explicit_steps=1e5))
     assert ch.method == "implicit" and ch.dt > 2.0 / ch.omega_max
     with pytest.raises(SceneError, match="dynamic.alpha"):
         solid_scene(**{"dynamic.alpha": 0.2})
