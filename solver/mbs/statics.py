@@ -57,15 +57,41 @@ class StaticResult:
         return self.iterations > 0
 
 
-def solve_static(model: Model, angles, torque: float, tol: float = 1e-10, max_iter: int = 60,
-                 phi0: np.ndarray | None = None, te0: float | None = None,
-                 raise_on_failure: bool = True, friction_speed: float = 1.0) -> StaticResult:
-    """Equilibrium under ``torque`` [N·m] on gear 2 at driver angles ``angles`` [rad].
+@dataclass(frozen=True)
+class StaticSolver:
+    """Newton with continuation over driver angles, and its settings; `run` finds the loaded
+    equilibria of a model.
 
-    ``tol`` is relative to the torque (residual torques below tol*|torque| count as converged).
-    ``friction_speed`` [rad/s]: the driver speed whose rigid kinematics set the sliding speed
-    of the flank friction (unused without friction).
+    ``tol`` is relative to the torque (residual torques below tol*|torque| count as converged);
+    ``max_iter`` Newton iterations an angle. ``raise_on_failure``: an angle not converged raises
+    `StaticSolveError` (else the result says so). ``friction_speed`` [rad/s]: the driver speed
+    whose rigid kinematics set the sliding speed of the flank friction (unused without
+    friction).
     """
+    tol: float = 1e-10
+    max_iter: int = 60
+    raise_on_failure: bool = True
+    friction_speed: float = 1.0
+
+    def run(self, model: Model, angles, torque: float, phi0: np.ndarray | None = None,
+            te0: float | None = None) -> StaticResult:
+        """Equilibrium under ``torque`` [N·m] on gear 2 at driver angles ``angles`` [rad], from
+        the tooth rotations ``phi0`` [rad] and the TE ``te0`` [m] (None: unloaded teeth, and the
+        backlash offset on the loaded flank)."""
+        return _solve(self, model, angles, torque, phi0, te0)
+
+
+def solve_static(model: Model, angles, torque: float, phi0: np.ndarray | None = None, te0: float | None = None,
+                 **settings) -> StaticResult:
+    """The static solver in one call: ``StaticSolver(**settings).run(model, angles, torque,
+    phi0, te0)``."""
+    return StaticSolver(**settings).run(model, angles, torque, phi0, te0)
+
+
+def _solve(settings: StaticSolver, model: Model, angles, torque: float, phi0, te0) -> StaticResult:
+    """`StaticSolver.run`."""
+    tol, max_iter = settings.tol, settings.max_iter
+    raise_on_failure, friction_speed = settings.raise_on_failure, settings.friction_speed
     angles = np.ascontiguousarray(angles, dtype=float)
     if angles.ndim != 1 or angles.size == 0:
         raise ValueError("angles: need a non-empty 1-D array of driver angles")
