@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -100,16 +101,10 @@ def mesh_states(model: Model, angles, torque: float, windup=None) -> MeshStates:
     compliance along the line of action [m/N] of the body wind-up from the bore that the plain
     model's tooth springs hold (a body-coupled model carries its own: refused there). Angles
     where the statics do not converge hold NaN."""
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
+    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
     from solver.mbs.linearization import linearize
     from solver.mbs.statics import solve_static
-    if windup is not None:
-        if model.coupled:
-            raise ValueError("windup: a body-coupled model carries the bodies' wind-up as its body springs "
-                             "(give it for the plain model only)")
-        windup = tuple(float(w) for w in windup)
-        if len(windup) != 2 or not all(math.isfinite(w) and w >= 0 for w in windup):
-            raise ValueError(f"windup: need two finite compliances >= 0 [m/N] (gear 1, gear 2), got {windup}")
+    windup = _checked_windup(model, windup)
     angles = np.asarray(angles, dtype=float)
     load = torque if abs(torque) > 1e-9 else 1.0
     z1, z2 = model.teeth
@@ -126,7 +121,6 @@ def mesh_states(model: Model, angles, torque: float, windup=None) -> MeshStates:
     rb1, rb2 = model.base_radii
     gp = model.gear_par
     tz2 = int(gp[1, L.TOOTH0])
-    levers = (pitch_lever(model, 0), pitch_lever(model, 1))
     rec, pairs = new_contact_buffer()
     zeros = np.zeros(model.n_teeth)
     phi, te0 = None, None
@@ -144,52 +138,98 @@ def mesh_states(model: Model, angles, torque: float, windup=None) -> MeshStates:
         lin = linearize(model, rim1, rim2, phi)
         hub = int(np.flatnonzero(lin.te)[0])            # the driven hub: theta2, or h2 when coupled
         k00, x = condense_onto(lin.K, hub)
-        th2 = lin.dofs.index("theta2")
-        r1 = lin.dofs.index("r1") if "r1" in lin.dofs else None
-        pos = {t: lin.n_body + j for j, t in enumerate(lin.teeth)}
+        dofs = _Dofs(lin.dofs.index("theta2"), lin.dofs.index("r1") if "r1" in lin.dofs else None,
+                     {t: lin.n_body + j for j, t in enumerate(lin.teeth)}, tz2)
         nc, _np = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, (gp, model.pair_par, model.law_par), (rec, pairs))
-        for c in range(nc):
-            a, b = int(rec[c, L.C_TOOTH1]), int(rec[c, L.C_TOOTH2])
-            f = rec[c, L.C_FORCE]
-            force[i, a] += f
-            force[i, tz2 + b] += f
-            if f > 0 and (mate[i, a] < 0 or f > force[i, tz2 + mate[i, a]]):
-                mate[i, a] = b
-        kp[i] = _pair_shares(rec, nc, x, th2, r1, pos, tz2, rb2, z1)
+        _tooth_forces(rec, nc, force[i], mate[i], tz2)
+        kp[i] = _pair_shares(rec, nc, x, dofs, rb2, z1)
         k[i] = k00 / rb2**2
-        if model.coupled:           # the body springs out, the driver rim prescribed, onto the driven rim
-            K = lin.K.copy()
-            K[r1, r1] -= gp[0, L.K_BODY]
-            h2 = lin.dofs.index("h2")
-            d = np.zeros(K.shape[0])
-            d[th2], d[h2] = 1.0, -1.0
-            K -= gp[1, L.K_BODY] * np.outer(d, d)
-            km, xm = condense_onto(K, th2, prescribed=(r1, h2))
-        elif windup is not None:    # each loaded tooth spring without the wind-up it holds
-            K = lin.K.copy()
-            held = True
-            for t, j in pos.items():
-                g = 1 if t >= tz2 else 0
-                kt = tooth_spring_tangent(t, phi, model.k_phi, gp)
-                if kt > 0:
-                    rest = 1.0 / kt - windup[g] / levers[g] ** 2
-                    held = held and rest > 0
-                    K[j, j] += 1.0 / rest - kt if rest > 0 else 0.0
-            if not held:            # a spring stiffer than the wind-up alone: it cannot hold it
-                kp_mesh[i] = np.nan
-                continue
-            km, xm = condense_onto(K, th2)
-        else:
+        alone = _mesh_alone(model, lin, dofs, phi, windup)
+        if alone is None:           # the plain model without the wind-up: no mesh alone
             continue
+        if alone is False:          # a spring stiffer than the wind-up alone: it cannot hold it
+            kp_mesh[i] = np.nan
+            continue
+        km, xm = alone
         k_mesh[i] = km / rb2**2
-        kp_mesh[i] = _pair_shares(rec, nc, xm, th2, r1, pos, tz2, rb2, z1)
+        kp_mesh[i] = _pair_shares(rec, nc, xm, dofs, rb2, z1)
     return MeshStates(angles, k, kp, force, mate, te, ok, k_mesh, kp_mesh)
 
 
-def _pair_shares(rec, nc: int, x: np.ndarray, th2: int, r1, pos: dict, tz2: int, rb2: float, z1: int) -> np.ndarray:
+def _checked_windup(model: Model, windup):
+    """``windup`` of `mesh_states` as two floats [m/N] (None as is); ValueError where it is no
+    pair of finite compliances >= 0, or the model carries its own wind-up."""
+    if windup is None:
+        return None
+    if model.coupled:
+        raise ValueError("windup: a body-coupled model carries the bodies' wind-up as its body springs "
+                         "(give it for the plain model only)")
+    windup = tuple(float(w) for w in windup)
+    if len(windup) != 2 or not all(math.isfinite(w) and w >= 0 for w in windup):
+        raise ValueError(f"windup: need two finite compliances >= 0 [m/N] (gear 1, gear 2), got {windup}")
+    return windup
+
+
+class _Dofs(NamedTuple):
+    """Where a linearization's degrees of freedom sit: the driven rim ``th2``, the driver rim
+    ``r1`` (None without body coupling), each tooth's by tooth index (``pos``), and the index
+    of the driven gear's first tooth (``tz2``)."""
+    th2: int
+    r1: int | None
+    pos: dict
+    tz2: int
+
+
+def _tooth_forces(rec, nc: int, force: np.ndarray, mate: np.ndarray, tz2: int) -> None:
+    """Add the ``nc`` contacts' forces [N] to each tooth's ``force`` (driver teeth first, the
+    driven from ``tz2``) and keep in ``mate`` each driver tooth's most loaded driven tooth."""
+    for c in range(nc):
+        a, b = int(rec[c, L.C_TOOTH1]), int(rec[c, L.C_TOOTH2])
+        f = rec[c, L.C_FORCE]
+        force[a] += f
+        force[tz2 + b] += f
+        if f > 0 and (mate[a] < 0 or f > force[tz2 + mate[a]]):
+            mate[a] = b
+
+
+def _mesh_alone(model: Model, lin, dofs: _Dofs, phi: np.ndarray, windup):
+    """(condensed stiffness, static response) of the mesh alone at the linearization ``lin``:
+    a coupled model without its body springs, the driver rim prescribed; the plain model with
+    ``windup`` [m/N], each loaded tooth spring without the wind-up it holds (False where a
+    spring is stiffer than the wind-up alone: it cannot hold it); None for the plain model
+    without it."""
+    from solver.mbs.kernels.gearmesh import tooth_spring_tangent
+    gp, th2, r1 = model.gear_par, dofs.th2, dofs.r1
+    if model.coupled:           # the body springs out, the driver rim prescribed, onto the driven rim
+        K = lin.K.copy()
+        K[r1, r1] -= gp[0, L.K_BODY]
+        h2 = lin.dofs.index("h2")
+        d = np.zeros(K.shape[0])
+        d[th2], d[h2] = 1.0, -1.0
+        K -= gp[1, L.K_BODY] * np.outer(d, d)
+        return condense_onto(K, th2, prescribed=(r1, h2))
+    if windup is None:
+        return None
+    levers = (pitch_lever(model, 0), pitch_lever(model, 1))
+    K = lin.K.copy()
+    held = True
+    for t, j in dofs.pos.items():
+        g = 1 if t >= dofs.tz2 else 0
+        kt = tooth_spring_tangent(t, phi, model.k_phi, gp)
+        if kt > 0:
+            rest = 1.0 / kt - windup[g] / levers[g] ** 2
+            held = held and rest > 0
+            K[j, j] += 1.0 / rest - kt if rest > 0 else 0.0
+    if not held:
+        return False
+    return condense_onto(K, th2)
+
+
+def _pair_shares(rec, nc: int, x: np.ndarray, dofs: _Dofs, rb2: float, z1: int) -> np.ndarray:
     """(Z1,) each loaded pair's share [N/m] of the condensed stiffness whose static response
     is ``x``, by driver tooth: over its contacts, the contact's part of the driven rim's moment
     (all of it reaches the hub), lever g2 times the contact's force change, over rb2**2."""
+    th2, r1, pos, tz2 = dofs
     out = np.zeros(z1)
     for c in range(nc):
         a, b = int(rec[c, L.C_TOOTH1]), int(rec[c, L.C_TOOTH2])
