@@ -123,16 +123,49 @@ def _linear_fit(sample_pair, n_pairs, LL, value, weight, shared):
     return c_body, A - c_body * B, float(np.sum(ws * r * r))
 
 
-def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, base_radius: float,
-                         psi_base: float, pivot_bounds: tuple, weight=None,
-                         own_completed: bool = False) -> ToothComplianceFit:
+@dataclass(frozen=True)
+class InfluenceSamples:
+    """FE influence coefficients to fit, k = 0..N-1: ``value[k]`` [m/N], the displacement along
+    the line of action at roll parameter ``u_read[k]`` of tooth ``pairs[sample_pair[k], 0]``
+    under a unit load at ``u_load[k]`` of tooth ``pairs[sample_pair[k], 1]``, at the points the
+    mesh loads together (a tooth's own block at its contact point, neighbours at their
+    simultaneous contact points); ``weight[k]`` [1] (default 1): how much load the mesh puts
+    there."""
+    pairs: np.ndarray
+    sample_pair: np.ndarray
+    u_read: np.ndarray
+    u_load: np.ndarray
+    value: np.ndarray
+    weight: np.ndarray | None = None
+
+    def checked(self) -> tuple:
+        """(pairs, sample_pair, u_read, u_load, value, weight) as arrays; ValueError naming what
+        is wrong."""
+        pairs = np.asarray(self.pairs, int)
+        sample_pair = np.asarray(self.sample_pair, int)
+        u_read, u_load, value = (np.asarray(x, float) for x in (self.u_read, self.u_load, self.value))
+        n = value.size
+        if pairs.ndim != 2 or pairs.shape[1] != 2:
+            raise ValueError(f"pairs: need (pairs, 2) tooth indices, got shape {pairs.shape}")
+        if not (sample_pair.shape == u_read.shape == u_load.shape == (n,)) or n == 0:
+            raise ValueError("samples: sample_pair, u_read, u_load and value need the same length, at least 1")
+        if sample_pair.min() < 0 or sample_pair.max() >= len(pairs) or np.bincount(sample_pair, minlength=len(pairs)).min() == 0:
+            raise ValueError("sample_pair: every pair needs at least one sample, and only listed pairs")
+        if not np.all(value > 0):
+            raise ValueError("value: influence coefficients along the load must be positive")
+        weight = np.ones(n) if self.weight is None else np.asarray(self.weight, float)
+        if weight.shape != (n,) or not np.all(weight >= 0) or np.bincount(sample_pair, weight, len(pairs)).min() <= 0:
+            raise ValueError("weight: need one non-negative weight per sample, and a positive one in every pair")
+        return pairs, sample_pair, u_read, u_load, value, weight
+
+
+def tooth_compliance_fit(samples: InfluenceSamples, teeth: int, base_radius: float, psi_base: float,
+                         pivot_bounds: tuple, own_completed: bool = False) -> ToothComplianceFit:
     """The full foundation coupling, identified from FE influence coefficients.
 
-    Samples k = 0..N-1: ``value[k]`` [m/N], the displacement along the line of action at roll
-    parameter ``u_read[k]`` of tooth ``pairs[sample_pair[k], 0]`` under a unit load at
-    ``u_load[k]`` of tooth ``pairs[sample_pair[k], 1]``, at the points the mesh loads together
-    (a tooth's own block at its contact point, neighbours at their simultaneous contact points).
-    The model of a sample is
+    ``samples``: the influence coefficients (`InfluenceSamples`) of a gear of ``teeth`` teeth,
+    base radius ``base_radius`` [m] and half base tooth angle ``psi_base`` [rad]. The model of a
+    sample is
 
         c_body + lever(u_read) * lever(u_load) * C[a, b],
 
@@ -140,7 +173,7 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
     action wherever the contact) plus the teeth's rotations about the pivot (levers about the
     pivot at radius r_Q). For a given r_Q the model is linear in c_body and the C of every
     pair (one least-squares solve on the relative residuals, each sample's squared residual
-    times its ``weight`` [1], default 1: how much load the mesh puts there); r_Q minimises
+    times its weight); r_Q minimises
     that residual within ``pivot_bounds`` [m] (the rim under the tooth; a bounded scalar
     search). ``rms_rel_error`` is the weighted RMS relative residual. Pairs not
     listed are not coupled (C = 0): the mesh never loads them together.
@@ -158,21 +191,8 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
     """
     from scipy.optimize import minimize_scalar
 
-    pairs = np.asarray(pairs, int)
-    sample_pair = np.asarray(sample_pair, int)
-    u_read, u_load, value = (np.asarray(x, float) for x in (u_read, u_load, value))
+    pairs, sample_pair, u_read, u_load, value, weight = samples.checked()
     n = value.size
-    if pairs.ndim != 2 or pairs.shape[1] != 2:
-        raise ValueError(f"pairs: need (pairs, 2) tooth indices, got shape {pairs.shape}")
-    if not (sample_pair.shape == u_read.shape == u_load.shape == (n,)) or n == 0:
-        raise ValueError("samples: sample_pair, u_read, u_load and value need the same length, at least 1")
-    if sample_pair.min() < 0 or sample_pair.max() >= len(pairs) or np.bincount(sample_pair, minlength=len(pairs)).min() == 0:
-        raise ValueError("sample_pair: every pair needs at least one sample, and only listed pairs")
-    if not np.all(value > 0):
-        raise ValueError("value: influence coefficients along the load must be positive")
-    weight = np.ones(n) if weight is None else np.asarray(weight, float)
-    if weight.shape != (n,) or not np.all(weight >= 0) or np.bincount(sample_pair, weight, len(pairs)).min() <= 0:
-        raise ValueError("weight: need one non-negative weight per sample, and a positive one in every pair")
     lo, hi = pivot_bounds
     if not 0 < lo < hi:
         raise ValueError(f"pivot_bounds: need 0 < lower < upper, got {pivot_bounds}")
@@ -193,6 +213,14 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
     c_body, c, j = fit(r_q)
     if not c_body > 0:
         raise ValueError(f"value: fitted body compliance {c_body:.4g} m/N is not positive")
+    C, reach = _compliance_matrix(pairs, c, teeth)
+    return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / weight[shared].sum())))
+
+
+def _compliance_matrix(pairs: np.ndarray, c: np.ndarray, teeth: int) -> tuple[np.ndarray, int]:
+    """(the symmetric tooth compliance matrix [m/N] of the fitted ``c`` of each pair, the
+    farthest pair's reach in teeth); ValueError where it is no valid stiffness (a window of
+    reach + 2 neighbouring teeth not positive definite)."""
     d = pairs[:, 1] - pairs[:, 0]
     reach = int(np.minimum(d % teeth, (-d) % teeth).max())
     C = np.zeros((teeth, teeth))
@@ -208,7 +236,7 @@ def tooth_compliance_fit(pairs, sample_pair, u_read, u_load, value, teeth: int, 
         except np.linalg.LinAlgError:
             raise ValueError(f"value: the fitted compliance of teeth {a}..{a + w - 1} is not positive "
                              "definite (not a valid stiffness)") from None
-    return ToothComplianceFit(base_radius**2 / c_body, c_body, C, r_q, reach, float(np.sqrt(j / weight[shared].sum())))
+    return C, reach
 
 
 def local_compliance(fit: ToothComplianceFit, u, own, base_radius: float, psi_base: float) -> np.ndarray:

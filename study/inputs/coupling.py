@@ -27,7 +27,14 @@ from dataclasses import replace
 import numpy as np
 
 from solver.fe.body import load_case
-from solver.identify.coupling import BodyTorsionFit, ToothComplianceFit, body_torsion_fit, local_compliance, tooth_compliance_fit
+from solver.identify.coupling import (
+    BodyTorsionFit,
+    InfluenceSamples,
+    ToothComplianceFit,
+    body_torsion_fit,
+    local_compliance,
+    tooth_compliance_fit,
+)
 from solver.mbs.model import Model
 from study.inputs.compliance import PROFILE_POINTS, compliance_cached, gear_compliance
 from study.inputs.gearsetup import GearSetup
@@ -164,8 +171,8 @@ def tooth_compliance(setup: GearSetup, samples: dict[int, np.ndarray]) -> ToothC
     # the pivot lies in the rim under the tooth
     bounds = (geo.root_radius - setup.body.rim_height, geo.root_radius)
     cat = np.concatenate
-    fit = tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z,
-                               geo.base_radius, geo.psi_base, bounds, cat(wt), own_completed=True)
+    fit = tooth_compliance_fit(InfluenceSamples(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), cat(wt)), z,
+                               geo.base_radius, geo.psi_base, bounds, own_completed=True)
     n = c.u.size
     own = np.array([[block(a, 0)[i, i] for i in range(n)] for a in range(z if setup.lightened else 1)])
     return replace(fit, local_u=np.array(c.u), local_compliance=local_compliance(fit, c.u, own, geo.base_radius, geo.psi_base))

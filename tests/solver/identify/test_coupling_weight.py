@@ -3,7 +3,7 @@ pull the fitted body and tooth compliance."""
 import numpy as np
 import pytest
 
-from solver.identify.coupling import tooth_compliance_fit
+from solver.identify.coupling import InfluenceSamples, tooth_compliance_fit
 from solver.identify.pivot import lever
 
 RB, PSI_B, Z = 0.047, 0.05, 6
@@ -38,7 +38,7 @@ def samples(corrupt: float):
 
 def test_samples_without_weight_do_not_pull_the_fit():
     pairs, sp, ur, ul, val, C, bad = samples(1.2)
-    fit = lambda w: tooth_compliance_fit(pairs, sp, ur, ul, val, Z, RB, PSI_B, (0.044, 0.048), weight=w)  # noqa: E731
+    fit = lambda w: tooth_compliance_fit(InfluenceSamples(pairs, sp, ur, ul, val, w), Z, RB, PSI_B, (0.044, 0.048))  # noqa: E731
     free = fit(np.where(bad, 0.0, 1.0))
     assert free.c_body == pytest.approx(C_BODY, rel=1e-6)
     assert free.pivot_radius == pytest.approx(R_Q, rel=1e-5)
@@ -53,7 +53,7 @@ def test_bad_weights_are_refused():
     pairs, sp, ur, ul, val, _, _ = samples(1.0)
     for w in (np.ones(val.size - 1), -np.ones(val.size), np.where(sp == 0, 0.0, 1.0)):
         with pytest.raises(ValueError, match="weight"):
-            tooth_compliance_fit(pairs, sp, ur, ul, val, Z, RB, PSI_B, (0.044, 0.048), weight=w)
+            tooth_compliance_fit(InfluenceSamples(pairs, sp, ur, ul, val, w), Z, RB, PSI_B, (0.044, 0.048))
 
 
 def test_own_samples_completed_in_series_leave_the_pivot_to_the_coupling():
@@ -65,7 +65,7 @@ def test_own_samples_completed_in_series_leave_the_pivot_to_the_coupling():
     pairs, sp, ur, ul, val, C, _ = samples(1.0)
     own = (pairs[sp, 0] == pairs[sp, 1])
     bent = val * np.where(own, 1.0 + 2.0 * (ur - 0.25) ** 2, 1.0)       # softer towards the tip
-    fit = lambda **k: tooth_compliance_fit(pairs, sp, ur, ul, bent, Z, RB, PSI_B, (0.044, 0.048), **k)  # noqa: E731
+    fit = lambda **k: tooth_compliance_fit(InfluenceSamples(pairs, sp, ur, ul, bent), Z, RB, PSI_B, (0.044, 0.048), **k)  # noqa: E731
     done = fit(own_completed=True)
     assert done.pivot_radius == pytest.approx(R_Q, rel=1e-5)
     assert done.c_body == pytest.approx(C_BODY, rel=1e-6)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from helpers import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
 
-from solver.identify.coupling import tooth_compliance_fit
+from solver.identify.coupling import InfluenceSamples, tooth_compliance_fit
 from solver.identify.pivot import lever
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.toothcoupling import set_energy, set_moment, set_stiffness
@@ -116,16 +116,17 @@ def test_compliance_of_the_body_tooth_model_is_recovered_by_the_fit():
             L = lever(rb, psi_b - uu[:, 0], r_q) * lever(rb, psi_b - uu[:, 1], r_q)
             val.append(c_body + L * C[a, b])
     cat = np.concatenate
-    fit = tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z, rb, psi_b, (0.044, 0.048))
+    fit = tooth_compliance_fit(InfluenceSamples(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val)), z, rb, psi_b, (0.044, 0.048))
     assert fit.c_body == pytest.approx(c_body, rel=1e-6)
     assert fit.pivot_radius == pytest.approx(r_q, rel=1e-5)
     assert fit.compliance == pytest.approx(np.where(np.abs(C) > 0, C, 0.0), rel=1e-5)
     assert fit.k_body == pytest.approx(rb**2 / c_body, rel=1e-6)
     assert fit.reach == 2 and fit.rms_rel_error < 1e-6
     with pytest.raises(ValueError, match="pivot_bounds"):
-        tooth_compliance_fit(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val), z, rb, psi_b, (0.048, 0.044))
+        tooth_compliance_fit(InfluenceSamples(np.array(pairs), cat(sp), cat(ur), cat(ul), cat(val)), z, rb, psi_b, (0.048, 0.044))
     with pytest.raises(ValueError, match="every pair"):
-        tooth_compliance_fit(np.array(pairs + [(0, 3)]), cat(sp), cat(ur), cat(ul), cat(val), z, rb, psi_b, (0.044, 0.048))
+        tooth_compliance_fit(InfluenceSamples(np.array(pairs + [(0, 3)]), cat(sp), cat(ur), cat(ul), cat(val)), z, rb, psi_b,
+                             (0.044, 0.048))
 
 
 def test_bad_compliance_matrices_are_refused(linear_pair):
