@@ -43,8 +43,11 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def _flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s):
-    """Overlap of two flanks of sense s along the internal tangent of their base circles."""
+def _flank_flank(a: tuple, b: tuple, s: float):
+    """Overlap of two flanks of sense s along the internal tangent of their base circles; each
+    flank ``a``, ``b`` as (centre x [m], centre y [m], base radius [m], flank angle [rad])."""
+    cax, cay, rba, ba = a
+    cbx, cby, rbb, bb = b
     dx, dy = cbx - cax, cby - cay
     c = (rba + rbb) / math.hypot(dx, dy)
     if c >= 1.0:
@@ -185,7 +188,7 @@ class PairEquations:
             pvax, pvay = o1x + ra * math.cos(axa), o1y + ra * math.sin(axa)
             pvbx, pvby = o2x + rb_ * math.cos(axb), o2y + rb_ * math.sin(axb)
             vel = (w1, dphi[ia], w2, dphi[ib])
-            delta, ua, ub, nx, ny, px, py = _flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
+            delta, ua, ub, nx, ny, px, py = _flank_flank((cax, cay, rba, ba), (cbx, cby, rbb, bb), s)
             a_in = gp[0, L.U_LO] <= ua <= gp[0, L.U_HI]
             b_in = gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]
             if a_in and b_in:
