@@ -24,16 +24,26 @@ N_CALLS = 200_000
 
 
 @njit(cache=False)
-def _loop_contacts(n, th1, th2, phi, dphi, gp, pp, lp, pairs, rec):
+def _loop_contacts(n, state, mdl, buf):
+    """``n`` contact searches at the angles and tooth states ``state`` (theta1, theta2, phi,
+    dphi) of the model arrays ``mdl`` (gear, pair, law), into the buffers ``buf`` (rec, pairs)."""
+    th1, th2, phi, dphi = state
     s = 0
     for k in range(n):
-        nc, npair = mesh_contacts((th1 + 1e-12 * k, th2, 100.0, 100.0), phi, dphi, (gp, pp, lp), (rec, pairs))
+        nc, npair = mesh_contacts((th1 + 1e-12 * k, th2, 100.0, 100.0), phi, dphi, mdl, buf)
         s += nc
     return s
 
 
 @njit(cache=False)
-def _loop_forces(n, rec, nc, phi, dphi, act, nact, kphi, gp, q, acc):
+def _loop_forces(n, contacts, state, mdl, out):
+    """``n`` force evaluations and arrowhead solves: the ``contacts`` (rec, nc), the tooth
+    ``state`` (phi, dphi, active teeth, their count), the model arrays ``mdl`` (k_phi, gear)
+    and the outputs ``out`` (q, acc)."""
+    rec, nc = contacts
+    phi, dphi, act, nact = state
+    kphi, gp = mdl
+    q, acc = out
     s = 0.0
     for _k in range(n):
         generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, 50.0, q)
@@ -77,14 +87,14 @@ def main(argv=None) -> int:
     rec, pairs = new_contact_buffer()
     nc, npair = mesh_contacts((theta1, st.theta2[0], 100.0, 100.0), phi, dphi, (gp, pp, lp), (rec, pairs))
     rows = [dict(part="contact search (mesh_contacts)", active_teeth=None,
-                 ns_per_call=per_call(_loop_contacts, theta1, st.theta2[0], phi, dphi, gp, pp, lp, pairs, rec),
+                 ns_per_call=per_call(_loop_contacts, (theta1, st.theta2[0], phi, dphi), (gp, pp, lp), (rec, pairs)),
                  note=f"{npair} candidate pairs, {nc} contacts")]
     near = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
     q = np.zeros(m.n_teeth + 2)
     acc = np.zeros(m.n_teeth)
     for label, act in (("near the mesh", np.array(near, dtype=np.int64)), ("all teeth", np.arange(m.n_teeth, dtype=np.int64))):
         rows.append(dict(part="forces + arrowhead solve", active_teeth=act.size,
-                         ns_per_call=per_call(_loop_forces, rec, nc, phi, dphi, act, act.size, m.k_phi, gp, q, acc),
+                         ns_per_call=per_call(_loop_forces, (rec, nc), (phi, dphi, act, act.size), (m.k_phi, gp), (q, acc)),
                          note=label))
         rows.append(dict(part="dissipation power (energy balance)", active_teeth=act.size,
                          ns_per_call=per_call(_loop_bookkeeping, dphi, act, act.size, mdl, rec, nc), note=label))
