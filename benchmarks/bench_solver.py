@@ -60,13 +60,23 @@ def run_first_call(cache_dir: str, model: str = "auto") -> tuple[dict, float]:
 
 def main(argv=None) -> int:
     args, rep = common.quick_options(__doc__.splitlines()[0], "fewer repeats, no lightened scene", argv)
-    rows = []
-    from solver.mbs.dynamics import simulate
-    from solver.mbs.stability import stable_time_step
-    from solver.mbs.statics import solve_static
-    from solver.peers.scipy_dynamics import simulate_scipy
-    from study.scene_model import static_angles
+    rows = _first_call_rows()
+    kinds = ["solid"] if args.quick else ["solid", "lightened"]
+    full_cpu = {}
+    for kind in kinds:
+        rows += _paper_rows(kind, rep, full_cpu)
+    window, tls, tim = _window_rows(rep)
+    rows += window
+    common.add_ratios(rows)
+    common.write_table("solver", "Solver speed, Table 1 pair (s; best of N; ratio on CPU time to the fastest in the case)", rows)
+    print(f"LSODA / lightgear on the same window: {tls['cpu_min_s'] / tim['cpu_min_s']:.0f}x; LSODA per simulated second / "
+          f"lightgear's on the full 0.2 s run: {tls['cpu_min_s'] / SHORT_DYNAMIC[-1] / (full_cpu['solid'] / PAPER_DYNAMIC[-1]):.0f}x")
+    return 0
 
+
+def _first_call_rows() -> list:
+    """The first call in a process with a fresh numba cache (compile), and the next ones."""
+    rows = []
     # --- compile and cache start (subprocesses, so nothing is warm here)
     for model, label in FIRST_CALL_MODELS:
         with tempfile.TemporaryDirectory() as cache:
@@ -83,48 +93,64 @@ def main(argv=None) -> int:
                      wall_median_s=float(np.median(walls)), cpu_min_s=min(d["cpu_total"] for d, _w in warm), repeats=3,
                      note="target < 2 s; whole process from outside: start-up, imports, cache load, 10-angle STE, "
                           "0.2 ms dynamic (cpu: inside the process)"))
+    return rows
 
-    kinds = ["solid"] if args.quick else ["solid", "lightened"]
-    full_cpu = {}
-    for kind in kinds:
-        m = common.model(kind, "paper")      # the solver's speed on the paper's model (the peers' equations)
-        sc = common.scene(kind, "paper")
-        # --- warm STE, 120 deg at 0.1 deg
-        ang = static_angles(sc)
-        torque = sc.quasi_static.torque
-        solve_static(m, ang[:5], torque)
-        tim, st = best_of(lambda: solve_static(m, ang, torque), rep + 2)
-        tight = solve_static(m, ang, torque, tol=1e-13)
-        rows.append(dict(case=f"STE {ang.size} angles, {kind}", method="lightgear solve_static", **tim,
-                         error_um=float(np.max(np.abs(st.te - tight.te))) * 1e6,
-                         note="target < 0.1 s; error vs Newton at tol 1e-13"))
-        # --- paper dynamic case
-        speed, sramp, tq, tramp, dur = PAPER_DYNAMIC
-        dt, _w = stable_time_step(m, tq)
-        simulate(m, speed, sramp, tq, tramp, 1e-3, dt=dt)
-        ref = simulate(m, speed, sramp, tq, tramp, dur, dt=dt / 8, phi_quiet=1e-9, implicit_dampers=False)
-        case = f"dynamic 0.2 s at 100 rad/s, {kind}"
-        simulate(m, speed, sramp, tq, tramp, 1e-3)
-        runs = ((dict(), "default"), (dict(dt=dt, phi_quiet=1e-9, implicit_dampers=False), "all explicit, phi_quiet 1e-9 rad"))
-        for kw, label in runs:
-            tim, dy = best_of(lambda: simulate(m, speed, sramp, tq, tramp, dur, **kw), 3)
-            err = float(np.max(np.abs(dy.te - ref.te))) * 1e6
-            if label == "default":
-                full_cpu[kind] = tim["cpu_min_s"]
-            rows.append(dict(case=case, method=f"lightgear explicit ({label})", **tim, error_um=err,
-                             note=f"target < 1 s; dt {dy.dt * 1e6:.3g} us, {dy.steps} steps, up to {dy.max_active_teeth} "
-                                  f"active teeth; {tim['cpu_min_s'] / dur:.2f} x real time; error vs the all-explicit run at dt/8"))
-        from solver.peers.scipy_dynamics import simulate_explicit_all_teeth
-        tim, da = best_of(lambda: simulate_explicit_all_teeth(m, speed, sramp, tq, tramp, dur, dt=dt), 1)
-        act = simulate(m, speed, sramp, tq, tramp, dur, dt=dt, phi_quiet=1e-9, implicit_dampers=False)
-        rows.append(dict(case=case, method="lightgear explicit, all teeth active", **tim,
-                         error_um=float(np.max(np.abs(act.te - da.te))) * 1e6,
-                         note="the full model (no tooth frozen); error column = what freezing idle teeth changes "
-                              "(default set vs this, same step)"))
-        tim, _d = best_of(lambda: simulate(m, speed, sramp, tq, tramp, dur), 1)
-        rows.append(dict(case=case, method="lightgear simulate() incl. step estimate", **tim,
-                         note="as `lightgear run` calls it (dt from the eigenvalues at 12 positions)"))
 
+def _paper_rows(kind: str, rep: int, full_cpu: dict) -> list:
+    """The warm STE and the paper's dynamic case of the ``kind`` pair (solid, lightened); the
+    default run's CPU time [s] into ``full_cpu``."""
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
+    from solver.mbs.statics import solve_static
+    from study.scene_model import static_angles
+    rows = []
+    m = common.model(kind, "paper")      # the solver's speed on the paper's model (the peers' equations)
+    sc = common.scene(kind, "paper")
+    # --- warm STE, 120 deg at 0.1 deg
+    ang = static_angles(sc)
+    torque = sc.quasi_static.torque
+    solve_static(m, ang[:5], torque)
+    tim, st = best_of(lambda: solve_static(m, ang, torque), rep + 2)
+    tight = solve_static(m, ang, torque, tol=1e-13)
+    rows.append(dict(case=f"STE {ang.size} angles, {kind}", method="lightgear solve_static", **tim,
+                     error_um=float(np.max(np.abs(st.te - tight.te))) * 1e6,
+                     note="target < 0.1 s; error vs Newton at tol 1e-13"))
+    # --- paper dynamic case
+    speed, sramp, tq, tramp, dur = PAPER_DYNAMIC
+    dt, _w = stable_time_step(m, tq)
+    simulate(m, speed, sramp, tq, tramp, 1e-3, dt=dt)
+    ref = simulate(m, speed, sramp, tq, tramp, dur, dt=dt / 8, phi_quiet=1e-9, implicit_dampers=False)
+    case = f"dynamic 0.2 s at 100 rad/s, {kind}"
+    simulate(m, speed, sramp, tq, tramp, 1e-3)
+    runs = ((dict(), "default"), (dict(dt=dt, phi_quiet=1e-9, implicit_dampers=False), "all explicit, phi_quiet 1e-9 rad"))
+    for kw, label in runs:
+        tim, dy = best_of(lambda: simulate(m, speed, sramp, tq, tramp, dur, **kw), 3)
+        err = float(np.max(np.abs(dy.te - ref.te))) * 1e6
+        if label == "default":
+            full_cpu[kind] = tim["cpu_min_s"]
+        rows.append(dict(case=case, method=f"lightgear explicit ({label})", **tim, error_um=err,
+                         note=f"target < 1 s; dt {dy.dt * 1e6:.3g} us, {dy.steps} steps, up to {dy.max_active_teeth} "
+                              f"active teeth; {tim['cpu_min_s'] / dur:.2f} x real time; error vs the all-explicit run at dt/8"))
+    from solver.peers.scipy_dynamics import simulate_explicit_all_teeth
+    tim, da = best_of(lambda: simulate_explicit_all_teeth(m, speed, sramp, tq, tramp, dur, dt=dt), 1)
+    act = simulate(m, speed, sramp, tq, tramp, dur, dt=dt, phi_quiet=1e-9, implicit_dampers=False)
+    rows.append(dict(case=case, method="lightgear explicit, all teeth active", **tim,
+                     error_um=float(np.max(np.abs(act.te - da.te))) * 1e6,
+                     note="the full model (no tooth frozen); error column = what freezing idle teeth changes "
+                          "(default set vs this, same step)"))
+    tim, _d = best_of(lambda: simulate(m, speed, sramp, tq, tramp, dur), 1)
+    rows.append(dict(case=case, method="lightgear simulate() incl. step estimate", **tim,
+                     note="as `lightgear run` calls it (dt from the eigenvalues at 12 positions)"))
+    return rows
+
+
+def _window_rows(rep: int) -> tuple:
+    """(rows, scipy LSODA timing, lightgear timing) of the short dynamic window, lightgear
+    against plain numpy + scipy LSODA."""
+    from solver.mbs.dynamics import simulate
+    from solver.mbs.stability import stable_time_step
+    from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
+    rows = []
     # --- plain numpy + scipy LSODA on a short window, against lightgear on the same window
     m = common.model("solid", "paper")     # scipy integrates the paper's per-tooth springs
     dt, _w = stable_time_step(m, 50.0)
@@ -142,11 +168,7 @@ def main(argv=None) -> int:
                      error_um=float(np.max(np.abs(ls.te - ref_all.te))) * 1e6,
                      note=f"{tls['cpu_min_s'] / win[-1]:.4g} s per simulated s; {ls.steps} steps, {ls.nfev} f-evals, "
                           f"{ls.njev} Jacobians; every tooth free: error vs the all-teeth explicit solver at dt/8"))
-    common.add_ratios(rows)
-    common.write_table("solver", "Solver speed, Table 1 pair (s; best of N; ratio on CPU time to the fastest in the case)", rows)
-    print(f"LSODA / lightgear on the same window: {tls['cpu_min_s'] / tim['cpu_min_s']:.0f}x; LSODA per simulated second / "
-          f"lightgear's on the full 0.2 s run: {tls['cpu_min_s'] / win[-1] / (full_cpu['solid'] / PAPER_DYNAMIC[-1]):.0f}x")
-    return 0
+    return rows, tls, tim
 
 
 if __name__ == "__main__":
