@@ -52,7 +52,7 @@ def dynamic_rows(kind, m, rep, quick):
     import exudyn
     from peers.exudyn_pair import simulate_exudyn
 
-    from solver.mbs.dynamics import simulate
+    from solver.mbs.dynamics import Drive, simulate
     from solver.mbs.kernels.status import OK
     from solver.mbs.stability import stable_time_step
     from solver.peers.scipy_dynamics import simulate_explicit_all_teeth, simulate_scipy
@@ -80,7 +80,7 @@ def dynamic_rows(kind, m, rep, quick):
                              error_um=err(r.te) if r.status == OK else float("nan"),
                              note=f"{r.steps} steps, {r.nfev} f-evals, {r.njev} Jacobians; {r.message}"))
     for solver, div in (("VelocityVerlet", 1), ("RK44", 1), ("RK44", 4)):
-        tim, (t, te, _wall) = best_of(lambda: simulate_exudyn(m, *win, dt=dt / div, solver=solver), 1)
+        tim, (t, te, _wall) = best_of(lambda: simulate_exudyn(m, Drive(*win), dt=dt / div, solver=solver), 1)
         rows.append(dict(case=case, method=f"Exudyn {solver} dt {dt / div * 1e6:.3g} us", **tim, error_um=err(te),
                          note=f"Exudyn {exudyn.__version__}; all teeth; Python user-function forces"))
     common.add_ratios(rows)

@@ -41,12 +41,13 @@ def peers_per_second(m) -> dict:
     Verlet at the all-explicit stability step) peers on the short window, every tooth free."""
     from peers.exudyn_pair import simulate_exudyn
 
+    from solver.mbs.dynamics import Drive
     from solver.mbs.stability import stable_time_step
     from solver.peers.scipy_dynamics import simulate_scipy
     win = SHORT_DYNAMIC
     dt, _w = stable_time_step(m, win[2])
     ts, _r = best_of(lambda: simulate_scipy(m, *win, method="LSODA", rtol=1e-4), 1)
-    te, _r = best_of(lambda: simulate_exudyn(m, *win, dt=dt, solver="VelocityVerlet"), 1)
+    te, _r = best_of(lambda: simulate_exudyn(m, Drive(*win), dt=dt, solver="VelocityVerlet"), 1)
     return dict(scipy=ts["cpu_min_s"] / win[-1], exudyn=te["cpu_min_s"] / win[-1])
 
 

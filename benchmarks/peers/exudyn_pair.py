@@ -38,10 +38,10 @@ def generalized_force(eq: PairEquations, t: float, q: np.ndarray, v: np.ndarray)
     return f
 
 
-def simulate_exudyn(model, speed: float, speed_ramp: float, torque: float, torque_ramp: float,
-                    duration: float, dt: float, output_step: float = 1e-5, solver: str = "VelocityVerlet"):
-    """Integrate the pair from rest in Exudyn at the fixed step dt [s] with `solver`
-    (an `exudyn.DynamicSolverType` name). Returns (time [s], TE [m], wall time of the solve [s]).
+def simulate_exudyn(model, drive, dt: float, output_step: float = 1e-5, solver: str = "VelocityVerlet"):
+    """Integrate the pair from rest under ``drive`` (`solver.mbs.dynamics.Drive`: its speed and
+    torque ramps, no load profile) in Exudyn at the fixed step dt [s] with `solver` (an
+    `exudyn.DynamicSolverType` name). Returns (time [s], TE [m], wall time of the solve [s]).
     dt is rounded down to divide output_step [s] (as `solver.mbs.dynamics.simulate` does), so
     the sensor samples fall on steps.
     """
@@ -50,6 +50,8 @@ def simulate_exudyn(model, speed: float, speed_ramp: float, torque: float, torqu
     import exudyn as exu
     from exudyn.itemInterface import NodeGenericODE2, ObjectGenericODE2, SensorNode
 
+    speed, speed_ramp, torque, torque_ramp, duration = (drive.speed, drive.speed_ramp, drive.torque, drive.torque_ramp,
+                                                        drive.duration)
     dt = output_step / max(1, int(math.ceil(output_step / dt - 1e-9)))
     eq = PairEquations(model, speed, speed_ramp, torque, torque_ramp)
     n = eq.n
