@@ -110,7 +110,7 @@ def precision_command(args) -> int:
         print(f"{kind} study ... (about {estimate.duration_text(part_s)}; its reference runs first, then each run "
               "is listed as it ends)", flush=True)
         ds = run_precision(scene, base, args.duration, args.ramp_fraction, args.rotation, args.repeats, kind,
-                           progress, model=model)[kind]
+                           progress=progress, model=model)[kind]
         path = ds.attrs["archive"]
         print(study.precision_table(ds))
         print(f"  archive: {path}\n  plot: {path[:-3]}.png", flush=True)

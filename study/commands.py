@@ -131,19 +131,23 @@ def precision_scene(scene: Scene) -> Scene:
 
 
 def precision(scene: Scene, output: str | Path | None = None, duration: float = 0.002, ramp_fraction: float = 0.5,
-              rotation: float = 6.0, repeats: int = 3, only: str | None = None, progress=None, model=None) -> dict:
+              rotation: float = 6.0, repeats: int = 3, only: str | None = None, **hooks) -> dict:
     """Work-precision studies of a scene: TE error [um] against wall time [s] for every solver
     -> {"static": Dataset, "dynamic": Dataset} (`study.verify.precision`). ``duration`` [s]: the
     dynamic window, its ramps ending at ``ramp_fraction`` of it; ``rotation`` [deg]: the
     quasi-static range; ``repeats``: timed runs per setting (the best is kept); ``only``:
     'static' or 'dynamic'. With ``output`` (BASE.nc) each study is written to BASE_static.nc and
-    BASE_dynamic.nc with its plot (.png). ``progress(i, spec, errors, wall, message)`` is called
-    after each run. ``model``: the model of `precision_scene` when the caller has built it
-    already. The integrators compared exist for the paper's model: `precision_scene`."""
+    BASE_dynamic.nc with its plot (.png). ``hooks`` (by keyword): ``progress(i, spec, errors, wall,
+    message)``, called after each run; ``model``, the model of `precision_scene` when the caller
+    has built it already. The integrators compared exist for the paper's model: `precision_scene`."""
     from study.archive.netcdf import write_netcdf
     from study.scene_model import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
     check_scene_argument("precision", scene)
+    unknown = set(hooks) - {"progress", "model"}
+    if unknown:
+        raise TypeError(f"precision: unknown keyword {sorted(unknown)[0]!r} (hooks: progress, model)")
+    progress, model = hooks.get("progress"), hooks.get("model")
     check_argument(output is None or is_path(output), "precision", "output", "an archive base name ending in .nc, or None",
                    output)
     for name, value, ok, what in (("duration", duration, lambda v: v > 0, "a positive number of seconds"),

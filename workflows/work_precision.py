@@ -38,7 +38,7 @@ def main(argv=None) -> int:
         print(f"  [{i + 1}] {s.method}, {setting}: linf {e[2]:.3g} um, {w:.3g} s  {'' if msg == 'ok' else msg}",
               flush=True)
     out = study.precision(scene, args.output, args.duration, args.ramp_fraction, args.rotation, args.repeats,
-                          args.only, progress)
+                          args.only, progress=progress)
     for ds in out.values():
         print(ds.attrs["title"])
         print(study.precision_table(ds))
