@@ -86,14 +86,23 @@ def dynamic_case(scene: Scene, duration: float = 0.002, ramp_fraction: float = 0
     return DynamicCase(d.speed, d.torque, ramp, duration, output_step)
 
 
-def dynamic_specs(model: Model, case: DynamicCase, explicit_fractions=(1, 2, 4, 8),
-                  implicit_multiples=(8, 4, 2, 1, 0.5), alphas=(0.0, -0.1),
-                  rtols=(1e-3, 1e-5), scipy_methods=("Radau", "LSODA"), active_set: bool = True,
-                  scipy_max_wall_time: float = 120.0) -> tuple[list[Spec], float]:
-    """The runs of the dynamic study and the explicit stability step [s] they are scaled by.
+@dataclass(frozen=True)
+class ScipyRuns:
+    """The scipy runs of the dynamic study: each of ``methods`` at each of ``rtols``; a run
+    taking longer than ``max_wall_time`` [s] stops and stays in the study as a failed run with
+    its message."""
+    methods: tuple = ("Radau", "LSODA")
+    rtols: tuple = (1e-3, 1e-5)
+    max_wall_time: float = 120.0
 
-    A scipy run taking longer than ``scipy_max_wall_time`` [s] stops and stays in the study
-    as a failed run with its message."""
+
+def dynamic_specs(model: Model, case: DynamicCase, explicit_fractions=(1, 2, 4, 8),
+                  implicit_multiples=(8, 4, 2, 1, 0.5), alphas=(0.0, -0.1), active_set: bool = True,
+                  scipy: ScipyRuns = ScipyRuns()) -> tuple[list[Spec], float]:
+    """The runs of the dynamic study and the explicit stability step [s] they are scaled by:
+    the explicit runs at the stability step over ``explicit_fractions`` (the active set too with
+    ``active_set``), the implicit ones at ``implicit_multiples`` of it for each HHT alpha of
+    ``alphas``, and the ``scipy`` runs."""
     dt_b, _w = stable_time_step(model, case.torque)
     L, o = case.loads, case.output_step
     explicit_steps = [dt_b / f for f in explicit_fractions]
@@ -115,11 +124,11 @@ def dynamic_specs(model: Model, case: DynamicCase, explicit_fractions=(1, 2, 4, 
         specs += fixed_step_specs(f"implicit alpha={a:g}", [min(dt_b * k, o) for k in implicit_multiples],
                                   lambda dt, a=a: _dyn(simulate_implicit(model, *L, dt=dt, output_step=o,
                                                                          alpha=a, all_teeth=True)))
-    for m in scipy_methods:
-        for tol in rtols:
+    for m in scipy.methods:
+        for tol in scipy.rtols:
             specs.append(Spec(m, math.nan, tol,
                               lambda m=m, tol=tol: _dyn(simulate_scipy(model, *L, method=m, rtol=tol, output_step=o,
-                                                                       max_wall_time=scipy_max_wall_time)),
+                                                                       max_wall_time=scipy.max_wall_time)),
                               warmup=False))
     return specs, dt_b
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from helpers import solid_scene
 
-from study.verify.precision_cases import Spec
+from study.verify.precision_cases import ScipyRuns, Spec
 from study.verify.precision_report import cheapest, plot
 from study.verify.precision_study import dynamic_study, run_study, static_study
 
@@ -20,7 +20,7 @@ def dyn(paper_solid_scene, paper_solid_model):
     implicit one at 1 and 4 times it (the scipy stiff solvers take minutes here: they run in
     the workflow, their code path is tested in tests/solver/peers/test_scipy_dynamics.py)."""
     return dynamic_study(paper_solid_scene, paper_solid_model, duration=0.001, repeats=1, explicit_fractions=(1, 2),
-                           implicit_multiples=(4, 1), alphas=(0.0,), scipy_methods=(), active_set=True)
+                           implicit_multiples=(4, 1), alphas=(0.0,), scipy=ScipyRuns(methods=()), active_set=True)
 
 
 def test_dynamic_dataset_contract(dyn):
