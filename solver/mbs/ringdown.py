@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
-from solver.mbs.dynamics import DivergenceError, simulate
+from solver.mbs.dynamics import DivergenceError, Drive, ExplicitIntegrator
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.status import COMPLETED, OK
 from solver.mbs.model import Model
@@ -74,9 +74,9 @@ def _ring_down(model: Model, torque: float, frequency: float, damping: float, cy
     t_ramp, t_step = 10 * period, 0.25 * period
     table = [[0.0, 0.0], [t_ramp, 0.9 * load], [t_ramp + t_step, load]]
     t_fit = t_ramp + t_step + period
+    drive = Drive(0.0, 1.0, load, t_ramp, t_fit + cycles * period, table)
     for dt in steps:
-        res = simulate(model, 0.0, 1.0, load, t_ramp, t_fit + cycles * period, dt=dt, output_step=period / 40,
-                       load_table=table)
+        res = ExplicitIntegrator(dt=dt, output_step=period / 40).run(model, drive)
         if res.status == OK:
             break
     if res.status not in COMPLETED:     # stopped by a guard (an inaccurate decay is still fitted)

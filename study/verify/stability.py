@@ -33,13 +33,13 @@ import scipy.linalg
 import xarray as xr
 
 from solver import units
-from solver.mbs.dynamics import simulate
-from solver.mbs.implicit import simulate_implicit
+from solver.mbs.dynamics import Drive, ExplicitIntegrator
+from solver.mbs.implicit import ImplicitIntegrator
 from solver.mbs.kernels.status import INACCURATE
 from solver.mbs.method import choose_method
 from solver.mbs.stability import linearized_system
 from solver.mbs.statics import solve_static
-from solver.peers.scipy_dynamics import simulate_scipy
+from solver.peers.scipy_dynamics import ScipyIntegrator
 from study.archive.netcdf import provenance
 from study.scene_model import build_scene_model, load_table
 
@@ -109,17 +109,16 @@ def plausibility(res, model, torque: float, method: str) -> str:
 def run_one(model, scene, method: str, duration: float, scipy_wall: float):
     d = scene.dynamic
     ramp = duration / 2
-    loads = (d.speed, ramp, d.torque, ramp, duration)
-    table = load_table(scene)          # the torque-reversal scene; None: the ramp
+    # the torque-reversal scene's table; None: the ramp
+    drive = Drive(d.speed, ramp, d.torque, ramp, duration, load_table(scene))
     if method == "LSODA":
-        return simulate_scipy(model, *loads, method="LSODA", rtol=1e-4, output_step=d.output_step,
-                              max_wall_time=scipy_wall, load_table=table), float("nan")
+        scipy = ScipyIntegrator(method="LSODA", rtol=1e-4, output_step=d.output_step, max_wall_time=scipy_wall)
+        return scipy.run(model, drive), float("nan")
     choice = choose_method(model, d.torque, duration, "explicit" if method == "explicit" else "implicit")
     if method == "explicit":
-        return simulate(model, *loads, dt=choice.dt, output_step=d.output_step, load_table=table), choice.dt
+        return ExplicitIntegrator(dt=choice.dt, output_step=d.output_step).run(model, drive), choice.dt
     alpha = 0.0 if method.endswith("=0") else -0.1
-    return simulate_implicit(model, *loads, dt=choice.dt, output_step=d.output_step, alpha=alpha,
-                             load_table=table), choice.dt
+    return ImplicitIntegrator(dt=choice.dt, output_step=d.output_step, alpha=alpha).run(model, drive), choice.dt
 
 
 def run_suite(scene, duration: float = 0.002, methods=None, scipy_wall: float = 20.0, names=None,
