@@ -4,10 +4,8 @@ refused or warned of, and outputs a run cannot support are left undefined with t
 import signal
 
 import numpy as np
-import pytest
 
 from tests.study.test_interrupt import SMALL, STEP, STOP_WITHIN_S, cli, stop_after
-
 
 # ---------------------------------------------------------------- SIGTERM after the mesher, in a sweep
 
@@ -48,3 +46,28 @@ def test_a_sweep_in_process_stops_on_sigterm_after_its_first_fe_body_and_resumes
     import xarray as xr
     with xr.open_dataset(out) as ds:
         assert np.isfinite(ds["ste_p2p"].values).all() and np.isfinite(ds["dte_rms"].values).all()
+
+
+# ---------------------------------------------------------------- K_v of a driver at standstill
+
+def test_a_run_at_standstill_archives_no_dynamic_factor_and_says_why(tmp_path, capsys, example_scene_file):
+    """dynamic.speed = 0: no mesh period to take the forces over. K_v used to come out about 0.6
+    (with numpy's "All-NaN slice" warning on the terminal); it is NaN with its reason in the
+    archive and the summary, and the strength's safety factors are the static ones, said as
+    such (not "no dynamic run": the run was made)."""
+    import xarray as xr
+
+    from study.cli import main
+    out = tmp_path / "r.nc"
+    code = main(["run", str(example_scene_file), "--set", "dynamic.speed=0", "-o", str(out)])
+    printed, err = capsys.readouterr()
+    assert code == 0, err
+    assert "RuntimeWarning" not in err and "All-NaN" not in err
+    why = "the driver stands still (dynamic.speed = 0)"
+    assert f"dynamic factor K_v undefined: {why}" in printed
+    with xr.open_dataset(out) as ds:
+        assert np.isnan(float(ds["dynamic_factor"])) and why in ds["dynamic_factor"].attrs["comment"]
+        assert why in ds.attrs["steady_window_note"]          # the DTE RMS and peak-to-peak likewise
+        assert ds["bending_safety"].attrs["loads"] == "static (K_v undefined)"
+        np.testing.assert_array_equal(ds["bending_safety"].values, ds["bending_safety_static"].values)
+    assert "S_F (18CrNiMo7-6, sigma_FG 1000 MPa, static (K_v undefined))" in printed
