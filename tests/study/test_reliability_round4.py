@@ -1,9 +1,11 @@
 """Reliability after the mesher and of the estimates: a sweep in one process stops on SIGTERM
 once gmsh has run in it, the FE reference's time and memory are estimated before its work and
 refused or warned of, and outputs a run cannot support are left undefined with their reason."""
+import math
 import signal
 
 import numpy as np
+import pytest
 
 from tests.study.test_interrupt import SMALL, STEP, STOP_WITHIN_S, cli, stop_after
 
@@ -71,3 +73,20 @@ def test_a_run_at_standstill_archives_no_dynamic_factor_and_says_why(tmp_path, c
         assert ds["bending_safety"].attrs["loads"] == "static (K_v undefined)"
         np.testing.assert_array_equal(ds["bending_safety"].values, ds["bending_safety_static"].values)
     assert "S_F (18CrNiMo7-6, sigma_FG 1000 MPa, static (K_v undefined))" in printed
+
+
+# ---------------------------------------------------------------- ligaments the FE cannot hold
+
+@pytest.mark.parametrize("overrides, field, between", [
+    # 17 holes of the paper's web leaving 3e-5 mm between neighbours (the STE levelled off, no word)
+    ({"gear2.body.holes": 17, "gear2.body.hole_radius": 32.36 * math.sin(math.pi / 17) - 1.5e-5},
+     "gear2.body.holes", "between neighbouring openings is 3e-05 mm"),
+    # a 6 mm hole exactly touching the rim (42.3 mm inside) and the hub (19.05 mm): a zero ligament
+    ({"gear2.body.hole_circle_radius": 36.3}, "gear2.body.hole_circle_radius", "between the openings and the rim"),
+    ({"gear2.body.hole_circle_radius": 25.05}, "gear2.body.hole_circle_radius", "between the openings and the hub"),
+])
+def test_a_ligament_the_fe_cannot_hold_is_refused_naming_the_field_and_its_width(overrides, field, between):
+    from study.scene import SceneError, load_scene
+    with pytest.raises(SceneError) as e:
+        load_scene(None, [f"{k}={v!r}" for k, v in overrides.items()])
+    assert e.value.field == field and between in str(e.value) and "thinner than the FE mesh can hold" in str(e.value)
