@@ -217,10 +217,6 @@ def body_seconds(setup) -> float:
 # 750 MB at 20 500 and 822 MB at 23 400 (the paper's driven gear) -> 22 kB an element over a
 # process of some 310 MB, growing like the time beyond FE_REF_ELEMENTS (the factor's fill-in).
 FE_BYTES_PER_ELEMENT = 2.2e4
-# the FE reference holds both bodies factorised with their influence coefficients: the small
-# pair's reference peaked at 525 MB (215 MB over the process: estimated 228 MB with this
-# factor), the paper pair's at 1151 MB (841 MB over the process: estimated 1439 MB, 1.7 x)
-REFERENCE_BODY_MEMORY = 1.4
 # share of the available memory above which a part is refused, and above which it is warned of
 MEMORY_REFUSE, MEMORY_WARN = 0.8, 0.5
 
@@ -279,33 +275,8 @@ def fe_seconds(scene) -> float:
     return sum(body_seconds(s) for _, s, _ in fe_bodies(scene)) * factor
 
 
-LTCA_S_PER_ANGLE = 1.6e-3        # contact solve of one angle, influence coefficients cached (paper: 2.0 s for 1201)
-# A body of the LTCA is loaded at several profile points per tooth: the paper's two bodies took
-# 1.0 x, the README pair's 2.0 x the time of a spring map's body
-LTCA_BODY_FACTOR = 1.4
 TEETH_SEARCH_ANGLES = 20000      # more angles than this: the cache is not searched (the bodies counted in full)
-
-
-def reference_parts(scene, angles, teeth=None) -> dict:
-    """Estimated seconds of the FE reference's parts: each body's influence coefficients (0 when
-    cached) and the contact sweep. ``teeth``: (teeth of gear 1, of gear 2, spread) in mesh over
-    ``angles`` (`solver.fe.ltca.teeth_in_mesh`; None: found here, from the geometry)."""
-    from study.inputs.compliance import compliance_cached
-    from study.inputs.gearsetup import gear_setups
-    if teeth is None and len(angles) <= TEETH_SEARCH_ANGLES:
-        from solver.fe.ltca import teeth_in_mesh
-        from study.scene_model import geometry_model
-        teeth = teeth_in_mesh(geometry_model(scene), angles)
-    parts = {}
-    for i, (g, s) in enumerate(zip((1, 2), gear_setups(scene))):
-        cached = teeth is not None and compliance_cached(s, teeth[i], teeth[2])
-        parts[f"gear {g} FE body"] = 0.0 if cached else LTCA_BODY_FACTOR * body_seconds(s)
-    parts["contact sweep"] = LTCA_S_PER_ANGLE * len(angles) * load_factor()
-    return parts
-
-
-def reference_estimate(scene, angles) -> Estimate:
-    return Estimate(reference_parts(scene, angles))
+# (the FE reference's own cost, time and memory: `study.verify.fe_reference.reference_cost`)
 
 
 def run_fe_bodies(scene, show: bool = True) -> None:
