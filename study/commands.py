@@ -102,6 +102,11 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
         settings = settings_for(scene, flank_size, contact_stiffness)
         est = peer_estimate(angles.size, settings, scene.gear1.module * 1e-3)
         estimate.check_time(est, max_time)
+        line = check_reference_memory(scene, est, "--flank-size", "a CalculiX deck needs about {need} (flanks at "
+                                      f"{settings.sizes.flank * 1e3:.3g} mm)", "a larger --flank-size")
+        if line:
+            from study.plausibility import report_warnings
+            report_warnings([line], True)
         if progress:
             print(f"CalculiX contact peer: {angles.size} decks, about {estimate.duration_text(est.total_s)} "
                   f"({est.total_s / angles.size:.0f} s a deck)", file=sys.stderr, flush=True)

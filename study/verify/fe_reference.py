@@ -76,22 +76,25 @@ def reference_cost(scene: Scene, angles, teeth=None):
     return est
 
 
-def check_reference_memory(scene: Scene, est) -> str | None:
-    """Refuse (BudgetError naming fe.mesh_size) a reference whose estimated memory ``est.memory``
+def check_reference_memory(scene: Scene, est, field: str = "fe.mesh_size", what: str | None = None,
+                           lever: str = "a coarser fe.mesh_size (or fewer teeth)") -> str | None:
+    """Refuse (BudgetError naming ``field``) a reference whose estimated memory ``est.memory``
     exceeds `study.estimate.MEMORY_REFUSE` of the memory available, before any FE work; a line
-    to warn with beyond `study.estimate.MEMORY_WARN`, else None."""
+    to warn with beyond `study.estimate.MEMORY_WARN`, else None. ``what``: what needs it (default:
+    the FE bodies of the scene's mesh); ``lever``: what needs less."""
     from study import estimate
     from study.errors import BudgetError
     from study.memory import bytes_text
     need, have = sum(est.memory.values()), estimate.available_memory()
-    elements = " and ".join(f"{estimate.body_elements(s):.3g}" for s in gear_setups(scene))
-    what = (f"the FE bodies need about {bytes_text(need)} for the reference ({elements} elements at fe.mesh_size "
-            f"{gear_setups(scene)[1].mesh_size * 1e3:.3g} mm, {scene.fe.mesh_grading}), {{}} the {bytes_text(have)} "
-            "of memory available")
+    if what is None:
+        elements = " and ".join(f"{estimate.body_elements(s):.3g}" for s in gear_setups(scene))
+        what = (f"the FE bodies need about {{need}} for the reference ({elements} elements at fe.mesh_size "
+                f"{gear_setups(scene)[1].mesh_size * 1e3:.3g} mm, {scene.fe.mesh_grading})")
+    text = what.format(need=bytes_text(need)) + ", {} the " + bytes_text(have) + " of memory available"
     if need > estimate.MEMORY_REFUSE * have:
-        raise BudgetError("fe.mesh_size", what.format("more than") + ": a coarser fe.mesh_size (or fewer teeth)")
+        raise BudgetError(field, text.format("more than") + ": " + lever)
     if need > estimate.MEMORY_WARN * have:
-        return "fe.mesh_size: " + what.format("more than half of") + "; a coarser fe.mesh_size needs less"
+        return f"{field}: " + text.format("more than half of") + "; " + lever + " needs less"
     return None
 
 

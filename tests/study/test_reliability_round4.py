@@ -137,3 +137,44 @@ def test_the_references_estimate_grows_with_the_fine_gradings_elements(private_f
     for part in ("gear 1 FE body", "gear 2 FE body"):
         assert 1.5 < fine.seconds[part] / graded.seconds[part] < 4.0
         assert 1.5 < fine.memory[part] / graded.memory[part] < 4.0
+
+
+# ---------------------------------------------------------------- a study whose scene is a number
+
+def test_a_study_whose_scene_is_a_number_is_named_through_every_door(tmp_path, capsys):
+    """``scene = 5``: the sweep named it already; the tolerance workflow's --set (which makes
+    the scene a table with its file) and a [scene] table's ``file = 5`` ended in
+    "TypeError: expected str, bytes or os.PathLike object" (exit 1)."""
+    import study
+    from study.scene import SceneError
+    from workflows.tolerance import main as tolerance
+    st = tmp_path / "s.toml"
+    st.write_text('scene = 5\n[sample]\nsize = 2\n"gear2.body.hole_radius" = {uniform = [1.0, 1.5]}\n')
+    assert tolerance([str(st), "--set", "dynamic.speed=60", "-o", str(tmp_path / "t"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "scene.file: must be a scene file or an embedded scene's name, got 5" in err and "TypeError" not in err
+    with pytest.raises(SceneError) as e:
+        study.study_from_dict({"scene": {"file": 5, "dynamic.speed": 60.0}, "grid": {"dynamic.speed": [50.0]}})
+    assert e.value.field == "scene.file"
+
+
+def test_the_contact_peers_deck_memory_is_estimated_and_refused_before_ccx_runs(monkeypatch, capsys):
+    """A CalculiX deck's ccx process: 37 kB a node measured (0.68 GB at 18 000 nodes, 1.38 GB at
+    38 000 on the small pair), its nodes growing as 1/flank_size; refused naming --flank-size."""
+    import study
+    from study import estimate
+    from study.errors import BudgetError
+    from study.verify import calculix_reference as peer
+    from tests.helpers import small_scene
+    scene = small_scene(**{"quasi_static.rotation": 1.0, "quasi_static.angle_step": 0.5})
+    coarse, fine = (peer.peer_estimate(1, peer.settings_for(scene, f), 3e-3) for f in (0.4, 0.1))
+    assert fine.memory["CalculiX deck"] == pytest.approx(4 * coarse.memory["CalculiX deck"])
+    assert 0.34e9 < coarse.memory["CalculiX deck"] < 1.36e9          # within 2 x of the 0.68 GB measured
+    ran = []
+    monkeypatch.setattr(peer, "calculix_dataset", lambda *a, **k: ran.append(1) or "ran")
+    monkeypatch.setattr(estimate, "available_memory", lambda: 1.5e9)
+    with pytest.raises(BudgetError) as e:
+        study.reference(scene, solver="calculix", max_time=1e9)          # module/30: some 3.7 GB a deck
+    assert e.value.field == "--flank-size" and "a CalculiX deck needs about" in str(e.value) and not ran
+    assert study.reference(scene, solver="calculix", flank_size=0.4, max_time=1e9) == "ran"
+    assert "warning: --flank-size" in capsys.readouterr().err            # 0.9 GB: over half of 1.5 GB
