@@ -212,19 +212,25 @@ def body_seconds(setup) -> float:
     return (FE_S_PER_BODY + FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25) * load_factor()
 
 
-# Peak memory of an FE body beyond the process's own (mesh, P2 assembly, factorisation, load
-# cases): maximum RSS of one spring map's body, 392 MB at 3 700 elements (the small pair's),
-# 750 MB at 20 500 and 822 MB at 23 400 (the paper's driven gear) -> 22 kB an element over a
-# process of some 310 MB, growing like the time beyond FE_REF_ELEMENTS (the factor's fill-in).
-FE_BYTES_PER_ELEMENT = 2.2e4
+# Peak memory of an FE body beyond the process's own (mesh, P2 assembly, factorisation, its
+# load cases or influence coefficients) by its elements n: 29 kB an element at FE_REF_ELEMENTS,
+# growing as n^0.8 (a body's fixed part weighs less as it grows), the fine grading's elements
+# (which `body_elements` counts for the outline's size) FINE_GRADING_COST times as dear. Fitted
+# to `lightgear reference` (both bodies held) from an empty FE cache: the small lightened pair
+# with a 1.5 mm rim at fe.mesh_size 0.5-0.18 mm and the paper pair with a 2.5 mm rim at
+# 0.375-0.25 mm, graded and fine, 0.38-6.2 GB, each estimate 0.85-1.05 x the peak over the
+# process (benchmarks/bench_reference_cost.py); a run's compliance-model bodies 0.75-0.85 x.
+FE_BYTES_PER_ELEMENT = 2.9e4
+FE_BYTES_EXPONENT = -0.2
+FINE_GRADING_COST = 1.6
 # share of the available memory above which a part is refused, and above which it is warned of
 MEMORY_REFUSE, MEMORY_WARN = 0.8, 0.5
 
 
 def body_bytes(setup) -> float:
     """Estimated peak memory [bytes] of one FE body (`body_elements`)."""
-    n = body_elements(setup)
-    return FE_BYTES_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25
+    n = body_elements(setup) * (FINE_GRADING_COST if setup.mesh_grading == "fine" else 1.0)
+    return FE_BYTES_PER_ELEMENT * n * (n / FE_REF_ELEMENTS) ** FE_BYTES_EXPONENT
 
 
 def check_fe_memory(scene, factor: float = 1.0, setups=None) -> str | None:

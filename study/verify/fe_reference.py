@@ -29,30 +29,23 @@ from study.scene_model import geometry_model, static_angles
 # load sharing per angle): its angles are checked against memory with this factor
 REFERENCE_MEMORY_FACTOR = 4.0
 
-# Cost of the reference's FE bodies (mesh, assembly, factorisation and influence coefficients)
-# by their elements n (`study.estimate.body_elements`), fitted to CPU time and peak memory over
-# the process of `lightgear reference` from an empty FE cache on 2 shared cores (load 10-13):
-# the small lightened pair (24 teeth, a 1.5 mm rim) at fe.mesh_size 0.5 to 0.18 mm and the
-# paper pair with a 2.5 mm rim at 0.375 to 0.2 mm, graded and fine (benchmarks/README.md,
-# "FE reference cost"). The seconds grow like n^(1 + REF_TIME_EXPONENT) (gmsh's size field is
-# evaluated against the whole outline, the factor's fill-in), and the fine grading's elements,
-# which body_elements counts for the outline's size only, cost REF_FINE_ELEMENTS as much.
-REF_S_PER_BODY = 0.6             # s: mesher and set-up of a body
-REF_S_PER_ELEMENT = 2.2e-4       # s an element at REF_ELEMENTS
-REF_TIME_EXPONENT = 0.03
-REF_BYTES_PER_ELEMENT = 2.9e4    # bytes an element at REF_ELEMENTS (both bodies are held at once)
-REF_MEMORY_EXPONENT = -0.2
-REF_ELEMENTS = 4e4
-REF_FINE_ELEMENTS = 1.6
-LTCA_S_PER_ANGLE = 1.0e-3        # s: contact solve of one angle (0.7-1.1 s for 1201 measured)
+# Seconds of one of the reference's FE bodies (mesh, assembly, factorisation and influence
+# coefficients) by its elements n (`study.estimate.body_elements`, the fine grading's
+# `study.estimate.FINE_GRADING_COST` times as dear, as their memory `study.estimate.body_bytes`):
+# fitted to the CPU time of `lightgear reference` from an empty FE cache on 2 shared cores (load
+# 10-15): the small lightened pair with a 1.5 mm rim at fe.mesh_size 0.5-0.18 mm
+# and the paper pair with a 2.5 mm rim at 0.375-0.25 mm, graded and fine (2.8-62 s CPU, each
+# within 0.75-1.35 x; benchmarks/bench_reference_cost.py).
+REF_S_PER_BODY = 0.5             # s: mesher and set-up of a body
+REF_S_PER_ELEMENT = 2.2e-4       # s an element
+LTCA_S_PER_ANGLE = 1.0e-3        # s: contact solve of one angle (0.7-1.4 s for 1201 measured)
 
 
 def body_cost(setup) -> tuple[float, float]:
     """(CPU seconds on a quiet machine, peak bytes) of one FE body of the reference."""
-    from study.estimate import body_elements
-    n = body_elements(setup) * (REF_FINE_ELEMENTS if setup.mesh_grading == "fine" else 1.0)
-    return (REF_S_PER_BODY + REF_S_PER_ELEMENT * n * (n / REF_ELEMENTS) ** REF_TIME_EXPONENT,
-            REF_BYTES_PER_ELEMENT * n * (n / REF_ELEMENTS) ** REF_MEMORY_EXPONENT)
+    from study.estimate import FINE_GRADING_COST, body_bytes, body_elements
+    n = body_elements(setup) * (FINE_GRADING_COST if setup.mesh_grading == "fine" else 1.0)
+    return REF_S_PER_BODY + REF_S_PER_ELEMENT * n, body_bytes(setup)
 
 
 def reference_cost(scene: Scene, angles, teeth=None):
