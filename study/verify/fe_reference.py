@@ -34,8 +34,8 @@ REFERENCE_MEMORY_FACTOR = 4.0
 # `study.estimate.FINE_GRADING_COST` times as dear, as their memory `study.estimate.body_bytes`):
 # fitted to the CPU time of `lightgear reference` from an empty FE cache on 2 shared cores (load
 # 10-15): the small lightened pair with a 1.5 mm rim at fe.mesh_size 0.5-0.18 mm
-# and the paper pair with a 2.5 mm rim at 0.375-0.25 mm, graded and fine (2.8-62 s CPU, each
-# within 0.75-1.35 x; benchmarks/bench_reference_cost.py).
+# and the paper pair with a 2.5 mm rim at 0.375-0.25 mm, graded and fine (3.5-62 s CPU, each
+# within 0.8-1.4 x; benchmarks/bench_reference_cost.py).
 REF_S_PER_BODY = 0.5             # s: mesher and set-up of a body
 REF_S_PER_ELEMENT = 2.2e-4       # s an element
 LTCA_S_PER_ANGLE = 1.0e-3        # s: contact solve of one angle (0.7-1.4 s for 1201 measured)
