@@ -89,7 +89,7 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
     ``flank_size`` [mm] and ``contact_stiffness`` [MPa/mm]); ``max_time`` [s]: refuse a run
     estimated to take longer (BudgetError, before any work)."""
     from study.scene_model import static_angles
-    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, reference_dataset
+    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, check_reference_memory, reference_cost, reference_dataset
     check_scene_argument("reference", scene)
     check_argument(step is None or is_number(step), "reference", "step", "a number of degrees or None", step)
     if step is not None and not step > 0:
@@ -102,13 +102,18 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
         settings = settings_for(scene, flank_size, contact_stiffness)
         est = peer_estimate(angles.size, settings, scene.gear1.module * 1e-3)
         estimate.check_time(est, max_time)
+        line = check_reference_memory(scene, est, "--flank-size", "a CalculiX deck needs about {need} (flanks at "
+                                      f"{settings.sizes.flank * 1e3:.3g} mm)", "a larger --flank-size")
+        if line:
+            from study.plausibility import report_warnings
+            report_warnings([line], True)
         if progress:
             print(f"CalculiX contact peer: {angles.size} decks, about {estimate.duration_text(est.total_s)} "
                   f"({est.total_s / angles.size:.0f} s a deck)", file=sys.stderr, flush=True)
         return calculix_dataset(scene, angles, settings, progress=progress)
-    estimate.check_time(estimate.reference_estimate(scene, angles), max_time)
-    from study.inputs.gearsetup import gear_setups
-    line = estimate.check_fe_memory(scene, estimate.REFERENCE_BODY_MEMORY, gear_setups(scene))
+    est = reference_cost(scene, angles)
+    estimate.check_time(est, max_time)
+    line = check_reference_memory(scene, est)      # refused whatever --max-time
     if line:
         from study.plausibility import report_warnings
         report_warnings([line], True)

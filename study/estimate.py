@@ -212,23 +212,25 @@ def body_seconds(setup) -> float:
     return (FE_S_PER_BODY + FE_S_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25) * load_factor()
 
 
-# Peak memory of an FE body beyond the process's own (mesh, P2 assembly, factorisation, load
-# cases): maximum RSS of one spring map's body, 392 MB at 3 700 elements (the small pair's),
-# 750 MB at 20 500 and 822 MB at 23 400 (the paper's driven gear) -> 22 kB an element over a
-# process of some 310 MB, growing like the time beyond FE_REF_ELEMENTS (the factor's fill-in).
-FE_BYTES_PER_ELEMENT = 2.2e4
-# the FE reference holds both bodies factorised with their influence coefficients: the small
-# pair's reference peaked at 525 MB (215 MB over the process: estimated 228 MB with this
-# factor), the paper pair's at 1151 MB (841 MB over the process: estimated 1439 MB, 1.7 x)
-REFERENCE_BODY_MEMORY = 1.4
+# Peak memory of an FE body beyond the process's own (mesh, P2 assembly, factorisation, its
+# load cases or influence coefficients) by its elements n: 29 kB an element at FE_REF_ELEMENTS,
+# growing as n^0.8 (a body's fixed part weighs less as it grows), the fine grading's elements
+# (which `body_elements` counts for the outline's size) FINE_GRADING_COST times as dear. Fitted
+# to `lightgear reference` (both bodies held) from an empty FE cache: the small lightened pair
+# with a 1.5 mm rim at fe.mesh_size 0.5-0.18 mm and the paper pair with a 2.5 mm rim at
+# 0.375-0.25 mm, graded and fine, 0.38-6.2 GB, each estimate 0.85-1.05 x the peak over the
+# process (benchmarks/bench_reference_cost.py); a run's compliance-model bodies 0.75-0.85 x.
+FE_BYTES_PER_ELEMENT = 2.9e4
+FE_BYTES_EXPONENT = -0.2
+FINE_GRADING_COST = 1.6
 # share of the available memory above which a part is refused, and above which it is warned of
 MEMORY_REFUSE, MEMORY_WARN = 0.8, 0.5
 
 
 def body_bytes(setup) -> float:
     """Estimated peak memory [bytes] of one FE body (`body_elements`)."""
-    n = body_elements(setup)
-    return FE_BYTES_PER_ELEMENT * n * max(1.0, n / FE_REF_ELEMENTS) ** 0.25
+    n = body_elements(setup) * (FINE_GRADING_COST if setup.mesh_grading == "fine" else 1.0)
+    return FE_BYTES_PER_ELEMENT * n * (n / FE_REF_ELEMENTS) ** FE_BYTES_EXPONENT
 
 
 def check_fe_memory(scene, factor: float = 1.0, setups=None) -> str | None:
@@ -279,33 +281,8 @@ def fe_seconds(scene) -> float:
     return sum(body_seconds(s) for _, s, _ in fe_bodies(scene)) * factor
 
 
-LTCA_S_PER_ANGLE = 1.6e-3        # contact solve of one angle, influence coefficients cached (paper: 2.0 s for 1201)
-# A body of the LTCA is loaded at several profile points per tooth: the paper's two bodies took
-# 1.0 x, the README pair's 2.0 x the time of a spring map's body
-LTCA_BODY_FACTOR = 1.4
 TEETH_SEARCH_ANGLES = 20000      # more angles than this: the cache is not searched (the bodies counted in full)
-
-
-def reference_parts(scene, angles, teeth=None) -> dict:
-    """Estimated seconds of the FE reference's parts: each body's influence coefficients (0 when
-    cached) and the contact sweep. ``teeth``: (teeth of gear 1, of gear 2, spread) in mesh over
-    ``angles`` (`solver.fe.ltca.teeth_in_mesh`; None: found here, from the geometry)."""
-    from study.inputs.compliance import compliance_cached
-    from study.inputs.gearsetup import gear_setups
-    if teeth is None and len(angles) <= TEETH_SEARCH_ANGLES:
-        from solver.fe.ltca import teeth_in_mesh
-        from study.scene_model import geometry_model
-        teeth = teeth_in_mesh(geometry_model(scene), angles)
-    parts = {}
-    for i, (g, s) in enumerate(zip((1, 2), gear_setups(scene))):
-        cached = teeth is not None and compliance_cached(s, teeth[i], teeth[2])
-        parts[f"gear {g} FE body"] = 0.0 if cached else LTCA_BODY_FACTOR * body_seconds(s)
-    parts["contact sweep"] = LTCA_S_PER_ANGLE * len(angles) * load_factor()
-    return parts
-
-
-def reference_estimate(scene, angles) -> Estimate:
-    return Estimate(reference_parts(scene, angles))
+# (the FE reference's own cost, time and memory: `study.verify.fe_reference.reference_cost`)
 
 
 def run_fe_bodies(scene, show: bool = True) -> None:

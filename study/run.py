@@ -401,5 +401,6 @@ def strength_fields(scene: Scene, model: Model, st, data: dict) -> tuple[dict, d
     if "dynamic_factor" in data and torque:
         kv = float(data["dynamic_factor"].values)
         scale = scene.dynamic.torque / torque * kv
-        note = f"dynamic torque {scene.dynamic.torque:g} N·m over static {torque:g} N·m, K_v {kv:.4f}"
+        note = (f"dynamic torque {scene.dynamic.torque:g} N·m over static {torque:g} N·m, K_v {kv:.4f}" if math.isfinite(kv)
+                else "K_v undefined")     # (a dynamic run that cannot support it: its reason is the K_v's)
     return strength_variables(setups, pair, results, scene, scale, note)

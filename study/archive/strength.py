@@ -49,7 +49,8 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
     """Coordinates and variables (see the module) of both gears from their
     `study.inputs.strength.GearStrength` ``results`` (a text: why not computed), the static torque's
     results scaled by ``dynamic_scale`` [1] (the dynamic torque over the static one times K_v;
-    NaN without a dynamic run) for the stresses with K_v."""
+    NaN without a dynamic run, or where its K_v is undefined: ``dynamic_note`` then says so) for the
+    stresses with K_v."""
     nl, nk = len(LOCATIONS), len(LIGAMENT_KINDS)
     stress, static, vm = (np.full((2, nl), np.nan) for _ in range(3))
     pos = np.full((2, nl, 2), np.nan)
@@ -129,7 +130,7 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
             safety_static[i, k] = bending_safety(limit, static[i, k])
     load = (f"the STE's static contact forces superposed on the FE load cases ({', '.join(str(r.steps) for r in results if r)} "
             f"angles)" + (f", times {scale:.4f} for the dynamic run ({dynamic_note})" if math.isfinite(dynamic_scale) else
-                          " (no dynamic run)"))
+                          f" ({dynamic_note or 'no dynamic run'})"))
     stress_kind = "largest principal stress (tensile)"
     how = ("FE plane-stress body (study.inputs.strength): stress per unit load at the site nodes (element vertex stress "
            "averaged over the elements of the location's region) for a load on each loaded tooth at five roll parameters, "
@@ -163,7 +164,7 @@ def strength_variables(setups, pair, results, scene, dynamic_scale: float, dynam
         "gear_material": variable("gear_material", np.array(names), comment="; ".join(mat_notes)),
         "bending_limit_stress": variable("bending_limit_stress", limits, material="; ".join(mat_notes)),
         "bending_safety": variable("bending_safety", safety, material="; ".join(mat_notes),
-                                   loads="with K_v" if math.isfinite(dynamic_scale) else "static (no dynamic run)"),
+                                   loads="with K_v" if math.isfinite(dynamic_scale) else f"static ({dynamic_note or 'no dynamic run'})"),
         "bending_safety_static": variable("bending_safety_static", safety_static, material="; ".join(mat_notes)),
     }
     return coords, data

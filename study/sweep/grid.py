@@ -174,6 +174,8 @@ def _base_scene(spec, folder: Path | None) -> dict:
     if isinstance(spec, dict):
         spec = copy.deepcopy(spec)
         file = spec.pop("file", None)
+        if file is not None and not isinstance(file, str):      # (Path() of a number: a TypeError)
+            raise SceneError("scene.file", f"must be a scene file or an embedded scene's name, got {file!r}")
         data = read(file) if file is not None else tomllib.loads(default_scene_text())
         for path, v in _flatten(spec, "scene", repeat=True).items():
             set_dotted(data, path, v)

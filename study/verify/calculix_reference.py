@@ -22,13 +22,21 @@ from study.scene_model import geometry_model
 # (the small pair at 0.15 mm: 106 s). Only the estimate printed before a run and checked
 # against --max-time uses it.
 DECK_S = 200.0
+# Peak memory of the ccx process of one deck (one at a time): 37 kB a node, measured on the
+# small pair (24 teeth, module 3 mm) at flank sizes of 0.4 and 0.2 mm: 18 000 and 38 000 nodes,
+# 0.68 and 1.38 GB; its nodes at module/30 taken between its 74 000 and the paper pair's 140 000
+# (within 1.4 x of both), growing as 1/flank_size like the time.
+DECK_BYTES_PER_NODE = 3.7e4
+DECK_NODES = 1.0e5
 
 
 def peer_estimate(n_decks: int, settings: CalculixSettings, module: float):
-    """`study.estimate.Estimate` of a peer run: ``n_decks`` decks at ``settings``, module [m]."""
+    """`study.estimate.Estimate` of a peer run: ``n_decks`` decks at ``settings``, module [m]:
+    seconds of all decks, bytes of the ccx process of one."""
     from study.estimate import Estimate
-    per = DECK_S * (module / 30.0 / settings.sizes.flank)
-    return Estimate(seconds={"CalculiX decks": n_decks * per},
+    scale = module / 30.0 / settings.sizes.flank
+    return Estimate(seconds={"CalculiX decks": n_decks * DECK_S * scale},
+                    memory={"CalculiX deck": DECK_BYTES_PER_NODE * DECK_NODES * scale},
                     levers={"CalculiX decks": "fewer angles (a larger --step) or a larger --flank-size"})
 
 

@@ -29,6 +29,67 @@ from study.scene_model import geometry_model, static_angles
 # load sharing per angle): its angles are checked against memory with this factor
 REFERENCE_MEMORY_FACTOR = 4.0
 
+# Seconds of one of the reference's FE bodies (mesh, assembly, factorisation and influence
+# coefficients) by its elements n (`study.estimate.body_elements`, the fine grading's
+# `study.estimate.FINE_GRADING_COST` times as dear, as their memory `study.estimate.body_bytes`):
+# fitted to the CPU time of `lightgear reference` from an empty FE cache on 2 shared cores (load
+# 10-15): the small lightened pair with a 1.5 mm rim at fe.mesh_size 0.5-0.18 mm
+# and the paper pair with a 2.5 mm rim at 0.375-0.25 mm, graded and fine (3.5-62 s CPU, each
+# within 0.8-1.4 x; benchmarks/bench_reference_cost.py).
+REF_S_PER_BODY = 0.5             # s: mesher and set-up of a body
+REF_S_PER_ELEMENT = 2.2e-4       # s an element
+LTCA_S_PER_ANGLE = 1.0e-3        # s: contact solve of one angle (0.7-1.4 s for 1201 measured)
+
+
+def body_cost(setup) -> tuple[float, float]:
+    """(CPU seconds on a quiet machine, peak bytes) of one FE body of the reference."""
+    from study.estimate import FINE_GRADING_COST, body_bytes, body_elements
+    n = body_elements(setup) * (FINE_GRADING_COST if setup.mesh_grading == "fine" else 1.0)
+    return REF_S_PER_BODY + REF_S_PER_ELEMENT * n, body_bytes(setup)
+
+
+def reference_cost(scene: Scene, angles, teeth=None):
+    """`study.estimate.Estimate` of the reference at driver ``angles`` [rad]: seconds (scaled by
+    the machine's load) and bytes of each gear's FE body (none when its influence coefficients
+    are cached) and of the contact sweep. ``teeth``: (teeth of gear 1, of gear 2, spread) in
+    mesh over ``angles`` (`solver.fe.ltca.teeth_in_mesh`; None: found here, from the geometry)."""
+    from study.estimate import TEETH_SEARCH_ANGLES, Estimate, load_factor
+    from study.inputs.compliance import compliance_cached
+    from study.scene_model import STATIC_BYTES_PER_ANGLE, STATIC_BYTES_PER_ANGLE_TOOTH
+    if teeth is None and len(angles) <= TEETH_SEARCH_ANGLES:
+        teeth = teeth_in_mesh(geometry_model(scene), angles)
+    est, load = Estimate(), load_factor()
+    for i, (g, s) in enumerate(zip((1, 2), gear_setups(scene))):
+        cached = teeth is not None and compliance_cached(s, teeth[i], teeth[2])
+        sec, size = (0.0, 0.0) if cached else body_cost(s)
+        est.seconds[f"gear {g} FE body"], est.memory[f"gear {g} FE body"] = sec * load, size
+    est.seconds["contact sweep"] = LTCA_S_PER_ANGLE * len(angles) * load
+    est.memory["contact sweep"] = REFERENCE_MEMORY_FACTOR * len(angles) * (
+        STATIC_BYTES_PER_ANGLE + STATIC_BYTES_PER_ANGLE_TOOTH * scene.gear1.teeth)
+    return est
+
+
+def check_reference_memory(scene: Scene, est, field: str = "fe.mesh_size", what: str | None = None,
+                           lever: str = "a coarser fe.mesh_size (or fewer teeth)") -> str | None:
+    """Refuse (BudgetError naming ``field``) a reference whose estimated memory ``est.memory``
+    exceeds `study.estimate.MEMORY_REFUSE` of the memory available, before any FE work; a line
+    to warn with beyond `study.estimate.MEMORY_WARN`, else None. ``what``: what needs it (default:
+    the FE bodies of the scene's mesh); ``lever``: what needs less."""
+    from study import estimate
+    from study.errors import BudgetError
+    from study.memory import bytes_text
+    need, have = sum(est.memory.values()), estimate.available_memory()
+    if what is None:
+        elements = " and ".join(f"{estimate.body_elements(s):.3g}" for s in gear_setups(scene))
+        what = (f"the FE bodies need about {{need}} for the reference ({elements} elements at fe.mesh_size "
+                f"{gear_setups(scene)[1].mesh_size * 1e3:.3g} mm, {scene.fe.mesh_grading})")
+    text = what.format(need=bytes_text(need)) + ", {} the " + bytes_text(have) + " of memory available"
+    if need > estimate.MEMORY_REFUSE * have:
+        raise BudgetError(field, text.format("more than") + ": " + lever)
+    if need > estimate.MEMORY_WARN * have:
+        return f"{field}: " + text.format("more than half of") + "; " + lever + " needs less"
+    return None
+
 
 def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS, progress: bool = False):
     """(LTCAResult, model, info) of the scene at driver ``angles`` [rad] (default: quasi-static).
@@ -43,7 +104,7 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     angles = static_angles(scene, memory_factor=REFERENCE_MEMORY_FACTOR) if angles is None else np.asarray(angles, float)
     model = geometry_model(scene)        # the LTCA takes its compliance from the FE, not springs
     teeth = None if rigid else teeth_in_mesh(model, angles)
-    parts = estimate.reference_parts(scene, angles, teeth) if not rigid else {"contact sweep": 0.0}
+    parts = reference_cost(scene, angles, teeth).seconds if not rigid else {"contact sweep": 0.0}
     bar = estimate.progress_bar(sum(parts.values()), sum(parts.values()), "FE reference", "s (estimated)", progress)
     try:
         return _reference(scene, angles, rigid, n_u, model, parts, bar, teeth)

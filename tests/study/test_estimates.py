@@ -19,15 +19,16 @@ def test_cached_fe_bodies_and_influence_coefficients_are_free(private_fe_cache):
     study.stiffness(scene)
     assert estimate.fe_bodies(scene) == [] and estimate.fe_seconds(scene) == 0.0
     from study.scene_model import static_angles
+    from study.verify.fe_reference import reference_cost
     angles = static_angles(scene)
-    before = estimate.reference_parts(scene, angles)
+    before = reference_cost(scene, angles).seconds
     assert before["gear 1 FE body"] > 0 and before["gear 2 FE body"] > 0
     ds = study.reference(scene)
-    after = estimate.reference_parts(scene, angles)
+    after = reference_cost(scene, angles).seconds
     assert after["gear 1 FE body"] == 0.0 and after["gear 2 FE body"] == 0.0
     assert after["contact sweep"] > 0       # the contact problems are solved each time
     # a finer angle step reads other teeth only if new ones enter the mesh: here none, still free
-    assert estimate.reference_parts(scene, static_angles(scene, 0.25))["gear 2 FE body"] == 0.0
+    assert reference_cost(scene, static_angles(scene, 0.25)).seconds["gear 2 FE body"] == 0.0
     assert ds.sizes["angle"] == angles.size
     private_fe_cache.clear()                  # memory dropped: the disk cache still answers
-    assert estimate.reference_parts(scene, angles)["gear 1 FE body"] == 0.0
+    assert reference_cost(scene, angles).seconds["gear 1 FE body"] == 0.0
