@@ -19,11 +19,14 @@ def stiffness(scene: Scene, max_time: float | None = None, progress: bool = Fals
     """Per-tooth FE stiffness map of both gears -> xarray.Dataset (``tooth_stiffness`` [N mm/rad^n],
     ``stiffness_ratio`` [1] over gear and tooth). ``max_time`` [s]: refuse (BudgetError) a map
     estimated to take longer, before any work; ``progress``: a bar on stderr for a long one."""
+    from study.inputs.gearsetup import gear_setups
     from study.inputs.springs import stiffness_dataset
+    from study.stages import compute_fe_bodies
     check_scene_argument("stiffness", scene)
-    est = estimate.Estimate({"FE bodies": estimate.fe_seconds(scene)})
+    setups = gear_setups(scene)
+    est = estimate.Estimate({"FE bodies": estimate.fe_seconds(setups, scene.coupling_model)})
     estimate.check_time(est, max_time)
-    estimate.run_fe_bodies(scene, progress)
+    compute_fe_bodies(setups, scene.coupling_model, progress)
     return stiffness_dataset(scene)
 
 
@@ -108,7 +111,7 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
         return calculix_dataset(scene, angles, settings, progress=progress)
     estimate.check_time(estimate.reference_estimate(scene, angles), max_time)
     from study.inputs.gearsetup import gear_setups
-    line = estimate.check_fe_memory(scene, estimate.REFERENCE_BODY_MEMORY, gear_setups(scene))
+    line = estimate.check_fe_memory(gear_setups(scene), estimate.REFERENCE_BODY_MEMORY)
     if line:
         from study.plausibility import report_warnings
         report_warnings([line], True)

@@ -24,10 +24,12 @@ def driver_angle(t, speed_end: float, ramp: float):
     return np.where(t < ramp, 0.5 * speed_end / ramp * t * t, speed_end * (t - 0.5 * ramp))
 
 
-def order_map(time, dte, speed_end: float, ramp: float, z1: int, z2: int, revs: float = 1.0,
-              samples_per_rev: int = 1024, speed_min: float = 0.0, hop: float = 0.125):
-    """(driver speed [rad/s] of each block, orders [1], amplitude (speed, order) [dte units]):
-    blocks of ``revs`` driven revolutions, one every ``hop`` revolutions (overlapping)."""
+def order_map(time, dte, runup: tuple, teeth: tuple, revs: float = 1.0, samples_per_rev: int = 1024,
+              speed_min: float = 0.0, hop: float = 0.125):
+    """(driver speed [rad/s] of each block, orders [1], amplitude (speed, order) [dte units]) of
+    a run-up ``runup`` = (speed_end [rad/s], ramp [s]) of a pair of ``teeth`` = (z1, z2): blocks
+    of ``revs`` driven revolutions, one every ``hop`` revolutions (overlapping)."""
+    (speed_end, ramp), (z1, z2) = runup, teeth
     time = np.asarray(time, dtype=float)
     rev = driver_angle(time, speed_end, ramp) * z1 / z2 / (2 * np.pi)      # driven revolutions
     grid = np.arange(int(np.floor(rev[-1] * samples_per_rev))) / samples_per_rev
@@ -57,7 +59,7 @@ def order_tracking_variables(time, dte_um, speed_end: float, ramp: float, z1: in
                              revs: float = 1.0, max_order: float | None = None) -> tuple[dict, dict]:
     """``order_amplitude(runup_speed, tracked_order)`` [um] of a run-up, orders up to ``max_order``
     (default 5 Z2 + 10)."""
-    speed, order, amp = order_map(time, dte_um, speed_end, ramp, z1, z2, revs, speed_min=0.05 * speed_end)
+    speed, order, amp = order_map(time, dte_um, (speed_end, ramp), (z1, z2), revs, speed_min=0.05 * speed_end)
     keep = order <= (max_order or 5 * z2 + 10)
     coords = {"runup_speed": variable("runup_speed", speed), "tracked_order": variable("tracked_order", order[keep])}
     data = {"order_amplitude": variable("order_amplitude", amp[:, keep], revolutions_per_block=revs)}

@@ -32,7 +32,7 @@ whose numba cache lacks the kernels, the pilot (a static and a dynamic task of t
 `pilot_tasks`) runs first and compiles them into the disk cache; the other tasks wait for it and
 load them, so the machine compiles once, not once per worker (the other workers compute the FE
 meanwhile). The tasks go to dask dearest first
-(`study.estimate.task_seconds`), the cheap ones of one model in batches
+(`study.sweep.cost.task_seconds`), the cheap ones of one model in batches
 (`study.sweep.tasks.batches`: a 10 ms dynamic run costs dask about as much as its physics);
 on a local cluster a batch's worker stores each of its tasks as it finishes, so that an
 interrupted batch loses only its unfinished tasks.
@@ -64,7 +64,7 @@ from study.errors import BudgetError, check_argument, checked_workers, is_path
 from study.scene import Scene, SceneError
 from study.sweep.archive import study_dataset, study_key
 from study.sweep.grid import Point, Study, check_points
-from study.sweep.outputs import CURVES, MESH_SCALARS, STRENGTH_SCALARS, Outputs, analysis_of
+from study.sweep.outputs import CURVES, Outputs, analysis_of, stages_of
 from study.sweep.tasks import plan, point_result
 
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
@@ -82,6 +82,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
     variables the outputs do not read); its numbers are read as from the archive
     (`point_values`).
     """
+    from study.plan import RunOptions
     from study.run import run_fields
     from study.scene import loads_scene, scene_from_dict
 
@@ -95,12 +96,8 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
         elif isinstance(scene, str):
             scene = loads_scene(scene)
         if outputs.static or outputs.dynamic or outputs.modes:
-            run = run_fields(scene, static=outputs.static, dynamic=outputs.dynamic,
-                             mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)),
-                             warn=False, keep_model=True,    # the sweep warns once; a body's points share its model
-                             archive=False, gear_variables=outputs.needs("geometry") or outputs.needs("fe"),
-                             modal=outputs.modes or "mesh_mode_damping_decay" in outputs.scalars,
-                             strength=bool(set(outputs.scalars) & set(STRENGTH_SCALARS)))
+            # the sweep warns once; a body's points share its model
+            run = run_fields(scene, stages_of(outputs), RunOptions(warn=False, keep_model=True, archive=False))
         else:   # geometry (and root stress) only: no model, no solve
             from study.inputs.springs import lightening_dataset
             run = lightening_dataset(scene, stress=outputs.fe)
@@ -501,9 +498,10 @@ def study_progress(title: str, points: int, tasks: list, in_process: bool, worke
     jobs they read, with their estimated costs, on the workers that run them."""
     from study import estimate
     from study.inputs.gearsetup import gear_setups
+    from study.sweep import cost
     from study.sweep.bodies import compute_body, fe_jobs
     from study.sweep.progress import COMPILE_S, START_S, StudyProgress
-    costs = estimate.progress_seconds(tasks) if show else {t.key: 1.0 for t in tasks}
+    costs = cost.progress_seconds(tasks) if show else {t.key: 1.0 for t in tasks}
     fe_costs, first_reader = {}, {}
     for t in tasks if show else ():
         for fe_key, func, args in fe_jobs(t.scene):
@@ -567,7 +565,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     dask cluster. The part files are removed once the archive holds every point (unless
     ``keep_parts``). ``max_time`` [s]: refuse (`study.errors.BudgetError`, before any work) a
     study too large to list or whose missing tasks are estimated to take longer in all
-    (`study.estimate.sweep_estimate`, CPU seconds summed over the tasks). The returned
+    (`study.sweep.cost.sweep_estimate`, CPU seconds summed over the tasks). The returned
     SweepResult has ``.dataset`` (the archive as written, its curves read from the file when
     used), ``.computed``, ``.reused``, ``.invalid``, ``.pending`` and ``.wall_time`` [s]. Finished
     points are kept on disk, so the same call after an interruption computes only the missing
@@ -576,6 +574,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     """
     from study import estimate
     from study.archive.netcdf import write_netcdf
+    from study.sweep import cost
 
     check_argument(isinstance(study, Study), "run_sweep", "study", "a Study (study.make_study(scene, grid={...}) or "
                    "study.load_study(path or name))", study)
@@ -585,7 +584,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
                    "a dask scheduler address such as 'tcp://host:8786', or None", scheduler)
     progress, keep_parts = bool(progress), bool(keep_parts)
     t0 = time.perf_counter()
-    estimate.check_study_size(study, max_time)
+    cost.check_study_size(study, max_time)
     points = check_points(study)
     out = study.outputs
     n_invalid = sum(p.scene is None for p in points)
@@ -603,7 +602,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
             todo[key] = task.scene
     reused = len(results)
     if max_time is not None and todo:
-        estimate.check_time(estimate.sweep_estimate([tasks[k] for k in todo]), max_time)
+        estimate.check_time(cost.sweep_estimate([tasks[k] for k in todo]), max_time)
     lost = {}
     todo = interleave(todo)
     if todo:

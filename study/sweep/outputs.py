@@ -222,6 +222,20 @@ class Outputs:
         return tuple(out)
 
 
+def stages_of(outputs: Outputs) -> frozenset:
+    """The stages of a run (`study.plan.STAGES`) the outputs need, each only when an output
+    asks for it: 'static' and 'dynamic' by the outputs' analyses, 'mesh' for `MESH_SCALARS`
+    (the linearised mesh over the STE; K_v with a dynamic run), 'gear' for the geometry and FE
+    outputs (mass, inertia, root stress), 'modes' for the modal outputs and the free decay
+    (``mesh_mode_damping_decay``, with the dynamic run), 'strength' for `STRENGTH_SCALARS`."""
+    names = set(outputs.scalars + outputs.curves)
+    wanted = {"static": outputs.static, "dynamic": outputs.dynamic, "mesh": bool(names & set(MESH_SCALARS)),
+              "gear": outputs.needs("geometry") or outputs.fe,
+              "modes": outputs.modes or "mesh_mode_damping_decay" in names,
+              "strength": bool(names & set(STRENGTH_SCALARS))}
+    return frozenset(k for k, v in wanted.items() if v)
+
+
 def outputs_from_table(table) -> Outputs:
     """The [outputs] table of a study ({scalars = [...], curves = [...]}) checked: unknown names
     and an empty selection are SceneErrors. Scalars default to all of `SCALARS` but the strength

@@ -68,7 +68,7 @@ def test_mesh_mode_critical_speed_is_the_runup_peak(cm, models, modes, runups):
     assert r.status in (0, 6) and r.time[-1] == pytest.approx(RUNUP_S)
     z1, z2 = m.teeth
     crit = critical_1z(m, modes[cm])
-    speed, order, amp = order_map(r.time, r.te * 1e6, w_end, RUNUP_S, z1, z2, revs=0.5, speed_min=0.5 * crit,
+    speed, order, amp = order_map(r.time, r.te * 1e6, (w_end, RUNUP_S), (z1, z2), revs=0.5, speed_min=0.5 * crit,
                                   hop=1 / 32)
     cut = order_cut(speed, order, amp, float(z2), 1.0)
     peak = speed[int(np.argmax(cut))]

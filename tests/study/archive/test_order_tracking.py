@@ -7,6 +7,7 @@ import pytest
 from helpers import solid_scene
 
 from solver.mbs.dynamics import simulate
+from solver.mbs.modes import modal_analysis
 from study.archive.modes import critical_speeds
 from study.archive.order_tracking import driver_angle, order_cut, order_map
 from study.archive.spectra import amplitude_spectrum
@@ -21,7 +22,7 @@ def test_order_map_recovers_the_orders_of_a_synthetic_run_up():
     t = np.arange(0.0, 1.0, 2e-5)
     rev = driver_angle(t, 300.0, 1.0) * 60 / 67 / (2 * math.pi)
     x = 0.3 * np.cos(2 * math.pi * 67 * rev) + 0.1 * np.sin(2 * math.pi * 6 * rev + 0.4)
-    speed, order, amp = order_map(t, x, 300.0, 1.0, 60, 67, speed_min=20.0)
+    speed, order, amp = order_map(t, x, (300.0, 1.0), (60, 67), speed_min=20.0)
     assert speed.min() >= 20 and np.all(np.diff(speed) > 0) and speed.max() < 300
     np.testing.assert_allclose(order_cut(speed, order, amp, 67), 0.3, rtol=0.02)
     np.testing.assert_allclose(order_cut(speed, order, amp, 6), 0.1, rtol=0.01)
@@ -38,7 +39,7 @@ def test_run_up_tracks_the_steady_mesh_order_and_peaks_at_the_critical_speed():
     m = build_scene_model(solid_scene())
     run = simulate(m, 400.0, 0.5, 50.0, 0.01, 0.5)
     assert run.status == 0
-    speed, order, amp = order_map(run.time, run.te * 1e6, 400.0, 0.5, 67, 67, speed_min=20.0)
+    speed, order, amp = order_map(run.time, run.te * 1e6, (400.0, 0.5), (67, 67), speed_min=20.0)
     z = order_cut(speed, order, amp, 67)
     for w in (100.0, 150.0, 200.0):
         st = simulate(m, w, 0.01, 50.0, 0.01, 0.05)
@@ -46,7 +47,7 @@ def test_run_up_tracks_the_steady_mesh_order_and_peaks_at_the_critical_speed():
         f, a = amplitude_spectrum(st.te[sel] * 1e6, 1e-5)
         steady = a[np.abs(f - 67 * w / (2 * math.pi)) < 2 * f[1]].max()
         assert np.interp(w, speed, z) == pytest.approx(steady, rel=0.10)
-    _c, data, attrs = modal_variables(m, 50.0, 0, decay=False)
+    _c, data, attrs = modal_variables(modal_analysis(m, 50.0), None, m, 50.0, 0)
     crit = critical_speeds(np.array([attrs["mesh_mode_frequency_hz"]]), np.array([67.0]), 67, 67)[0, 0]
     assert speed[np.argmax(z)] == pytest.approx(crit, rel=0.03)
 
