@@ -147,9 +147,18 @@ def _lobe_window(order: np.ndarray):
     return window
 
 
+@dataclass(frozen=True)
+class PeakTable:
+    """What `named_peaks` names and looks for: the mesh harmonics kZ (k = 1..mesh_harmonics)
+    and hole harmonics, the unexplained peaks besides them, from ``min_order`` [1] on."""
+    mesh_harmonics: int = 5
+    hole_harmonics: int = 2
+    unexplained: int = 4
+    min_order: float = 0.5
+
+
 def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resolution: float,
-                mesh_harmonics: int = 5, hole_harmonics: int = 2, unexplained: int = 4,
-                min_order: float = 0.5, revolution_orders: tuple | None = None) -> list[Peak]:
+                revolution_orders: tuple | None = None, settings: PeakTable = PeakTable()) -> list[Peak]:
     """The amplitude found at each named order and the ``unexplained`` largest local maxima that
     lie outside every named order's main lobe and off the higher mesh harmonics kZ (and kZ+-N)
     the table does not name (names "other 1", ...; NaN when fewer).
@@ -162,6 +171,8 @@ def named_peaks(order, amplitude, hole_order: float, mesh_order: float, resoluti
     than a main lobe's width; no hole order (jN, kZ +- jN) when the record is shorter than one
     hole period (`hole_period_note`). Maxima on DC's main lobe (window leakage of the mean) are
     never unexplained peaks."""
+    mesh_harmonics, hole_harmonics = settings.mesh_harmonics, settings.hole_harmonics
+    unexplained, min_order = settings.unexplained, settings.min_order
     order = np.asarray(order, float)
     amp = np.asarray(amplitude, float)
     tol = max(HANN_MAIN_LOBE_BINS * resolution, 1e-9)
