@@ -104,6 +104,8 @@ def make_plan(scene: Scene, stages, options: RunOptions = RunOptions()) -> RunPl
     time, then (with the model built) the load the teeth carry and the estimated time of the
     statics and the dynamic run (`study.errors.BudgetError`, `study.scene.SceneError`)."""
     stages = frozenset(stages)
+    if not stages <= set(STAGES):
+        raise ValueError(f"stages: unknown {', '.join(sorted(stages - set(STAGES)))} (expected some of {', '.join(STAGES)})")
     static, dynamic = "static" in stages, "dynamic" in stages
     warnings = scene_warnings(scene) if dynamic else [w for w in scene_warnings(scene) if not w.startswith("dynamic.")]
     report_warnings(warnings, options.warn)

@@ -7,9 +7,10 @@
   root_stress_max(gear)      the largest of them [MPa]                        (FE body)
   root_stress_ratio(gear)    root_stress_max over the solid gear's value [1]  (FE body; 1 for a solid gear)
 
-Mass and inertia are cheap geometry (`solver.inertia.gear_mass`, computed by the run's gear stage: the body rings at their
+Mass and inertia are cheap geometry (`solver.inertia.gear_mass`: the body rings at their
 thickness less the holes, plus the teeth from their outline; the solid gear is
-`solver.geometry.solid_body`) and are always computed. The root stress comes from the FE solve
+`solver.geometry.solid_body`), computed by the run's gear stage (`study.stages.gear_stage`) and
+always given. The root stress comes from the FE solve
 of the stiffness map (`study.inputs.springs.root_stresses`, cached with it), so it is given only
 for a gear whose springs come from the FE (a lightened gear, springs not 'uniform'); the solid
 reference's value is the same FE of the solid body that the stiffness ratio uses. Other gears

@@ -77,3 +77,5 @@ def test_the_stages_asked_are_the_only_ones_that_run(counted):
     assert "mass" not in run and "mesh_stiffness" not in run
     assert len(counted["gear_setups"]) == 1 and len(counted["scene_model"]) == 1
     assert len(counted["loaded_equilibria"]) <= 1
+    with pytest.raises(ValueError, match="stages: unknown statics"):
+        run_fields(scene, {"statics"})
