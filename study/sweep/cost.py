@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from study import estimate
 from study.errors import BudgetError
 from study.estimate import (
     ACTIVE_TEETH_PER_GEAR,
@@ -22,7 +23,6 @@ from study.estimate import (
     dynamic_lever,
     dynamic_seconds,
     fe_bodies,
-    load_factor,
 )
 from study.memory import available_memory, bytes_text
 from study.scene_model import static_angle_count
@@ -194,5 +194,5 @@ def progress_seconds(tasks) -> dict:
         s = task_seconds(t.scene, t.outputs)
         if t.outputs.modes or t.outputs.dynamic:
             s += MODES_S_PER_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
-        out[t.key] = s * load_factor()
+        out[t.key] = s * estimate.load_factor()     # the one load factor of a run's and a study's costs
     return out
