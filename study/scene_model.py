@@ -153,7 +153,7 @@ def flankless_model(scene: Scene, springs=None, setups: tuple | None = None) -> 
     and the FE cache it read; shared, never changed in place (`build_scene_model` hands out
     `with_flank_deviations`' copies)."""
     # the FE cache's folder: springs read from another cache are made again (as
-    # `study.run.kept_springs_and_model`; `solver.store.STORE.clear` empties this shelf too)
+    # `study.plan.kept_springs_and_model`; `solver.store.STORE.clear` empties this shelf too)
     key = digest(model_key(scene, springs, False, flanks=False), str(FE_CACHE.folder))
     return FLANKLESS.kept(key, lambda: _build_flankless(scene, springs, setups or gear_setups(scene)))
 

@@ -117,7 +117,7 @@ for _g, _which in ((1, "driver"), (2, "driven gear")):
     }
     SCALARS.update(_s)
     STRENGTH_SCALARS += tuple(_s)
-# the outputs of the linearised mesh and the tooth loads (`study.run.run_scene`'s mesh_outputs):
+# the outputs of the linearised mesh and the tooth loads (the run's 'mesh' stage, `stages_of`):
 # a study that asks for none of them skips that part
 MESH_SCALARS = ("mesh_stiffness", "mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha",
                 "mesh_stiffness_mesh_mean", "c_prime_mesh", "c_gamma_alpha_mesh", "c_prime_iso6336",
@@ -140,7 +140,7 @@ CURVES = {
 #             density (solver.inertia.gear_mass via study.inputs.gearsetup); not the gears' errors
 #   fe        root stress: the gears (springs included: 'uniform' runs no FE), the material, the
 #             backlash, the FE mesh and the torque that sets the FE load (gearsetup.reference_torque)
-#   static    STE: every field but the dynamic run's (study.run.run_static reads no 'dynamic.*')
+#   static    STE: every field but the dynamic run's (study.stages.run_static reads no 'dynamic.*')
 #   modes     the pair linearised at the mean load (its dampers given as ratios converted there):
 #             the static fields (damping included) and the mean load, the dynamic run's torque
 #             when it runs (study.scene_model.mean_load reads dynamic.enabled and dynamic.torque)
