@@ -24,6 +24,7 @@ import numpy as np
 from solver.mbs.model import Model
 from solver.store import STORE, digest
 from study import estimate
+from study.inputs.gearsetup import gear_setups
 from study.plausibility import report_warnings, scene_warnings
 from study.scene import Scene
 from study.scene_model import (
@@ -112,7 +113,6 @@ def make_plan(scene: Scene, stages, options: RunOptions = RunOptions()) -> RunPl
     if dynamic:
         estimate.check_dynamic_memory(scene)
     angles = static_angles(scene) if static else None     # checked before the FE bodies are made
-    from study.inputs.gearsetup import gear_setups
     setups = gear_setups(scene)
     springs = options.springs
     est = estimate.Estimate()
@@ -184,5 +184,4 @@ def kept_springs_and_model(scene: Scene):
     """(springs, model) of a scene kept as a study's worker keeps them (`make_plan` with
     ``keep_model``): those of the last scene that differs from this one only in ``dynamic.*``
     fields that leave the model as it is. The objects are shared: not to be changed in place."""
-    from study.inputs.gearsetup import gear_setups
     return _springs_and_model(scene, gear_setups(scene), None, True)[:2]
