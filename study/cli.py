@@ -140,7 +140,7 @@ def sweep_command(args) -> int:
                                "move it away or choose another output name")
     if args.workers is not None and args.workers < 0:
         raise UsageError("--workers", f"must be >= 0 (0 runs the points in this process), got {args.workers}")
-    from study.estimate import check_study_size
+    from study.sweep.cost import check_study_size
     n = check_study_size(st, checked_max_time(args))      # before its points are built
     from study.plausibility import face_width_note
     if any(f.endswith(".face_width") for f in st.fields):

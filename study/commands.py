@@ -19,11 +19,14 @@ def stiffness(scene: Scene, max_time: float | None = None, progress: bool = Fals
     """Per-tooth FE stiffness map of both gears -> xarray.Dataset (``tooth_stiffness`` [N mm/rad^n],
     ``stiffness_ratio`` [1] over gear and tooth). ``max_time`` [s]: refuse (BudgetError) a map
     estimated to take longer, before any work; ``progress``: a bar on stderr for a long one."""
+    from study.inputs.gearsetup import gear_setups
     from study.inputs.springs import stiffness_dataset
+    from study.stages import compute_fe_bodies
     check_scene_argument("stiffness", scene)
-    est = estimate.Estimate({"FE bodies": estimate.fe_seconds(scene)})
+    setups = gear_setups(scene)
+    est = estimate.Estimate({"FE bodies": estimate.fe_seconds(setups, scene.coupling_model)})
     estimate.check_time(est, max_time)
-    estimate.run_fe_bodies(scene, progress)
+    compute_fe_bodies(setups, scene.coupling_model, progress)
     return stiffness_dataset(scene)
 
 

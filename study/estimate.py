@@ -15,8 +15,6 @@ import os
 import sys
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from solver.mbs.kernels import layout as L
 from study.errors import BudgetError
 from study.memory import available_memory, bytes_text
@@ -132,23 +130,22 @@ def check_dynamic_memory(scene, field: str = "dynamic.duration") -> None:
                           "dynamic.output_step")
 
 
-def dynamic_seconds(model, choice, duration: float, scene=None) -> float:
+def dynamic_seconds(model, choice, duration: float, runup: bool = False) -> float:
     """Estimated run time [s] of the time integration with the chosen method and step
-    (``scene``: tells a run-up, whose teeth all stay active and whose run is repeated)."""
+    (``runup``: a run-up, whose teeth all stay active and whose run is repeated)."""
     steps = duration / choice.dt
     if choice.method == "implicit":
         return (DYNAMIC_S_PER_RUN + steps * IMPLICIT_S_PER_STEP_TOOTH * model.n_teeth) * load_factor()
-    runup = scene is not None and scene.dynamic.speed_end > 0
     active = model.n_teeth if runup else min(model.n_teeth, 2 * ACTIVE_TEETH_PER_GEAR)
     per_step = EXPLICIT_S_PER_STEP + EXPLICIT_S_PER_STEP_TOOTH * active
     return (DYNAMIC_S_PER_RUN + steps * per_step) * (RUNUP_RUNS if runup else 1.0) * load_factor()
 
 
-def static_seconds(scene, model) -> float:
-    """Estimated run time [s] of the quasi-static analysis."""
-    qs = scene.quasi_static
-    if qs.method == "static":
-        return static_angle_count(scene) * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth * load_factor()
+def static_seconds(method: str, angles: int, teeth: int) -> float:
+    """Estimated run time [s] of the quasi-static analysis by ``method`` (quasi_static.method)
+    over ``angles`` driver angles of a pair of ``teeth`` teeth in all."""
+    if method == "static":
+        return angles * STATIC_S_PER_ANGLE_TOOTH * teeth * load_factor()
     return 0.0      # the transient's steps are counted like a dynamic run's by the caller when needed
 
 
@@ -158,16 +155,15 @@ def static_seconds(scene, model) -> float:
 MESH_S_PER_ANGLE = 2e-3
 
 
-def mesh_seconds(scene) -> float:
-    """Estimated run time [s] of the linearised mesh over the STE angles, and for the plain
-    model the FE bodies of the wind-up its springs hold that the cache lacks
-    (`study.inputs.coupling.plain_windup`: the mesh alone)."""
-    from study.scene_model import static_angles
-    s = static_angles(scene).size * MESH_S_PER_ANGLE
-    if scene.coupling_model == "none":
+def mesh_seconds(angles: int, setups, coupling_model: str) -> float:
+    """Estimated run time [s] of the linearised mesh over ``angles`` STE angles, and for the
+    plain model (``coupling_model`` 'none') the FE bodies of the wind-up its springs hold that
+    the cache lacks (`study.inputs.coupling.plain_windup`: the mesh alone); ``setups``: both
+    gears' `study.inputs.gearsetup.GearSetup`."""
+    s = angles * MESH_S_PER_ANGLE
+    if coupling_model == "none":
         from study.inputs.coupling import pitch_compliances_cached, windup_body
-        from study.inputs.gearsetup import gear_setups
-        bodies = {b.key: b for b in map(windup_body, gear_setups(scene))}
+        bodies = {b.key: b for b in map(windup_body, setups)}
         s += sum(body_seconds(b) for b in bodies.values() if not pitch_compliances_cached(b))
     return s
 
@@ -233,13 +229,13 @@ def body_bytes(setup) -> float:
     return FE_BYTES_PER_ELEMENT * n * (n / FE_REF_ELEMENTS) ** FE_BYTES_EXPONENT
 
 
-def check_fe_memory(scene, factor: float = 1.0, setups=None) -> str | None:
+def check_fe_memory(setups, factor: float = 1.0) -> str | None:
     """Refuse, before any FE work, bodies whose estimated memory (`body_bytes`; the two largest
     are held at once, ``factor`` times that: the FE reference's influence coefficients)
     exceeds MEMORY_REFUSE of the memory available (BudgetError naming fe.mesh_size); a line to
-    warn with above MEMORY_WARN, else None. ``setups``: the gear setups to count (default: the
-    bodies the scene needs and the FE cache lacks)."""
-    setups = [s for _, s, _ in fe_bodies(scene)] if setups is None else list(setups)
+    warn with above MEMORY_WARN, else None. ``setups``: the gear setups to count (a run: the
+    bodies it needs and the FE cache lacks, `fe_bodies`)."""
+    setups = list(setups)
     if not setups:
         return None
     sizes = sorted((body_bytes(s), body_elements(s)) for s in setups)[-2:]
@@ -254,18 +250,17 @@ def check_fe_memory(scene, factor: float = 1.0, setups=None) -> str | None:
     return None
 
 
-def fe_bodies(scene) -> list:
-    """(label, setup, teeth) of the FE bodies the scene's springs need and the cache lacks."""
+def fe_bodies(setups, coupling_model: str) -> list:
+    """(label, setup, teeth) of the FE bodies the springs of gears ``setups`` (both gears'
+    `study.inputs.gearsetup.GearSetup`) under ``coupling_model`` need and the cache lacks."""
     from study.inputs.cache import FE_CACHE
-    from study.inputs.gearsetup import gear_setups
     from study.inputs.springs import uses_fe_springs
     out = []
-    setups = gear_setups(scene)
     for g, setup in zip((1, 2), setups):
         need = []
         if uses_fe_springs(setup):
             need += [(f"gear {g}", setup, None), (f"gear {g} solid reference", setup.solid(), [0])]
-        elif scene.coupling_model != "none":
+        elif coupling_model != "none":
             need.append((f"gear {g}", setup, None))
         for label, s, teeth in need:
             key = FE_CACHE.key({**s.settings, "teeth": list(range(s.teeth)) if teeth is None else teeth})
@@ -274,36 +269,16 @@ def fe_bodies(scene) -> list:
     return out
 
 
-def fe_seconds(scene) -> float:
-    """Estimated run time [s] of the FE bodies the scene needs and the cache lacks (the
-    coupling fits load each body at several profile points: counted as three bodies)."""
-    factor = 3.0 if scene.coupling_model == "compliance" else 1.0
-    return sum(body_seconds(s) for _, s, _ in fe_bodies(scene)) * factor
+def fe_seconds(setups, coupling_model: str) -> float:
+    """Estimated run time [s] of the FE bodies gears ``setups`` need under ``coupling_model``
+    and the cache lacks (`fe_bodies`; the coupling fits load each body at several profile
+    points: counted as three bodies)."""
+    factor = 3.0 if coupling_model == "compliance" else 1.0
+    return sum(body_seconds(s) for _, s, _ in fe_bodies(setups, coupling_model)) * factor
 
 
 TEETH_SEARCH_ANGLES = 20000      # more angles than this: the cache is not searched (the bodies counted in full)
 # (the FE reference's own cost, time and memory: `study.verify.fe_reference.reference_cost`)
-
-
-def run_fe_bodies(scene, show: bool = True) -> None:
-    """Compute (into the FE cache) the bodies the scene's springs need, with a bar whose unit
-    is the estimated second, when they are expected to take more than PROGRESS_AFTER_S; else
-    nothing (the springs compute them as they go). The coupling fits compute their own bodies."""
-    if scene.coupling_model != "none":
-        return
-    bodies = fe_bodies(scene)
-    secs = [body_seconds(s) for _, s, _ in bodies]
-    bar = progress_bar(sum(secs), sum(secs), "FE bodies", "s (estimated)", show)
-    if bar is None:
-        return
-    from study.inputs.springs import fe_stiffness
-    try:
-        for (label, setup, teeth), sec in zip(bodies, secs):
-            bar.set_postfix_str(label)
-            fe_stiffness(setup, teeth)
-            bar.update(sec)
-    finally:
-        bar.close()
 
 
 def check_time(est: Estimate, max_time: float | None) -> None:
@@ -339,178 +314,6 @@ def progress_bar(expected_s: float, total: float, desc: str, unit: str, show: bo
     from tqdm import tqdm
     return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, leave=False, dynamic_ncols=True,
                 bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} {unit} [{elapsed}<{remaining}]")
-
-
-# ---------------------------------------------------------------- studies
-
-# Building and checking one study point (its Scene and the cross-field checks): 20-60 ms on
-# 2 shared cores; its Scene and Point hold about 5 KB, its task records as much again.
-POINT_CHECK_S = 0.03
-POINT_BYTES = 1e4
-DYNAMIC_SAMPLES = 3          # dynamic tasks whose model gives the step of the estimate
-
-
-def study_points(study) -> int:
-    """Points of a study (grid product, times the builds of its sample, plus explicit points),
-    counted without building them."""
-    n = 1
-    for a in study.axes:
-        n *= len(a.values)
-    n = n if study.axes else 0
-    if study.sample:        # every grid point (or the base scene alone) gets the whole sample
-        n = max(n, 1) * study.sample.builds
-    return n + len(study.extra)
-
-
-def study_sizes(study) -> str:
-    """The factors of `study_points` in words: '3 x 4', '1e+06 draws', '2 x 500 draws + 3'."""
-    parts = [str(len(a.values)) for a in study.axes]
-    if study.sample:
-        parts.append(f"{study.sample.builds:.4g} draws" if study.sample.builds >= 1e6 else f"{study.sample.builds} draws")
-    return " x ".join(parts) or "0"
-
-
-def check_study_size(study, max_time: float | None) -> int:
-    """Refuse, before its points are built, a study too large to enumerate: memory beyond what
-    the machine has, or its checks alone beyond ``max_time`` [s]. Returns its point count
-    (grid points and sampled builds alike: `study_points`)."""
-    n = study_points(study)
-    need = n * POINT_BYTES
-    have = available_memory()
-    sizes = study_sizes(study)
-    field, lever = ("sample.size", "draw fewer (sample.size)") if study.sample else ("grid", "sweep fewer values")
-    if need > 0.5 * have:
-        raise BudgetError(field, f"the study has {n:.4g} points ({sizes}{f' + {len(study.extra)}' if study.extra else ''}); "
-                                 f"only listing them needs about {bytes_text(need)}, more than half the {bytes_text(have)} "
-                                 f"of memory available: {lever}, or split the study")
-    if max_time is not None and n * POINT_CHECK_S > max_time:
-        raise BudgetError(field, f"the study has {n:.4g} points ({sizes}); building and checking them alone takes "
-                                 f"about {duration_text(n * POINT_CHECK_S)}, beyond --max-time {max_time:.4g} s: "
-                                 f"{lever}, or split the study")
-    return n
-
-
-def estimate_model(scene):
-    """A model of ``scene`` for the step estimate that needs no FE: uniform tooth springs (an FE
-    map scales the calibrated spring by a ratio near 1) and no body coupling."""
-    from study.scene_model import build_scene_model
-    plain = scene.replace(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform",
-                             "coupling.model": "none"})
-    return build_scene_model(plain)
-
-
-# A study's task, costed without a model (for the order and batching of the tasks on dask, not
-# for a budget): the dynamic run at a typical step (the paper pair's 1.1 us, the small 20-tooth
-# pair's 1.4 us), the fixed part of a task (its run archive, summary and record: 0.015-0.02 s
-# measured on the small pair) and the part of the first point of a model (its build, damping
-# conversion, modes and step bound), paid once per worker and model and left out here.
-TASK_S = 0.02
-TYPICAL_STEP_S = 1.2e-6
-
-
-def task_seconds(scene, outputs) -> float:
-    """Estimated compute seconds of one study task (`study.sweep.tasks.Task`: its scene and
-    outputs) on a quiet core, from the scene alone: the statics by their angles, the mesh
-    outputs, the dynamic run by its duration at TYPICAL_STEP_S (a run-up's teeth all active and
-    its run repeated). A relative figure: the order in which a study's tasks start and how
-    many share a dask task (`study.sweep.tasks.batches`)."""
-    from study.sweep.outputs import MESH_SCALARS
-    teeth = scene.gear1.teeth + scene.gear2.teeth
-    s = TASK_S
-    if outputs.static and scene.quasi_static.method == "static":
-        angles = static_angle_count(scene)
-        s += angles * STATIC_S_PER_ANGLE_TOOTH * teeth
-        if set(outputs.scalars + outputs.curves) & set(MESH_SCALARS):
-            s += angles * MESH_S_PER_ANGLE
-    if outputs.dynamic:
-        runup = scene.dynamic.speed_end > 0
-        active = teeth if runup else min(teeth, 2 * ACTIVE_TEETH_PER_GEAR)
-        steps = scene.dynamic.duration / (scene.dynamic.time_step or TYPICAL_STEP_S)
-        s += steps * (EXPLICIT_S_PER_STEP + EXPLICIT_S_PER_STEP_TOOTH * active) * (RUNUP_RUNS if runup else 1.0)
-    return s
-
-
-GIVEN_STEP_GROUPS = 20      # distinct given steps estimated one by one, the smallest (the others sampled)
-
-
-def sweep_estimate(tasks) -> Estimate:
-    """Estimated seconds of a study's tasks (`study.sweep.tasks.Task`), summed: FE bodies (each
-    distinct body the cache lacks), statics (per static task, by its angles) and dynamics
-    (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
-    from study.inputs.cache import FE_CACHE
-    from study.scene_model import dynamic_choice
-    est = Estimate()
-    bodies, body_s = {}, {}
-    static_s = 0.0
-    dyn = [t for t in tasks if t.outputs.dynamic]
-    for t in tasks:
-        try:        # the bodies of its springs or of its coupling model (compliance: fits at three loads)
-            needed = fe_bodies(t.scene)
-        except Exception:  # noqa: BLE001 - a scene that cannot be prepared: its task records why
-            needed = []
-        for _label, setup, teeth in needed:
-            key = FE_CACHE.key({**setup.settings, "teeth": list(range(setup.teeth)) if teeth is None else teeth})
-            if key not in bodies:
-                bodies[key] = setup
-                body_s[key] = body_seconds(setup) * (3.0 if t.scene.coupling_model == "compliance" else 1.0)
-        if t.outputs.static and t.scene.quasi_static.method == "static":
-            static_s += static_angle_count(t.scene) * STATIC_S_PER_ANGLE_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
-    est.seconds["FE bodies"] = sum(body_s.values())
-    line = check_fe_memory(None, setups=bodies.values())        # BudgetError beyond the memory available
-    if line:
-        from study.plausibility import report_warnings
-        report_warnings([line], True)
-    est.seconds["statics"] = static_s
-    # the runs whose step is given (dynamic.time_step) each at their own step, one model per
-    # distinct step and pair; the others at the worst step of up to DYNAMIC_SAMPLES of them
-    given: dict = {}
-    for t in dyn:
-        d = t.scene.dynamic
-        if d.time_step > 0:
-            given.setdefault((d.time_step, d.method, t.scene.gear1.teeth, t.scene.gear2.teeth), []).append(t)
-    given = dict(sorted(given.items(), key=lambda kv: kv[0][0])[:GIVEN_STEP_GROUPS])     # the smallest steps
-    free = [t for t in dyn if not any(t in g for g in given.values())]
-    groups = [(g[0], g) for g in given.values()]
-    if free:
-        picks = [free[int(i)] for i in sorted({round(k * (len(free) - 1) / max(DYNAMIC_SAMPLES - 1, 1))
-                                                for k in range(min(DYNAMIC_SAMPLES, len(free)))})]
-        groups += [(t, None) for t in picks]
-    rates, dts, choice_of, seconds = [], [], [], 0.0
-    for t, group in groups:
-        model = estimate_model(t.scene)
-        choice = dynamic_choice(t.scene, model)
-        rate = dynamic_seconds(model, choice, 1.0)      # s of run time per s simulated
-        rates.append(rate)
-        dts.append(choice.dt)
-        choice_of.append(choice)
-        if group is not None:
-            seconds += rate * sum(u.scene.dynamic.duration for u in group)
-    if free:
-        seconds += max(r for (_, g), r in zip(groups, rates) if g is None) * sum(t.scene.dynamic.duration for t in free)
-    if dyn:
-        part = f"dynamics ({len(dyn)} runs, dt down to {min(dts):.3g} s)"
-        est.seconds[part] = seconds
-        worst = int(np.argmax(rates))
-        est.levers[part] = dynamic_lever(groups[worst][0].scene, choice_of[worst]) + ", or fewer grid points"
-    return est
-
-
-# A study task's modal analysis (mesh mode, critical speeds, damping), which `task_seconds`
-# leaves out: about 0.5 s on the paper pair (12 mesh positions, 134 teeth), 4 ms a tooth.
-MODES_S_PER_TOOTH = 4e-3
-
-
-def progress_seconds(tasks) -> dict:
-    """Estimated seconds of each study task (`study.sweep.tasks.Task`) for a progress bar's ETA:
-    `task_seconds` with the modal analysis its outputs need, scaled by `load_factor` ->
-    {task key: s}. (The FE bodies it reads are costed apart: `body_seconds`.)"""
-    out = {}
-    for t in tasks:
-        s = task_seconds(t.scene, t.outputs)
-        if t.outputs.modes or t.outputs.dynamic:
-            s += MODES_S_PER_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
-        out[t.key] = s * load_factor()
-    return out
 
 
 # ---------------------------------------------------------------- work-precision study

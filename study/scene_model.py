@@ -32,16 +32,17 @@ from study.scene import (
 )
 
 __all__ = ["GearSetup", "gear_setup", "gear_setups", "coupling_fit", "scene_springs",
-           "build_scene_model", "kept_scene_model", "geometry_model", "static_angles", "static_angle_count",
+           "build_scene_model", "kept_scene_model", "scene_model", "geometry_model", "static_angles", "static_angle_count",
            "check_static_memory", "dynamic_choice", "load_table", "damping_ratios", "mean_load"]
 
 
-def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple | None = None):
+def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple | None = None, kinematics=None):
     """Gear g's foundation coupling identified from its FE body: a `BodyTorsionFit`
     ('body-torsion'), a `ToothComplianceFit` ('compliance'), or None (the plain model).
     ``model``: the coupling model (default: the scene's); ``setups``: the scene's gear setups
-    when already made. Kept in `FE_CACHE` by both gears' FE settings: a run asks for it for
-    the springs and again for the model."""
+    when already made; ``kinematics``: a function giving the pair's `geometry_model` (the
+    compliance fit's mesh positions; default: built here). Kept in `FE_CACHE` by both gears'
+    FE settings: a run asks for it for the springs and again for the model."""
     model = scene.coupling_model if model is None else model
     if model not in ("body-torsion", "compliance"):
         return None
@@ -51,16 +52,17 @@ def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple |
     def fit():
         if model == "body-torsion":
             return coupling.body_torsion(setup)
-        return coupling.tooth_compliance(setup, coupling.mesh_samples(geometry_model(scene), g))
+        pair = kinematics() if kinematics is not None else geometry_model(scene, setups)
+        return coupling.tooth_compliance(setup, coupling.mesh_samples(pair, g))
     # both gears' FE settings in the key: the compliance fit reads the pair's rigid geometry too
     return FE_CACHE.fit((model, g, setups[0].key, setups[1].key), fit)
 
 
-def coupled_springs(scene: Scene, setup: GearSetup, setups: tuple) -> tuple[np.ndarray, np.ndarray]:
+def coupled_springs(scene: Scene, setup: GearSetup, setups: tuple, kinematics=None) -> tuple[np.ndarray, np.ndarray]:
     """The gear's tooth springs without the body wind-up [N·mm/rad] (linear, n_k = 1; with the
     compliance model each tooth's own spring, loaded alone) and the FE stiffness ratio [1] of
-    the plain model's springs."""
-    fit = coupling_fit(scene, setup.gear, setups=setups)
+    the plain model's springs (``kinematics`` as `coupling_fit`'s)."""
+    fit = coupling_fit(scene, setup.gear, setups=setups, kinematics=kinematics)
     k = fit.k_tooth if scene.coupling_model == "body-torsion" else fit.k_own
     return k / units.spring_stiffness_to_si(1.0), tooth_springs(setup)[1]
 
@@ -69,7 +71,13 @@ def scene_springs(scene: Scene, setups: tuple | None = None):
     """((k1, r1), (k2, r2)): per-tooth springs [N·mm/rad^n_k] and stiffness ratios of both gears."""
     setups = setups or gear_setups(scene)
     if scene.coupling_model != "none":
-        return tuple(coupled_springs(scene, s, setups) for s in setups)
+        pair = []       # the pair's kinematics for both gears' fits, built once when a fit needs it
+
+        def kinematics():
+            if not pair:
+                pair.append(geometry_model(scene, setups))
+            return pair[0]
+        return tuple(coupled_springs(scene, s, setups, kinematics) for s in setups)
     return tuple(tooth_springs(s) for s in setups)
 
 
@@ -100,7 +108,7 @@ def kept_scene_model(scene: Scene, springs=None) -> Model:
     point that differs from an earlier one of the process only in ``dynamic.*`` builds nothing,
     its damping conversion (dozens of modal analyses) included. For callers that never change
     a model in place (the solver does not; the sweep's tasks do not): the object is shared."""
-    return MODELS.kept(model_key(scene, springs, True), lambda: build_scene_model(scene, springs))
+    return scene_model(scene, springs, gear_setups(scene), keep=True)[0]
 
 
 def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) -> Model:
@@ -109,16 +117,35 @@ def build_scene_model(scene: Scene, springs=None, convert_damping: bool = True) 
     ``convert_damping=False`` leaves the dampers given as ratios at zero (`damping_from_ratios`).
     The model without the flank deviations and pitch errors is made once for the scenes that
     differ only in those (`flankless_model`); the scene's own are written into a copy."""
+    setups = gear_setups(scene)
+    if not convert_damping:
+        return _with_flanks(scene, springs, setups)
+    return scene_model(scene, springs, setups)[0]
+
+
+def scene_model(scene: Scene, springs, setups: tuple, keep: bool = False) -> tuple[Model, list | None]:
+    """(model, loaded equilibria under the mean load at 12 positions, or None where the damping
+    conversion needed none) of a scene whose gear setups are ``setups``: the model of
+    `build_scene_model`, its dampers converted from the scene's ratios at those equilibria
+    (`damping_from_ratios`). ``keep``: kept (`kept_scene_model`), model and equilibria shared."""
+    if keep:
+        return MODELS.kept(model_key(scene, springs, True),
+                           lambda: converted_damping(scene, _with_flanks(scene, springs, setups)))
+    return converted_damping(scene, _with_flanks(scene, springs, setups))
+
+
+def _with_flanks(scene: Scene, springs, setups: tuple) -> Model:
+    """The scene's model, dampers as given: the kept flankless model with the scene's flank
+    deviations and pitch errors written into a copy."""
     flanks = tuple(scene.modification_spec(g) for g in (1, 2)), tuple(scene.errors_spec(g) for g in (1, 2))
-    model = with_flank_deviations(flankless_model(scene, springs), *flanks)
-    return damping_from_ratios(scene, model) if convert_damping else model
+    return with_flank_deviations(flankless_model(scene, springs, setups), *flanks)
 
 
 FLANKLESS_SLOTS = 2     # a tolerance study's builds share one; its geometry model a second
 FLANKLESS = STORE.shelf("flankless models", FLANKLESS_SLOTS)
 
 
-def flankless_model(scene: Scene, springs=None) -> Model:
+def flankless_model(scene: Scene, springs=None, setups: tuple | None = None) -> Model:
     """The scene's model with perfect involutes and no pitch errors, its dampers as given (the
     ratios not converted): what the builds of a tolerance study, which draw the reliefs, pitch
     deviations and runout, have in common (geometry, inertia, FE springs and body coupling,
@@ -126,13 +153,12 @@ def flankless_model(scene: Scene, springs=None) -> Model:
     and the FE cache it read; shared, never changed in place (`build_scene_model` hands out
     `with_flank_deviations`' copies)."""
     # the FE cache's folder: springs read from another cache are made again (as
-    # `study.run.kept_springs_and_model`; `solver.store.STORE.clear` empties this shelf too)
+    # `study.plan.kept_springs_and_model`; `solver.store.STORE.clear` empties this shelf too)
     key = digest(model_key(scene, springs, False, flanks=False), str(FE_CACHE.folder))
-    return FLANKLESS.kept(key, lambda: _build_flankless(scene, springs))
+    return FLANKLESS.kept(key, lambda: _build_flankless(scene, springs, setups or gear_setups(scene)))
 
 
-def _build_flankless(scene: Scene, springs) -> Model:
-    setups = gear_setups(scene)
+def _build_flankless(scene: Scene, springs, setups: tuple) -> Model:
     springs = springs or scene_springs(scene, setups)
     gears = []
     for setup, (k_phi, _) in zip(setups, springs):
@@ -203,17 +229,28 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
       A body-coupled pair whose joint dampers alone cannot reach the ratio (a very stiff joint
       locks; about 4.7 % at most on a small 24-tooth pair with a thin web) scales its body
       dampers with them, all at one ratio of their own modes."""
+    return converted_damping(scene, model)[0]
+
+
+def converted_damping(scene: Scene, model: Model) -> tuple[Model, list | None]:
+    """(`damping_from_ratios`' model, the loaded equilibria under the mean load it was converted
+    at, or None when the scene gives no ratio)."""
     ratios = damping_ratios(scene)
     if not ratios:
-        return model
+        return model, None
+    from study.plausibility import carrying_equilibria
+    eqs = carrying_equilibria(scene, model, mean_load(scene))      # SceneError when the teeth cannot carry it
+    return _converted(model, eqs, ratios), eqs
+
+
+def _converted(model: Model, eqs: list, ratios: dict) -> Model:
+    """The model with the dampers of ``ratios`` (`damping_ratios`) converted at ``eqs``."""
     from solver.mbs.modes import (
         joint_and_body_damping_for_ratio,
         joint_damping_for_ratio,
         tooth_damping_for_ratio,
         with_damping,
     )
-    from study.plausibility import carrying_equilibria
-    eqs = carrying_equilibria(scene, model, mean_load(scene))      # SceneError when the teeth cannot carry it
     c_phi = tuple(tooth_damping_for_ratio(model, eqs, ratios[f"gear{g}"], g) if f"gear{g}" in ratios
                   else float(model.gear_par[g - 1, L.C_PHI]) for g in (1, 2))
     model = with_damping(model, c_phi=c_phi)
@@ -234,14 +271,15 @@ def damping_from_ratios(scene: Scene, model: Model) -> Model:
     return with_damping(model, c_con=0.0, c_phi=c_phi, c_body=c_body)
 
 
-def geometry_model(scene: Scene) -> Model:
+def geometry_model(scene: Scene, setups: tuple | None = None) -> Model:
     """The pair's geometry, inertia and contact law without any FE: plain uniform springs of
     the scene's k_phi, no foundation coupling and the dampers given as ratios left at zero. For what needs the kinematics and the
-    contact law only (the mesh positions, the FE reference), not the tooth springs."""
+    contact law only (the mesh positions, the FE reference), not the tooth springs. ``setups``:
+    the scene's gear setups when already made (they do not depend on the coupling model)."""
     plain = scene.replace(**{"coupling.model": "none"})
     z1, z2 = scene.gear1.teeth, scene.gear2.teeth
-    return build_scene_model(plain, springs=((np.full(z1, scene.gear1.spring.k_phi), np.ones(z1)),
-                                             (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2))), convert_damping=False)
+    springs = ((np.full(z1, scene.gear1.spring.k_phi), np.ones(z1)), (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2)))
+    return _with_flanks(plain, springs, setups or gear_setups(plain))
 
 
 def static_angle_count(scene: Scene, step_deg: float | None = None) -> float:
@@ -289,13 +327,16 @@ def static_angles(scene: Scene, step_deg: float | None = None, memory_factor: fl
     return np.radians(np.arange(n) * step)
 
 
-def dynamic_choice(scene: Scene, model: Model):
-    """Integrator and step of the scene's dynamic run (`solver.mbs.method.choose_method`)."""
+def dynamic_choice(scene: Scene, model: Model, equilibria=None, equilibria_load: float | None = None):
+    """Integrator and step of the scene's dynamic run (`solver.mbs.method.choose_method`).
+    ``equilibria``: the model's loaded equilibria under ``equilibria_load`` [N·m] when already
+    solved (the step bound linearises there when that is the run's step torque)."""
     from solver.mbs.dynamics import run_loads  # the integrators load numba: not for `lightgear --help`
     from solver.mbs.method import choose_method
     d = scene.dynamic
     step_torque = run_loads(load_table(scene), d.torque)[1]
-    return choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha)
+    eqs = equilibria if equilibria is not None and step_torque == equilibria_load else None
+    return choose_method(model, step_torque, d.duration, d.method, d.time_step or None, d.alpha, equilibria=eqs)
 
 
 def load_table(scene: Scene) -> np.ndarray | None:

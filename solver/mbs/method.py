@@ -35,7 +35,8 @@ class MethodLimits:
 
 
 def choose_method(model: Model, torque: float, duration: float, method: str = "auto",
-                  dt: float | None = None, alpha: float = 0.0, limits: MethodLimits = MethodLimits()) -> MethodChoice:
+                  dt: float | None = None, alpha: float = 0.0, limits: MethodLimits = MethodLimits(),
+                  equilibria=None) -> MethodChoice:
     """Method and step [s] for a run of ``duration`` [s] under ``torque`` [N·m] (``alpha``, the
     HHT parameter of an implicit run, does not change its step).
 
@@ -51,6 +52,8 @@ def choose_method(model: Model, torque: float, duration: float, method: str = "a
     The explicit step takes the tooth-root dampers implicitly where `simulate` does
     (`solver.mbs.stability.implicit_dampers_apply`; ``safety`` None: that default); the
     implicit step is a multiple of the all-explicit bound (safety 0.5 by default), as before.
+    ``equilibria``: the model's loaded equilibria under ``torque`` when already solved
+    (`solver.mbs.equilibria.loaded_equilibria`; the step bound linearises there).
     """
     max_explicit_steps, implicit_factor, safety = limits.max_explicit_steps, limits.implicit_factor, limits.safety
     if method not in ("explicit", "implicit", "auto"):
@@ -59,11 +62,11 @@ def choose_method(model: Model, torque: float, duration: float, method: str = "a
     if method != "auto" and given:
         return MethodChoice(method, float(dt), float("nan"), "method and step given")
     if method == "implicit":
-        dt_stable, w = stable_time_step(model, torque, safety)
+        dt_stable, w = stable_time_step(model, torque, safety, equilibria=equilibria)
         return MethodChoice("implicit", implicit_factor * dt_stable, w,
                             f"implicit at {implicit_factor:g} x the explicit stability step")
     imex = implicit_dampers_apply(model)
-    dt_stable, w = stable_time_step(model, torque, safety, implicit_dampers=imex)
+    dt_stable, w = stable_time_step(model, torque, safety, implicit_dampers=imex, equilibria=equilibria)
     how = "tooth-root dampers implicit, " if imex else ""
     if method == "explicit":
         return MethodChoice("explicit", dt_stable, w, f"explicit ({how}the default fraction of the stability step)"
@@ -79,6 +82,6 @@ def choose_method(model: Model, torque: float, duration: float, method: str = "a
                             f"auto: explicit, {n:.3g} steps at the stability step ({dt_stable * 1e9:.4g} ns){bound}",
                             estimated=not given)
     if imex:
-        dt_stable = stable_time_step(model, torque, safety)[0]
+        dt_stable = stable_time_step(model, torque, safety, equilibria=equilibria)[0]
     return MethodChoice("implicit", float(dt) if given else implicit_factor * dt_stable, w,
                         f"auto: implicit, the explicit run would take {n:.3g} steps > {max_explicit_steps:.3g}")

@@ -137,13 +137,13 @@ class Modes:
 
 def modal_analysis(model: Model, torque: float, positions: int = 12, equilibria=None) -> Modes:
     """Modes of the pair linearised at static equilibrium under ``torque`` [N·m] at
-    ``positions`` driver angles across one mesh period (see the module docstring). Without
-    given ``equilibria``, solved once per model and load (`solver.mbs.memo`)."""
-    if equilibria is None:
-        from solver.mbs.memo import kept
-        return kept("modal_analysis", model, (float(torque), int(positions)),
-                    lambda: _modal_analysis(model, torque, positions, None))
-    return _modal_analysis(model, torque, positions, equilibria)
+    ``positions`` driver angles across one mesh period (see the module docstring); solved once
+    per model and load (`solver.mbs.memo`). ``equilibria``: the model's loaded equilibria under
+    ``torque`` at ``positions`` when already solved (`solver.mbs.equilibria.loaded_equilibria`:
+    the same numbers, not solved again)."""
+    from solver.mbs.memo import kept
+    return kept("modal_analysis", model, (float(torque), int(positions)),
+                lambda: _modal_analysis(model, torque, positions, equilibria))
 
 
 def _modal_analysis(model: Model, torque: float, positions: int, equilibria) -> Modes:

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.linearization import linearizations, linearize
+from solver.mbs.linearization import at_equilibrium, linearizations, linearize
 from solver.mbs.model import Model
 
 
@@ -46,7 +46,7 @@ def linearized_system(model: Model, theta1: float, theta2: float, phi: np.ndarra
 
 
 def stability_limit(model: Model, torque: float, positions: int = 12,
-                    implicit_dampers: bool = False) -> tuple[float, float]:
+                    implicit_dampers: bool = False, equilibria=None) -> tuple[float, float]:
     """(critical Verlet step [s], highest natural frequency [rad/s]) of the loaded pair over one
     mesh cycle.
 
@@ -63,17 +63,21 @@ def stability_limit(model: Model, torque: float, positions: int = 12,
     (IMEX kicks, `implicit_dampers_apply`), which are stable at any damping: only the contact
     and body dampers count then. Solved once per model and arguments (`solver.mbs.memo`: a
     run asks for it in its method choice and again in `simulate`; a study's points of one body
-    share it).
+    share it). ``equilibria``: the model's loaded equilibria under ``torque`` at ``positions``
+    when already solved (`solver.mbs.equilibria.loaded_equilibria`: the same numbers).
     """
     from solver.mbs.memo import kept
     args = (float(torque), int(positions), bool(implicit_dampers))
-    return kept("stability_limit", model, args, lambda: _stability_limit(model, *args))
+    return kept("stability_limit", model, args, lambda: _stability_limit(model, *args, equilibria))
 
 
-def _stability_limit(model: Model, torque: float, positions: int, implicit_dampers: bool) -> tuple[float, float]:
+def _stability_limit(model: Model, torque: float, positions: int, implicit_dampers: bool,
+                     equilibria=None) -> tuple[float, float]:
     wmax = 0.0
     dt_crit = math.inf
-    for sy in linearizations(model, torque, positions):
+    systems = (linearizations(model, torque, positions) if equilibria is None
+               else [at_equilibrium(model, eq) for eq in equilibria])
+    for sy in systems:
         M, K, C = sy.M, sy.K, sy.damping(joint=not implicit_dampers, friction=True)
         lam, x = scipy.linalg.eigh(K, M)
         w = np.sqrt(np.maximum(lam, 0.0))
@@ -91,13 +95,14 @@ def highest_frequency(model: Model, torque: float, positions: int = 12) -> float
 
 
 def stable_time_step(model: Model, torque: float, safety: float | None = None,
-                     implicit_dampers: bool = False) -> tuple[float, float]:
+                     implicit_dampers: bool = False, equilibria=None) -> tuple[float, float]:
     """(dt [s], omega_max [rad/s]) for the explicit integrator: safety times the critical step
     of `stability_limit` (2/omega_max without damping); ``implicit_dampers`` as there.
-    ``safety`` None: SAFETY, or IMEX_SAFETY with implicit dampers (see there)."""
+    ``safety`` None: SAFETY, or IMEX_SAFETY with implicit dampers (see there); ``equilibria``
+    as there."""
     if safety is None:
         safety = IMEX_SAFETY if implicit_dampers else SAFETY
-    dt_crit, w = stability_limit(model, torque, implicit_dampers=implicit_dampers)
+    dt_crit, w = stability_limit(model, torque, implicit_dampers=implicit_dampers, equilibria=equilibria)
     if not w > 0:
         raise ValueError("no loaded contact found to estimate the highest natural frequency")
     return safety * dt_crit, w

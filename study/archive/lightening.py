@@ -9,7 +9,8 @@
 
 Mass and inertia are cheap geometry (`solver.inertia.gear_mass`: the body rings at their
 thickness less the holes, plus the teeth from their outline; the solid gear is
-`solver.geometry.solid_body`) and are always computed. The root stress comes from the FE solve
+`solver.geometry.solid_body`), computed by the run's gear stage (`study.stages.gear_stage`) and
+always given. The root stress comes from the FE solve
 of the stiffness map (`study.inputs.springs.root_stresses`, cached with it), so it is given only
 for a gear whose springs come from the FE (a lightened gear, springs not 'uniform'); the solid
 reference's value is the same FE of the solid body that the stiffness ratio uses. Other gears
@@ -25,22 +26,21 @@ from __future__ import annotations
 import numpy as np
 
 from solver import units
-from solver.inertia import gear_mass
 from study.archive.schema import variable
 
 
-def lightening_variables(setups, stresses: dict) -> tuple[dict, dict]:
+def lightening_variables(setups, masses, stresses: dict) -> tuple[dict, dict]:
     """Coordinates and variables (see the module) of both gears of a scene, from its gear setups
-    (`study.inputs.gearsetup.gear_setups`) and ``stresses`` {gear: (root stress of each tooth
-    [Pa], of the solid body's tooth 0 [Pa]) or the reason it is not computed}
+    (`study.inputs.gearsetup.gear_setups`), their mass properties ``masses``
+    (`solver.inertia.gear_mass`, SI) and ``stresses`` {gear: (root stress of each tooth [Pa], of
+    the solid body's tooth 0 [Pa]) or the reason it is not computed}
     (`study.inputs.springs.root_stresses`)."""
     zmax = max(s.teeth for s in setups)
     mass, saving, inertia = (np.empty(2) for _ in range(3))
     sigma = np.full((2, zmax), np.nan)
     sigma_max, ratio = np.full(2, np.nan), np.full(2, np.nan)
     reasons = []
-    for i, s in enumerate(setups):
-        mp = gear_mass(s.geometry, s.body, s.material.density)
+    for i, (s, mp) in enumerate(zip(setups, masses)):
         mass[i], saving[i], inertia[i] = mp.mass, mp.mass_saving, mp.inertia * units.MM_PER_M**2
         if not s.lightened:
             ratio[i] = 1.0          # the solid gear is the reference of the ratio: 1 by definition

@@ -1,5 +1,6 @@
 """Modes of the loaded pair, their damping, the free decay and the critical speeds -> run
-archive variables (`solver.mbs.modes`, `solver.mbs.ringdown`).
+archive variables (the modal analysis `solver.mbs.modes` and the free decay `solver.mbs.ringdown`
+as the run's modes stage, `study.stages.modes_stage`, made them).
 
   mode_frequency(mode, mesh_position)   natural frequency [Hz]
   mode_damping(mode, mesh_position)     damping ratio [1] (mode 0: the mesh mode)
@@ -38,9 +39,11 @@ def critical_speeds(freq_hz: np.ndarray, orders: np.ndarray, z1: int, z2: int) -
     return 2 * math.pi * freq_hz[None, :] * z2 / (z1 * orders[:, None])
 
 
-def modal_variables(model: Model, torque: float, holes: int, decay: bool = True) -> tuple[dict, dict, dict]:
-    from solver.mbs.modes import modal_analysis
-    md = modal_analysis(model, torque)
+def modal_variables(md, decay, model: Model, torque: float, holes: int) -> tuple[dict, dict, dict]:
+    """Coordinates, variables and attributes (see the module) of the modal analysis ``md``
+    (`solver.mbs.modes.Modes`) of ``model`` under ``torque`` [N·m] on a driven gear with
+    ``holes`` openings, and of the free decay ``decay``: (mesh position index, its
+    `solver.mbs.ringdown.RingDown`), or None without one."""
     z1, z2 = model.teeth
     exc = excitation_orders(z2, holes)
     coords = {
@@ -65,12 +68,8 @@ def modal_variables(model: Model, torque: float, holes: int, decay: bool = True)
         "c_con_used": float(model.law_par[L.C_CON] / units.contact_damping_to_si(1.0, model.law_par[L.M2], model.law_par[L.M3])),
         "c_phi_used_N_mm_s_rad": model.gear_par[:, L.C_PHI] / units.spring_damping_to_si(1.0),
     }
-    if decay:
-        from solver.mbs.ringdown import ring_down
-        # where the mesh mode's ratio is nearest its mean over the mesh period (the ratio a
-        # run-up's resonance sees: at 1Z one mesh period passes per vibration period)
-        j = int(np.nanargmin(np.abs(md.damping[0] - np.nanmean(md.damping[0]))))
-        rd = ring_down(model, torque, float(md.frequency[0, j]), float(md.damping[0, j]), driver_angle=float(md.position[j]))
+    if decay is not None:
+        j, rd = decay
         attrs.update(mesh_mode_frequency_decay_hz=rd.frequency, mesh_mode_damping_decay=rd.damping,
                      mesh_mode_damping_at_decay=float(md.damping[0, j]),
                      mesh_mode_decay_angle_deg=float(np.degrees(md.position[j])),

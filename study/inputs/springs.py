@@ -96,9 +96,11 @@ def lightening_dataset(scene: Scene, stress: bool = True):
     solve: the FE runs only for a gear whose springs need it and whose map is not cached)."""
     import xarray as xr
 
+    from solver.inertia import gear_mass
     from study.archive.lightening import lightening_variables
     setups = gear_setups(scene)
-    coords, data = lightening_variables(setups, root_stresses(setups, stress))
+    masses = [gear_mass(s.geometry, s.body, s.material.density) for s in setups]
+    coords, data = lightening_variables(setups, masses, root_stresses(setups, stress))
     return xr.Dataset(data, coords=coords)
 
 

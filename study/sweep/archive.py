@@ -125,6 +125,89 @@ def output_axes(study: Study, output: str) -> tuple[int, ...]:
     return tuple(i for i, a in enumerate(study.axes) if reads(analysis_of(output), a.path)) + sample
 
 
+class _Placement:
+    """Where each output of a study lies: its dimensions, shape and a point's position in it (a
+    grid study's output over the swept dimensions it reads, `output_axes`; others over all)."""
+
+    def __init__(self, study: Study, dims: tuple):
+        self.dims, self.shape, self.grid = dims, study.shape, study.layout == "grid"
+        out = study.outputs
+        self.own = {k: output_axes(study, k) for k in out.scalars + out.curves}
+
+    def dims_of(self, k):
+        return tuple(self.dims[i] for i in self.own[k]) if self.grid else self.dims
+
+    def shape_of(self, k):
+        return tuple(self.shape[i] for i in self.own[k]) if self.grid else self.shape
+
+    def at(self, k, idx):
+        return tuple(idx[i] for i in self.own[k]) if self.grid else idx
+
+
+class _Gathered:
+    """The records of a study's points laid out: status, message, compute time, scalars, and per
+    curve its axis, attributes and per position the values held ({position: values}) or the
+    task whose part file has them ({position: key})."""
+
+    def __init__(self, study: Study, place: _Placement):
+        shape = place.shape
+        self.status = np.zeros(shape, np.int8)
+        self.message = np.full(shape, "not computed yet", dtype=object)
+        self.wall = np.full(shape, np.nan)
+        self.scalars = {k: np.full(place.shape_of(k), np.nan) for k in study.outputs.scalars}
+        self.axes, self.held, self.where, self.curve_attrs = {}, {}, {}, {}
+
+    def add(self, idx, r: dict, place: _Placement, read) -> None:
+        """Point ``idx``'s record ``r`` (`tasks.point_result`)."""
+        self.status[idx] = STATUS.index(r["status"])
+        self.message[idx] = r["message"]
+        self.wall[idx] = r["wall_time"]
+        for k, arr in self.scalars.items():
+            v = r["scalars"].get(k, np.nan)
+            if np.isnan(arr[place.at(k, idx)]):
+                arr[place.at(k, idx)] = v
+        point_curves = dict(r.get("curves", {}))
+        keys = {key for name, key in r.get("curve_keys", {}).items()
+                if place.at(name, idx) not in self.where.get(name, {}) and place.at(name, idx) not in self.held.get(name, {})}
+        for key in keys:            # read once for the axes of the curves it brings to new positions
+            full = read(key) if read is not None else None
+            for name, curve in (full["curves"] if full else {}).items():
+                if r["curve_keys"].get(name) == key:
+                    point_curves[name] = (*curve[:3], key, curve[4])
+            del full
+        for name, curve in point_curves.items():
+            self._add_curve(idx, name, curve, place)
+
+    def _add_curve(self, idx, name: str, curve: tuple, place: _Placement) -> None:
+        axis, ax_vals, ax_attrs, vals, attrs = curve
+        if name not in self.axes:
+            self.axes[name] = (axis, ax_vals, ax_attrs)
+            self.held[name], self.where[name] = {}, {}
+            self.curve_attrs[name] = attrs
+        ref = self.axes[name][1]
+        pos = place.at(name, idx)
+        if pos in self.held[name] or pos in self.where[name]:
+            return
+        if ax_vals.shape == ref.shape and np.allclose(ax_vals, ref, rtol=1e-9, atol=0.0):
+            (self.where if isinstance(vals, str) else self.held)[name][pos] = vals
+        else:
+            self.message[idx] = f"{self.message[idx]}; {name} not stored: its {axis} axis differs from the archive's"
+
+    def curve_arrays(self, place: _Placement, read, block_bytes: int | None) -> dict:
+        """Each curve over its dimensions and axis: in memory, or a dask array reading the part files."""
+        curves = {}
+        for name in self.axes:
+            n = self.axes[name][1].size
+            if self.where[name]:
+                curves[name] = lazy_curve(name, place.shape_of(name), n, self.where[name], read,
+                                          block_bytes or MERGE_BLOCK_BYTES, self.held[name])
+            else:
+                curves[name] = np.full(place.shape_of(name) + (n,), np.nan)
+                for pos, vals in self.held[name].items():
+                    curves[name][pos] = vals
+        return curves
+
+
 def study_dataset(study: Study, points: list[Point], results: dict, read=None, lost: dict | None = None,
                   block_bytes: int | None = None) -> xr.Dataset:
     """The labelled archive of a study from ``results`` (point index -> record of
@@ -145,96 +228,38 @@ def study_dataset(study: Study, points: list[Point], results: dict, read=None, l
     """
     out = study.outputs
     dims, coords = study_layout(study, points)
-    shape = study.shape
-    grid = study.layout == "grid"
-    own = {k: output_axes(study, k) for k in out.scalars + out.curves}
-
-    def dims_of(k):
-        return tuple(dims[i] for i in own[k]) if grid else dims
-
-    def shape_of(k):
-        return tuple(shape[i] for i in own[k]) if grid else shape
-
-    def at(k, idx):
-        return tuple(idx[i] for i in own[k]) if grid else idx
-
-    status = np.zeros(shape, np.int8)
-    message = np.full(shape, "not computed yet", dtype=object)
-    wall = np.full(shape, np.nan)
-    scal = {k: np.full(shape_of(k), np.nan) for k in out.scalars}
-    # per curve: its axis, and per position of the curve the values held ({position: values}) or
-    # the task whose part file has them ({position: key})
-    axes, held, where, curve_attrs = {}, {}, {}, {}
+    place = _Placement(study, dims)
+    got = _Gathered(study, place)
     for p in points:
-        idx = p.index
-        r = results.get(idx)
-        if r is None:
-            if lost and idx in lost:
-                message[idx] = f"lost: {lost[idx]}; run the same command to compute it"
-            continue
-        status[idx] = STATUS.index(r["status"])
-        message[idx] = r["message"]
-        wall[idx] = r["wall_time"]
-        for k in out.scalars:
-            v = r["scalars"].get(k, np.nan)
-            if np.isnan(scal[k][at(k, idx)]):
-                scal[k][at(k, idx)] = v
-        point_curves = dict(r.get("curves", {}))
-        keys = {key for name, key in r.get("curve_keys", {}).items()
-                if at(name, idx) not in where.get(name, {}) and at(name, idx) not in held.get(name, {})}
-        for key in keys:            # read once for the axes of the curves it brings to new positions
-            full = read(key) if read is not None else None
-            for name, curve in (full["curves"] if full else {}).items():
-                if r["curve_keys"].get(name) == key:
-                    point_curves[name] = (*curve[:3], key, curve[4])
-            del full
-        for name, (axis, ax_vals, ax_attrs, vals, attrs) in point_curves.items():
-            if name not in axes:
-                axes[name] = (axis, ax_vals, ax_attrs)
-                held[name], where[name] = {}, {}
-                curve_attrs[name] = attrs
-            ref = axes[name][1]
-            pos = at(name, idx)
-            if pos in held[name] or pos in where[name]:
-                continue
-            if ax_vals.shape == ref.shape and np.allclose(ax_vals, ref, rtol=1e-9, atol=0.0):
-                (where if isinstance(vals, str) else held)[name][pos] = vals
-            else:
-                message[idx] = f"{message[idx]}; {name} not stored: its {axis} axis differs from the archive's"
-        del point_curves
-    curves = {}
-    for name in axes:
-        n = axes[name][1].size
-        if where[name]:
-            curves[name] = lazy_curve(name, shape_of(name), n, where[name], read, block_bytes or MERGE_BLOCK_BYTES,
-                                      held[name])
-        else:
-            curves[name] = np.full(shape_of(name) + (n,), np.nan)
-            for pos, vals in held[name].items():
-                curves[name][pos] = vals
+        r = results.get(p.index)
+        if r is not None:
+            got.add(p.index, r, place, read)
+        elif lost and p.index in lost:
+            got.message[p.index] = f"lost: {lost[p.index]}; run the same command to compute it"
+    curves = got.curve_arrays(place, read, block_bytes)
     data = {
-        "status": xr.Variable(dims, status, {
+        "status": xr.Variable(dims, got.status, {
             "long_name": "status of the study point", "units": "1",
             "flag_values": np.arange(len(STATUS), dtype=np.int8), "flag_meanings": " ".join(STATUS)}),
-        "message": xr.Variable(dims, message, {"long_name": "why the point is not ok ('ok' when it is)"}),
-        "wall_time": xr.Variable(dims, wall, {
+        "message": xr.Variable(dims, got.message, {"long_name": "why the point is not ok ('ok' when it is)"}),
+        "wall_time": xr.Variable(dims, got.wall, {
             "units": "s", "long_name": "compute time of the point",
             "comment": "an analysis shared by several points (a static one over the speeds, say) counts "
                        "its time split equally over them"}),
     }
     for k in out.scalars:
-        data[k] = xr.Variable(dims_of(k), scal[k], {"units": SCALARS[k].units, "long_name": SCALARS[k].long_name,
-                                                    "analysis": SCALARS[k].analysis})
+        data[k] = xr.Variable(place.dims_of(k), got.scalars[k], {"units": SCALARS[k].units, "long_name": SCALARS[k].long_name,
+                                                                 "analysis": SCALARS[k].analysis})
     for name in out.curves:
-        if name not in axes:
+        if name not in got.axes:
             continue  # no point produced it (all failed): nothing to label its axis with
-        axis, ax_vals, ax_attrs = axes[name]
+        axis, ax_vals, ax_attrs = got.axes[name]
         coords[axis] = xr.Variable(axis, ax_vals, {k: v for k, v in ax_attrs.items() if k in ("units", "long_name", "comment")})
-        attrs = {k: v for k, v in curve_attrs[name].items() if k in ("units", "long_name", "window", "comment")}
+        attrs = {k: v for k, v in got.curve_attrs[name].items() if k in ("units", "long_name", "window", "comment")}
         if CURVES[name].comment:
             attrs["comment"] = CURVES[name].comment
         attrs["analysis"] = CURVES[name].analysis
-        data[name] = xr.Variable(dims_of(name) + (axis,), curves[name], attrs)
+        data[name] = xr.Variable(place.dims_of(name) + (axis,), curves[name], attrs)
     if study.sample:
         data.update(sample_variables(study.sample))
     attrs = {"title": study.title, "study": study.text, "base_scene": study.base_scene_toml(),

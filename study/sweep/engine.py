@@ -36,7 +36,7 @@ whose numba cache lacks the kernels, the pilot (a static and a dynamic task of t
 `pilot_tasks`) runs first and compiles them into the disk cache; the other tasks wait for it and
 load them, so the machine compiles once, not once per worker (the other workers compute the FE
 meanwhile). The tasks go to dask dearest first
-(`study.estimate.task_seconds`), the cheap ones of one model in batches
+(`study.sweep.cost.task_seconds`), the cheap ones of one model in batches
 (`study.sweep.tasks.batches`: a 10 ms dynamic run costs dask about as much as its physics);
 on a local cluster a batch's worker stores each of its tasks as it finishes, so that an
 interrupted batch loses only its unfinished tasks.
@@ -96,9 +96,10 @@ def study_progress(title: str, points: int, tasks: list, in_process: bool, worke
     jobs they read, with their estimated costs, on the workers that run them."""
     from study import estimate
     from study.inputs.gearsetup import gear_setups
+    from study.sweep import cost
     from study.sweep.bodies import compute_body, fe_jobs
     from study.sweep.progress import COMPILE_S, START_S, StudyProgress
-    costs = estimate.progress_seconds(tasks) if show else {t.key: 1.0 for t in tasks}
+    costs = cost.progress_seconds(tasks) if show else {t.key: 1.0 for t in tasks}
     fe_costs, first_reader = {}, {}
     for t in tasks if show else ():
         for fe_key, func, args in fe_jobs(t.scene):
@@ -140,7 +141,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     dask cluster. The part files are removed once the archive holds every point (unless
     ``keep_parts``). ``max_time`` [s]: refuse (`study.errors.BudgetError`, before any work) a
     study too large to list or whose missing tasks are estimated to take longer in all
-    (`study.estimate.sweep_estimate`, CPU seconds summed over the tasks). The returned
+    (`study.sweep.cost.sweep_estimate`, CPU seconds summed over the tasks). The returned
     SweepResult has ``.dataset`` (the archive as written, its curves read from the file when
     used), ``.computed``, ``.reused``, ``.invalid``, ``.pending`` and ``.wall_time`` [s]. Finished
     points are kept on disk, so the same call after an interruption computes only the missing
@@ -149,6 +150,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     """
     from study import estimate
     from study.archive.netcdf import write_netcdf
+    from study.sweep import cost
 
     check_argument(isinstance(study, Study), "run_sweep", "study", "a Study (study.make_study(scene, grid={...}) or "
                    "study.load_study(path or name))", study)
@@ -158,7 +160,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
                    "a dask scheduler address such as 'tcp://host:8786', or None", scheduler)
     progress, keep_parts = bool(progress), bool(keep_parts)
     t0 = time.perf_counter()
-    estimate.check_study_size(study, max_time)
+    cost.check_study_size(study, max_time)
     points = check_points(study)
     out = study.outputs
     n_invalid = sum(p.scene is None for p in points)
@@ -176,7 +178,7 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
             todo[key] = task.scene
     reused = len(results)
     if max_time is not None and todo:
-        estimate.check_time(estimate.sweep_estimate([tasks[k] for k in todo]), max_time)
+        estimate.check_time(cost.sweep_estimate([tasks[k] for k in todo]), max_time)
     lost = {}
     todo = interleave(todo)
     if todo:

@@ -117,7 +117,7 @@ for _g, _which in ((1, "driver"), (2, "driven gear")):
     }
     SCALARS.update(_s)
     STRENGTH_SCALARS += tuple(_s)
-# the outputs of the linearised mesh and the tooth loads (`study.run.run_scene`'s mesh_outputs):
+# the outputs of the linearised mesh and the tooth loads (the run's 'mesh' stage, `stages_of`):
 # a study that asks for none of them skips that part
 MESH_SCALARS = ("mesh_stiffness", "mesh_stiffness_mean", "mesh_stiffness_p2p", "c_prime", "c_gamma_alpha",
                 "mesh_stiffness_mesh_mean", "c_prime_mesh", "c_gamma_alpha_mesh", "c_prime_iso6336",
@@ -140,7 +140,7 @@ CURVES = {
 #             density (solver.inertia.gear_mass via study.inputs.gearsetup); not the gears' errors
 #   fe        root stress: the gears (springs included: 'uniform' runs no FE), the material, the
 #             backlash, the FE mesh and the torque that sets the FE load (gearsetup.reference_torque)
-#   static    STE: every field but the dynamic run's (study.run.run_static reads no 'dynamic.*')
+#   static    STE: every field but the dynamic run's (study.stages.run_static reads no 'dynamic.*')
 #   modes     the pair linearised at the mean load (its dampers given as ratios converted there):
 #             the static fields (damping included) and the mean load, the dynamic run's torque
 #             when it runs (study.scene_model.mean_load reads dynamic.enabled and dynamic.torque)
@@ -220,6 +220,20 @@ class Outputs:
             if sc or cu:
                 out.append(Outputs(sc, cu))
         return tuple(out)
+
+
+def stages_of(outputs: Outputs) -> frozenset:
+    """The stages of a run (`study.plan.STAGES`) the outputs need, each only when an output
+    asks for it: 'static' and 'dynamic' by the outputs' analyses, 'mesh' for `MESH_SCALARS`
+    (the linearised mesh over the STE; K_v with a dynamic run), 'gear' for the geometry and FE
+    outputs (mass, inertia, root stress), 'modes' for the modal outputs and the free decay
+    (``mesh_mode_damping_decay``, with the dynamic run), 'strength' for `STRENGTH_SCALARS`."""
+    names = set(outputs.scalars + outputs.curves)
+    wanted = {"static": outputs.static, "dynamic": outputs.dynamic, "mesh": bool(names & set(MESH_SCALARS)),
+              "gear": outputs.needs("geometry") or outputs.fe,
+              "modes": outputs.modes or "mesh_mode_damping_decay" in names,
+              "strength": bool(names & set(STRENGTH_SCALARS))}
+    return frozenset(k for k, v in wanted.items() if v)
 
 
 def outputs_from_table(table) -> Outputs:

@@ -12,7 +12,7 @@ from pathlib import Path
 from study.errors import BudgetError
 from study.scene import Scene, SceneError
 from study.sweep.grid import Point
-from study.sweep.outputs import MESH_SCALARS, STRENGTH_SCALARS, Outputs, analysis_of
+from study.sweep.outputs import Outputs, analysis_of, stages_of
 
 
 def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
@@ -25,6 +25,7 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
     variables the outputs do not read); its numbers are read as from the archive
     (`point_values`).
     """
+    from study.plan import RunOptions
     from study.run import run_fields
     from study.scene import loads_scene, scene_from_dict
 
@@ -38,12 +39,8 @@ def run_point(scene: Scene | dict | str, outputs: Outputs) -> dict:
         elif isinstance(scene, str):
             scene = loads_scene(scene)
         if outputs.static or outputs.dynamic or outputs.modes:
-            run = run_fields(scene, static=outputs.static, dynamic=outputs.dynamic,
-                             mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)),
-                             warn=False, keep_model=True,    # the sweep warns once; a body's points share its model
-                             archive=False, gear_variables=outputs.needs("geometry") or outputs.needs("fe"),
-                             modal=outputs.modes or "mesh_mode_damping_decay" in outputs.scalars,
-                             strength=bool(set(outputs.scalars) & set(STRENGTH_SCALARS)))
+            # the sweep warns once; a body's points share its model
+            run = run_fields(scene, stages_of(outputs), RunOptions(warn=False, keep_model=True, archive=False))
         else:   # geometry (and root stress) only: no model, no solve
             from study.inputs.springs import lightening_dataset
             run = lightening_dataset(scene, stress=outputs.fe)

@@ -2,7 +2,7 @@
 to the end from the start (not '?' until the first point ends).
 
 The bar counts points (a point is done when all its analyses are) and says how many FE bodies
-and analyses are done. Its ETA is the estimated work left (`study.estimate.progress_seconds` per
+and analyses are done. Its ETA is the estimated work left (`study.sweep.cost.progress_seconds` per
 analysis, `study.estimate.body_seconds` per FE body), divided among the workers, and, once
 analyses have ended, calibrated by what they took: the median over the ended analyses of their
 measured time over their estimate, leaving out each worker's first (which also loads or

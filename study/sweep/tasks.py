@@ -116,7 +116,7 @@ def plan(study: Study, points: list[Point]) -> tuple[dict[str, Task], dict[tuple
 # Tasks per dask task: a cheap task (a 10 ms dynamic run of a small pair) costs dask and the
 # client about as much as its physics (submit, schedule, transfer, its part file), so on dask
 # the tasks of one model (`model_group`) are run in batches of about BATCH_S estimated
-# compute seconds (`study.estimate.task_seconds`): under 1 % of overhead, and a worker's
+# compute seconds (`study.sweep.cost.task_seconds`): under 1 % of overhead, and a worker's
 # kept model and its model-only analyses (`study.scene_model.kept_scene_model`, `solver.mbs.memo`)
 # serve the whole batch. At least BATCHES_PER_WORKER batches per worker are kept, so that the
 # end of a study still spreads over the workers; a study with fewer tasks is not batched.
@@ -137,7 +137,7 @@ def batches(tasks: list[Task], workers: int) -> list[tuple[Task, ...]]:
     """The tasks grouped into dask tasks, dearest first: tasks of one `model_group`, dearest
     first, up to BATCH_S estimated seconds and at most len(tasks) / (BATCHES_PER_WORKER x
     workers) tasks a batch (one task a batch for a small study)."""
-    from study.estimate import task_seconds
+    from study.sweep.cost import task_seconds
     cost = {t.key: task_seconds(t.scene, t.outputs) for t in tasks}
     cap = max(1, len(tasks) // (BATCHES_PER_WORKER * max(workers, 1)))
     groups: dict[tuple, list[Task]] = {}

@@ -36,10 +36,11 @@ def paper_pair(**kw):
 def dynamic_fields(scene):
     import warnings
 
+    from study.plan import RunOptions
     from study.run import run_fields
     with warnings.catch_warnings():
         warnings.simplefilter("error")      # no raw library warning either
-        return run_fields(scene, static=False, dynamic=True, modal=False, warn=False)
+        return run_fields(scene, {"dynamic", "mesh", "gear"}, RunOptions(warn=False))
 
 
 def sample_study(tmp_path, sample: str) -> str:

@@ -13,11 +13,13 @@ def small_fe_scene():
 
 
 def test_cached_fe_bodies_and_influence_coefficients_are_free(private_fe_cache):
+    from study.inputs.gearsetup import gear_setups
     scene = small_fe_scene()
-    labels = [label for label, _s, _t in estimate.fe_bodies(scene)]
-    assert labels == ["gear 2", "gear 2 solid reference"] and estimate.fe_seconds(scene) > 0
+    setups, coupling = gear_setups(scene), scene.coupling_model
+    labels = [label for label, _s, _t in estimate.fe_bodies(setups, coupling)]
+    assert labels == ["gear 2", "gear 2 solid reference"] and estimate.fe_seconds(setups, coupling) > 0
     study.stiffness(scene)
-    assert estimate.fe_bodies(scene) == [] and estimate.fe_seconds(scene) == 0.0
+    assert estimate.fe_bodies(setups, coupling) == [] and estimate.fe_seconds(setups, coupling) == 0.0
     from study.scene_model import static_angles
     from study.verify.fe_reference import reference_cost
     angles = static_angles(scene)

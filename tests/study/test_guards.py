@@ -125,9 +125,9 @@ def test_unconverged_statics_exit_3_with_the_count(example_scene_file, tmp_path,
     cause are on stderr, exit 3 (the load bound of the scene check is lifted for the test, and
     the damping and modes, which a static-only run takes at the STE's torque and which would
     refuse 2000 N·m before the statics, are taken at 50 N·m)."""
-    from study import plausibility, run, scene_model
+    from study import plan, plausibility, scene_model
     monkeypatch.setattr(plausibility, "DEFLECTION_FRACTION", 10.0)
-    for module in (run, scene_model):
+    for module in (plan, scene_model):
         monkeypatch.setattr(module, "mean_load", lambda scene: 50.0)
     out = tmp_path / "x.nc"
     assert main(["run", str(example_scene_file), "-o", str(out), "--no-dynamic", "--set", "quasi_static.torque=2000"]) == 3

@@ -153,13 +153,14 @@ def test_an_override_that_invalidates_another_field_is_named(capsys):
 
 
 def test_a_run_up_whose_teeth_lose_contact_says_its_critical_speeds_are_linear(capsys, tmp_path):
+    from study.plan import RunOptions
     from study.report.summary import print_summary
     from study.run import run_fields
 
     def runup(speed_end):
         scene = paper_pair(**{"dynamic.speed_end": speed_end, "dynamic.torque": 20.0, "dynamic.ramp_time": 0.002,
                               "dynamic.duration": 0.1})      # (the tracked speeds from some 430 rad/s)
-        return run_fields(scene, static=False, dynamic=True, warn=False, mesh_outputs=False).dataset()
+        return run_fields(scene, {"dynamic", "modes", "gear"}, RunOptions(warn=False)).dataset()
     rattles = runup(1500.0)         # through 2Z and 1Z (about 250 and 495 rad/s) at 20 N·m: the teeth separate
     lo, hi = rattles.attrs["contact_lost_speed_rad_s"]
     z1 = float(rattles["critical_speed"].sel(excitation="1Z", mode=0))
@@ -194,9 +195,9 @@ def test_fe_bodies_beyond_the_memory_are_refused_before_any_fe_work(tmp_path, ca
     from study.inputs.gearsetup import gear_setups
     from tests.helpers import small_scene
     setups = gear_setups(small_scene())
-    assert estimate.check_fe_memory(None, setups=setups) is None
+    assert estimate.check_fe_memory(setups) is None
     monkeypatch.setattr(estimate, "available_memory", lambda: 600e6)
-    assert "more than half of" in estimate.check_fe_memory(None, setups=setups)
+    assert "more than half of" in estimate.check_fe_memory(setups)
 
 
 def test_precision_outputs_beyond_the_memory_are_refused_naming_its_option(tmp_path, capsys):

@@ -7,6 +7,7 @@ import pytest
 from helpers import solid_scene
 
 from solver.mbs.dynamics import simulate
+from solver.mbs.modes import modal_analysis
 from study.archive.modes import critical_speeds
 from study.archive.order_tracking import OrderBlocks, driver_angle, order_cut, order_map
 from study.archive.spectra import amplitude_spectrum
@@ -46,7 +47,7 @@ def test_run_up_tracks_the_steady_mesh_order_and_peaks_at_the_critical_speed():
         f, a = amplitude_spectrum(st.te[sel] * 1e6, 1e-5)
         steady = a[np.abs(f - 67 * w / (2 * math.pi)) < 2 * f[1]].max()
         assert np.interp(w, speed, z) == pytest.approx(steady, rel=0.10)
-    _c, data, attrs = modal_variables(m, 50.0, 0, decay=False)
+    _c, data, attrs = modal_variables(modal_analysis(m, 50.0), None, m, 50.0, 0)
     crit = critical_speeds(np.array([attrs["mesh_mode_frequency_hz"]]), np.array([67.0]), 67, 67)[0, 0]
     assert speed[np.argmax(z)] == pytest.approx(crit, rel=0.03)
 

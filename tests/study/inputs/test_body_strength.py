@@ -74,10 +74,11 @@ def test_fe_root_stress_of_the_solid_gear_against_iso_6336_3():
     FE's largest tensile root stress lies 0-15 % above sigma_F0 = F_t/(b m) Y_F Y_S (Y_B = 1):
     the model's fillet is a circular arc of the tool tip radius, sharper than the generated
     trochoid the standard's Y_S assumes (measured: +4.1 %)."""
+    from study.plan import RunOptions
     from study.run import run_fields
     sc = study.load_scene("paper_solid").replace(**{"quasi_static.rotation": 6.0, "quasi_static.angle_step": 0.5,
                                                    "dynamic.enabled": False})
-    r = run_fields(sc, modal=False, mesh_outputs=False, archive=False)
+    r = run_fields(sc, {"static", "gear", "strength"}, RunOptions(archive=False))
     fe, iso = r["root_stress_hpstc"].values, r["root_stress_iso6336"].values
     assert np.allclose(r["rim_thickness_factor_iso6336"].values, 1.0)
     assert np.all((fe / iso > 1.0) & (fe / iso < 1.15)), fe / iso
@@ -138,9 +139,10 @@ def test_a_material_the_table_does_not_hold_is_refused_by_name():
 def test_a_coast_side_load_is_not_rated_and_says_why():
     """A negative static torque loads the coast flanks, which the load cases do not hold: every
     strength variable NaN (the failure mode empty) with the reason, and the summary NaN."""
+    from study.plan import scene_stages
     from study.run import run_fields
-    r = run_fields(small(**{"quasi_static.torque": -50.0, "quasi_static.rotation": 5.0}), modal=False,
-                   mesh_outputs=False)
+    sc = small(**{"quasi_static.torque": -50.0, "quasi_static.rotation": 5.0})
+    r = run_fields(sc, scene_stages(sc) - {"modes", "mesh"})
     assert np.isnan(r["bending_stress"].values).all() and list(r["failure_mode"].values) == ["", ""]
     assert "coast flanks" in r["bending_stress"].attrs["not_computed"]
     assert math.isnan(study.summarize(r.dataset())["failure_mode_gear2"])

@@ -10,6 +10,7 @@ import xarray as xr
 from sweep_cases import BASE
 
 from study.archive.summary import summarize
+from study.plan import RunOptions, scene_stages
 from study.run import RunFields, run_fields, run_scene
 from study.scene import scene_from_dict
 from study.sweep.engine import point_values, run_point
@@ -31,8 +32,10 @@ def scene_of(**changes):
 def archive_values(scene, outputs: Outputs):
     """(status, message, scalars, curves) read from the full run archive, as a study's task
     read them before it took the lean path."""
-    ds = run_scene(scene, static=outputs.static, dynamic=outputs.dynamic,
-                   mesh_outputs=bool(set(outputs.scalars + outputs.curves) & set(MESH_SCALARS)), warn=False)
+    stages = scene_stages(scene, outputs.static, outputs.dynamic)
+    if not set(outputs.scalars + outputs.curves) & set(MESH_SCALARS):
+        stages -= {"mesh"}
+    ds = run_fields(scene, stages, RunOptions(warn=False)).dataset()
     return point_values(ds, outputs)
 
 
@@ -56,7 +59,7 @@ def test_run_fields_summarise_like_the_run_archive():
     the efficiency; a lightened driven gear: the per-gear variables) read from the variables
     equals the one read from the archive they make."""
     scene = scene_of(contact={"friction": 0.05})
-    run = run_fields(scene, warn=False)
+    run = run_fields(scene, options=RunOptions(warn=False))
     ds = run.dataset()
     a, b = summarize(run), summarize(ds)
     assert list(a) == list(b) and len(a) > 30
@@ -141,7 +144,7 @@ def test_points_of_one_model_share_its_springs_and_model_only():
     """A study's worker keeps the springs and model of the last scene: reused for a scene that
     differs only in its run's speed, made again when the mean load (the damping conversion's)
     or the body changes."""
-    from study.run import kept_springs_and_model
+    from study.plan import kept_springs_and_model
     base = scene_of()
     springs, model = kept_springs_and_model(base)
     faster = kept_springs_and_model(scene_of(dynamic={"speed": 180.0, "duration": 0.02}))

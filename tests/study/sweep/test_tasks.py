@@ -174,7 +174,7 @@ def test_the_merge_reads_each_task_part_once_per_position_of_its_curves(swept, t
 
 
 def test_cheap_tasks_go_to_dask_in_batches_of_one_model_dearest_first():
-    from study.estimate import task_seconds
+    from study.sweep.cost import task_seconds
     from study.sweep.grid import check_points
     from study.sweep.tasks import BATCH_S, batches, model_group
     st = tiny_study(grid='[grid]\ngear2.body.holes = [0, 4]\n"dynamic.speed" = {start = 50.0, stop = 100.0, num = 40}\n'
