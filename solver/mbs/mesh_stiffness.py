@@ -100,7 +100,7 @@ def mesh_states(model: Model, angles, torque: float, windup=None) -> MeshStates:
     compliance along the line of action [m/N] of the body wind-up from the bore that the plain
     model's tooth springs hold (a body-coupled model carries its own: refused there). Angles
     where the statics do not converge hold NaN."""
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer, tooth_spring_tangent
     from solver.mbs.linearization import linearize
     from solver.mbs.statics import solve_static
     if windup is not None:
@@ -147,7 +147,7 @@ def mesh_states(model: Model, angles, torque: float, windup=None) -> MeshStates:
         th2 = lin.dofs.index("theta2")
         r1 = lin.dofs.index("r1") if "r1" in lin.dofs else None
         pos = {t: lin.n_body + j for j, t in enumerate(lin.teeth)}
-        nc, _np = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, (gp, model.pair_par, model.law_par), (rec, pairs))
+        nc, _np = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, contact_geo(gp, model.pair_par, model.law_par), (rec, pairs))
         for c in range(nc):
             a, b = int(rec[c, L.C_TOOTH1]), int(rec[c, L.C_TOOTH2])
             f = rec[c, L.C_FORCE]

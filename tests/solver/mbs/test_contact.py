@@ -7,7 +7,7 @@ from matplotlib.path import Path
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.contact import flank_flank, point_flank
-from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
 
 
 def _tooth_world(g, center, axis, phi=0.0, pivot_radius=None):
@@ -47,12 +47,12 @@ def test_penetration_matches_brute_force_distance(paper_solid_model, deg, phi_a,
     phi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()
     # first find the contacts with rigid teeth, then rotate the teeth involved
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     assert nc >= 2
     k, j = int(rec[0, L.C_TOOTH1]), int(rec[0, L.C_TOOTH2])
     phi[k] = phi_a
     phi[m.teeth[0] + j] = phi_b
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     rows = [c for c in range(nc) if int(rec[c, L.C_TOOTH1]) == k and int(rec[c, L.C_TOOTH2]) == j]
     exact = max([rec[c, L.C_DELTA] for c in rows], default=0.0)
     ax1 = th1 + m.gear_par[0, L.GAMMA0] + k * g1.pitch_angle
@@ -94,7 +94,7 @@ def test_gradient_matches_finite_differences(paper_solid_model):
         th2 = m.theta2_for_te(th1, m.backlash_offset + 5.5e-6)
         phi = np.zeros(m.n_teeth)
         z = np.zeros(m.n_teeth)
-        nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, z, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+        nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, z, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
         base = rec[:nc].copy()
         h = 1e-8
         for c in range(nc):
@@ -105,7 +105,7 @@ def test_gradient_matches_finite_differences(paper_solid_model):
                 p = phi.copy()
                 p[k] += da
                 p[m.teeth[0] + j] += db
-                n2, _ = mesh_contacts((th1 + d1, th2 + d2, 0.0, 0.0), p, z, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+                n2, _ = mesh_contacts((th1 + d1, th2 + d2, 0.0, 0.0), p, z, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
                 for r in range(n2):
                     if int(rec[r, L.C_TOOTH1]) == k and int(rec[r, L.C_TOOTH2]) == j and rec[r, L.C_KIND] == base[c, L.C_KIND]:
                         return rec[r, L.C_DELTA]

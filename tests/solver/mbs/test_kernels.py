@@ -44,6 +44,7 @@ def test_generalized_forces_are_minus_the_energy_gradient(paper_solid_model):
 def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
     """The compiled static sweep (plain model: ctooth None, the coupled code pruned) gives
     what its source gives when run as plain Python."""
+    from solver.mbs.kernels.gearmesh import contact_parts
     from solver.mbs.kernels.statics import static_sweep, static_work
     m = paper_solid_model
     angles = np.radians(np.arange(0.0, 3.0, 0.5))
@@ -54,7 +55,8 @@ def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
         res = (np.zeros((n, L.N_S_OUT)), np.zeros((n, m.teeth[0])))
         phi = np.zeros(m.n_teeth)
         ctl = (np.array([50.0, theta2, 1e-10, 0.0, 0.0]), np.array([60]))     # (S_ABORT last)
-        fails = f((m.gear_par, m.pair_par, m.law_par, m.k_phi), None, ctl, angles, phi, *res, static_work(m.n_teeth))
+        mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, contact_parts(m.gear_par, m.pair_par, m.law_par))
+        fails = f(mdl, None, ctl, angles, phi, *res, static_work(m.n_teeth))
         assert fails == 0
         out.append((*res, phi))
     for a, b in zip(*out):
