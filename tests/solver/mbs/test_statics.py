@@ -33,7 +33,7 @@ def test_single_pair_matches_series_springs_in_closed_form(paper_solid_model):
         # the gear-2 partner sits where conjugate rolling puts it: find it from the contact record
         rec, pairs = new_contact_buffer()
         phi = np.zeros(m.n_teeth)
-        nc, _ = mesh_contacts((angles[a], st.theta2[a], 0.0, 0.0), phi, phi, (gp, m.pair_par, m.law_par), (rec, pairs))
+        nc, _ = mesh_contacts((angles[a], st.theta2[a], 0.0, 0.0), phi, phi, contact_geo(gp, m.pair_par, m.law_par), (rec, pairs))
         j = [int(rec[c, L.C_TOOTH2]) for c in range(nc) if int(rec[c, L.C_TOOTH1]) == k][0]
         ax2 = st.theta2[a] + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
         d1 = rb1 - gp[0, L.R_PV] * math.cos(ax1 + alpha)
