@@ -26,7 +26,7 @@ N_CALLS = 200_000
 @njit(cache=False)
 def _loop_contacts(n, state, mdl, buf):
     """``n`` contact searches at the angles and tooth states ``state`` (theta1, theta2, phi,
-    dphi) of the model arrays ``mdl`` (gear, pair, law), into the buffers ``buf`` (rec, pairs)."""
+    dphi) of the contact search's arrays ``mdl`` (`gearmesh.contact_geo`), into the buffers ``buf`` (rec, pairs)."""
     th1, th2, phi, dphi = state
     s = 0
     for k in range(n):
@@ -73,21 +73,22 @@ def per_call(fn, *args) -> float:
 def main(argv=None) -> int:
     from solver.mbs.dynamics import simulate
     from solver.mbs.kernels import layout as L
-    from solver.mbs.kernels.gearmesh import new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, new_contact_buffer
     from solver.mbs.stability import stable_time_step
     from solver.mbs.statics import solve_static
     m = common.model("solid", "paper")     # the plain contact search and forces
     gp, pp, lp = m.gear_par, m.pair_par, m.law_par
-    mdl = (gp, pp, lp, m.k_phi, m.tooth_compliance)
+    geo = contact_geo(gp, pp, lp)
+    mdl = (gp, pp, lp, m.k_phi, m.tooth_compliance, geo[3])
     tz2 = int(gp[1, L.TOOTH0])
     theta1 = np.radians(2.0)
     st = solve_static(m, np.array([theta1]), 50.0)
     phi = st.phi_last
     dphi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()
-    nc, npair = mesh_contacts((theta1, st.theta2[0], 100.0, 100.0), phi, dphi, (gp, pp, lp), (rec, pairs))
+    nc, npair = mesh_contacts((theta1, st.theta2[0], 100.0, 100.0), phi, dphi, geo, (rec, pairs))
     rows = [dict(part="contact search (mesh_contacts)", active_teeth=None,
-                 ns_per_call=per_call(_loop_contacts, (theta1, st.theta2[0], phi, dphi), (gp, pp, lp), (rec, pairs)),
+                 ns_per_call=per_call(_loop_contacts, (theta1, st.theta2[0], phi, dphi), geo, (rec, pairs)),
                  note=f"{npair} candidate pairs, {nc} contacts")]
     near = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
     q = np.zeros(m.n_teeth + 2)

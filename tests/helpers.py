@@ -73,15 +73,15 @@ def loaded_mesh_state(m, angle_deg: float, phi_scale: float, seed: int = 3):
 
     import numpy as np
 
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
     th1 = math.radians(angle_deg)
     th2 = m.theta2_for_te(th1, m.backlash_offset + 5.0e-6)
     phi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()
-    _nc, npair = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    _nc, npair = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     teeth = sorted({int(p) for p in pairs[:npair, 0]} | {m.teeth[0] + int(p) for p in pairs[:npair, 1]})
     phi[teeth] = np.random.default_rng(seed).normal(scale=phi_scale, size=len(teeth))
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     return th1, th2, phi, teeth, rec, nc
 
 
@@ -92,10 +92,10 @@ def mesh_potential(m, th1, th2, phi) -> float:
     import numpy as np
 
     from solver.mbs.kernels import layout as L
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
     from solver.mbs.kernels.laws import series_energy
     rec, pairs = new_contact_buffer()
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     n = m.gear_par[:, L.N_K]
     z1 = m.teeth[0]
     e = sum(m.k_phi[i] * abs(phi[i]) ** (n[0 if i < z1 else 1] + 1) / (n[0 if i < z1 else 1] + 1) for i in range(len(phi)))

@@ -17,6 +17,7 @@ import numpy as np
 from solver.mbs.energy_guard import ENERGY_ERROR_RATIO, ENERGY_FLOW_RATIO, energy_error_limit
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.explicit import verlet
+from solver.mbs.kernels.gearmesh import contact_parts
 from solver.mbs.kernels.mechanics import driver_motion
 from solver.mbs.kernels.status import ENERGY, INACCURATE, PENETRATION, STATUS_TEXT
 from solver.mbs.kernels.stepping import work_arrays
@@ -183,10 +184,10 @@ def start_te(model: Model, side: float) -> float:
     te0 = s * model.backlash_offset
     if model.pair_par.size <= L.N_PAIR_PAR:
         return te0
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
     rec, pairs = new_contact_buffer()
     zeros = np.zeros(model.n_teeth)
-    geo = (model.gear_par, model.pair_par, model.law_par)
+    geo = contact_geo(model.gear_par, model.pair_par, model.law_par)
 
     def touching(te):
         nc, _ = mesh_contacts((0.0, model.theta2_for_te(0.0, te), 0.0, 0.0), zeros, zeros, geo, (rec, pairs))
@@ -236,7 +237,9 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     if all_teeth:
         teeth[L.POS] = 1e-300
     out = np.zeros((n_out, L.N_OUT + L.CONTACT_SLOTS * L.O_CONTACT_COLS))
-    mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance)
+    # contact_parts: which parts of the contact search the model has, so which compiled variant runs
+    mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance,
+           contact_parts(model.gear_par, model.pair_par, model.law_par))
     args = (mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out,
             work_arrays(model.n_teeth, model.tooth_compliance))
     poll = None if progress is None else (lambda: progress(float(out[last_record(out), L.O_TIME])))

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer, tooth_spring_tangent
+from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer, tooth_spring_tangent
 from solver.mbs.kernels.laws import contact_damping_tangents, spring_damping_tangent
 from solver.mbs.model import Model
 
@@ -80,7 +80,7 @@ def linearize(model: Model, rim1: float, rim2: float, phi: np.ndarray) -> Linear
     rec, pairs = new_contact_buffer()
     zeros = np.zeros(model.n_teeth)
     gp, lp = model.gear_par, model.law_par
-    nc, npair = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, (gp, model.pair_par, lp), (rec, pairs))
+    nc, npair = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, contact_geo(gp, model.pair_par, lp), (rec, pairs))
     tz2 = int(gp[1, L.TOOTH0])
     teeth = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
     coupled = model.coupled

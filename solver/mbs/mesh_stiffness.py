@@ -101,7 +101,7 @@ def mesh_states(model: Model, angles, torque: float, windup=None) -> MeshStates:
     compliance along the line of action [m/N] of the body wind-up from the bore that the plain
     model's tooth springs hold (a body-coupled model carries its own: refused there). Angles
     where the statics do not converge hold NaN."""
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
     from solver.mbs.linearization import linearize
     from solver.mbs.statics import solve_static
     windup = _checked_windup(model, windup)
@@ -140,7 +140,7 @@ def mesh_states(model: Model, angles, torque: float, windup=None) -> MeshStates:
         k00, x = condense_onto(lin.K, hub)
         dofs = _Dofs(lin.dofs.index("theta2"), lin.dofs.index("r1") if "r1" in lin.dofs else None,
                      {t: lin.n_body + j for j, t in enumerate(lin.teeth)}, tz2)
-        nc, _np = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, (gp, model.pair_par, model.law_par), (rec, pairs))
+        nc, _np = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, contact_geo(gp, model.pair_par, model.law_par), (rec, pairs))
         _tooth_forces(rec, nc, force[i], mate[i], tz2)
         kp[i] = _pair_shares(rec, nc, x, dofs, rb2, z1)
         k[i] = k00 / rb2**2

@@ -25,6 +25,7 @@ import numpy as np
 
 from solver.mbs import interrupt
 from solver.mbs.kernels import layout as L
+from solver.mbs.kernels.gearmesh import contact_parts
 from solver.mbs.kernels.statics import static_sweep, static_work
 from solver.mbs.model import Model
 
@@ -119,7 +120,7 @@ def _solve(settings: StaticSolver, model: Model, angles, torque: float, phi0, te
             raise ValueError(f"friction_speed: the driver speed of the friction's kinematics must be positive, got {friction_speed}")
         lp, w1 = lp.copy(), float(friction_speed)
         lp[L.C_CON] = 0.0
-    mdl = (model.gear_par, model.pair_par, lp, kphi)
+    mdl = (model.gear_par, model.pair_par, lp, kphi, contact_parts(model.gear_par, model.pair_par, lp))
     ctl = (np.array([float(torque), theta2, tol, w1, 0.0]), np.array([max_iter], dtype=np.int64))
     # stoppable by Ctrl-C / SIGTERM before the next angle (KeyboardInterrupt raised here)
     sw = static_work(model.n_teeth, ctooth is not None)

@@ -12,8 +12,11 @@ The stepping loops (`explicit`, `explicit_coupled`, `implicit`) and the static s
 all find the contacts with `gearmesh.mesh_contacts`, which reads the flanks' profile deviations
 (gear_par DEV_*, `solver.modification`), the local compliances in series with the contact
 (CLOC_*) and the pitch errors and eccentricities (pair_par E_*, `solver.pitch_errors`) from the model
-arrays: each kernel runs modified, compliant and erroneous pairs alike. `layout` also holds a
-glossary of the kernels' short names and the named work tuples they carry.
+arrays. Which of those parts a model has (and its friction) the caller says with
+`layout.ContactParts`, each part's array or None (`gearmesh.contact_parts`): numba compiles a
+variant of the search, and of every kernel around it, per set of parts, with the code of the
+absent ones pruned (a plain pair's search has none of it). `layout` also holds a glossary of
+the kernels' short names and the named work tuples they carry.
 
 The disk cache sits in a folder named after a hash of every kernel source,
 ``$NUMBA_CACHE_DIR/kernels-<KERNELS_FINGERPRINT>`` (without ``NUMBA_CACHE_DIR``: this package's

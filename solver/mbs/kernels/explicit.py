@@ -51,7 +51,8 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0; write every
     ipar[OUT_EVERY]-th state to ``out`` (`layout` O_* columns).
 
-    mdl: (gear_par, pair_par, law_par, k_phi, tooth_compliance; the last unused here);
+    mdl: (gear_par, pair_par, law_par, k_phi, tooth_compliance, `layout.ContactParts`; the
+    compliance unused here);
     ctl: (par, ipar, load_table) with the `layout` control columns and the load profile
     (n x 2; 0 rows: the torque ramp, see `load_torque`); hub[:, H_TH2] and teeth (rows
     angle, rate, acceleration) the initial state, advanced in place. The run stops on the
@@ -59,7 +60,8 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     instants). ws: the work arrays (`layout.StepWork`, from `stepping.work_arrays`). Returns
     (status, step reached, max active teeth, 0).
     """
-    gp, pp, lp, kphi = mdl[0], mdl[1], mdl[2], mdl[3]
+    gp, kphi = mdl[0], mdl[3]
+    geo = (gp, mdl[1], mdl[2], mdl[5])
     par, ipar, table = ctl
     phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
     rec, pairs, q, vpred, book = ws.rec, ws.pairs, ws.q, ws.vpred, ws.book
@@ -70,7 +72,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     gpk = kick_gear_par(gp, dt, imex)
     theta2, w2 = hub[L.POS, L.H_TH2], hub[L.RATE, L.H_TH2]
     th1, w1, acc1, tl = drive(0.0, par, table)
-    nc, npair = mesh_contacts((th1, theta2, w1, w2), phi, dphi, (gp, pp, lp), (rec, pairs))
+    nc, npair = mesh_contacts((th1, theta2, w1, w2), phi, dphi, geo, (rec, pairs))
     nact = initial_set(ws.tset, teeth, pairs, npair, tz2)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     a2, s1, r1 = arrowhead_accelerations(q, act, nact, gpk, acc)
@@ -108,7 +110,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
             if i < tz2:
                 vpred[i] -= cr1 * dw_b
         # contacts; activate the teeth the pre-search finds
-        nc, npair = mesh_contacts((th1, theta2, w1, w2p), phi, vpred, (gp, pp, lp), (rec, pairs))
+        nc, npair = mesh_contacts((th1, theta2, w1, w2p), phi, vpred, geo, (rec, pairs))
         n_old = nact
         nact = activate(ws.tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):

@@ -104,7 +104,7 @@ def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
     [N m], acc); gpk: gear_par of the arrowhead solve (with implicit tooth-root dampers the
     tooth inertia I_P + dt/4 c_phi, `explicit.py`). Returns (driver torque [N m], body-spring
     moment on the driver rim [N m])."""
-    gp, _pp, _lp, kphi, _ct = mdl
+    gp, kphi = mdl[0], mdl[3]
     q, act = ws.q, ws.tset[L.T_ACT]
     th1, w1, acc1, tl, acc = drv
     phi = teeth[0]
@@ -125,7 +125,7 @@ def coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth):
     the teeth on the rims, and the coupled set's springs through K_S instead of their own.
     Arguments as `coupled_forces` but drv = (theta1 [rad], theta1' [rad/s]) (always this
     pair: another tuple type would compile the function once more)."""
-    gp, _pp, _lp, kphi, _ct = mdl
+    gp, kphi = mdl[0], mdl[3]
     th1, w1 = drv[0], drv[1]
     x = hub[L.POS]
     v = hub[L.RATE]
@@ -161,10 +161,12 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     """Integrate ipar[N_STEPS] steps of par[DT] [s] from t = 0 (see the module docstring);
     arguments, outputs and guards as `explicit.verlet`, with the body angles hub[:, H_*]
     (driver rim, driven rim, driven hub) and TE and theta2 at the hubs. mdl[4]: the tooth
-    compliance [rad/(N m)] of teeth coupled through the body, or 0 x 0.
+    compliance [rad/(N m)] of teeth coupled through the body, or 0 x 0; mdl[5] the
+    `layout.ContactParts`.
     Returns (status, step reached, max active teeth, 0).
     """
-    gp, pp, lp, kphi, ctooth = mdl
+    gp, pp, lp, kphi, ctooth, parts = mdl
+    geo = (gp, pp, lp, parts)
     par, ipar, table = ctl
     phi, dphi, acc = teeth[L.POS], teeth[L.RATE], teeth[L.ACC]
     rec, pairs, q, vpred, tset, book, cset = ws.rec, ws.pairs, ws.q, ws.vpred, ws.tset, ws.book, ws.cset
@@ -182,10 +184,10 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     if imex:
         for g in range(2):
             gpd[g, L.C_PHI] = 0.0
-    mdl_d = (gpd, pp, lp, kphi, ctooth)
+    mdl_d = (gpd, pp, lp, kphi, ctooth, parts)
     coupled = ctooth.shape[0] > 0
     th1, w1, acc1, tl = drive(0.0, par, table)
-    nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
+    nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, geo, (rec, pairs))
     ns = np.int64(0)
     if coupled:
         nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2)
@@ -224,7 +226,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         for a in range(nact):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
-        nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, (gp, pp, lp), (rec, pairs))
+        nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, geo, (rec, pairs))
         nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2) if coupled else 0
         n_old = nact
         nact = activate(tset, nact, pairs, npair, tz2)

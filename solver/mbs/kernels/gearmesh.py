@@ -208,7 +208,7 @@ def _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser):
+def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, friction):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
     flank-flank case), -1 when gear 2 does; ids = (gear-1 tooth, gear-2 tooth, kind);
@@ -218,7 +218,8 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser):
     deviations' part [m]. blend = (c [1/m], v [-]): the curvature d2 delta/dq2 = c * v v^T of a
     modified tip corner's blend into its flank (c = 0 otherwise), stored times the force.
     ser = (c_loc [m/N], -d c_loc/d(theta1, phi_A, theta2, phi_B) [m/N]): the local compliance in
-    series with the contact law (0 and zeros: the plain law)."""
+    series with the contact law (0 and zeros: the plain law). series, friction: the model's
+    `ContactParts` of those names (None: the model has none, and the code is not compiled)."""
     delta, px, py, nx, ny = hit
     o1x, o1y, pvax, pvay, o2x, o2y, pvbx, pvby = frame
     w1, wa, w2, wb = vel
@@ -228,7 +229,7 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser):
     gb = -own * cross(px - pvbx, py - pvby, nx, ny) + dg[3]
     ddelta = g1 * w1 + ga * wa + g2 * w2 + gb * wb
     cl, gc = ser
-    if cl == 0.0:
+    if series is None or cl == 0.0:
         f = contact_force(delta, ddelta, lp[L.K_CON], lp[L.M1], lp[L.C_CON], lp[L.M2], lp[L.M3])
         dcon = delta
         kt = contact_tangent(delta, lp[L.K_CON], lp[L.M1])
@@ -264,17 +265,19 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser):
     rec[nc, L.C_TOOTH1], rec[nc, L.C_TOOTH2], rec[nc, L.C_KIND] = ids
     rec[nc, L.C_KGEO] = f * blend[0]
     rec[nc, L.C_DG1], rec[nc, L.C_DGA], rec[nc, L.C_DG2], rec[nc, L.C_DGB] = blend[1]
-    if lp[L.MU] > 0.0:
+    if friction is not None and lp[L.MU] > 0.0:
         _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
+def pair_contacts(pair, state, phi, dphi, geo, rec, nc, deviations, series, errors, friction):
     """Detailed search for the candidate pair = (gear-1 tooth k, gear-2 tooth j, side s) at
     state = (theta1, theta2 [rad], theta1', theta2' [rad/s]) with the tooth rotations phi
     [rad] and rates dphi [rad/s]; geo = (gear_par, pair_par, law_par). Appends to rec and
     returns the new number of contacts. Each record holds the penetration, its rate, the
-    force and the gradient G = d delta/d(theta1, phi_k, theta2, phi_j).
+    force and the gradient G = d delta/d(theta1, phi_k, theta2, phi_j). deviations, series,
+    errors, friction: the model's `ContactParts` (geo[3]) as arguments of their own, so that
+    numba prunes the code of each part that is None (it prunes on an argument's type only).
 
     One function on purpose, its stages (gap bound, the teeth's poses, flank-flank contact,
     tip corners) marked by comments: split into small kernels, even inlined by numba
@@ -283,7 +286,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     """
     k, j, side = pair[0], pair[1], pair[2]
     theta1, theta2, w1, w2 = state
-    gp, pp, lp = geo
+    gp, pp, lp, _parts = geo
     s = float(side)
     ia = int(gp[0, L.TOOTH0]) + k
     ib = int(gp[1, L.TOOTH0]) + j
@@ -292,12 +295,9 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     # phase 1b: rigid gap bound
     te = gp[0, L.RB] * theta1 + gp[1, L.RB] * theta2
     bound = s * te - pp[L.JN_HALF] + abs(pa) * gp[0, L.R_BND] + abs(pb) * gp[1, L.R_BND]
-    modified = gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0
-    series = gp[0, L.CLOC_ON] + gp[1, L.CLOC_ON] > 0.0
-    if modified:
+    if deviations is not None:
         bound += gp[0, L.DEV_NEG] + gp[1, L.DEV_NEG]
-    errs = pp.shape[0] > L.N_PAIR_PAR
-    if errs:
+    if errors is not None:
         bound += pp[L.E_BOUND]
     if bound <= 0.0:
         return nc
@@ -307,7 +307,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     axb = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
     # the teeth's centres: off the bearing axes O by the eccentricity (the moment arms stay about O)
     e1x, e1y, e2x, e2y = 0.0, 0.0, 0.0, 0.0
-    if errs:
+    if errors is not None:
         axa += pp[L.E_EPS + ia]
         axb += pp[L.E_EPS + ib]
         c1 = theta1 + gp[0, L.GAMMA0] + pp[L.E_ECC + 1]
@@ -331,19 +331,20 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
     delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
     if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
         dg = (0.0, 0.0, 0.0, 0.0)
-        if modified:
+        if deviations is not None:
             da, sa = flank_deviation(gp[0], ua)
             db, sb = flank_deviation(gp[1], ub)
             delta -= da + db
             dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
         if delta > 0.0 and nc < rec.shape[0]:
             ser = (0.0, (0.0, 0.0, 0.0, 0.0))
-            if series:
+            if series is not None:
                 c1, s1 = local_compliance(gp[0], ua)
                 c2, s2 = local_compliance(gp[1], ub)
                 ser = (c1 + c2, _deviation_gradient(s1, s2, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
             # owner A (gear 1)
-            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg), ser)
+            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg), ser, series,
+                    friction)
             nc += 1
         return nc
     flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
@@ -359,7 +360,7 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
             dg = (0.0, 0.0, 0.0, 0.0)
             du = (0.0, 0.0, 0.0, 0.0)
             blend = 0.0
-            if modified:
+            if deviations is not None:
                 # the tip's deviation, blended C1 into the flank's beyond the tip (TIP_BLEND)
                 last = L.DEV0 + L.N_DEV - 1
                 slope = (gp[g, last] - gp[g, last - 1]) / gp[g, L.DEV_DU]
@@ -374,13 +375,13 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
                     blend = sw / TIP_BLEND
             if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
                 ser = (0.0, (0.0, 0.0, 0.0, 0.0))
-                if series:
+                if series is not None:
                     cf, sf = local_compliance(gp[f], uf)
                     ser = (local_compliance(gp[g], gp[g, L.U_HI])[0] + cf,
                            _deviation_gradient(sf if f == 0 else 0.0, sf if f == 1 else 0.0, s,
                                                (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
                 _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
-                        frame, vel, lp, dg, (blend, du), ser)
+                        frame, vel, lp, dg, (blend, du), ser, series, friction)
                 nc += 1
     return nc
 
@@ -389,14 +390,16 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc):
 def mesh_contacts(state, phi, dphi, geo, buf):
     """All contacts of the mesh at state = (theta1, theta2 [rad], theta1', theta2' [rad/s])
     with the tooth rotations phi [rad] and rates dphi [rad/s]; geo = (gear_par, pair_par,
-    law_par), buf = (rec, pairs) (`new_contact_buffer`). Returns (n_contacts, n_pairs);
-    pairs holds the candidates."""
+    law_par, `ContactParts`) (`contact_geo`), buf = (rec, pairs) (`new_contact_buffer`).
+    Returns (n_contacts, n_pairs); pairs holds the candidates. Compiled once for each
+    combination of the parts a model has (the types of geo[3])."""
     rec, pairs = buf
-    gp, pp, _lp = geo
+    gp, pp, _lp, parts = geo
     npair = candidate_pairs(state[0], state[1], gp, pp, pairs)
     nc = np.int64(0)    # not a literal 0: numba would compile pair_contacts once more for Literal[int](0)
     for i in range(npair):
-        nc = pair_contacts(pairs[i], state, phi, dphi, geo, rec, nc)
+        nc = pair_contacts(pairs[i], state, phi, dphi, geo, rec, nc, parts.deviations, parts.series, parts.errors,
+                           parts.friction)
     return nc, npair
 
 
@@ -435,6 +438,22 @@ def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
 def tooth_spring_tangent(i, phi, kphi, gp):
     g = 0 if i < int(gp[1, L.TOOTH0]) else 1
     return spring_tangent(phi[i], kphi[i], gp[g, L.N_K])
+
+
+def contact_parts(gp, pp, lp):
+    """The `ContactParts` of the model arrays gear_par, pair_par, law_par: each part's array
+    where the model has the part (a gear with a flank deviation, a gear with a local
+    compliance table, the pitch-error block, a friction coefficient above zero), else None.
+    Plain Python: what it returns picks the compiled variant of the contact search."""
+    return L.ContactParts(gp if gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0 else None,
+                          gp if gp[0, L.CLOC_ON] + gp[1, L.CLOC_ON] > 0.0 else None,
+                          pp if pp.shape[0] > L.N_PAIR_PAR else None,
+                          lp if lp[L.MU] > 0.0 else None)
+
+
+def contact_geo(gp, pp, lp):
+    """The contact search's ``geo`` = (gear_par, pair_par, law_par, `contact_parts`)."""
+    return gp, pp, lp, contact_parts(gp, pp, lp)
 
 
 def new_contact_buffer():

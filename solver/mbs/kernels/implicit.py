@@ -75,7 +75,7 @@ def newton_arrays(ntooth, alpha, dt):
 @njit(cache=True, no_cfunc_wrapper=True)
 def _tooth_tangent(i, mdl, teeth, coef):
     """(diagonal entry, coupling to theta2) of tooth i in the Newton matrix."""
-    gp, _pp, _lp, kphi, _ct = mdl
+    gp, kphi = mdl[0], mdl[3]
     g = 1 if i >= int(gp[1, L.TOOTH0]) else 0
     d = (coef[K_CM] * gp[g, L.I_P] + coef[K_CK] * tooth_spring_tangent(i, teeth[L.POS], kphi, gp)
          + coef[K_CC] * spring_damping_tangent(teeth[L.RATE, i], gp[g, L.C_PHI], gp[g, L.N_C]))
@@ -256,7 +256,7 @@ def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
             i = act[a]
             acc[i] = (phi[i] - pred[L.POS, i]) * cm
             dphi[i] = pred[L.RATE, i] + gamma * dt * acc[i]
-        nc, npair = mesh_contacts((th1, hub[L.POS, L.H_TH2], w1, hub[L.RATE, L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
+        nc, npair = mesh_contacts((th1, hub[L.POS, L.H_TH2], w1, hub[L.RATE, L.H_TH2]), phi, dphi, (gp, pp, lp, mdl[5]), (rec, pairs))
         n_before = nact
         nact = activate(tset, nact, pairs, npair, tz2)
         for a in range(n_before, nact):
@@ -305,7 +305,7 @@ def hht(mdl, ctl, hub, teeth, out, ws):
     act = tset[L.T_ACT]
     nact = initial_set(tset, teeth, pairs, np.int64(0), tz2)     # the teeth already moving
     th1, w1, acc1, tl = drive(0.0, par, table)
-    nc, npair = mesh_contacts((th1, hub[L.POS, L.H_TH2], w1, hub[L.RATE, L.H_TH2]), phi, dphi, (gp, pp, lp), (rec, pairs))
+    nc, npair = mesh_contacts((th1, hub[L.POS, L.H_TH2], w1, hub[L.RATE, L.H_TH2]), phi, dphi, (gp, pp, lp, mdl[5]), (rec, pairs))
     nact = activate(tset, nact, pairs, npair, tz2)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     # initial accelerations: the explicit arrowhead solve, plus the driver coupling

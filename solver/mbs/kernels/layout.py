@@ -11,7 +11,9 @@ Glossary of the kernels' short names (SI units throughout):
     kphi          tooth spring stiffness k_phi of each tooth [N m/rad^n_k]
     ctooth        tooth compliance matrix of teeth coupled through the body [rad/(N m)] (0 x 0 or
                   None: plain springs)
-    mdl           (gp, pp, lp, kphi) or (gp, pp, lp, kphi, ctooth): the model
+    parts         which optional parts of the contact search a model has (`ContactParts`)
+    geo           (gp, pp, lp, parts): what the contact search reads (`gearmesh.contact_geo`)
+    mdl           (gp, pp, lp, kphi, parts) or (gp, pp, lp, kphi, ctooth, parts): the model
     ctl           (par, ipar[, load table]): the control scalars and integers (columns below)
     g             gear: 0 driver, 1 driven; s, side: flank side, +1 drive, -1 coast
     i, tz2        tooth index over both gears (gear 1 first); tz2 = gp[1, TOOTH0], the index of
@@ -273,3 +275,11 @@ CoupledSet = namedtuple("CoupledSet", "C ks lst newl inset innew mo dmo")
 CoupledSet.__doc__ = """The coupled set S of teeth (`toothcoupling.coupled_set`): the compliance C
 [rad/(N m)], the set's stiffness K_S [N m/rad] (with as many scratch columns), its teeth, the
 next set's teeth, per-tooth 0/1 flags of the current and the next set, scratch moments [N m]."""
+ContactParts = namedtuple("ContactParts", "deviations series errors friction")
+ContactParts.__doc__ = """The optional parts of the contact search a model has, each the array
+that holds its data or None where the model lacks it (`gearmesh.contact_parts`): flank
+deviations (gear_par DEV_*), local compliances in series with the contact (gear_par CLOC_*),
+pitch errors and eccentricity (the pair_par block E_*), sliding friction (law_par MU > 0).
+numba types a None apart from an array and prunes the branches under ``x is None`` (for an
+argument of the compiled function), so each combination compiles its own contact search with
+only the code it runs."""

@@ -3,7 +3,7 @@ motion, the load torque, the arrowhead accelerations, the energies and the dissi
 
 ``act[:nact]`` are the active (integrated) teeth; ``rec[:nc]`` the contact records
 (`layout` C_* columns); ``mdl`` the model arrays (gear_par, pair_par, law_par, k_phi,
-tooth_compliance) as the stepping kernels take them. SI units.
+tooth_compliance, `layout.ContactParts`) as the stepping kernels take them. SI units.
 """
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit

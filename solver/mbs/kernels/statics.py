@@ -96,7 +96,7 @@ def _unknown_forces(mdl, ks, sw, nc, nt, phi, torque):
     """Residual sw.r [N m] on theta2 and the nt unknown teeth from the contacts sw.rec[:nc]
     under the resisting torque [N m]; returns its max-norm. A coupled model's tooth springs
     act through the set stiffness ks (its per-tooth kphi are zero; ks is None otherwise)."""
-    gp, _pp, _lp, kphi = mdl
+    gp, kphi = mdl[0], mdl[3]
     q, lst, r = sw.q, sw.lst, sw.r
     generalized_forces(sw.rec, nc, phi, sw.zero_rates, lst, nt, kphi, gp, torque, q)
     r[0] = q[1]
@@ -115,7 +115,7 @@ def _tangent(mdl, ks, sw, nc, nt, phi):
     """Newton tangent [N m/rad] over theta2 and the nt unknown teeth: the contacts sw.rec[:nc]
     plus the tooth springs (the set stiffness ks of a coupled model, else each tooth's own
     tangent, regularised where it vanishes at phi = 0)."""
-    gp, _pp, lp, kphi = mdl
+    gp, lp, kphi = mdl[0], mdl[2], mdl[3]
     rec, pos, lst = sw.rec, sw.pos, sw.lst
     friction = lp[L.MU] > 0.0
     n = nt + 1
@@ -164,9 +164,9 @@ def newton_system(mdl, theta1, theta2, phi, torque, sw):
     the tooth rotations phi [rad] under the resisting torque [N m]: (tangent [N m/rad],
     residual [N m], the unknown teeth), the unknowns being theta2 and those teeth, as the
     sweep below builds them (for checks against finite differences); sw: `static_work`."""
-    gp, pp, lp, _kphi = mdl
+    gp = mdl[0]
     ph = phi.copy()
-    nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), ph, sw.zero_rates, (gp, pp, lp), (sw.rec, sw.pairs))
+    nc, npair = mesh_contacts((theta1, theta2, 0.0, 0.0), ph, sw.zero_rates, (gp, mdl[1], mdl[2], mdl[4]), (sw.rec, sw.pairs))
     nt = _unknown_set(sw, npair, gp, ph)
     _unknown_forces(mdl, None, sw, nc, nt, ph, torque)
     return _tangent(mdl, None, sw, nc, nt, ph), sw.r[:nt + 1].copy(), sw.lst[:nt].copy()
@@ -253,7 +253,7 @@ def _store(out, force1, a, rec, nc, row):
 def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1, sw):
     """Equilibrium at each driver angle theta1s[a] [rad].
 
-    mdl: (gear_par, pair_par, law_par, k_phi); ctl: (par, ipar) with the `layout` S_*
+    mdl: (gear_par, pair_par, law_par, k_phi, `layout.ContactParts`); ctl: (par, ipar) with the `layout` S_*
     columns (resisting torque [N m], start guess of theta2 [rad], tolerance, driver speed of
     the friction's sliding [rad/s], abort flag; Newton iterations). ``ctooth``: the tooth compliance matrix [rad/(N m)] of a model whose teeth
     are coupled through the body (`toothcoupling`; its k_phi are then zero), or None. The
@@ -271,7 +271,8 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1, sw):
     The Newton of each angle is written out here, not in a helper kernel: a kernel around
     mesh_contacts costs its own optimisation of the whole contact search at compile time.
     """
-    gp, pp, lp, _kphi = mdl
+    gp, pp, lp, _kphi, parts = mdl
+    geo = (gp, pp, lp, parts)
     par, ipar = ctl
     torque = par[L.S_TORQUE]
     rec, pairs, zeros, lst, ks = sw.rec, sw.pairs, sw.zero_rates, sw.lst, sw.ks
@@ -298,7 +299,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1, sw):
         while it < ipar[L.S_MAX_ITER]:
             it += 1
             if not fresh:
-                nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
+                nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, geo, (rec, pairs))
             fresh = False
             # the unknowns: the teeth the pre-search finds at the current iterate
             nt = _unknown_set(sw, npair, gp, phi)
@@ -325,7 +326,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1, sw):
             step = 1.0
             for _ in range(30):
                 theta2 = _line_step(th_old, ph_old, dx, step, phi, lst, nt)
-                nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
+                nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, geo, (rec, pairs))
                 rn2 = _unknown_forces(mdl, ks, sw, nc, nt, phi, torque)
                 if rn2 < rn or rn2 < tol_abs:
                     break
@@ -336,7 +337,7 @@ def static_sweep(mdl, ctooth, ctl, theta1s, phi, out, force1, sw):
                 break
         # outputs at the solution: a converged iteration ended on a search at this very state
         if not converged:
-            nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, (gp, pp, lp), (rec, pairs))
+            nc, npair = mesh_contacts((theta1, theta2, w1, w2), phi, zeros, geo, (rec, pairs))
             failures += 1
         _store(out, force1, a, rec, nc, (rb1 * theta1 + rb2 * theta2, theta2, float(it if converged else -it)))
     return failures

@@ -7,7 +7,7 @@ from matplotlib.path import Path
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.contact import flank_flank, point_flank
-from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
 
 
 def _tooth_world(g, center, axis, phi=0.0, pivot_radius=None):
@@ -47,12 +47,12 @@ def test_penetration_matches_brute_force_distance(paper_solid_model, deg, phi_a,
     phi = np.zeros(m.n_teeth)
     rec, pairs = new_contact_buffer()
     # first find the contacts with rigid teeth, then rotate the teeth involved
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     assert nc >= 2
     k, j = int(rec[0, L.C_TOOTH1]), int(rec[0, L.C_TOOTH2])
     phi[k] = phi_a
     phi[m.teeth[0] + j] = phi_b
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, np.zeros_like(phi), contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     rows = [c for c in range(nc) if int(rec[c, L.C_TOOTH1]) == k and int(rec[c, L.C_TOOTH2]) == j]
     exact = max([rec[c, L.C_DELTA] for c in rows], default=0.0)
     ax1 = th1 + m.gear_par[0, L.GAMMA0] + k * g1.pitch_angle
@@ -94,7 +94,7 @@ def test_gradient_matches_finite_differences(paper_solid_model):
         th2 = m.theta2_for_te(th1, m.backlash_offset + 5.5e-6)
         phi = np.zeros(m.n_teeth)
         z = np.zeros(m.n_teeth)
-        nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, z, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+        nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, z, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
         base = rec[:nc].copy()
         h = 1e-8
         for c in range(nc):
@@ -105,7 +105,7 @@ def test_gradient_matches_finite_differences(paper_solid_model):
                 p = phi.copy()
                 p[k] += da
                 p[m.teeth[0] + j] += db
-                n2, _ = mesh_contacts((th1 + d1, th2 + d2, 0.0, 0.0), p, z, (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+                n2, _ = mesh_contacts((th1 + d1, th2 + d2, 0.0, 0.0), p, z, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
                 for r in range(n2):
                     if int(rec[r, L.C_TOOTH1]) == k and int(rec[r, L.C_TOOTH2]) == j and rec[r, L.C_KIND] == base[c, L.C_KIND]:
                         return rec[r, L.C_DELTA]
@@ -115,3 +115,54 @@ def test_gradient_matches_finite_differences(paper_solid_model):
             g = base[c, [L.C_G1, L.C_GA, L.C_G2, L.C_GB]]
             np.testing.assert_allclose(g, fd, rtol=1e-5, atol=1e-9)
     assert kinds >= {1, 2}
+
+
+# flank deviations, pitch errors and friction on the paper pair (the series compliance needs the
+# FE springs of the compliance model: `test_kernels.test_first_run_compiles_each_kernel_once...`)
+PARTS = {"deviations": {"gear1.modification.tip_relief": 10.0, "gear1.modification.tip_length": 3.0,
+                        "gear2.modification.tip_relief": 10.0, "gear2.modification.tip_length": 3.0},
+         "errors": {"gear1.errors.grade": 6, "gear1.errors.seed": 1, "gear2.errors.eccentricity": 5.0},
+         "friction": {"contact.friction": 0.1}}
+
+
+@pytest.mark.parametrize("present", [(), ("deviations",), ("errors", "friction")])
+def test_contact_search_variant_holds_the_parts_the_model_has(present):
+    """`contact_parts` names exactly the parts a model has (each part's array, None for the
+    others), and the contact search compiled for that set, the branches of the absent parts
+    pruned by numba, gives every contact record to the bit as its source run as plain Python
+    (which tests the parts at run time), at a loaded state with teeth rotated and moving and
+    contacts of both kinds (flank-flank and tip corner)."""
+    from helpers import solid_scene
+
+    from solver.mbs.kernels.gearmesh import contact_parts, pair_contacts
+    from study.scene_model import build_scene_model
+    over = {k: v for name in present for k, v in PARTS[name].items()}
+    m = build_scene_model(solid_scene(**over))
+    gp, pp, lp = m.gear_par, m.pair_par, m.law_par
+    parts = contact_parts(gp, pp, lp)
+    arrays = {"deviations": gp, "series": gp, "errors": pp, "friction": lp}
+    for name in L.ContactParts._fields:
+        assert (getattr(parts, name) is arrays[name]) == (name in present), name
+    geo = (gp, pp, lp, parts)
+    rng = np.random.default_rng(5)
+    kinds = set()
+    for deg in (0.3, 1.9, 3.9, 4.3):
+        th1 = math.radians(deg)
+        th2 = m.theta2_for_te(th1, m.backlash_offset + 16e-6)    # through the 10 um relief
+        phi = rng.normal(scale=2e-4, size=m.n_teeth)
+        dphi = rng.normal(scale=5.0, size=m.n_teeth)
+        state = (th1, th2, 100.0, -100.0 * m.base_radii[0] / m.base_radii[1])
+        rec, pairs = new_contact_buffer()
+        nc, npair = mesh_contacts(state, phi, dphi, geo, (rec, pairs))
+        ref = np.zeros_like(rec)
+        n = 0
+        for i in range(npair):
+            n = pair_contacts.py_func(pairs[i], state, phi, dphi, geo, ref, n, *parts)
+        assert n == nc >= 1
+        np.testing.assert_array_equal(rec[:nc], ref[:nc])
+        kinds |= {abs(int(rec[c, L.C_KIND])) for c in range(nc)}
+        if "friction" in present:
+            assert np.any(rec[:nc, L.C_FT] != 0.0)
+        else:
+            assert np.all(rec[:nc, L.C_FT] == 0.0)
+    assert 1 in kinds and kinds & {2, 3}

@@ -11,7 +11,7 @@ from helpers import RAW_DAMPING, solid_scene
 from solver.mbs.dynamics import simulate
 from solver.mbs.implicit import simulate_implicit
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
 from solver.mbs.model import build_model
 from solver.mbs.statics import solve_static
 from study.errors import SceneError
@@ -64,7 +64,7 @@ def _contacts(m, th1, w1, w2):
     rec, pairs = new_contact_buffer()
     phi = np.zeros(m.n_teeth)
     te = m.backlash_offset + 0.5e-6
-    nc, _ = mesh_contacts((th1, float(m.theta2_for_te(th1, te)), w1, w2), phi, phi, (m.gear_par, m.pair_par, m.law_par),
+    nc, _ = mesh_contacts((th1, float(m.theta2_for_te(th1, te)), w1, w2), phi, phi, contact_geo(m.gear_par, m.pair_par, m.law_par),
                           (rec, pairs))
     return rec[:nc].copy()
 

@@ -44,6 +44,7 @@ def test_generalized_forces_are_minus_the_energy_gradient(paper_solid_model):
 def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
     """The compiled static sweep (plain model: ctooth None, the coupled code pruned) gives
     what its source gives when run as plain Python."""
+    from solver.mbs.kernels.gearmesh import contact_parts
     from solver.mbs.kernels.statics import static_sweep, static_work
     m = paper_solid_model
     angles = np.radians(np.arange(0.0, 3.0, 0.5))
@@ -54,7 +55,8 @@ def test_static_kernel_matches_its_plain_python_run(paper_solid_model):
         res = (np.zeros((n, L.N_S_OUT)), np.zeros((n, m.teeth[0])))
         phi = np.zeros(m.n_teeth)
         ctl = (np.array([50.0, theta2, 1e-10, 0.0, 0.0]), np.array([60]))     # (S_ABORT last)
-        fails = f((m.gear_par, m.pair_par, m.law_par, m.k_phi), None, ctl, angles, phi, *res, static_work(m.n_teeth))
+        mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, contact_parts(m.gear_par, m.pair_par, m.law_par))
+        fails = f(mdl, None, ctl, angles, phi, *res, static_work(m.n_teeth))
         assert fails == 0
         out.append((*res, phi))
     for a, b in zip(*out):
@@ -100,7 +102,10 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code(model):
     compiles each kernel for one argument list only: no second version for a literal-0
     argument (numba specialises callees on Literal[int](0)) nor for another tuple; the plain
     model none of the coupled-teeth kernels (pruned from the plain static sweep); and neither
-    numba's string machinery (an array copied into a slice compiles its shape-error message)."""
+    numba's string machinery (an array copied into a slice compiles its shape-error message);
+    nor the contact search's parts the scene lacks (`layout.ContactParts`): no friction, flank
+    deviation or pitch error in either, no series compliance in the plain model (the compliance
+    model's identification reads the flank deviations from Python, in its FE contact)."""
     import os
     import subprocess
     import sys
@@ -119,11 +124,14 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code(model):
     assert not [ln for ln in lines if "Literal" in ln]
     assert not [ln for ln in lines if int(ln.split()[1]) > 1]
     assert not [c for c in compiled if "raise_with_shape_context" in c or "unicode" in c or "str_generic" in c]
+    assert "_friction" not in names
     if model == "paper":
         assert {"verlet", "arrowhead_accelerations"} <= names
         assert "set_stiffness" not in names and "set_moment" not in names
+        assert not {"local_compliance", "series_contact", "flank_deviation"} & names
     else:
         assert {"verlet_coupled", "coupled_energies", "set_stiffness", "set_moment"} <= names
+        assert {"local_compliance", "series_contact"} <= names
 
 
 def test_the_kernel_cache_is_keyed_by_every_kernel_source(tmp_path):

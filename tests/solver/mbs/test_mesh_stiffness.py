@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
 from solver.mbs.mesh_stiffness import condense, mesh_states, pitch_lever, pitch_point_stiffness
 from solver.mbs.statics import solve_static
 
@@ -49,7 +49,7 @@ def test_pitch_lever_is_the_contact_gradient_at_the_pitch_point(paper_solid_mode
     best = (np.inf, 0.0)
     for th in np.radians(np.linspace(-3.0, 3.0, 601)):
         nc, _ = mesh_contacts((th, m.theta2_for_te(th, m.backlash_offset + 2e-6), 0.0, 0.0), z, z,
-                              (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+                              contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
         for c in range(nc):
             d = np.hypot(rec[c, L.C_PX] - rp, rec[c, L.C_PY])
             if d < best[0]:
@@ -126,7 +126,7 @@ def test_plain_mesh_alone_takes_the_windup_out_of_every_loaded_spring(paper_soli
     for i in np.flatnonzero(ms.loaded_pairs() == 1):
         st = solve_static(m, ang[i:i + 1], 5.0)
         nc, _ = mesh_contacts((ang[i], float(st.theta2[0]), 0.0, 0.0), st.phi_last, z,
-                              (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+                              contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
         loaded = [c for c in range(nc) if rec[c, L.C_FORCE] > 0]
         if len(loaded) != 1:
             continue

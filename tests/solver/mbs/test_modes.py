@@ -25,13 +25,13 @@ def test_rigid_teeth_mesh_mode_is_the_two_inertia_closed_form():
     over the loaded pairs: w² = k_m rb2² / I2 at every mesh position."""
     m = _model(**{"gear1.spring.k_phi": 1.06e12, "gear2.spring.k_phi": 1.06e12, "contact.c_con": 0.0,
                   "gear1.spring.c_phi": 0.0, "gear2.spring.c_phi": 0.0})
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
     md = modal_analysis(m, 50.0)
     rb2 = m.base_radii[1]
     for j, eq in enumerate(loaded_equilibria(m, 50.0)):
         rec, pairs = new_contact_buffer()
         nc, _np = mesh_contacts((eq.rim1, eq.rim2, 0.0, 0.0), eq.phi, np.zeros(m.n_teeth),
-                                (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+                                contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
         km = sum(rec[c, L.C_KT] for c in range(nc) if rec[c, L.C_FORCE] > 0)
         f = math.sqrt(km * rb2 ** 2 / m.gear_par[1, L.I_TOT]) / (2 * math.pi)
         assert md.frequency[0, j] == pytest.approx(f, rel=0.01)

@@ -159,7 +159,7 @@ def test_a_dynamic_run_with_errors_starts_touching_without_penetration():
     does, and the start lies the driver's offset along the line of action, e*cos(gamma1 + phase
     - psi_n), below jn/2 (first order: within 2 nm)."""
     from solver.mbs.dynamics import start_te
-    from solver.mbs.kernels.gearmesh import mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
     scene = small(**{"gear1.errors.eccentricity": 5.0, "gear1.errors.eccentricity_phase": 20.0})
     model = geometry_model(scene)
     assert start_te(geometry_model(small()), 1.0) == model.backlash_offset
@@ -170,5 +170,5 @@ def test_a_dynamic_run_with_errors_starts_touching_without_penetration():
     zeros = np.zeros(model.n_teeth)
     for te, n in ((te0, 0), (te0 + 1e-9, 1)):
         nc, _ = mesh_contacts((0.0, model.theta2_for_te(0.0, te), 0.0, 0.0), zeros, zeros,
-                              (model.gear_par, model.pair_par, model.law_par), (rec, pairs))
+                              contact_geo(model.gear_par, model.pair_par, model.law_par), (rec, pairs))
         assert (nc > 0) == (n > 0)

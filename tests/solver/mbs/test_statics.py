@@ -6,7 +6,7 @@ import pytest
 from helpers import solid_scene
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.gearmesh import contact_geo, generalized_forces, mesh_contacts, new_contact_buffer
 from solver.mbs.statics import solve_static
 from study.scene_model import build_scene_model
 
@@ -33,7 +33,7 @@ def test_single_pair_matches_series_springs_in_closed_form(paper_solid_model):
         # the gear-2 partner sits where conjugate rolling puts it: find it from the contact record
         rec, pairs = new_contact_buffer()
         phi = np.zeros(m.n_teeth)
-        nc, _ = mesh_contacts((angles[a], st.theta2[a], 0.0, 0.0), phi, phi, (gp, m.pair_par, m.law_par), (rec, pairs))
+        nc, _ = mesh_contacts((angles[a], st.theta2[a], 0.0, 0.0), phi, phi, contact_geo(gp, m.pair_par, m.law_par), (rec, pairs))
         j = [int(rec[c, L.C_TOOTH2]) for c in range(nc) if int(rec[c, L.C_TOOTH1]) == k][0]
         ax2 = st.theta2[a] + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
         d1 = rb1 - gp[0, L.R_PV] * math.cos(ax1 + alpha)
@@ -53,7 +53,7 @@ def test_equilibrium_residual_vanishes(paper_solid_model):
     a = 5
     st1 = solve_static(m, st.angle[: a + 1], 50.0)
     phi = st1.phi_last
-    nc, npair = mesh_contacts((st.angle[a], st1.theta2[-1], 0.0, 0.0), phi, np.zeros_like(phi), (m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    nc, npair = mesh_contacts((st.angle[a], st1.theta2[-1], 0.0, 0.0), phi, np.zeros_like(phi), contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
     act = np.unique(np.r_[pairs[:npair, 0], m.teeth[0] + pairs[:npair, 1]]).astype(np.int64)
     generalized_forces(rec, nc, phi, np.zeros_like(phi), act, act.size, m.k_phi, m.gear_par, 50.0, q)
     assert abs(q[1]) < 1e-7 * 50

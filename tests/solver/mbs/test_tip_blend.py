@@ -8,7 +8,7 @@ import numpy as np
 from test_relief import ELASTIC, small
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.kernels.gearmesh import TIP_BLEND, mesh_contacts, new_contact_buffer
+from solver.mbs.kernels.gearmesh import TIP_BLEND, contact_geo, mesh_contacts, new_contact_buffer
 from solver.mbs.kernels.statics import newton_system, static_work
 from solver.mbs.statics import solve_static
 from study.scene import load_scene
@@ -33,7 +33,7 @@ def _corner_pair(model):
     rec, pairs = new_contact_buffer()
     for th1 in np.radians(np.arange(0.0, 20.0, 0.01)):
         th2 = _th2(model, th1)
-        nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (model.gear_par, model.pair_par, model.law_par), (rec, pairs))
+        nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, contact_geo(model.gear_par, model.pair_par, model.law_par), (rec, pairs))
         for c in range(nc):
             if rec[c, L.C_KIND] == 2.0:
                 return th1, th2, (rec[c, L.C_TOOTH1], rec[c, L.C_TOOTH2])
@@ -42,7 +42,7 @@ def _corner_pair(model):
 
 def _delta(model, th1, th2, phi, key):
     rec, pairs = new_contact_buffer()
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi * 0, (model.gear_par, model.pair_par, model.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi * 0, contact_geo(model.gear_par, model.pair_par, model.law_par), (rec, pairs))
     for c in range(nc):
         if (rec[c, L.C_TOOTH1], rec[c, L.C_TOOTH2]) == key:
             return rec[c, L.C_DELTA], rec[c, L.C_KIND]
@@ -83,7 +83,8 @@ def test_statics_tangent_matches_the_finite_difference_jacobian_in_the_blend():
     several fold)."""
     model = geometry_model(small(**RELIEF))
     th1, _th, key = _corner_pair(model)
-    mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi)
+    geo = contact_geo(model.gear_par, model.pair_par, model.law_par)
+    mdl = (*geo[:3], model.k_phi, geo[3])
     phi = np.zeros(model.n_teeth)
     # move into the blend: half a blend length past the switch, found along the conjugate motion
     lo, hi = th1 - math.radians(0.01), th1
@@ -93,7 +94,7 @@ def test_statics_tangent_matches_the_finite_difference_jacobian_in_the_blend():
     th1 = hi + 0.5 * TIP_BLEND
     th2 = _th2(model, th1)
     rec, pairs = new_contact_buffer()
-    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, (model.gear_par, model.pair_par, model.law_par), (rec, pairs))
+    nc, _ = mesh_contacts((th1, th2, 0.0, 0.0), phi, phi, contact_geo(model.gear_par, model.pair_par, model.law_par), (rec, pairs))
     assert any(rec[c, L.C_KGEO] != 0.0 for c in range(nc))
     K, _r, teeth = newton_system(mdl, th1, th2, phi, 0.0, static_work(model.n_teeth))
 

@@ -196,6 +196,7 @@ def test_coupled_kernel_matches_its_plain_python_run(imex):
     included (300 steps through a change of the candidate teeth), with the tooth-root dampers
     explicit and implicit."""
     from solver.mbs.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.kernels.gearmesh import contact_parts
     from solver.mbs.kernels.stepping import work_arrays
     from solver.mbs.stability import stable_time_step
     m = coupled_pair({"gear1.spring.n_k": 1.0, "gear2.spring.n_k": 1.0})
@@ -214,7 +215,7 @@ def test_coupled_kernel_matches_its_plain_python_run(imex):
         hub[L.RATE, L.H_R1] = 300.0
         hub[L.RATE, L.H_TH2] = hub[L.RATE, L.H_H2] = -300.0
         teeth = np.zeros((3, m.n_teeth))
-        mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance)
+        mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance, contact_parts(m.gear_par, m.pair_par, m.law_par))
         res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out, work_arrays(m.n_teeth, m.tooth_compliance))
         runs.append((res, out, teeth[L.POS]))
     (r1, o1, p1), (r2, o2, p2) = runs
