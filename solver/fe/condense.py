@@ -307,15 +307,15 @@ class CondensedBody:
         u[self.pos_r] = y - rim.model.solve(np.ascontiguousarray(rim.K_ri @ u_i))
         return u[:, 0] if vec else u
 
-    def column_reads(self, f: np.ndarray, reads: list) -> list:
-        """Column j of K_ff^-1 f (f (n_free, k) [N]) at the body free positions ``reads[j]``
-        [m], for each j: the full solve's numbers (to rounding) at a fraction of its cost where
-        the loads lie in the teeth and rim and each column reads a few DOFs there (see the
-        module doc). Loads or reads elsewhere (web, interface loads): the full solve."""
+    def column_reads(self, f, reads: list) -> list:
+        """Column j of K_ff^-1 f (f (n_free, k) [N], dense or sparse) at the body free positions
+        ``reads[j]`` [m], for each j: the full solve's numbers (to rounding) at a fraction of its
+        cost where the loads lie in the teeth and rim and each column reads a few DOFs there (see
+        the module doc). Loads or reads elsewhere (web, interface loads): the full solve."""
         import scipy.sparse as sp
         from scipy.sparse.linalg import spsolve_triangular
 
-        f = np.asarray(f, float).reshape(f.shape[0], -1)
+        f = f.tocsc() if sp.issparse(f) else np.asarray(f, float).reshape(f.shape[0], -1)
         reads = [np.asarray(r, np.int64) for r in reads]
         rim = self.rim
         if self._to_rim is None:
@@ -325,7 +325,7 @@ class CondensedBody:
         fs = sp.csc_matrix(f)
         in_rim = all(np.all(self._to_rim[r] >= 0) for r in reads) and np.all(self._to_rim[fs.indices] >= 0)
         if not in_rim:
-            u = self.solve(f)
+            u = self.solve(fs.toarray())
             return [u[r, j] for j, r in enumerate(reads)]
         F_r = sp.csc_matrix((fs.data, self._to_rim[fs.indices], fs.indptr), shape=(self.pos_r.size, f.shape[1]))
         F_r.sort_indices()
@@ -458,6 +458,9 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     K_ww = K_W[web_free][:, web_free].tocsc()
     K_wi = K_W[web_free][:, body_i].tocsr()
     S = rim.S + K_W[body_i][:, body_i].toarray()
+    # the Cholesky factorisation below reads the lower triangle of 0.5 (S + S^T) only: where
+    # S_R + K_ii^W is exactly symmetric (as assembled) that is S - tril(W) itself, bit for bit
+    S_t = None if np.array_equal(S, S.T) else S.T.copy()
     t1, c1 = time.perf_counter(), time.process_time()
     web_solve = None
     if web_free.size:
@@ -465,13 +468,18 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
         web_solve = blas1_solver(lu_w)
         # K_iw K_ww^-1 K_wi by a triangular solve restricted to the web DOFs the interface
         # reaches and a symmetric product (two solves and a general product if not symmetric)
-        W = congruence(lu_w, K_wi)
+        W = Wt = congruence(lu_w, K_wi, lower=True)      # (W^T's lower triangle is W's)
         if W is None:
             web = BodyModel(mesh, _Size(web_free.size), None, np.arange(web_free.size), web_solve, material, factor=lu_w)
             W = influence(web, K_wi.T.tocsr(), K_wi)
+            Wt, S_t = W.T, S.T.copy() if S_t is None else S_t
         S -= W
+        if S_t is not None:
+            S_t -= Wt
+    if S_t is not None:
+        S = 0.5 * (S + S_t)
     with one_blas_thread():
-        schur = cho_factor(0.5 * (S + S.T), lower=True, check_finite=False)
+        schur = cho_factor(S, lower=True, check_finite=False)
     cb = CondensedBody(rim, pos_r, pos_i, pos_w, web_solve, K_wi if web_free.size else sp.csr_matrix((0, body_i.size)),
                        schur, free.size)
     t2, c2 = time.perf_counter(), time.process_time()

@@ -120,9 +120,10 @@ def factorised_body(setup: GearSetup, stages: dict | None = None):
                 if rim is not None:        # only the web is meshed, and joined to the kept rim
                     whole = join_rim(rim, mesh(rim=False))
                 else:
-                    whole = mesh()
-                    rim = condensed_rim(setup, whole)
-                    whole = join_rim(rim, whole)      # numbered as any later body of this rim
+                    rim = condensed_rim(setup, mesh())
+                    # the web meshed alone, as for every later body of this rim (the whole
+                    # body's web has other node numbers in gmsh, and so other triangles)
+                    whole = join_rim(rim, mesh(rim=False))
                 t1, c1 = time.perf_counter(), time.process_time()    # a rim's own cost is not the body's
                 model = assemble_condensed(whole, geo.spec.face_width, body.web_thickness, setup.material, rim)
             except RimMismatch:
