@@ -161,9 +161,8 @@ def _build(gmsh, g: GearGeometry, body: BodySpec, h: float, grading: str, rim: b
         # its 1D mesh (two thirds of a web's meshing time) is left out, one element a curve.
         for c in outline.curves:
             gmsh.model.mesh.setTransfiniteCurve(c, 2)
-    corners = outline.corners
-    corner_size = opening_edge_sizes(body, h)[1] if any(corners) else None
-    _size_field(gmsh, g, outline.curves, outline.fillets, h, 5.0 * h, GRADINGS[grading], corners, corner_size)
+    corner_size = opening_edge_sizes(body, h)[1] if any(outline.corners) else None
+    _size_field(gmsh, g, outline, h, GRADINGS[grading], corner_size)
     generate(gmsh)
     return _collect(gmsh, outline.surfaces, outline.bore_radius, h)
 
@@ -320,14 +319,15 @@ def _opening_loop(geo, pieces: list, size: float, corners: tuple | None, corner_
     return geo.addCurveLoop(tags)
 
 
-def _size_field(gmsh, g: GearGeometry, curves: list, fillets: list, h: float, h_body: float, grade: dict,
-                corners=((), ()), corner_size: float | None = None) -> None:
-    """Background size field [m] of a `GRADINGS` entry: ``h`` within ``outline_fine_m`` modules
-    of the outline, growing linearly to ``h_body`` over ``outline_growth_m`` modules plus
-    ``outline_growth_h`` h; ``h/2`` within ``fillet_fine_h`` h of the fillets, growing to
-    ``h_body`` at ``fillet_growth_h`` h; ``corner_size`` within that size of a window's corners
-    (``corners``: its fillet curves and sharp corner points), growing to ``h_body`` over
-    CORNER_GROWTH times the difference."""
+def _size_field(gmsh, g: GearGeometry, outline: Outline, h: float, grade: dict, corner_size: float | None = None) -> None:
+    """Background size field [m] of a `GRADINGS` entry, with h_body = 5 h: ``h`` within
+    ``outline_fine_m`` modules of the outline's curves, growing linearly to ``h_body`` over
+    ``outline_growth_m`` modules plus ``outline_growth_h`` h; ``h/2`` within ``fillet_fine_h`` h
+    of its fillets, growing to ``h_body`` at ``fillet_growth_h`` h; ``corner_size`` within that
+    size of a window's corners (``outline.corners``: its fillet curves and sharp corner points),
+    growing to ``h_body`` over CORNER_GROWTH times the difference."""
+    curves, fillets, corners = outline.curves, outline.fillets, outline.corners
+    h_body = 5.0 * h
     m = g.spec.module
     f = gmsh.model.mesh.field
     d_out = f.add("Distance")
