@@ -135,7 +135,7 @@ def mesh_body(g: GearGeometry, body: BodySpec, size: float | None = None, prefix
     ``rim=False``: only the web and hub (a body with neither: an error), by the same size
     field, so that their boundary nodes are those of the whole body's (gmsh meshes each region
     from its own boundary; inside, the triangles may differ from the whole body's, whose other
-    node numbers steer gmsh's Delaunay otherwise: stiffness and stress within 3e-7): the part
+    node numbers steer gmsh's Delaunay otherwise: stiffness and stress within 1e-6): the part
     that differs between bodies of one rim height, to be joined to their common teeth and rim
     (`solver.fe.condense.join_rim`)."""
     validate_body(g, body, prefix)
