@@ -231,11 +231,21 @@ def point_displacement(model: BodyModel, u: np.ndarray, x: np.ndarray) -> np.nda
     return np.asarray(P @ u).ravel()
 
 
-def _map_loads(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth: list, force: float, patch: float):
+def _map_loads(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth: list, force: float, patch: float,
+               free_sparse: bool = False):
     """(load cases, their nodal forces F (N_dofs, n) [N], the probes P (2n, N_dofs) of their
-    tooth-centreline points: rows x of all points, then y) of the spring map."""
+    tooth-centreline points: rows x of all points, then y) of the spring map. ``free_sparse``:
+    F on the free DOFs only, (n_free, n) CSC (a few dozen nonzeros a column, against a dense
+    block of some 70,000 rows)."""
+    import scipy.sparse as sp
     cases = [load_case(g, i, pivot_radius) for i in teeth]
-    F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
+    if free_sparse:
+        cols = [load_vector(model, c, force, patch)[model.free] for c in cases]
+        nz = [np.flatnonzero(f) for f in cols]
+        F = sp.csc_matrix((np.concatenate([f[i] for f, i in zip(cols, nz)]), np.concatenate(nz),
+                           np.cumsum([0] + [i.size for i in nz])), shape=(model.free.size, len(cases)))
+    else:
+        F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
     P = model.basis.probes(np.column_stack([c.centre_point for c in cases])).tocsr()
     return cases, F, P
 
@@ -266,7 +276,7 @@ def tooth_map(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, for
     if model.condensed is None:
         k, U = tooth_stiffness(model, g, pivot_radius, teeth, force, patch)
         return k, fillet_stress(model, g, U, teeth)
-    cases, F, P = _map_loads(model, g, pivot_radius, teeth, force, patch)
+    cases, F, P = _map_loads(model, g, pivot_radius, teeth, force, patch, free_sparse=True)
     bands = _fillet_bands(model, g, teeth)
     n, ed = len(teeth), model.basis.element_dofs
     pos = np.full(model.basis.N, -1, np.int64)
@@ -275,7 +285,7 @@ def tooth_map(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, for
     for j, band in enumerate(bands):
         dofs = np.unique(np.concatenate([ed[:, band].ravel(), P[j].indices, P[n + j].indices]))
         reads.append(dofs[pos[dofs] >= 0])                  # a clamped DOF reads 0
-    cols = model.condensed.column_reads(np.ascontiguousarray(F[model.free]), [pos[r] for r in reads])
+    cols = model.condensed.column_reads(F, [pos[r] for r in reads])
     U = np.full((model.basis.N, n), np.nan)                 # NaN: not read (would show in k or stress)
     U[pos < 0] = 0.0
     for j, (r, c) in enumerate(zip(reads, cols)):

@@ -27,6 +27,7 @@ the interface-last factorisation, the forward solve s = L11^-1 Pr1 f_j and B are
 (made once per load set), and per body only u_i = -S^-1 B and, per column, the back-substitution
 U11 w = s - U12 u_i restricted to the rows the column's reads depend on (their ancestors in
 U11's graph: some 2,000 of the rim's 71,000 interior DOFs on a gear), not the whole rim.
+The rim's restricted solves are in `solver.fe.rim_solves`.
 
 Units: SI (m, N, N/m).
 """
@@ -39,6 +40,7 @@ import numpy as np
 from solver.fe.body import BodyModel, plane_stress_lame, plane_stress_p2_stiffness
 from solver.fe.factor import blas1_solver, congruence, factorise, influence, one_blas_thread
 from solver.fe.mesh import REGION_RIM, REGION_WEB, BodyMesh
+from solver.fe.rim_solves import ReadSet, _closed_block, make_read_set, rim_products
 from solver.geometry import Material
 from solver.store import Shelf, digest
 
@@ -162,71 +164,12 @@ class RimBlock:
         reads the same teeth under the same loads)."""
         key = digest(F.shape, F.data, F.indices.astype(np.int64), F.indptr.astype(np.int64),
                      *(np.asarray(r, np.int64) for r in reads))
-        return self.read_sets.kept(key, lambda: _read_set(self, F, reads))
+        return self.read_sets.kept(key, lambda: make_read_set(self, F, reads))
 
     def rim_solve(self, f: np.ndarray) -> np.ndarray:
         """K_rr^-1 f [m] for loads f (n_interior, k) [N]; the last `SOLVES_KEPT` results are
         kept by the loads' bytes (every web of the rim solves its teeth's reference loads)."""
         return self.solves.kept(digest(f), lambda: self.model.solve(f))
-
-
-@dataclass
-class ReadSet:
-    """The rim's part of per-column reads (`RimBlock.read_set`): for each load column j, the
-    rows ``rows[j]`` of the interface-last factorisation's U11 that its reads depend on (sorted,
-    closed under U11's graph), the forward solution s_j = L11^-1 Pr1 f_j on them, and where in
-    them each read lies; and B = K_ir K_rr^-1 F of the module doc."""
-
-    rows: list            # k arrays: U11 positions of column j's restricted back-substitution
-    s: list               # k arrays: L11^-1 Pr1 f_j on ``rows[j]`` (U11 w = s gives w in m)
-    at: list              # k arrays: position in ``rows[j]`` of each of column j's reads
-    B: np.ndarray         # (n_i, k) K_ir K_rr^-1 F [N]
-
-
-def _closed_block(T, rows: np.ndarray):
-    """T[rows][:, rows] (CSC) of a lower-triangular T (CSC) whose ``rows`` (sorted) are closed
-    under its graph (every entry of those columns lies in those rows): a column slice and a
-    renumbering, not a row search through all of T."""
-    import scipy.sparse as sp
-    sub = T[:, rows]
-    inv = np.full(T.shape[0], -1, np.int64)
-    inv[rows] = np.arange(rows.size)
-    return sp.csc_matrix((sub.data, inv[sub.indices], sub.indptr), shape=(rows.size, rows.size))
-
-
-def _read_set(rim: RimBlock, F, reads: list) -> ReadSet:
-    """`ReadSet` of the loads F (n_interior, k; CSC) and reads (k arrays of rim interior indices)."""
-    from solver.fe.factor import _lower_solve, _reach
-    if rim.split is None:           # a rim whose S_R was read from a cache
-        rim.make_split()
-    sp_ = rim.split
-    n = sp_["n"]
-    if "L21c" not in sp_:
-        sp_["L21c"] = sp_["L21"].tocsc()
-    L11, Ut11, L21 = sp_["L11"], sp_["Ut11"], sp_["L21c"]
-    pr1, pc1 = sp_["pr"][:n], sp_["pc"][:n]
-    inv_order = np.empty(n, np.int64)
-    inv_order[sp_["order"]] = np.arange(n)
-    to_row = pr1[inv_order]                   # rim interior index -> row of Pr1 f
-    to_col = pc1[inv_order]                   # rim interior index -> U11 position of its unknown
-    prb = sp_["pr"][n:] - n
-    B = np.zeros((rim.n_interface, F.shape[1]))
-    rows, s, at = [], [], []
-    for j in range(F.shape[1]):
-        loaded = F.indices[F.indptr[j]:F.indptr[j + 1]]
-        fwd = np.flatnonzero(_reach(L11, to_row[loaded]))
-        b = np.zeros(n)
-        b[to_row[loaded]] = F.data[F.indptr[j]:F.indptr[j + 1]]
-        y = _lower_solve(_closed_block(L11, fwd), b[fwd, None], 1)[:, 0]
-        B[:, j] = (L21[:, fwd] @ y)[prb]
-        read = to_col[np.asarray(reads[j], np.int64)]
-        back = np.flatnonzero(_reach(Ut11, read))
-        full = np.zeros(n)
-        full[fwd] = y
-        rows.append(back)
-        s.append(full[back])
-        at.append(np.searchsorted(back, read))
-    return ReadSet(rows, s, at, B)
 
 
 def rim_block(mesh: BodyMesh, face_width: float, material: Material, r_interface: float,
@@ -307,15 +250,15 @@ class CondensedBody:
         u[self.pos_r] = y - rim.model.solve(np.ascontiguousarray(rim.K_ri @ u_i))
         return u[:, 0] if vec else u
 
-    def column_reads(self, f: np.ndarray, reads: list) -> list:
-        """Column j of K_ff^-1 f (f (n_free, k) [N]) at the body free positions ``reads[j]``
-        [m], for each j: the full solve's numbers (to rounding) at a fraction of its cost where
-        the loads lie in the teeth and rim and each column reads a few DOFs there (see the
-        module doc). Loads or reads elsewhere (web, interface loads): the full solve."""
+    def column_reads(self, f, reads: list) -> list:
+        """Column j of K_ff^-1 f (f (n_free, k) [N], dense or sparse) at the body free positions
+        ``reads[j]`` [m], for each j: the full solve's numbers (to rounding) at a fraction of its
+        cost where the loads lie in the teeth and rim and each column reads a few DOFs there (see
+        the module doc). Loads or reads elsewhere (web, interface loads): the full solve."""
         import scipy.sparse as sp
         from scipy.sparse.linalg import spsolve_triangular
 
-        f = np.asarray(f, float).reshape(f.shape[0], -1)
+        f = f.tocsc() if sp.issparse(f) else np.asarray(f, float).reshape(f.shape[0], -1)
         reads = [np.asarray(r, np.int64) for r in reads]
         rim = self.rim
         if self._to_rim is None:
@@ -325,7 +268,7 @@ class CondensedBody:
         fs = sp.csc_matrix(f)
         in_rim = all(np.all(self._to_rim[r] >= 0) for r in reads) and np.all(self._to_rim[fs.indices] >= 0)
         if not in_rim:
-            u = self.solve(f)
+            u = self.solve(fs.toarray())
             return [u[r, j] for j, r in enumerate(reads)]
         F_r = sp.csc_matrix((fs.data, self._to_rim[fs.indices], fs.indptr), shape=(self.pos_r.size, f.shape[1]))
         F_r.sort_indices()
@@ -358,52 +301,6 @@ class CondensedBody:
         X = self.schur_solve(B)
         with one_blas_thread():
             return G0 + A @ X
-
-
-def rim_products(rim: RimBlock, R, F, key) -> tuple:
-    """(G0, A, B) of the module doc for reads R (m, N_R) and loads F (N_R, k) on the rim's
-    interior DOFs, kept in ``rim.products[key]``. With Pr Kp Pc = L U the interface-last
-    factorisation (`rim_block`), y = L11^-1 Pr1 F and z = U11^-T (R Pc1)^T:
-
-        G0 = z^T y,   B = Pr_b^T L21 y,   A = z^T U12 Pc_b^T,
-
-    each triangular solve restricted to the DOFs the loads (reads) reach (`solver.fe.factor`)."""
-    import scipy.sparse as sp
-
-    from solver.fe.factor import _lower_solve, _reach
-    if key in rim.products:
-        return rim.products[key]
-    if rim.split is None:           # a rim whose S_R was read from a cache
-        rim.make_split()
-    sp_ = rim.split
-    free, n = rim.model.free, sp_["n"]
-    F = sp.csr_matrix(F)
-    R = sp.csr_matrix(R)
-    on_iface = np.zeros(rim.model.basis.N, bool)
-    on_iface[rim.interface] = True
-    if np.any(on_iface[F.nonzero()[0]]) or np.any(on_iface[R.nonzero()[1]]):
-        raise ValueError("loads or reads on the rim's interface with the web: condense a deeper rim")
-    order = sp_["order"]
-    pr1, pc1 = sp_["pr"][:n], sp_["pc"][:n]
-    Ff = F[free][order]                                           # (n, k) in Kp's interior order
-    Rt = sp.csr_matrix(R[:, free][:, order].T)                    # (n, m)
-    inv_c = np.empty(n, dtype=np.int64)
-    inv_c[pc1] = np.arange(n)
-    b_f = Ff[np.argsort(pr1)]                                     # Pr1 F
-    b_r = Rt[inv_c]                                               # (R Pc1)^T
-    L11, Ut11 = sp_["L11"], sp_["Ut11"]
-    reach = (_reach(L11, pr1[np.flatnonzero(np.diff(Ff.indptr))])
-             | _reach(Ut11, pc1[np.flatnonzero(np.diff(Rt.indptr))]))
-    S = np.flatnonzero(reach)
-    y = _lower_solve(L11[S][:, S], b_f[S].toarray(), 48)
-    z = _lower_solve(Ut11[S][:, S], b_r[S].toarray(), 48)
-    prb, pcb = sp_["pr"][n:] - n, sp_["pc"][n:] - n
-    with one_blas_thread():
-        G0 = z.T @ y
-    B = (sp_["L21"][:, S] @ y)[prb]
-    A = (sp_["U12"][S].T @ z).T[:, pcb]
-    rim.products[key] = (G0, A, B)
-    return rim.products[key]
 
 
 def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material,
@@ -458,6 +355,9 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     K_ww = K_W[web_free][:, web_free].tocsc()
     K_wi = K_W[web_free][:, body_i].tocsr()
     S = rim.S + K_W[body_i][:, body_i].toarray()
+    # the Cholesky factorisation below reads the lower triangle of 0.5 (S + S^T) only: where
+    # S_R + K_ii^W is exactly symmetric (as assembled) that is S - tril(W) itself, bit for bit
+    S_t = None if np.array_equal(S, S.T) else S.T.copy()
     t1, c1 = time.perf_counter(), time.process_time()
     web_solve = None
     if web_free.size:
@@ -465,13 +365,18 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
         web_solve = blas1_solver(lu_w)
         # K_iw K_ww^-1 K_wi by a triangular solve restricted to the web DOFs the interface
         # reaches and a symmetric product (two solves and a general product if not symmetric)
-        W = congruence(lu_w, K_wi)
+        W = Wt = congruence(lu_w, K_wi, lower=True)      # (W^T's lower triangle is W's)
         if W is None:
             web = BodyModel(mesh, _Size(web_free.size), None, np.arange(web_free.size), web_solve, material, factor=lu_w)
             W = influence(web, K_wi.T.tocsr(), K_wi)
+            Wt, S_t = W.T, S.T.copy() if S_t is None else S_t
         S -= W
+        if S_t is not None:
+            S_t -= Wt
+    if S_t is not None:
+        S = 0.5 * (S + S_t)
     with one_blas_thread():
-        schur = cho_factor(0.5 * (S + S.T), lower=True, check_finite=False)
+        schur = cho_factor(S, lower=True, check_finite=False)
     cb = CondensedBody(rim, pos_r, pos_i, pos_w, web_solve, K_wi if web_free.size else sp.csr_matrix((0, body_i.size)),
                        schur, free.size)
     t2, c2 = time.perf_counter(), time.process_time()

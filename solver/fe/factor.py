@@ -131,7 +131,7 @@ def influence(model, R, F, block: int = 48) -> np.ndarray:
         return z.T @ y
 
 
-def congruence(lu, C, block: int = 48) -> np.ndarray | None:
+def congruence(lu, C, block: int = 48, lower: bool = False) -> np.ndarray | None:
     """C^T K^-1 C (k, k), dense, for the SPD K factorised by `factorise` (``lu``) and C (n, k)
     sparse (the condensation of a block onto the DOFs C couples to: [N/m] for stiffness).
 
@@ -142,7 +142,9 @@ def congruence(lu, C, block: int = 48) -> np.ndarray | None:
 
     one triangular solve (restricted to the rows C reaches, as in `influence`) and one
     symmetric rank-k product: about half the work of `influence`'s two solves and general
-    product. None where the factorisation is not of that form (then use `influence`)."""
+    product. None where the factorisation is not of that form (then use `influence`).
+    ``lower``: only the lower triangle (the upper one zero), for a caller that reads no more
+    (a Cholesky factorisation), without the copies that fill the upper one."""
     import scipy.sparse as sp
     from scipy.linalg.blas import dsyrk
 
@@ -159,6 +161,8 @@ def congruence(lu, C, block: int = 48) -> np.ndarray | None:
     Y *= (1.0 / np.sqrt(d[S]))[:, None]              # D^-1/2 Y
     with one_blas_thread():                          # the same bits whatever the process's BLAS threads
         W = dsyrk(1.0, Y.T, lower=1)                 # Y^T Y, lower triangle (Y.T: Fortran order, no copy)
+    if lower:
+        return W                                     # (dsyrk leaves the upper triangle zero)
     return np.tril(W) + np.tril(W, -1).T
 
 

@@ -160,15 +160,29 @@ class StrengthSites:
         return np.unique(np.concatenate(parts)) if parts else np.empty(0, np.int64)
 
 
-def strength_sites(points: np.ndarray, triangles: np.ndarray, region: np.ndarray, root_radius: float,
-                   form_radius: float, rim_radius: float, web_inner_radius: float, bore_radius: float,
+@dataclass(frozen=True)
+class SiteRadii:
+    """The radii [m] that place a body's strength sites: the gear's root and form circles, where
+    the web meets the rim (``rim``), where it meets the hub or the bore (``web_inner``), and
+    the bore."""
+
+    root: float
+    form: float
+    rim: float
+    web_inner: float
+    bore: float
+
+
+def strength_sites(points: np.ndarray, triangles: np.ndarray, region: np.ndarray, radii: SiteRadii,
                    teeth: int) -> StrengthSites:
     """`StrengthSites` of a body mesh (points (n, 2) [m], triangles (m, 3), region of each
-    triangle, `solver.fe.mesh`), from the gear's root and form radii, the radius where the web
-    meets the rim (``rim_radius``), where it meets the hub or the bore (``web_inner_radius``),
-    the bore and the tooth count. Shape-agnostic: the openings are the web's free edges."""
+    triangle, `solver.fe.mesh`), from its `SiteRadii` and the tooth count. Shape-agnostic: the
+    openings are the web's free edges."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
+
+    root_radius, form_radius, rim_radius = radii.root, radii.form, radii.rim
+    web_inner_radius, bore_radius = radii.web_inner, radii.bore
 
     r = np.hypot(points[:, 0], points[:, 1])
     edges, owner = boundary_edges(triangles)
@@ -244,7 +258,7 @@ def load_case_stress(model, op: StressOperator, teeth, rolls, load_vector) -> np
     """Stress per unit load (3 components, n_nodes, n_teeth, n_rolls) [Pa/N] at the nodes of
     ``op`` under a 1 N load on each of ``teeth`` at each roll parameter of ``rolls``;
     ``load_vector(tooth, roll)`` gives the nodal forces of that load [N] (e.g. the flank load
-    of `solver.fe.ltca.flank_load_vector`, whose patch moves continuously with the roll). One
+    of `solver.fe.flank_compliance.flank_load_vector`, whose patch moves continuously with the roll). One
     block of right-hand sides per roll through the body's one factorisation."""
     teeth = [int(t) for t in teeth]
     out = np.empty((3, op.nodes.size, len(teeth), len(rolls)))

@@ -7,7 +7,7 @@ named by `FECache.key` of everything the result depends on:
   JSON attribute) and the largest fillet stress of each tooth under the same load
   (``root_stress`` [Pa]; a file written before it was stored lacks it: the map is then
   recomputed when the stress is asked for);
-* ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.ltca.BodyCompliance`);
+* ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.flank_compliance.BodyCompliance`);
 * ``fields-{key}.npz``: a body's FE fields under the load on a few teeth (mesh, displacement,
   von Mises stress: `solver.fe.body.BodyField`), for the renders of an archive.
 * ``rim-{key}.npz``: the teeth and rim of one rim height condensed onto the web
@@ -134,7 +134,7 @@ class FECache:
     def read_compliance(self, key: str):
         """The `BodyCompliance` of ``key`` from memory or disk, or None."""
         def load(path):
-            from solver.fe.ltca import BodyCompliance
+            from solver.fe.flank_compliance import BodyCompliance
             with np.load(path) as d:
                 return BodyCompliance(d["u"], d["read"], d["load"], d["g"], bool(d["symmetric"]), int(d["teeth"]))
         return self._read(self.compliance, key, f"ltca-{key}.npz", load)

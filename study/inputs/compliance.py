@@ -4,7 +4,7 @@ read.
 
 `gear_compliance(setup, teeth, spread)` meshes, assembles and factorises the gear's body (same
 mesh size and load patch as the tooth springs of `study.inputs.springs`) and computes its
-`solver.fe.ltca.BodyCompliance` on a roll-parameter grid along the drive flanks. Results are
+`solver.fe.flank_compliance.BodyCompliance` on a roll-parameter grid along the drive flanks. Results are
 kept by `study.inputs.cache.FE_CACHE` in memory and on disk (``ltca-{key}.npz``, the key made of
 the gear setup's settings, the load and read teeth, the grid and `LTCA_VERSION`); the factorised
 bodies stay in memory for other load sets of the same body.
@@ -36,7 +36,7 @@ def compliance_key(setup: GearSetup, teeth: list, spread: int, u: np.ndarray) ->
 def compliance_cached(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFILE_POINTS,
                       u: np.ndarray | None = None) -> bool:
     """True when the compliance `gear_compliance` would compute is in the cache (memory or disk)."""
-    from solver.fe.ltca import profile_grid
+    from solver.fe.flank_compliance import profile_grid
     key, _, _ = compliance_key(setup, teeth, spread, profile_grid(setup.geometry, n_u) if u is None else u)
     return key in FE_CACHE.compliance or (FE_CACHE.folder / f"ltca-{key}.npz").exists()
 
@@ -47,7 +47,7 @@ def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFI
     read at offsets -spread..spread; a lightened body: every tooth in ``teeth`` loaded and read.
     ``u``: the roll grid (default: ``n_u`` points from the form circle to the tip). ``info``:
     mesh size [m], whether it came from the cache, wall and CPU times [s] of each stage."""
-    from solver.fe.ltca import body_compliance, profile_grid
+    from solver.fe.flank_compliance import FlankLoads, body_compliance, profile_grid
 
     geo = setup.geometry
     symmetric = not setup.lightened
@@ -61,7 +61,7 @@ def gear_compliance(setup: GearSetup, teeth: list, spread: int, n_u: int = PROFI
     stages = {}              # wall and CPU seconds of each stage (CPU: all threads of the process)
     model = factorised_body(setup, stages)
     rim, pkey = _rim_products(model, u, load, read, setup.patch)
-    c = body_compliance(model, geo, u, load, read, setup.patch, symmetric_body=symmetric, timings=stages)
+    c = body_compliance(model, geo, FlankLoads(u, load, read, setup.patch, symmetric), timings=stages)
     if rim is not None and pkey in rim.products and not (FE_CACHE.folder / f"{_products_file(rim, pkey)}.npz").exists():
         G0, A, B = rim.products[pkey]
         FE_CACHE.write_arrays(_products_file(rim, pkey), G0=G0, A=A, B=B)
@@ -78,7 +78,7 @@ def _products_file(rim, pkey: str) -> str:
 def _rim_products(model, u, load, read, patch) -> tuple:
     """(rim, load-set key) of a condensed body, the rim's products of the load set read from
     disk into it when stored there; (None, None) for a body factorised whole."""
-    from solver.fe.ltca import products_key
+    from solver.fe.flank_compliance import products_key
     cb = model.condensed
     if cb is None or not cb.rim.key:
         return None, None
@@ -120,9 +120,10 @@ def factorised_body(setup: GearSetup, stages: dict | None = None):
                 if rim is not None:        # only the web is meshed, and joined to the kept rim
                     whole = join_rim(rim, mesh(rim=False))
                 else:
-                    whole = mesh()
-                    rim = condensed_rim(setup, whole)
-                    whole = join_rim(rim, whole)      # numbered as any later body of this rim
+                    rim = condensed_rim(setup, mesh())
+                    # the web meshed alone, as for every later body of this rim (the whole
+                    # body's web has other node numbers in gmsh, and so other triangles)
+                    whole = join_rim(rim, mesh(rim=False))
                 t1, c1 = time.perf_counter(), time.process_time()    # a rim's own cost is not the body's
                 model = assemble_condensed(whole, geo.spec.face_width, body.web_thickness, setup.material, rim)
             except RimMismatch:

@@ -85,9 +85,9 @@ def _compute(setup: GearSetup, teeth: np.ndarray, rolls: np.ndarray) -> BodyStre
     import scipy.sparse as sp
 
     from solver.fe.body import load_case, plane_stress_lame
-    from solver.fe.ltca import flank_load_vector
+    from solver.fe.flank_compliance import flank_load_vector
     from solver.fe.mesh import REGION_RIM, REGION_WEB
-    from solver.fe.stress import LIGAMENT_KINDS, StressOperator, load_case_stress, strength_sites, stress_operator
+    from solver.fe.stress import LIGAMENT_KINDS, SiteRadii, StressOperator, load_case_stress, strength_sites, stress_operator
     from solver.geometry import bore_radius
     from study.inputs.compliance import factorised_body
 
@@ -95,8 +95,8 @@ def _compute(setup: GearSetup, teeth: np.ndarray, rolls: np.ndarray) -> BodyStre
     model = factorised_body(setup)
     mesh = model.mesh
     r_rim = g.root_radius - body.rim_height
-    sites = strength_sites(mesh.points, mesh.triangles, mesh.region, g.root_radius, g.form_radius, r_rim,
-                           r_rim - body.web_height, bore_radius(g, body), g.teeth)
+    radii = SiteRadii(g.root_radius, g.form_radius, r_rim, r_rim - body.web_height, bore_radius(g, body))
+    sites = strength_sites(mesh.points, mesh.triangles, mesh.region, radii, g.teeth)
     lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
     web = sites.web
     ops = [stress_operator(model.basis, lam, mu, sites.root, mesh.region == REGION_RIM),

@@ -78,7 +78,7 @@ def fe_jobs(scene: Scene) -> list[tuple[str, object, tuple]]:
     compliance model a `compute_body` per gear whose spring map or compliance is missing (key
     ``body-`` + the compliance's cache key) and a `compute_map` per missing solid reference.
     [] when the scene cannot be prepared (its task reports why) or for the body-torsion model."""
-    from solver.fe.ltca import profile_grid
+    from solver.fe.flank_compliance import profile_grid
     from study.inputs.compliance import PROFILE_POINTS, compliance_cached, compliance_key
     from study.inputs.gearsetup import gear_setups
     from study.inputs.springs import uses_fe_springs

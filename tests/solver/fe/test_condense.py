@@ -174,7 +174,8 @@ def test_column_reads_equal_the_whole_body_solve(ring):
 def test_congruence_equals_the_solves(ring):
     """C^T K^-1 C by one restricted solve and a symmetric product (`factor.congruence`, the
     web's condensation onto the interface) equals C^T times the full solves of C, and is
-    symmetric."""
+    symmetric; its lower triangle alone (what the Cholesky of the condensed body reads) is
+    the full result's to the bit, the upper one zero."""
     from solver.fe.factor import congruence
     mesh, _ = ring
     whole = fe.assemble(mesh, T_RIM, 0.008, STEEL)
@@ -184,3 +185,5 @@ def test_congruence_equals_the_solves(ring):
     ref = C.T @ whole.solve(C.toarray())
     assert W is not None and np.array_equal(W, W.T)
     assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
+    lower = congruence(whole.factor, C, lower=True)
+    assert np.array_equal(lower, np.tril(W)) and not np.triu(lower, 1).any()

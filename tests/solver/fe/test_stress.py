@@ -165,9 +165,9 @@ def test_openings_of_any_shape_and_their_ligaments_come_from_the_mesh():
     web's inner interfaces are not openings), ligaments to the rim 24 - |corner| =
     24 - hypot(20, 3) mm, to the hub 14 - 10 = 4 mm, between windows sqrt(2) (14 - 3) mm corner
     to corner, within the element size's chord error."""
-    from solver.fe.stress import LIGAMENT_KINDS, strength_sites
+    from solver.fe.stress import LIGAMENT_KINDS, SiteRadii, strength_sites
     m = window_body()
-    sites = strength_sites(m.points, m.triangles, m.region, 29.999e-3, 30.001e-3, 24e-3, 10e-3, 6e-3, 4)
+    sites = strength_sites(m.points, m.triangles, m.region, SiteRadii(29.999e-3, 30.001e-3, 24e-3, 10e-3, 6e-3), 4)
     assert len(sites.openings) == 4
     for o in sites.openings:                       # each loop lies on its window's edges
         r = np.hypot(*m.points[o].T)

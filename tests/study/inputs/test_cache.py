@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from solver.fe.body import BodyField
-from solver.fe.ltca import BodyCompliance
+from solver.fe.flank_compliance import BodyCompliance
 from study.inputs.cache import FE_CACHE
 
 

@@ -31,11 +31,21 @@ def _inputs(setup):
 
 
 def test_condensed_inputs_equal_the_whole_body(monkeypatch, tmp_path):
+    """The condensed body solves as the whole-body factorisation of its own (joined) mesh to
+    rounding; against the body meshed whole (whose web gmsh triangulates a little otherwise)
+    within the mesh's own scatter, far inside the FE tolerances (0.5 % stiffness)."""
+    from solver.fe import body as fe
     bodies = [small_scene(), small_scene(**{"gear2.body.holes": 0, "gear2.body.web_thickness": 5.0})]
     got = []
     for scene in bodies:
-        got.append(_inputs(gear_setup(scene, 2)))
-        assert FE_CACHE.bodies and list(FE_CACHE.bodies.values())[-1].condensed is not None
+        setup = gear_setup(scene, 2)
+        got.append(_inputs(setup))
+        model = list(FE_CACHE.bodies.values())[-1]
+        assert model.condensed is not None
+        same_mesh = fe.assemble(model.mesh, setup.geometry.spec.face_width, setup.body.web_thickness, setup.material)
+        k_whole, _ = fe.tooth_stiffness(same_mesh, setup.geometry, setup.pivot_radius, range(setup.teeth),
+                                        setup.force, setup.patch)
+        assert np.abs(got[-1][0] / k_whole - 1).max() < 1e-9
     assert len(FE_CACHE.rims) == 1                          # both webs on one rim
     assert len(list((tmp_path / "cache" / "fe").glob("rim-*.npz"))) == 2   # its S_R and one load set
     monkeypatch.setattr(compliance, "CONDENSE", False)
@@ -45,9 +55,9 @@ def test_condensed_inputs_equal_the_whole_body(monkeypatch, tmp_path):
                 f.unlink()
         k0, s0, g0 = _inputs(gear_setup(scene, 2))
         assert list(FE_CACHE.bodies.values())[-1].condensed is None
-        assert np.abs(k / k0 - 1).max() < 1e-9
-        assert np.abs(s / s0 - 1).max() < 1e-9
-        assert np.abs(g - g0).max() < 1e-9 * np.abs(g0).max()
+        assert np.abs(k / k0 - 1).max() < 1e-5
+        assert np.abs(s / s0 - 1).max() < 1e-5
+        assert np.abs(g - g0).max() < 1e-5 * np.abs(g0).max()
 
 
 def test_a_rim_read_from_disk_gives_the_same_inputs_and_another_rim_height_its_own(tmp_path):

@@ -1,0 +1,118 @@
+"""Restricted triangular solves through a condensed rim's interface-last factorisation
+(`solver.fe.condense.RimBlock.make_split`): the rim's part of a body's influence coefficients
+(`rim_products`: G0, A, B) and of its per-column reads (`make_read_set`), each made once per rim and
+load set and shared by every web of the rim. Each solve runs only over the rows the loads (the
+reads) reach through the factors' graphs (`solver.fe.factor`). Units: SI (m, N, N/m).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.fe.factor import _lower_solve, _reach, one_blas_thread
+
+
+@dataclass
+class ReadSet:
+    """The rim's part of per-column reads (`RimBlock.read_set`): for each load column j, the
+    rows ``rows[j]`` of the interface-last factorisation's U11 that its reads depend on (sorted,
+    closed under U11's graph), the forward solution s_j = L11^-1 Pr1 f_j on them, and where in
+    them each read lies; and B = K_ir K_rr^-1 F of the module doc."""
+
+    rows: list            # k arrays: U11 positions of column j's restricted back-substitution
+    s: list               # k arrays: L11^-1 Pr1 f_j on ``rows[j]`` (U11 w = s gives w in m)
+    at: list              # k arrays: position in ``rows[j]`` of each of column j's reads
+    B: np.ndarray         # (n_i, k) K_ir K_rr^-1 F [N]
+
+
+def _closed_block(T, rows: np.ndarray):
+    """T[rows][:, rows] (CSC) of a lower-triangular T (CSC) whose ``rows`` (sorted) are closed
+    under its graph (every entry of those columns lies in those rows): a column slice and a
+    renumbering, not a row search through all of T."""
+    import scipy.sparse as sp
+    sub = T[:, rows]
+    inv = np.full(T.shape[0], -1, np.int64)
+    inv[rows] = np.arange(rows.size)
+    return sp.csc_matrix((sub.data, inv[sub.indices], sub.indptr), shape=(rows.size, rows.size))
+
+
+def make_read_set(rim, F, reads: list) -> ReadSet:
+    """`ReadSet` of the loads F (n_interior, k; CSC) and reads (k arrays of rim interior
+    indices) on the rim interior of ``rim`` (a `solver.fe.condense.RimBlock`)."""
+    if rim.split is None:           # a rim whose S_R was read from a cache
+        rim.make_split()
+    sp_ = rim.split
+    n = sp_["n"]
+    if "L21c" not in sp_:
+        sp_["L21c"] = sp_["L21"].tocsc()
+    L11, Ut11, L21 = sp_["L11"], sp_["Ut11"], sp_["L21c"]
+    pr1, pc1 = sp_["pr"][:n], sp_["pc"][:n]
+    inv_order = np.empty(n, np.int64)
+    inv_order[sp_["order"]] = np.arange(n)
+    to_row = pr1[inv_order]                   # rim interior index -> row of Pr1 f
+    to_col = pc1[inv_order]                   # rim interior index -> U11 position of its unknown
+    prb = sp_["pr"][n:] - n
+    B = np.zeros((rim.n_interface, F.shape[1]))
+    rows, s, at = [], [], []
+    for j in range(F.shape[1]):
+        loaded = F.indices[F.indptr[j]:F.indptr[j + 1]]
+        fwd = np.flatnonzero(_reach(L11, to_row[loaded]))
+        b = np.zeros(n)
+        b[to_row[loaded]] = F.data[F.indptr[j]:F.indptr[j + 1]]
+        y = _lower_solve(_closed_block(L11, fwd), b[fwd, None], 1)[:, 0]
+        B[:, j] = (L21[:, fwd] @ y)[prb]
+        read = to_col[np.asarray(reads[j], np.int64)]
+        back = np.flatnonzero(_reach(Ut11, read))
+        full = np.zeros(n)
+        full[fwd] = y
+        rows.append(back)
+        s.append(full[back])
+        at.append(np.searchsorted(back, read))
+    return ReadSet(rows, s, at, B)
+
+
+def rim_products(rim, R, F, key) -> tuple:
+    """(G0, A, B) of the module doc for reads R (m, N_R) and loads F (N_R, k) on the rim's
+    interior DOFs, kept in ``rim.products[key]``. With Pr Kp Pc = L U the interface-last
+    factorisation (`rim_block`), y = L11^-1 Pr1 F and z = U11^-T (R Pc1)^T:
+
+        G0 = z^T y,   B = Pr_b^T L21 y,   A = z^T U12 Pc_b^T,
+
+    each triangular solve restricted to the DOFs the loads (reads) reach (`solver.fe.factor`);
+    ``rim``: a `solver.fe.condense.RimBlock`."""
+    import scipy.sparse as sp
+
+    if key in rim.products:
+        return rim.products[key]
+    if rim.split is None:           # a rim whose S_R was read from a cache
+        rim.make_split()
+    sp_ = rim.split
+    free, n = rim.model.free, sp_["n"]
+    F = sp.csr_matrix(F)
+    R = sp.csr_matrix(R)
+    on_iface = np.zeros(rim.model.basis.N, bool)
+    on_iface[rim.interface] = True
+    if np.any(on_iface[F.nonzero()[0]]) or np.any(on_iface[R.nonzero()[1]]):
+        raise ValueError("loads or reads on the rim's interface with the web: condense a deeper rim")
+    order = sp_["order"]
+    pr1, pc1 = sp_["pr"][:n], sp_["pc"][:n]
+    Ff = F[free][order]                                           # (n, k) in Kp's interior order
+    Rt = sp.csr_matrix(R[:, free][:, order].T)                    # (n, m)
+    inv_c = np.empty(n, dtype=np.int64)
+    inv_c[pc1] = np.arange(n)
+    b_f = Ff[np.argsort(pr1)]                                     # Pr1 F
+    b_r = Rt[inv_c]                                               # (R Pc1)^T
+    L11, Ut11 = sp_["L11"], sp_["Ut11"]
+    reach = (_reach(L11, pr1[np.flatnonzero(np.diff(Ff.indptr))])
+             | _reach(Ut11, pc1[np.flatnonzero(np.diff(Rt.indptr))]))
+    S = np.flatnonzero(reach)
+    y = _lower_solve(L11[S][:, S], b_f[S].toarray(), 48)
+    z = _lower_solve(Ut11[S][:, S], b_r[S].toarray(), 48)
+    prb, pcb = sp_["pr"][n:] - n, sp_["pc"][n:] - n
+    with one_blas_thread():
+        G0 = z.T @ y
+    B = (sp_["L21"][:, S] @ y)[prb]
+    A = (sp_["U12"][S].T @ z).T[:, pcb]
+    rim.products[key] = (G0, A, B)
+    return rim.products[key]
