@@ -18,7 +18,7 @@ from solver.geometry import BodySpec, GearGeometry, Material, ToothSpec, body_se
 from study.inputs.cache import FE_CACHE
 from study.scene import Scene, SpringSection
 
-FE_VERSION = "1"   # bump when the FE model or the stiffness definition changes (it is in every key)
+FE_VERSION = "3"   # bump when the FE model or the stiffness definition changes (it is in every key); 3: rims condensed from a body of their own
 
 
 @dataclass(frozen=True)
