@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 
+from solver.body import BodySpec
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup
 
@@ -115,15 +116,9 @@ def factorised_body(setup: GearSetup, stages: dict | None = None):
         whole, model = None, None
         has_web = body.web_height > 0 or body.hub_height > 0
         if CONDENSE and has_web:
-            rim = FE_CACHE.rims.get(rim_key(setup))
-            try:
-                if rim is not None:        # only the web is meshed, and joined to the kept rim
-                    whole = join_rim(rim, mesh(rim=False))
-                else:
-                    rim = condensed_rim(setup, mesh())
-                    # the web meshed alone, as for every later body of this rim (the whole
-                    # body's web has other node numbers in gmsh, and so other triangles)
-                    whole = join_rim(rim, mesh(rim=False))
+            try:        # the rim of this rim height (kept, read from disk or condensed), the web meshed alone
+                rim = condensed_rim(setup)
+                whole = join_rim(rim, mesh(rim=False))
                 t1, c1 = time.perf_counter(), time.process_time()    # a rim's own cost is not the body's
                 model = assemble_condensed(whole, geo.spec.face_width, body.web_thickness, setup.material, rim)
             except RimMismatch:
@@ -142,7 +137,7 @@ def factorised_body(setup: GearSetup, stages: dict | None = None):
 
 
 CONDENSE = True         # solve bodies with a web or hub through their condensed teeth and rim
-RIM_VERSION = "1"       # bump when the condensation changes (it is in every rim key)
+RIM_VERSION = "2"       # bump when the condensation changes (it is in every rim key); 2: condensed from `rim_source`
 
 
 def rim_key(setup: GearSetup) -> str:
@@ -153,17 +148,24 @@ def rim_key(setup: GearSetup) -> str:
                          "size": st["size"], "grading": setup.mesh_grading, "version": st["version"], "rim": RIM_VERSION})
 
 
-def condensed_rim(setup: GearSetup, mesh):
-    """The gear's teeth and rim condensed onto the web (`solver.fe.condense.RimBlock`), from
-    the teeth-and-rim elements of ``mesh`` (a body mesh of the gear), kept by `FE_CACHE` in
-    memory and, its condensed stiffness and its mesh, on disk (``rim-{key}.npz``).
+def rim_source(setup: GearSetup) -> BodySpec:
+    """The body a rim is condensed from: the gear's teeth and rim over a plain hub down to half
+    the rim's inner radius, made of the rim key's content alone. Two bodies' meshes hold the same
+    rim elements, but gmsh places their nodes a few 1e-15 m apart (1e-13 in a body's stiffness
+    and root stress): condensed from whichever body asked first, a body's bits would depend on
+    the order the bodies of its rim were computed in."""
+    r_in = setup.geometry.root_radius - setup.body.rim_height
+    return BodySpec(rim_height=setup.body.rim_height, web_height=0.0, hub_height=0.5 * r_in,
+                    web_thickness=setup.geometry.spec.face_width)
 
-    A rim read from disk keeps the stored mesh, not the rim elements of ``mesh``: two bodies'
-    meshes hold the same rim elements, but gmsh places their nodes a few 1e-15 m apart, which
-    moves the solves in the 13th digit; with the stored nodes every body of the rim gets the
-    same bits whichever body condensed it and whether in this process or another."""
+
+def condensed_rim(setup: GearSetup):
+    """The gear's teeth and rim condensed onto the web (`solver.fe.condense.RimBlock`), from the
+    mesh of `rim_source`, kept by `FE_CACHE` in memory and, its condensed stiffness and its mesh,
+    on disk (``rim-{key}.npz``): the same bits for every body of the rim, whichever came first,
+    in this process or another."""
     from solver.fe.condense import RimMismatch, rim_block
-    from solver.fe.mesh import BodyMesh
+    from solver.fe.mesh import BodyMesh, mesh_body
 
     key = rim_key(setup)
 
@@ -173,15 +175,14 @@ def condensed_rim(setup: GearSetup, mesh):
         stored = FE_CACHE.read_arrays(f"rim-{key}")
         if stored is not None:
             try:
-                own = mesh
-                if "points" in stored:      # the rim's own nodes, not this body's (see above)
-                    own = BodyMesh(stored["points"], stored["triangles"], stored["region"], mesh.bore_radius, mesh.size)
+                own = BodyMesh(stored["points"], stored["triangles"], stored["region"], 0.5 * r_if, setup.mesh_size)
                 rim = rim_block(own, geo.spec.face_width, setup.material, r_if, S=stored["S"])
                 if rim.keys.shape == stored["keys"].shape and np.allclose(rim.keys, stored["keys"], rtol=0, atol=1e-9):
                     rim.key = key
                     return rim
             except (RimMismatch, KeyError):
                 pass
+        mesh = mesh_body(geo, rim_source(setup), setup.mesh_size, prefix=f"{setup.prefix}.body", grading=setup.mesh_grading)
         rim = rim_block(mesh, geo.spec.face_width, setup.material, r_if)
         rim.key = key
         rm = rim.model.mesh

@@ -18,7 +18,9 @@ from solver.geometry import BodySpec, GearGeometry, Material, ToothSpec, body_se
 from study.inputs.cache import FE_CACHE
 from study.scene import Scene, SpringSection
 
-FE_VERSION = "2"   # bump when the FE model or the stiffness definition changes (it is in every key)
+# bump when the FE model or the stiffness definition changes (it is in every key); 2: the webs
+# meshed without the outline's 1D mesh; 3: rims condensed from a body of their own
+FE_VERSION = "3"
 
 
 @dataclass(frozen=True)
