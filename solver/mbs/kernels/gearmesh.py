@@ -57,6 +57,7 @@ from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
 from solver.mbs.kernels.contact import cross, flank_flank, moved_center, point_flank, tip_corner, wrap
 from solver.mbs.kernels.laws import contact_force, contact_tangent, series_contact, signed_pow, spring_tangent, spring_torque
+from solver.mbs.kernels.layout import contact_geo, contact_parts, new_contact_buffer  # noqa: F401 - plain Python
 
 # roll-parameter length [-] over which a modified tip corner blends into its flank (see above)
 TIP_BLEND = 1e-6
@@ -438,24 +439,3 @@ def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
 def tooth_spring_tangent(i, phi, kphi, gp):
     g = 0 if i < int(gp[1, L.TOOTH0]) else 1
     return spring_tangent(phi[i], kphi[i], gp[g, L.N_K])
-
-
-def contact_parts(gp, pp, lp):
-    """The `ContactParts` of the model arrays gear_par, pair_par, law_par: each part's array
-    where the model has the part (a gear with a flank deviation, a gear with a local
-    compliance table, the pitch-error block, a friction coefficient above zero), else None.
-    Plain Python: what it returns picks the compiled variant of the contact search."""
-    return L.ContactParts(gp if gp[0, L.DEV_ON] + gp[1, L.DEV_ON] > 0.0 else None,
-                          gp if gp[0, L.CLOC_ON] + gp[1, L.CLOC_ON] > 0.0 else None,
-                          pp if pp.shape[0] > L.N_PAIR_PAR else None,
-                          lp if lp[L.MU] > 0.0 else None)
-
-
-def contact_geo(gp, pp, lp):
-    """The contact search's ``geo`` = (gear_par, pair_par, law_par, `contact_parts`)."""
-    return gp, pp, lp, contact_parts(gp, pp, lp)
-
-
-def new_contact_buffer():
-    """Preallocated contact records and candidate-pair table."""
-    return np.zeros((L.MAX_CONTACTS, L.N_C_COLS)), np.zeros((L.MAX_CONTACTS, 3), dtype=np.int64)

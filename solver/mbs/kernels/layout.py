@@ -64,6 +64,8 @@ Glossary of the kernels' short names (SI units throughout):
 """
 from collections import namedtuple
 
+import numpy as np
+
 # gear_par columns
 RB = 0          # base radius [m]
 PSI_B = 1       # half tooth angle on the base circle [rad]
@@ -283,3 +285,26 @@ pitch errors and eccentricity (the pair_par block E_*), sliding friction (law_pa
 numba types a None apart from an array and prunes the branches under ``x is None`` (for an
 argument of the compiled function), so each combination compiles its own contact search with
 only the code it runs."""
+
+
+# ---------------------------------------------------------------- what the contact search is given (plain Python)
+
+def contact_parts(gp, pp, lp):
+    """The `ContactParts` of the model arrays gear_par, pair_par, law_par: each part's array
+    where the model has the part (a gear with a flank deviation, a gear with a local
+    compliance table, the pitch-error block, a friction coefficient above zero), else None.
+    Plain Python: what it returns picks the compiled variant of the contact search."""
+    return ContactParts(gp if gp[0, DEV_ON] + gp[1, DEV_ON] > 0.0 else None,
+                        gp if gp[0, CLOC_ON] + gp[1, CLOC_ON] > 0.0 else None,
+                        pp if pp.shape[0] > N_PAIR_PAR else None,
+                        lp if lp[MU] > 0.0 else None)
+
+
+def contact_geo(gp, pp, lp):
+    """The contact search's ``geo`` = (gear_par, pair_par, law_par, `contact_parts`)."""
+    return gp, pp, lp, contact_parts(gp, pp, lp)
+
+
+def new_contact_buffer():
+    """Preallocated contact records and candidate-pair table."""
+    return np.zeros((MAX_CONTACTS, N_C_COLS)), np.zeros((MAX_CONTACTS, 3), dtype=np.int64)
