@@ -26,7 +26,7 @@ def _helper_solves(model):
 
 
 def _imports_study_inside():
-    import study as api         # a name the test file's globals do not hold
+    import study as api  # a name the test file's globals do not hold
     return api.run_scene(load_scene("small_pair"))
 
 
@@ -87,3 +87,13 @@ def test_a_test_is_marked_by_what_it_reaches(function, fixtures, markers):
     item = _Item(function, fixtures)
     tiers.mark([item], pytest)
     assert sorted(item.markers) == markers
+
+
+def test_the_longest_files_make_test_hands_out_first_exist():
+    """A renamed or removed file in conftest's LONGEST_FIRST would silently go back to the usual order."""
+    from pathlib import Path
+
+    from conftest import LONGEST_FIRST
+    root = Path(__file__).resolve().parents[1]
+    assert len(set(LONGEST_FIRST)) == len(LONGEST_FIRST)
+    assert [f for f in LONGEST_FIRST if not (root / f).is_file()] == []
