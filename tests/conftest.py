@@ -10,7 +10,7 @@ import pytest  # noqa: E402
 import tiers  # noqa: E402
 from helpers import solid_scene  # noqa: E402
 
-# The test files that take longest from a fresh clone, longest first (CPU seconds measured on two
+# The test files that take longest from a fresh clone, about longest first (CPU seconds on two
 # shared cores: benchmarks/README.md, "Test tiers"). `make test` hands whole files to its two
 # processes in the order collected (``--no-loadscope-reorder``): these first, so that neither
 # process starts a long file while the other is nearly done; the rest follow in their usual order.
