@@ -8,7 +8,8 @@ export VTK_DEFAULT_OPENGL_WINDOW ?= vtkEGLRenderWindow
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.lightgear-cache/numba
 export MPLBACKEND ?= Agg
 # test processes (pytest-xdist): the suite's two halves on the two cores of a small machine, each
-# test file on one process (its module fixtures, built scenes and runs, made once)
+# test file on one process (its module fixtures, built scenes and runs, made once), handed out in
+# the order collected: the longest files first (tests/conftest.py LONGEST_FIRST)
 JOBS   ?= 2
 # the fast tier: tests/tiers.py marks each test by what it reaches (FE, solver, processes)
 FAST   := not (fe or solver or process or slow)
@@ -20,7 +21,7 @@ run: $(STAMP)
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check --quiet .
-	$(PY) -m pytest -q -n $(JOBS) --dist loadscope
+	$(PY) -m pytest -q -n $(JOBS) --dist loadscope --no-loadscope-reorder
 
 test-fast: $(STAMP)
 	$(PY) -m pytest -q -m "$(FAST)"

@@ -25,6 +25,21 @@ def _helper_solves(model):
     return solve_static(model, [0.0], 1.0)
 
 
+def _imports_study_inside():
+    import study as api  # a name the test file's globals do not hold
+    return api.run_scene(load_scene("small_pair"))
+
+
+def _imports_the_function_inside():
+    from study import run_scene
+    return run_scene(load_scene("small_pair"))
+
+
+def _imports_study_inside_and_loads_a_scene():
+    import study as api
+    return api.load_scene("small_pair").gear1.teeth
+
+
 def _calls_helper():
     return _helper_solves(None)
 
@@ -59,6 +74,9 @@ class _Item:
 @pytest.mark.parametrize("function, fixtures, markers", [
     (_pure, None, []),
     (_runs, None, ["solver"]),                            # study.run_scene -> study.run
+    (_imports_study_inside, None, ["solver"]),            # `import study` in the test itself
+    (_imports_the_function_inside, None, ["solver"]),     # `from study import run_scene`
+    (_imports_study_inside_and_loads_a_scene, None, []),
     (_calls_helper, None, ["solver"]),                    # through a helper of the test file
     (_starts_a_process, None, ["process"]),
     (_command_line, None, ["solver"]),                    # the command line runs whatever it is given
@@ -69,3 +87,13 @@ def test_a_test_is_marked_by_what_it_reaches(function, fixtures, markers):
     item = _Item(function, fixtures)
     tiers.mark([item], pytest)
     assert sorted(item.markers) == markers
+
+
+def test_the_longest_files_make_test_hands_out_first_exist():
+    """A renamed or removed file in conftest's LONGEST_FIRST would silently go back to the usual order."""
+    from pathlib import Path
+
+    from conftest import LONGEST_FIRST
+    root = Path(__file__).resolve().parents[1]
+    assert len(set(LONGEST_FIRST)) == len(LONGEST_FIRST)
+    assert [f for f in LONGEST_FIRST if not (root / f).is_file()] == []

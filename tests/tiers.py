@@ -17,7 +17,9 @@ call refer to, each resolved to the module that defines it (``study.X`` through 
 from __future__ import annotations
 
 import ast
+import collections
 import inspect
+import sys
 import textwrap
 import types
 
@@ -65,6 +67,25 @@ def _resolve(base, attribute: str | None):
     return getattr(base, "__module__", "") or "", base if _own(base) else None
 
 
+def _imported_here(tree) -> dict:
+    """The names the function's own imports bind (``import study`` inside a test) to the modules
+    and objects they name, as far as the process holds them already (nothing is imported here):
+    ``study.run_scene`` after a function-level ``import study`` reaches `study.run` as it does
+    after a module-level one."""
+    bound = {}
+    for node in ast.walk(tree):
+        for a in node.names if isinstance(node, ast.Import | ast.ImportFrom) else ():
+            if isinstance(node, ast.Import):
+                top = a.name if a.asname else a.name.split(".")[0]
+                if top in sys.modules:
+                    bound[a.asname or top] = sys.modules[top]
+            elif node.level == 0 and node.module in sys.modules:
+                value = vars(sys.modules[node.module]).get(a.name)     # not getattr: no lazy import
+                if value is not None:
+                    bound[a.asname or a.name] = value
+    return bound
+
+
 def _uses(function, seen: dict) -> set:
     """The markers a function of the tests reaches, through the names it uses."""
     function = inspect.unwrap(function)
@@ -76,12 +97,15 @@ def _uses(function, seen: dict) -> set:
         tree = ast.parse(textwrap.dedent(inspect.getsource(function)))
     except (OSError, TypeError, SyntaxError):
         return found
-    names = getattr(function, "__globals__", {})
+    names = collections.ChainMap(_imported_here(tree), getattr(function, "__globals__", {}))
     for node in ast.walk(tree):
         if isinstance(node, ast.Import | ast.ImportFrom):
             for a in node.names:
                 mod = a.name if isinstance(node, ast.Import) else f"{node.module or ''}.{a.name}"
-                if marker := _reached(mod):
+                offered = {}        # `from study import run_scene`: the module that does the work
+                if isinstance(node, ast.ImportFrom):
+                    offered = getattr(sys.modules.get(node.module or ""), "_OFFERED", {})
+                if marker := _reached(offered[a.name][0] if a.name in offered else mod):
                     found.add(marker)
             continue
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):

@@ -1,7 +1,9 @@
 """Every fenced block of the README and docs/ is code that works: Python blocks run in a
 temporary directory, TOML blocks load as the scene or study they show, and every command line
-of a shell block names a command and options that exist (the cheap ones run; the README's
-first run and study run in full, marked slow). Nothing in the repository points outside it."""
+of a shell block names a command and options that exist (the cheap ones run). Nothing in the
+repository points outside it. The blocks that take long run from files of their own, so that the
+two test processes of ``make test`` take them at once: the Python blocks in
+test_doc_python_blocks.py, the README's first run and study in test_doc_first_run.py."""
 from __future__ import annotations
 
 import math
@@ -79,37 +81,10 @@ def options_of(cmd: str) -> list[str]:
     return [t.split("=")[0] for t in cmd.replace("[", " ").replace("]", " ").split() if t.startswith("-")]
 
 
-# Python blocks that another test runs with checks of its results
-RUN_ELSEWHERE = {"README.md": "tests/study/test_api.py runs the README's first study and checks its numbers"}
-# Python blocks that wait for a fix of the code they document: strict xfail, so the fix shows up as a failure here
-# the blocks cheap enough to run on every test run (seconds); the others are slow
-CHEAP_PYTHON = {"docs/tolerance.md"}
-
-
 def test_every_block_says_what_it_holds():
     assert blocks(), "no fenced blocks found"
     unlabelled = [str(b) for b in blocks() if b.lang not in LANGUAGES]
     assert unlabelled == [], f"fenced blocks to label with one of the languages {sorted(LANGUAGES)}"
-
-
-def python_params():
-    out = []
-    for b in blocks("python"):
-        marks = []
-        if b.page not in CHEAP_PYTHON:
-            marks.append(pytest.mark.slow)
-        out.append(pytest.param(b, id=str(b), marks=marks))
-    return out
-
-
-@pytest.mark.parametrize("block", python_params())
-def test_a_python_block_runs_from_an_empty_directory(block, tmp_path, monkeypatch):
-    if block.page in RUN_ELSEWHERE:
-        from test_api import SCRIPT
-        assert block.text.strip() == SCRIPT.strip(), RUN_ELSEWHERE[block.page]
-        return
-    monkeypatch.chdir(tmp_path)
-    exec(compile(block.text, str(block), "exec"), {"__name__": "doc_block"})
 
 
 @pytest.mark.parametrize("block", [pytest.param(b, id=str(b)) for b in blocks("toml")])
@@ -177,22 +152,6 @@ def test_a_cheap_command_of_the_docs_runs(cmd, capsys):
     assert capsys.readouterr().out.strip()
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("section", ["## A first run", "## A first study"])
-def test_the_readme_commands_run_in_order(section, tmp_path, monkeypatch, capsys):
-    """Each command of a README section, as written, from an empty directory: exit 0."""
-    from study.cli import main
-    text = (ROOT / "README.md").read_text()
-    start = text.index(section)
-    block = next(b for b in blocks("sh") if b.page == "README.md" and b.line > text.count("\n", 0, start))
-    monkeypatch.chdir(tmp_path)
-    ran = []
-    for cmd in commands(block):
-        assert main(shlex.split(cmd)[1:]) == 0, cmd
-        ran.append(cmd)
-    assert ran and all(p.stat().st_size > 0 for p in (tmp_path / "results").glob("*.nc"))
-
-
 def tracked_files() -> list[Path]:
     out = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
     return [ROOT / f for f in out.splitlines()]
@@ -253,21 +212,3 @@ def test_the_runup_scene_names_the_critical_speeds_of_its_model():
     for order, value in said.items():
         assert abs(float(cs.sel(excitation=order)) - float(value)) < 1.0, order
     assert ds.attrs["coupling_model"] in text.split("title")[0]
-
-
-@pytest.mark.slow
-def test_the_teeth_over_a_hole_are_the_stiffest_as_design_md_says():
-    """docs/design.md: on the paper's gear the stiffest teeth lie within about one pitch of a
-    hole's centre line, the softest about 3 pitches from it, ratios 0.754-0.799."""
-    import numpy as np
-
-    import study
-    from solver.geometry import hole_offset
-    scene = study.load_scene("paper")
-    ds = study.stiffness(scene)
-    g = scene.gear2
-    ratio = ds["stiffness_ratio"].sel(gear=2).values[: g.teeth]
-    off = hole_offset(g.teeth, g.body.holes, g.body.hole_phase)
-    assert abs(off[np.argmax(ratio)]) <= 1.2 and 2.5 <= abs(off[np.argmin(ratio)]) <= 4.0
-    assert ratio.min() == pytest.approx(0.754, abs=0.003) and ratio.max() == pytest.approx(0.799, abs=0.003)
-    assert "0.754 to 0.799" in (ROOT / "docs" / "design.md").read_text()
