@@ -23,7 +23,8 @@ EXIT_CODES = """exit codes:
        archive to render; or a run refused by its estimate (memory it would need, or a
        run time beyond --max-time)
   3    a run that diverged, whose energy balance does not close (inaccurate) or whose statics
-       did not converge (archive written, cause and count on stderr)
+       did not converge (archive written, cause and count on stderr); a CalculiX peer deck
+       that did not converge within its CPU-time limit (no archive; the angle on stderr)
   130  interrupted by Ctrl-C or SIGTERM (a sweep keeps its finished points)"""
 
 
@@ -488,8 +489,13 @@ def reference_command(args) -> int:
     if args.step is not None and not args.step > 0:
         raise study.SceneError("--step", f"must be positive, got {args.step}")
     checked_output(args.output)
-    ds = study.reference(scene, args.step, max_time=checked_max_time(args), progress=True, solver=args.solver,
-                         flank_size=args.flank_size, contact_stiffness=args.contact_stiffness)
+    from solver.peers.calculix import CalculixFailed
+    try:
+        ds = study.reference(scene, args.step, max_time=checked_max_time(args), progress=True, solver=args.solver,
+                             flank_size=args.flank_size, contact_stiffness=args.contact_stiffness)
+    except CalculixFailed as e:
+        print(f"lightgear reference: the CalculiX peer stopped, no archive written: {e}", file=sys.stderr)
+        return 3
     study.write(ds, args.output)
     ste = ds["ste"].values
     name = "FE contact peer (CalculiX)" if args.solver == "calculix" else "FE reference"

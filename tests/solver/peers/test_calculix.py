@@ -10,10 +10,10 @@ from helpers import small_scene
 
 from solver import units
 from solver.fe.mesh import REGION_WEB, tooth_pieces
-from solver.peers.calculix import CalculixMissing, ccx_path
+from solver.peers.calculix import CalculixFailed, CalculixMissing, ccx_path
 from solver.peers.calculix.deck import GearPlacement, placed_points, write_deck
 from solver.peers.calculix.mesh import EDGES, MeshSizes, mesh_gear, teeth_near
-from solver.peers.calculix.run import read_dat
+from solver.peers.calculix.run import reached, read_dat, run_deck
 
 # the default model's elastic STE against the peer at a coarse peer mesh (0.3 mm, module/10), per
 # position and on the step from double to single contact, as documented in docs/models.md
@@ -140,6 +140,82 @@ def test_relief_moves_the_flank_by_its_deviation_along_the_normal():
     assert pg.deviation(g.u_tip) == pytest.approx(20e-6)
     # the tip arc ends at the relieved corners
     assert np.allclose(relieved[len(relieved) // 2][0][-1], moved[0])
+
+
+def test_soft_start_deck_stiffens_the_contact_in_a_second_step(small_light_meshes):
+    """A soft start carries the torque at 1/8 of the contact stiffness in a first step, then
+    stiffens the contact under the same torque; the result is read at the end of the second."""
+    scene, gears, model, meshes = small_light_meshes
+    placed = tuple(GearPlacement(m, 0.02, g.body.web_thickness, c, 0.0)
+                   for m, g, c in zip(meshes, gears, ((0.0, 0.0), (model.pair.center_distance, 0.0))))
+    one, n1 = write_deck(placed, scene.material_spec(), 100.0, 2e16)
+    two, n2 = write_deck(placed, scene.material_spec(), 100.0, 2e16, soft_start=0.125)
+    assert (n1.end_time, n2.end_time) == (1.0, 2.0)
+    assert one.count("*STEP") == 1 and two.count("*STEP") == 2 and "*CHANGE SURFACE BEHAVIOR" not in one
+    laws = [ln for blk in two.split("*SURFACE BEHAVIOR")[1:] for ln in [blk.splitlines()[1]]]
+    # MPa/mm: 2e16 Pa/m = 2e7 MPa/mm, first an eighth of it
+    assert [float(v.split(",")[0]) for v in laws] == [2.5e6, 2e7]
+    assert two.index("*CHANGE SURFACE BEHAVIOR, INTERACTION=FLANK") > two.rindex("*STEP")
+    # the torque is applied once (in the first step) and held
+    assert two.count("*CLOAD") == 1
+    with pytest.raises(ValueError, match="soft_start"):
+        write_deck(placed, scene.material_spec(), 100.0, 2e16, soft_start=1.0)
+
+
+def test_a_deck_past_its_cpu_limit_is_stopped_with_one_line(tmp_path, monkeypatch):
+    """A ccx that never converges (here one that spins) is stopped by the kernel at its CPU
+    limit and reported in one line, not waited for."""
+    spin = tmp_path / "ccx"
+    spin.write_text("#!/bin/sh\nwhile :; do :; done\n")
+    spin.chmod(0o755)
+    monkeypatch.setenv("LIGHTGEAR_CCX", str(spin))
+    import time
+    t0 = time.perf_counter()
+    with pytest.raises(CalculixFailed, match="CPU-time limit of 1 s") as e:
+        run_deck("*HEADING\n", 2, 1, cpu_limit_s=1.0, timeout_s=60.0)
+    assert time.perf_counter() - t0 < 30.0
+    assert e.value.cpu_time_s >= 0.9 and "\n" not in str(e.value)
+
+
+def test_reached_reads_the_last_converged_increment(tmp_path):
+    (tmp_path / "pair.sta").write_text(
+        "SUMMARY OF JOB INFORMATION\n  STEP      INC     ATT  ITRS     TOT TIME     STEP TIME      INC TIME\n"
+        "     1          1     1   6  0.100000E+01  0.100000E+01  0.100000E+01\n"
+        "     2          1     1U  12  0.100000E+01  0.000000E+00  0.100000E+01\n"
+        "     2          1     2   7  0.125000E+01  0.250000E+00  0.250000E+00\n")
+    assert reached(str(tmp_path), 2.0) == ", having converged up to 0.62 of the deck"
+    assert reached(str(tmp_path / "none"), 1.0) == ""
+
+
+def test_a_deck_that_never_converges_ends_with_its_angle_and_attempts(small_light_meshes, monkeypatch, capsys, tmp_path):
+    """Every attempt of `ATTEMPTS` tried within the deck's CPU limit, then one `CalculixFailed`
+    naming the angle and each attempt; the command line prints it in one line, exit 3, no archive."""
+    import solver.peers.calculix as peer
+    from study.cli import main
+    from study.verify.calculix_reference import peer_gears
+    calls = []
+
+    def never(text, rot, ref, timeout_s=0.0, keep=None, cpu_limit_s=None, end_time=1.0):
+        calls.append((cpu_limit_s, "*CHANGE SURFACE BEHAVIOR" in text, end_time))
+        raise CalculixFailed("ccx did not converge within its CPU-time limit", cpu_limit_s)
+    monkeypatch.setattr(peer, "run_deck", never)
+    scene, gears, model, meshes = small_light_meshes
+    monkeypatch.setattr(peer, "pair_meshes", lambda *a: tuple(meshes))
+    settings = peer.CalculixSettings(MeshSizes(1e-3, 1e-3, 1.5e-3), 2e16, deck_cpu_s=100.0)
+    with pytest.raises(CalculixFailed, match=r"driver angle 2\.0000 deg did not converge \(100 of 100 s CPU\)") as e:
+        peer.ste_sweep(peer_gears(scene)[0], model.pair, scene.material_spec(), [math.radians(2.0)], 100.0, settings)
+    # the stiff deck first, then the soft starts; half the time left each, the last all of it
+    assert [c[1] for c in calls] == [soft > 0 for _, soft in peer.ATTEMPTS]
+    assert [c[0] for c in calls] == pytest.approx([50.0, 25.0, 25.0])
+    assert [c[2] for c in calls] == [1.0, 2.0, 2.0]
+    assert str(e.value).count("soft start") == 2 and "\n" not in str(e.value)
+    # the command line: one line, exit 3, nothing written
+    monkeypatch.setenv("LIGHTGEAR_CCX", "true")
+    code = main(["reference", "small_pair", "--solver", "calculix", "--flank-size", "1.0", "--step", "15",
+                 "--set", "quasi_static.rotation=15", "-o", str(tmp_path / "r.nc")])
+    err = [ln for ln in capsys.readouterr().err.strip().splitlines() if not ln.startswith(("CalculiX contact peer", "  deck"))]
+    assert code == 3 and len(err) == 1 and "did not converge" in err[0] and "driver angle 0.0000 deg" in err[0]
+    assert not (tmp_path / "r.nc").exists()
 
 
 def test_read_dat_takes_the_last_converged_block():
