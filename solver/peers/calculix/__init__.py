@@ -164,7 +164,10 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
             # a ground spring of 1e-4 of the mesh's torsional stiffness (about torque / start angle):
             # it takes 1e-4 of the torque per start error of the size of the approach
             ground = GROUND_FRACTION * torque * rb2 / max(s, 1e-9)
-            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, (1.0, 1.0), ground,
+            # the stiff deck without cut-backs: its start overclosure is not scaled by the
+            # increment, so a smaller one does not help it (a soft start's may)
+            inc = (1.0, 1.0, 1.0) if soft == 0 else (1.0, 1.0)
+            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, inc, ground,
                                     settings.both_ways, soft_start=soft)
             # half of what is left, all of it for the last attempt: a chattering attempt leaves
             # time for the next

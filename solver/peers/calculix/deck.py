@@ -66,7 +66,8 @@ def write_deck(gears: tuple, material: Material, torque: float, contact_stiffnes
                both_ways: bool = False, soft_start: float = 0.0) -> tuple[str, DeckNumbers]:
     """The .inp text and its numbering. ``gears``: (GearPlacement of gear 1, of gear 2);
     ``torque`` [N·m] resisting on gear 2 (> 0); ``contact_stiffness`` [Pa/m] slope of the linear
-    pressure-overclosure law; ``increments``: (initial, maximum) fraction of the step's load;
+    pressure-overclosure law; ``increments``: (initial, maximum[, minimum]) fraction of the
+    step's load (minimum: `MIN_INCREMENT` unless given);
     ``ground_stiffness`` [N·m/rad]: a torsion spring from the driven gear to the ground (SPRING1 on
     the rotation node; 0: none) that keeps the system regular when a Newton iteration opens every
     contact: it carries ground_stiffness * U3 of the torque, U3 the rotation from the start;
@@ -137,7 +138,8 @@ def write_deck(gears: tuple, material: Material, torque: float, contact_stiffnes
         w("*CONTACT PAIR, INTERACTION=FLANK, TYPE=NODE TO SURFACE\nFLANKS1,FLANKS2\n")
     # the smallest increment 1/64 of the step: a deck whose contact chatters fails after a few
     # cut-backs (each one Newton iterations of the whole pair) instead of after seventeen
-    static = f"*STATIC\n{increments[0]:.6g},1.,{MIN_INCREMENT:.6g},{increments[1]:.6g}\n"
+    smallest = increments[2] if len(increments) > 2 else MIN_INCREMENT
+    static = f"*STATIC\n{increments[0]:.6g},1.,{smallest:.6g},{increments[1]:.6g}\n"
     prints = "*NODE PRINT, NSET=ROT\nU\n*NODE PRINT, NSET=REF, TOTALS=ONLY\nRF\n"
     w(f"*STEP, INC=100\n{static}*CLOAD\n{rot},3,{torque / units.NMM:.9g}\n{prints}*END STEP\n")
     if soft_start > 0:

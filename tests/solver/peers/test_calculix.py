@@ -196,7 +196,8 @@ def test_a_deck_that_never_converges_ends_with_its_angle_and_attempts(small_ligh
     calls = []
 
     def never(text, rot, ref, timeout_s=0.0, keep=None, cpu_limit_s=None, end_time=1.0):
-        calls.append((cpu_limit_s, "*CHANGE SURFACE BEHAVIOR" in text, end_time))
+        static = text[text.index("*STATIC\n") + 8:].splitlines()[0].split(",")
+        calls.append((cpu_limit_s, "*CHANGE SURFACE BEHAVIOR" in text, end_time, float(static[2])))
         raise CalculixFailed("ccx did not converge within its CPU-time limit", cpu_limit_s)
     monkeypatch.setattr(peer, "run_deck", never)
     scene, gears, model, meshes = small_light_meshes
@@ -208,6 +209,8 @@ def test_a_deck_that_never_converges_ends_with_its_angle_and_attempts(small_ligh
     assert [c[1] for c in calls] == [soft > 0 for _, soft in peer.ATTEMPTS]
     assert [c[0] for c in calls] == pytest.approx([50.0, 25.0, 25.0])
     assert [c[2] for c in calls] == [1.0, 2.0, 2.0]
+    # the stiff deck without cut-backs (they do not scale its start overclosure), the soft ones with
+    assert [c[3] for c in calls] == [1.0, 1 / 64, 1 / 64]
     assert str(e.value).count("soft start") == 2 and "\n" not in str(e.value)
     # the command line: one line, exit 3, nothing written
     monkeypatch.setenv("LIGHTGEAR_CCX", "true")
