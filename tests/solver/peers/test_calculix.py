@@ -258,6 +258,27 @@ def test_solver_options_need_the_peer(capsys, tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed: make sysdeps installs it")
+def test_a_chattering_deck_stops_at_its_cpu_limit_in_one_line(small_light_meshes):
+    """A flank mesh of 1 mm against a contact patch of ~0.2 mm (the lightened small pair at
+    100 N·m): the few contact nodes chatter in and out under the stiff and the soft penalty
+    alike, and the deck never converges. It must end at its CPU limit (4 s here), the attempts
+    tried in turn, with one line that names the angle, not hang (such a deck ran for hours)."""
+    import solver.peers.calculix as peer
+    from study.verify.calculix_reference import peer_gears
+    scene, _, model, _ = small_light_meshes
+    gears = peer_gears(scene)[0]
+    settings = peer.CalculixSettings(MeshSizes(1e-3, 1e-3, 1.5e-3), 2e16, deck_cpu_s=4.0)
+    with pytest.raises(CalculixFailed, match=r"driver angle 0\.0000 deg did not converge") as e:
+        peer.ste_sweep(gears, model.pair, scene.material_spec(), [0.0], 100.0, settings)
+    msg = str(e.value)
+    # the stiff deck first, then the soft start, until the time is spent
+    assert "\n" not in msg and msg.index("stiff contact") < msg.index("soft start")
+    used, limit = (float(v) for v in re.search(r"\((\d+) of (\d+) s CPU\)", msg).groups())
+    assert limit == 4.0 and used <= limit + 3 * 1.0     # s: each attempt's limit rounds up to a second
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed: make sysdeps installs it")
 def test_default_model_ste_within_tolerance_of_the_peer():
     """Small pair at 100 N·m, the peer at 0.3 mm on the flanks (two decks, ~30 s each on a quiet
     machine), at a double-contact (0 deg) and a single-contact position (11 deg): the default
