@@ -205,12 +205,12 @@ def test_a_deck_that_never_converges_ends_with_its_angle_and_attempts(small_ligh
     settings = peer.CalculixSettings(MeshSizes(1e-3, 1e-3, 1.5e-3), 2e16, deck_cpu_s=100.0)
     with pytest.raises(CalculixFailed, match=r"driver angle 2\.0000 deg did not converge \(100 of 100 s CPU\)") as e:
         peer.ste_sweep(peer_gears(scene)[0], model.pair, scene.material_spec(), [math.radians(2.0)], 100.0, settings)
-    # the stiff deck first, then the soft starts; half the time left each, the last all of it
-    assert [c[1] for c in calls] == [soft > 0 for _, soft in peer.ATTEMPTS]
+    # the soft start, the stiff deck, the soft start from nearer; half the time left each, the last all of it
+    assert [c[1] for c in calls] == [soft > 0 for _, soft in peer.ATTEMPTS] == [True, False, True]
     assert [c[0] for c in calls] == pytest.approx([50.0, 25.0, 25.0])
-    assert [c[2] for c in calls] == [1.0, 2.0, 2.0]
+    assert [c[2] for c in calls] == [2.0, 1.0, 2.0]
     # the stiff deck without cut-backs (they do not scale its start overclosure), the soft ones with
-    assert [c[3] for c in calls] == [1.0, 1 / 64, 1 / 64]
+    assert [c[3] for c in calls] == [1 / 64, 1.0, 1 / 64]
     assert str(e.value).count("soft start") == 2 and "\n" not in str(e.value)
     # the command line: one line, exit 3, nothing written
     monkeypatch.setenv("LIGHTGEAR_CCX", "true")
@@ -261,32 +261,36 @@ def test_solver_options_need_the_peer(capsys, tmp_path):
 def test_a_chattering_deck_stops_at_its_cpu_limit_in_one_line(small_light_meshes):
     """A flank mesh of 1 mm against a contact patch of ~0.2 mm (the lightened small pair at
     100 N·m): the few contact nodes chatter in and out under the stiff and the soft penalty
-    alike, and the deck never converges. It must end at its CPU limit (4 s here), the attempts
+    alike, and the deck never converges. It must end at its CPU limit (5 s here), the attempts
     tried in turn, with one line that names the angle, not hang (such a deck ran for hours)."""
     import solver.peers.calculix as peer
     from study.verify.calculix_reference import peer_gears
     scene, _, model, _ = small_light_meshes
     gears = peer_gears(scene)[0]
-    settings = peer.CalculixSettings(MeshSizes(1e-3, 1e-3, 1.5e-3), 2e16, deck_cpu_s=4.0)
+    settings = peer.CalculixSettings(MeshSizes(1e-3, 1e-3, 1.5e-3), 2e16, deck_cpu_s=5.0)
     with pytest.raises(CalculixFailed, match=r"driver angle 0\.0000 deg did not converge") as e:
         peer.ste_sweep(gears, model.pair, scene.material_spec(), [0.0], 100.0, settings)
     msg = str(e.value)
-    # the stiff deck first, then the soft start, until the time is spent
-    assert "\n" not in msg and msg.index("stiff contact") < msg.index("soft start")
+    # the soft start first, then the stiff deck, until the time is spent
+    assert "\n" not in msg and msg.index("soft start") < msg.index("stiff contact")
     used, limit = (float(v) for v in re.search(r"\((\d+) of (\d+) s CPU\)", msg).groups())
-    assert limit == 4.0 and used <= limit + 3 * 1.0     # s: each attempt's limit rounds up to a second
+    assert limit == 5.0 and used <= limit + 3 * 1.0     # s: each attempt's limit rounds up to a second
 
 
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed: make sysdeps installs it")
-def test_default_model_ste_within_tolerance_of_the_peer():
+def test_default_model_ste_within_tolerance_of_the_peer(monkeypatch):
     """Small pair at 100 N·m, the peer at 0.3 mm on the flanks (two decks, ~30 s each on a quiet
     machine), at a double-contact (0 deg) and a single-contact position (11 deg): the default
     (compliance) model's elastic STE within the documented tolerance at both (measured: +0.4 %
     and -2.5 %), and the step from double to single contact (-11.9 %). A flank 4 um off the
     involute (+13 % at 0 deg) or the paper model's springs (x4) fail it."""
+    import solver.peers.calculix as peer
     import study
     from study.verify.model_validation import model_ste
+    # these decks converge under the stiff penalty at once (26 s each against the soft start's
+    # 34 s, the same STE: docs/models.md); the soft start is held to its failure above
+    monkeypatch.setattr(peer, "ATTEMPTS", tuple(a for a in peer.ATTEMPTS if a[1] == 0.0))
     scene = small_scene(**{"quasi_static.rotation": 11.0})
     peer = study.reference(scene, step=11.0, solver="calculix", flank_size=0.3)
     assert peer.attrs["solver"] == "calculix" and peer["ste"].attrs["units"] == "um"
