@@ -27,8 +27,8 @@ from solver.peers.calculix.deck import GearPlacement, write_deck
 from solver.peers.calculix.mesh import GearMesh, MeshSizes, mesh_gear, teeth_near
 from solver.peers.calculix.run import CalculixFailed, CalculixMissing, ccx_path, ccx_version, run_deck
 
-__all__ = ["CalculixFailed", "CalculixMissing", "CalculixSettings", "PeerGear", "PeerResult", "ccx_path",
-           "ccx_version", "default_settings", "pair_meshes", "ste_sweep"]
+__all__ = ["ATTEMPTS", "CalculixFailed", "CalculixMissing", "CalculixSettings", "PeerGear", "PeerResult", "ccx_path",
+           "ccx_version", "deck_cpu_limit", "default_settings", "pair_meshes", "ste_sweep"]
 
 
 # stiffness of the driven gear's ground spring over the mesh's (`deck.write_deck`)

@@ -294,6 +294,8 @@ def test_default_model_ste_within_tolerance_of_the_peer(monkeypatch):
     scene = small_scene(**{"quasi_static.rotation": 11.0})
     peer = study.reference(scene, step=11.0, solver="calculix", flank_size=0.3)
     assert peer.attrs["solver"] == "calculix" and peer["ste"].attrs["units"] == "um"
+    # s: 6 ms a node of the pair, at least 120 s
+    assert peer.attrs["deck_cpu_limit_s"] == pytest.approx(max(120.0, 6e-3 * peer.attrs["nodes"]))
     np.testing.assert_allclose(peer["angle"].values, [0.0, 11.0])
     ste_peer = peer["ste"].values - peer.attrs["backlash_offset_um"]
     te, off = model_ste(scene, "compliance", np.radians(peer["angle"].values))
