@@ -109,7 +109,7 @@ def run_deck(text: str, rot_node: int, ref_node: int, timeout_s: float = 3600.0,
 
 
 def reached(folder: str, end_time: float) -> str:
-    """', having converged up to X of the load' from the deck's .sta file (its last converged
+    """', having converged up to X of the deck' from the deck's .sta file (its last converged
     increment's total time over ``end_time``), '' when there is none."""
     path = os.path.join(folder, "pair.sta")
     if not os.path.exists(path):
