@@ -74,12 +74,14 @@ def peer(name: str, torque: float, angles_deg, flank_size: float | None, log) ->
         ds = calculix_dataset(scene, np.radians(todo), settings_for(scene, flank_size), progress=True, starts=te - off)
         for a, s in zip(ds["angle"].values, ds["ste"].values - ds.attrs["backlash_offset_um"]):
             done[round(float(a), 6)] = float(s)
-        if path.exists():           # decks another process wrote meanwhile (one process an angle)
+        merged = ds
+        if path.exists():           # the archive as it is now (another process may have added decks)
             with xr.open_dataset(path) as old:
-                for a, s in zip(np.round(old["angle"].values, 6), old["ste"].values - old.attrs["backlash_offset_um"]):
-                    done.setdefault(a, float(s))
-        merged = ds.reindex(angle=sorted(done))
-        merged["ste"].values[:] = np.array([done[round(a, 6)] for a in merged["angle"].values]) + ds.attrs["backlash_offset_um"]
+                old = old.load()
+            for a, s in zip(np.round(old["angle"].values, 6), old["ste"].values - old.attrs["backlash_offset_um"]):
+                done.setdefault(a, float(s))
+            # the new decks, and the archive's others with their own deck times
+            merged = ds.combine_first(old)
         path.parent.mkdir(parents=True, exist_ok=True)
         study.write(merged, path)
         log(f"{tag}: {len(todo)} decks, ccx CPU {ds.attrs['cpu_time_ccx_s']:.0f} s")

@@ -45,7 +45,8 @@ EXIT_CODES = """exit codes:
        archive to render; or a run refused by its estimate (memory it would need, or a
        run time beyond --max-time)
   3    a run that diverged, whose energy balance does not close (inaccurate) or whose statics
-       did not converge (archive written, cause and count on stderr)
+       did not converge (archive written, cause and count on stderr); a CalculiX peer deck
+       that did not converge within its CPU-time limit (no archive; the angle on stderr)
   130  interrupted by Ctrl-C or SIGTERM (a sweep keeps its finished points)"""
 
 

@@ -5,6 +5,8 @@ pair of functions each, as in `study.cli`.
 """
 from __future__ import annotations
 
+import sys
+
 from study.cli_options import args_scene, checked_max_time, checked_output, max_time_argument, scene_arguments
 from study.errors import UsageError
 
@@ -161,8 +163,13 @@ def reference_command(args) -> int:
     if args.step is not None and not args.step > 0:
         raise study.SceneError("--step", f"must be positive, got {args.step}")
     checked_output(args.output)
-    ds = study.reference(scene, args.step, max_time=checked_max_time(args), progress=True, solver=args.solver,
-                         flank_size=args.flank_size, contact_stiffness=args.contact_stiffness)
+    from solver.peers.calculix import CalculixFailed
+    try:
+        ds = study.reference(scene, args.step, max_time=checked_max_time(args), progress=True, solver=args.solver,
+                             flank_size=args.flank_size, contact_stiffness=args.contact_stiffness)
+    except CalculixFailed as e:
+        print(f"lightgear reference: the CalculiX peer stopped, no archive written: {e}", file=sys.stderr)
+        return 3
     study.write(ds, args.output)
     ste = ds["ste"].values
     name = "FE contact peer (CalculiX)" if args.solver == "calculix" else "FE reference"

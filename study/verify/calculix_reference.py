@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.peers.calculix import CalculixSettings, PeerGear, default_settings, ste_sweep
+from solver.peers.calculix import ATTEMPTS, CalculixSettings, PeerGear, deck_cpu_limit, default_settings, ste_sweep
 from study.scene import Scene, SceneError
 from study.scene_model import geometry_model
 
@@ -113,6 +113,9 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
              "body_mesh_size_mm": s.sizes.body * units.MM_PER_M,
              "contact_stiffness_MPa_per_mm": s.contact_stiffness / units.MPA * units.MM,
              "fine_teeth_each_side": s.fine_teeth, "contact_teeth_each_side": s.contact_teeth,
+             "deck_cpu_limit_s": deck_cpu_limit(res.meshes, s),
+             "deck_attempts": "; ".join(f"{'soft start (contact stiffness x' + format(soft, 'g') + ', then stiffened)' if soft else 'stiff contact'}"
+                                        f" from {frac:g} x the start approach" for frac, soft in ATTEMPTS),
              "nodes": nodes, "elements": sum(m.n_elements for m in res.meshes),
              "wall_time_reference_s": time.perf_counter() - t_start, "cpu_time_ccx_s": float(res.cpu_time_s.sum()),
              "method": "FE contact analysis: both gears meshed in full (quadratic plane-stress triangles), driver bore fixed, "

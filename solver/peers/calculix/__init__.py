@@ -27,12 +27,25 @@ from solver.peers.calculix.deck import GearPlacement, write_deck
 from solver.peers.calculix.mesh import GearMesh, MeshSizes, mesh_gear, teeth_near
 from solver.peers.calculix.run import CalculixFailed, CalculixMissing, ccx_path, ccx_version, run_deck
 
-__all__ = ["CalculixFailed", "CalculixMissing", "CalculixSettings", "PeerGear", "PeerResult", "ccx_path",
-           "ccx_version", "default_settings", "pair_meshes", "ste_sweep"]
+__all__ = ["ATTEMPTS", "CalculixFailed", "CalculixMissing", "CalculixSettings", "PeerGear", "PeerResult", "ccx_path",
+           "ccx_version", "deck_cpu_limit", "default_settings", "pair_meshes", "ste_sweep"]
 
 
 # stiffness of the driven gear's ground spring over the mesh's (`deck.write_deck`)
 GROUND_FRACTION = 1e-4
+# the attempts at a deck, in order: (start approach over the given one, soft_start of
+# `deck.write_deck`). The stiff penalty in one step converges in 5-10 Newton iterations where the
+# contact patch spans several elements; where it spans one or two (a single pair near the tip,
+# a low load) its few nodes chatter in and out and the step never converges (the 12-hole body
+# at 4.0 deg; the relieved pair's single-contact decks crawl): a penalty 1/8 as stiff first,
+# then stiffened, settles them in about 1.3 times a converging stiff deck's iterations. So the
+# soft start first, the stiff deck where it chatters too, then the soft start from nearer.
+ATTEMPTS = ((1.0, 0.125), (1.0, 0.0), (0.7, 0.125))
+# CPU seconds a deck may use per node of the pair, all attempts together, and at least
+DECK_CPU_PER_NODE = 6e-3
+DECK_CPU_MIN = 120.0
+# wall seconds allowed per CPU second of the limit (a shared machine gives ccx a fraction of a core)
+WALL_PER_CPU = 10.0
 
 
 @dataclass(frozen=True)
@@ -44,6 +57,7 @@ class CalculixSettings:
     fine_teeth: int = 3          # teeth each side of the line of centres meshed fine (at every angle)
     contact_teeth: int = 2       # teeth each side whose drive flanks and tips are contact faces
     both_ways: bool = True       # a second contact pair, gear 1 the slave (`deck.write_deck`)
+    deck_cpu_s: float | None = None  # CPU seconds a deck may use (None: `deck_cpu_limit`'s default)
 
 
 def default_settings(module: float, flank_size: float | None = None) -> CalculixSettings:
@@ -107,17 +121,28 @@ def start_approach(gears: tuple, material: Material, torque: float) -> float:
     return load / (10.0e6 * 1e3 * b) * (material.youngs_modulus / 206e9) ** -1
 
 
+def deck_cpu_limit(meshes, settings: CalculixSettings) -> float:
+    """CPU seconds one deck may use, all its attempts together: ``settings.deck_cpu_s``, or
+    `DECK_CPU_PER_NODE` per node of the pair (a converging deck of the paper pair at 0.1 mm,
+    ~66,000 nodes, takes 60-120 s; the limit is 400 s), at least `DECK_CPU_MIN`."""
+    if settings.deck_cpu_s is not None:
+        return float(settings.deck_cpu_s)
+    return max(DECK_CPU_MIN, DECK_CPU_PER_NODE * sum(m.n_nodes for m in meshes))
+
+
 def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torque: float,
               settings: CalculixSettings, progress=None, keep: str | None = None, starts=None) -> PeerResult:
     """STE at every driver angle [rad] under the resisting ``torque`` [N·m] on gear 2, one deck
     an angle. ``progress(i, n, te_m, wall_s)``: called after each deck. Each deck starts from
     ``starts[i]`` [m] (an approach near the loaded one, e.g. a model's elastic STE: fewer Newton
     iterations; the result does not depend on it) or else from the previous deck's approach (the
-    first from `start_approach`); a deck that does not converge is retried with smaller load
-    increments and a smaller, then larger start."""
+    first from `start_approach`), and is tried as `ATTEMPTS` says until one converges, within
+    `deck_cpu_limit` CPU seconds in all; `CalculixFailed` (one line: the angle, each attempt's
+    reason) when none does."""
     ccx_path()
     angles = np.asarray(angles, float)
     meshes = pair_meshes(gears, pair, angles, settings)
+    limit = deck_cpu_limit(meshes, settings)
     g1, g2 = gears[0].geometry, gears[1].geometry
     rb1, rb2 = g1.base_radius, g2.base_radius
     jn2 = 0.5 * pair.normal_backlash
@@ -129,8 +154,11 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
         if starts is not None:
             start = float(starts[a])
         th2 = (jn2 - rb1 * th1) / rb2
-        last = None
-        for frac, inc in ((1.0, (1.0, 1.0)), (1.0, (0.25, 0.5)), (0.5, (0.1, 0.25)), (1.5, (0.1, 0.25))):
+        why, used, res = [], 0.0, None
+        for n, (frac, soft) in enumerate(ATTEMPTS):
+            if limit - used < 1.0:
+                why.append("no CPU time left for the next attempt")
+                break
             s = frac * start
             placed = (GearPlacement(meshes[0], g1.spec.face_width, gears[0].body.web_thickness, (0.0, 0.0), th1),
                       GearPlacement(meshes[1], g2.spec.face_width, gears[1].body.web_thickness, (pair.center_distance, 0.0),
@@ -138,18 +166,29 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
             # a ground spring of 1e-4 of the mesh's torsional stiffness (about torque / start angle):
             # it takes 1e-4 of the torque per start error of the size of the approach
             ground = GROUND_FRACTION * torque * rb2 / max(s, 1e-9)
-            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, inc, ground, settings.both_ways)
+            # the stiff deck without cut-backs: its start overclosure is not scaled by the
+            # increment, so a smaller one does not help it (a soft start's may)
+            inc = (1.0, 1.0, 1.0) if soft == 0 else (1.0, 1.0)
+            text, nums = write_deck(placed, material, torque, settings.contact_stiffness, inc, ground,
+                                    settings.both_ways, soft_start=soft)
+            # half of what is left, all of it for the last attempt: a chattering attempt leaves
+            # time for the next
+            cap = (limit - used) * (1.0 if n == len(ATTEMPTS) - 1 else 0.5)
             try:
-                res = run_deck(text, nums.rot_node, nums.ref_node, keep=keep and f"{keep}/deck{a:03d}")
+                res = run_deck(text, nums.rot_node, nums.ref_node, timeout_s=WALL_PER_CPU * cap,
+                               keep=keep and f"{keep}/deck{a:03d}_{n}", cpu_limit_s=cap, end_time=nums.end_time)
+                used += res.cpu_time_s
                 break
             except CalculixFailed as e:
-                last = e
-        else:
-            raise CalculixFailed(f"{last} at driver angle {math.degrees(th1):.4f} deg")
+                used += e.cpu_time_s
+                why.append(f"{'soft start' if soft else 'stiff contact'} from {s * 1e6:.3g} um: {e}")
+        if res is None:
+            raise CalculixFailed(f"the deck at driver angle {math.degrees(th1):.4f} deg did not converge "
+                                 f"({used:.0f} of {limit:.0f} s CPU): " + "; ".join(why))
         # the ground spring took ground * U3 of the torque: back to the full torque along the
         # pair's secant stiffness (a correction of order 1e-4 of the start error)
         te[a] = jn2 + s + rb2 * res.rotation * (1.0 + GROUND_FRACTION)
-        wall[a], cpu[a] = time.perf_counter() - t0, res.cpu_time_s
+        wall[a], cpu[a] = time.perf_counter() - t0, used
         start = te[a] - jn2
         if progress is not None:
             progress(a, angles.size, te[a], wall[a])

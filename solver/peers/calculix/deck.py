@@ -26,6 +26,8 @@ from solver.geometry import Material
 from solver.peers.calculix.mesh import GearMesh
 
 REGION_LABEL = {REGION_RIM: "RIM", REGION_WEB: "WEB", REGION_HUB: "HUB"}
+# smallest load increment of a step (a fraction of the step)
+MIN_INCREMENT = 1.0 / 64.0
 
 
 @dataclass(frozen=True)
@@ -49,6 +51,7 @@ class DeckNumbers:
     rot_node: int           # rigid body rotation node: its U3 is gear 2's rotation [rad]
     n_nodes: int
     n_elements: int
+    end_time: float = 1.0   # total time at the end of the last step (one per step)
 
 
 def placed_points(p: GearPlacement) -> np.ndarray:
@@ -60,14 +63,22 @@ def placed_points(p: GearPlacement) -> np.ndarray:
 
 def write_deck(gears: tuple, material: Material, torque: float, contact_stiffness: float,
                increments: tuple = (1.0, 1.0), ground_stiffness: float = 0.0,
-               both_ways: bool = False) -> tuple[str, DeckNumbers]:
+               both_ways: bool = False, soft_start: float = 0.0) -> tuple[str, DeckNumbers]:
     """The .inp text and its numbering. ``gears``: (GearPlacement of gear 1, of gear 2);
     ``torque`` [N·m] resisting on gear 2 (> 0); ``contact_stiffness`` [Pa/m] slope of the linear
-    pressure-overclosure law; ``increments``: (initial, maximum) fraction of the step's load;
+    pressure-overclosure law; ``increments``: (initial, maximum[, minimum]) fraction of the
+    step's load (minimum: `MIN_INCREMENT` unless given);
     ``ground_stiffness`` [N·m/rad]: a torsion spring from the driven gear to the ground (SPRING1 on
     the rotation node; 0: none) that keeps the system regular when a Newton iteration opens every
     contact: it carries ground_stiffness * U3 of the torque, U3 the rotation from the start;
-    ``both_ways``: a second contact pair with gear 1's faces as the slave surface."""
+    ``both_ways``: a second contact pair with gear 1's faces as the slave surface;
+    ``soft_start`` (0 < f < 1): the torque is first carried with the contact stiffness times f
+    (a first step), then the contact is stiffened to ``contact_stiffness`` under the same torque
+    (*CHANGE SURFACE BEHAVIOR, a second step): a soft penalty lets the few nodes of a narrow
+    contact patch settle where a stiff one makes them chatter in and out; 0: one step. The
+    deck's last step ends at total time `DeckNumbers.end_time`."""
+    if not 0.0 <= soft_start < 1.0:
+        raise ValueError(f"soft_start must lie in [0, 1), got {soft_start}")
     if not torque > 0:
         raise ValueError(f"quasi_static.torque: the contact peer needs a positive (drive-side) torque, got {torque}")
     if not contact_stiffness > 0:
@@ -115,19 +126,25 @@ def write_deck(gears: tuple, material: Material, torque: float, contact_stiffnes
     w(f"*BOUNDARY\nBORE1,1,2\n{ref},1,3\n{rot},1,2\n")
     if ground_stiffness > 0:
         w(f"*ELEMENT, TYPE=SPRING1, ELSET=GROUND\n{e + 1},{rot}\n*SPRING, ELSET=GROUND\n3\n{ground_stiffness / units.NMM:.9g}\n")
-    w("*SURFACE INTERACTION, NAME=FLANK\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n")
     # slope [MPa/mm]; a small tension (0.1 MPa) for clearances below 0.1 um keeps the slave
     # nodes next to the contact from chattering in and out between iterations
-    w(f"{contact_stiffness / units.MPA / mm:.9g},0.1,1.e-4\n")
+    law = "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{:.9g},0.1,1.e-4\n"
+    k = contact_stiffness / units.MPA / mm
+    w("*SURFACE INTERACTION, NAME=FLANK\n" + law.format(k * soft_start if soft_start > 0 else k))
     # both ways round: each gear's tip corner is then a slave node on the other's flank (a
     # master corner pokes between the slave nodes and carries too little of the tip contact)
     w("*CONTACT PAIR, INTERACTION=FLANK, TYPE=NODE TO SURFACE\nFLANKS2,FLANKS1\n")
     if both_ways:
         w("*CONTACT PAIR, INTERACTION=FLANK, TYPE=NODE TO SURFACE\nFLANKS1,FLANKS2\n")
-    w(f"*STEP, INC=200\n*STATIC\n{increments[0]:.6g},1.,1.e-5,{increments[1]:.6g}\n")
-    w(f"*CLOAD\n{rot},3,{torque / units.NMM:.9g}\n")
-    w("*NODE PRINT, NSET=ROT\nU\n*NODE PRINT, NSET=REF, TOTALS=ONLY\nRF\n*END STEP\n")
-    return out.getvalue(), DeckNumbers(tuple(node_off), tuple(elem_off), ref, rot, n + 2, e)
+    # the smallest increment 1/64 of the step: a deck whose contact chatters fails after a few
+    # cut-backs (each one Newton iterations of the whole pair) instead of after seventeen
+    smallest = increments[2] if len(increments) > 2 else MIN_INCREMENT
+    static = f"*STATIC\n{increments[0]:.6g},1.,{smallest:.6g},{increments[1]:.6g}\n"
+    prints = "*NODE PRINT, NSET=ROT\nU\n*NODE PRINT, NSET=REF, TOTALS=ONLY\nRF\n"
+    w(f"*STEP, INC=100\n{static}*CLOAD\n{rot},3,{torque / units.NMM:.9g}\n{prints}*END STEP\n")
+    if soft_start > 0:
+        w(f"*STEP, INC=100\n{static}*CHANGE SURFACE BEHAVIOR, INTERACTION=FLANK\n{law.format(k)}{prints}*END STEP\n")
+    return out.getvalue(), DeckNumbers(tuple(node_off), tuple(elem_off), ref, rot, n + 2, e, 2.0 if soft_start > 0 else 1.0)
 
 
 def _ids(out, ids) -> None:

@@ -10,10 +10,10 @@ from helpers import small_scene
 
 from solver import units
 from solver.fe.mesh import REGION_WEB, tooth_pieces
-from solver.peers.calculix import CalculixMissing, ccx_path
+from solver.peers.calculix import CalculixFailed, CalculixMissing, ccx_path
 from solver.peers.calculix.deck import GearPlacement, placed_points, write_deck
 from solver.peers.calculix.mesh import EDGES, MeshSizes, mesh_gear, teeth_near
-from solver.peers.calculix.run import read_dat
+from solver.peers.calculix.run import reached, read_dat, run_deck
 
 # the default model's elastic STE against the peer at a coarse peer mesh (0.3 mm, module/10), per
 # position and on the step from double to single contact, as documented in docs/models.md
@@ -142,6 +142,85 @@ def test_relief_moves_the_flank_by_its_deviation_along_the_normal():
     assert np.allclose(relieved[len(relieved) // 2][0][-1], moved[0])
 
 
+def test_soft_start_deck_stiffens_the_contact_in_a_second_step(small_light_meshes):
+    """A soft start carries the torque at 1/8 of the contact stiffness in a first step, then
+    stiffens the contact under the same torque; the result is read at the end of the second."""
+    scene, gears, model, meshes = small_light_meshes
+    placed = tuple(GearPlacement(m, 0.02, g.body.web_thickness, c, 0.0)
+                   for m, g, c in zip(meshes, gears, ((0.0, 0.0), (model.pair.center_distance, 0.0))))
+    one, n1 = write_deck(placed, scene.material_spec(), 100.0, 2e16)
+    two, n2 = write_deck(placed, scene.material_spec(), 100.0, 2e16, soft_start=0.125)
+    assert (n1.end_time, n2.end_time) == (1.0, 2.0)
+    assert one.count("*STEP") == 1 and two.count("*STEP") == 2 and "*CHANGE SURFACE BEHAVIOR" not in one
+    laws = [ln for blk in two.split("*SURFACE BEHAVIOR")[1:] for ln in [blk.splitlines()[1]]]
+    # MPa/mm: 2e16 Pa/m = 2e7 MPa/mm, first an eighth of it
+    assert [float(v.split(",")[0]) for v in laws] == [2.5e6, 2e7]
+    assert two.index("*CHANGE SURFACE BEHAVIOR, INTERACTION=FLANK") > two.rindex("*STEP")
+    # the torque is applied once (in the first step) and held
+    assert two.count("*CLOAD") == 1
+    with pytest.raises(ValueError, match="soft_start"):
+        write_deck(placed, scene.material_spec(), 100.0, 2e16, soft_start=1.0)
+
+
+def test_a_deck_past_its_cpu_limit_is_stopped_with_one_line(tmp_path, monkeypatch):
+    """A ccx that never converges (here one that spins) is stopped by the kernel at its CPU
+    limit and reported in one line, not waited for."""
+    spin = tmp_path / "ccx"
+    spin.write_text("#!/bin/sh\nwhile :; do :; done\n")
+    spin.chmod(0o755)
+    monkeypatch.setenv("LIGHTGEAR_CCX", str(spin))
+    import time
+    t0 = time.perf_counter()
+    with pytest.raises(CalculixFailed, match="CPU-time limit of 1 s") as e:
+        run_deck("*HEADING\n", 2, 1, cpu_limit_s=1.0, timeout_s=60.0)
+    assert time.perf_counter() - t0 < 30.0
+    assert e.value.cpu_time_s >= 0.9 and "\n" not in str(e.value)
+
+
+def test_reached_reads_the_last_converged_increment(tmp_path):
+    (tmp_path / "pair.sta").write_text(
+        "SUMMARY OF JOB INFORMATION\n  STEP      INC     ATT  ITRS     TOT TIME     STEP TIME      INC TIME\n"
+        "     1          1     1   6  0.100000E+01  0.100000E+01  0.100000E+01\n"
+        "     2          1     1U  12  0.100000E+01  0.000000E+00  0.100000E+01\n"
+        "     2          1     2   7  0.125000E+01  0.250000E+00  0.250000E+00\n")
+    assert reached(str(tmp_path), 2.0) == ", having converged up to 0.62 of the deck"
+    assert reached(str(tmp_path / "none"), 1.0) == ""
+
+
+def test_a_deck_that_never_converges_ends_with_its_angle_and_attempts(small_light_meshes, monkeypatch, capsys, tmp_path):
+    """Every attempt of `ATTEMPTS` tried within the deck's CPU limit, then one `CalculixFailed`
+    naming the angle and each attempt; the command line prints it in one line, exit 3, no archive."""
+    import solver.peers.calculix as peer
+    from study.cli import main
+    from study.verify.calculix_reference import peer_gears
+    calls = []
+
+    def never(text, rot, ref, timeout_s=0.0, keep=None, cpu_limit_s=None, end_time=1.0):
+        static = text[text.index("*STATIC\n") + 8:].splitlines()[0].split(",")
+        calls.append((cpu_limit_s, "*CHANGE SURFACE BEHAVIOR" in text, end_time, float(static[2])))
+        raise CalculixFailed("ccx did not converge within its CPU-time limit", cpu_limit_s)
+    monkeypatch.setattr(peer, "run_deck", never)
+    scene, gears, model, meshes = small_light_meshes
+    monkeypatch.setattr(peer, "pair_meshes", lambda *a: tuple(meshes))
+    settings = peer.CalculixSettings(MeshSizes(1e-3, 1e-3, 1.5e-3), 2e16, deck_cpu_s=100.0)
+    with pytest.raises(CalculixFailed, match=r"driver angle 2\.0000 deg did not converge \(100 of 100 s CPU\)") as e:
+        peer.ste_sweep(peer_gears(scene)[0], model.pair, scene.material_spec(), [math.radians(2.0)], 100.0, settings)
+    # the soft start, the stiff deck, the soft start from nearer; half the time left each, the last all of it
+    assert [c[1] for c in calls] == [soft > 0 for _, soft in peer.ATTEMPTS] == [True, False, True]
+    assert [c[0] for c in calls] == pytest.approx([50.0, 25.0, 25.0])
+    assert [c[2] for c in calls] == [2.0, 1.0, 2.0]
+    # the stiff deck without cut-backs (they do not scale its start overclosure), the soft ones with
+    assert [c[3] for c in calls] == [1 / 64, 1.0, 1 / 64]
+    assert str(e.value).count("soft start") == 2 and "\n" not in str(e.value)
+    # the command line: one line, exit 3, nothing written
+    monkeypatch.setenv("LIGHTGEAR_CCX", "true")
+    code = main(["reference", "small_pair", "--solver", "calculix", "--flank-size", "1.0", "--step", "15",
+                 "--set", "quasi_static.rotation=15", "-o", str(tmp_path / "r.nc")])
+    err = [ln for ln in capsys.readouterr().err.strip().splitlines() if not ln.startswith(("CalculiX contact peer", "  deck"))]
+    assert code == 3 and len(err) == 1 and "did not converge" in err[0] and "driver angle 0.0000 deg" in err[0]
+    assert not (tmp_path / "r.nc").exists()
+
+
 def test_read_dat_takes_the_last_converged_block():
     dat = """
  displacements (vx,vy,vz) for set ROT and time  0.5000000E+00
@@ -179,17 +258,44 @@ def test_solver_options_need_the_peer(capsys, tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed: make sysdeps installs it")
-def test_default_model_ste_within_tolerance_of_the_peer():
+def test_a_chattering_deck_stops_at_its_cpu_limit_in_one_line(small_light_meshes):
+    """A flank mesh of 1 mm against a contact patch of ~0.2 mm (the lightened small pair at
+    100 N·m): the few contact nodes chatter in and out under the stiff and the soft penalty
+    alike, and the deck never converges. It must end at its CPU limit (5 s here), the attempts
+    tried in turn, with one line that names the angle, not hang (such a deck ran for hours)."""
+    import solver.peers.calculix as peer
+    from study.verify.calculix_reference import peer_gears
+    scene, _, model, _ = small_light_meshes
+    gears = peer_gears(scene)[0]
+    settings = peer.CalculixSettings(MeshSizes(1e-3, 1e-3, 1.5e-3), 2e16, deck_cpu_s=5.0)
+    with pytest.raises(CalculixFailed, match=r"driver angle 0\.0000 deg did not converge") as e:
+        peer.ste_sweep(gears, model.pair, scene.material_spec(), [0.0], 100.0, settings)
+    msg = str(e.value)
+    # the soft start first, then the stiff deck, until the time is spent
+    assert "\n" not in msg and msg.index("soft start") < msg.index("stiff contact")
+    used, limit = (float(v) for v in re.search(r"\((\d+) of (\d+) s CPU\)", msg).groups())
+    assert limit == 5.0 and used <= limit + 3 * 1.0     # s: each attempt's limit rounds up to a second
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed: make sysdeps installs it")
+def test_default_model_ste_within_tolerance_of_the_peer(monkeypatch):
     """Small pair at 100 N·m, the peer at 0.3 mm on the flanks (two decks, ~30 s each on a quiet
     machine), at a double-contact (0 deg) and a single-contact position (11 deg): the default
     (compliance) model's elastic STE within the documented tolerance at both (measured: +0.4 %
     and -2.5 %), and the step from double to single contact (-11.9 %). A flank 4 um off the
     involute (+13 % at 0 deg) or the paper model's springs (x4) fail it."""
+    import solver.peers.calculix as peer
     import study
     from study.verify.model_validation import model_ste
+    # these decks converge under the stiff penalty at once (26 s each against the soft start's
+    # 34 s, the same STE: docs/models.md); the soft start is held to its failure above
+    monkeypatch.setattr(peer, "ATTEMPTS", tuple(a for a in peer.ATTEMPTS if a[1] == 0.0))
     scene = small_scene(**{"quasi_static.rotation": 11.0})
     peer = study.reference(scene, step=11.0, solver="calculix", flank_size=0.3)
     assert peer.attrs["solver"] == "calculix" and peer["ste"].attrs["units"] == "um"
+    # s: 6 ms a node of the pair, at least 120 s
+    assert peer.attrs["deck_cpu_limit_s"] == pytest.approx(max(120.0, 6e-3 * peer.attrs["nodes"]))
     np.testing.assert_allclose(peer["angle"].values, [0.0, 11.0])
     ste_peer = peer["ste"].values - peer.attrs["backlash_offset_um"]
     te, off = model_ste(scene, "compliance", np.radians(peer["angle"].values))
