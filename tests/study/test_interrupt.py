@@ -77,25 +77,43 @@ def ctrl_c():
     os.kill(os.getpid(), signal.SIGINT)
 
 
-def test_an_interrupt_stops_the_time_integration_within_a_step(paper_solid_model):
+def ctrl_c_after(seconds: float, monkeypatch):
+    """Ctrl-C in ``seconds`` [s], and a watchdog: should the interrupt be lost, `stop_all` ends
+    the kernel 20 s later, so that the test fails (Interrupted, not KeyboardInterrupt) naming
+    the SIGINT handler in place instead of waiting out the kernel's hours."""
+    monkeypatch.setattr(interrupt, "_stopping", threading.Event())
+    handler = signal.getsignal(signal.SIGINT)
+    threading.Timer(seconds, ctrl_c).start()
+    watchdog = threading.Timer(seconds + 20.0, interrupt.stop_all)
+    watchdog.daemon = True
+    watchdog.start()
+    return handler, watchdog
+
+
+def test_an_interrupt_stops_the_time_integration_within_a_step(paper_solid_model, monkeypatch):
     from solver.mbs.dynamics import simulate
-    timer = threading.Timer(1.5, ctrl_c)
     t0 = time.monotonic()
-    timer.start()
+    handler, watchdog = ctrl_c_after(1.5, monkeypatch)
     with pytest.raises(KeyboardInterrupt):
-        # about 40 min of stepping at this step
-        simulate(paper_solid_model, 100.0, 0.01, 50.0, 0.01, 0.2, dt=1e-10, output_step=1e-4)
+        try:    # about 40 min of stepping at this step
+            simulate(paper_solid_model, 100.0, 0.01, 50.0, 0.01, 0.2, dt=1e-10, output_step=1e-4)
+        except interrupt.Interrupted:
+            pytest.fail(f"Ctrl-C was lost (the SIGINT handler in place: {handler!r})")
+    watchdog.cancel()
     assert time.monotonic() - t0 < 1.5 + 1.0
 
 
-def test_an_interrupt_stops_the_statics_before_the_next_angle(paper_solid_model):
+def test_an_interrupt_stops_the_statics_before_the_next_angle(paper_solid_model, monkeypatch):
     from solver.mbs.statics import solve_static
     angles = np.radians(np.arange(0.0, 3600.0, 1e-3))        # 3.6 million angles: minutes
-    timer = threading.Timer(1.0, ctrl_c)
     t0 = time.monotonic()
-    timer.start()
+    handler, watchdog = ctrl_c_after(1.0, monkeypatch)
     with pytest.raises(KeyboardInterrupt):
-        solve_static(paper_solid_model, angles, 50.0, raise_on_failure=False)
+        try:
+            solve_static(paper_solid_model, angles, 50.0, raise_on_failure=False)
+        except interrupt.Interrupted:
+            pytest.fail(f"Ctrl-C was lost (the SIGINT handler in place: {handler!r})")
+    watchdog.cancel()
     assert time.monotonic() - t0 < 1.0 + 1.0
 
 
