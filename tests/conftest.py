@@ -43,6 +43,18 @@ def pytest_collection_modifyitems(config, items):
     items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))     # stable
 
 
+@pytest.fixture(scope="module", autouse=True)
+def collect_in_the_main_thread():
+    """Each test file's dropped archives are collected here, in the main thread: an xarray
+    dataset left open (a sweep result's lazy curves) is otherwise closed by whichever thread
+    the garbage collector next runs in (a dask client's IO loop among them), outside the
+    HDF5 lock, while the main thread may be reading or writing another NetCDF file; HDF5 is
+    not thread-safe and such a close once took a test process down."""
+    yield
+    import gc
+    gc.collect()
+
+
 @pytest.fixture
 def private_fe_cache(tmp_path, monkeypatch):
     """FE results of the test go to a fresh disk cache, and nothing the process holds in memory
