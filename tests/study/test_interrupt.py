@@ -71,6 +71,23 @@ def stop_after(proc, ready, sig, timeout=240.0):
     return proc.returncode, time.monotonic() - t0
 
 
+@pytest.fixture(autouse=True)
+def ctrl_c_as_a_shell_gives_it():
+    """Each test starts with SIGINT as a terminal delivers it: Python's KeyboardInterrupt here,
+    the default action in the commands started (children inherit an ignored SIGINT). In a full
+    run from empty caches an earlier test of the same process left SIGINT ignored (the
+    test processes' children then ignored Ctrl-C too); it is said as a warning, so that it
+    can be traced, and undone, so that these tests check lightgear and not that test."""
+    import warnings
+    found = signal.getsignal(signal.SIGINT)
+    ignored = int(next(line.split()[1] for line in open("/proc/self/status") if line.startswith("SigIgn:")), 16) \
+        & (1 << (signal.SIGINT - 1)) if Path("/proc/self/status").exists() else 0
+    if found is not signal.default_int_handler or ignored:
+        warnings.warn(f"SIGINT was {found!r}{' (ignored by the OS)' if ignored else ''} before this test: reset", stacklevel=2)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+
+
 # ---------------------------------------------------------------- the mechanism, in process
 
 def ctrl_c():
