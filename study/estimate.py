@@ -240,13 +240,21 @@ def check_fe_memory(setups, factor: float = 1.0) -> str | None:
         return None
     sizes = sorted((body_bytes(s), body_elements(s)) for s in setups)[-2:]
     need = factor * sum(b for b, _ in sizes)
+    what = f"the FE bodies need about {bytes_text(need)} ({' and '.join(f'{n:.3g}' for _, n in sizes)} elements)"
+    return check_memory(need, "fe.mesh_size", what, "a coarser fe.mesh_size (or fewer teeth)", "a coarser fe.mesh_size")
+
+
+def check_memory(need: float, field: str, what: str, lever: str, warn_lever: str | None = None) -> str | None:
+    """Refuse, before the work, a part that needs ``need`` [bytes], more than MEMORY_REFUSE of
+    the memory available (BudgetError naming ``field``, ``what`` needs it, ``lever`` needs
+    less); a line to warn with above MEMORY_WARN (its lever ``warn_lever``, default ``lever``),
+    else None."""
     have = available_memory()
-    what = (f"the FE bodies need about {bytes_text(need)} ({' and '.join(f'{n:.3g}' for _, n in sizes)} elements), "
-            f"{{}} the {bytes_text(have)} of memory available")
+    text = f"{what}, {{}} the {bytes_text(have)} of memory available"
     if need > MEMORY_REFUSE * have:
-        raise BudgetError("fe.mesh_size", what.format("more than") + ": a coarser fe.mesh_size (or fewer teeth)")
+        raise BudgetError(field, text.format("more than") + ": " + lever)
     if need > MEMORY_WARN * have:
-        return "fe.mesh_size: " + what.format("more than half of") + "; a coarser fe.mesh_size needs less"
+        return f"{field}: " + text.format("more than half of") + "; " + (warn_lever or lever) + " needs less"
     return None
 
 

@@ -76,19 +76,13 @@ def check_reference_memory(scene: Scene, est, field: str = "fe.mesh_size", what:
     to warn with beyond `study.estimate.MEMORY_WARN`, else None. ``what``: what needs it (default:
     the FE bodies of the scene's mesh); ``lever``: what needs less."""
     from study import estimate
-    from study.errors import BudgetError
     from study.memory import bytes_text
-    need, have = sum(est.memory.values()), estimate.available_memory()
+    need = sum(est.memory.values())
     if what is None:
         elements = " and ".join(f"{estimate.body_elements(s):.3g}" for s in gear_setups(scene))
         what = (f"the FE bodies need about {{need}} for the reference ({elements} elements at fe.mesh_size "
                 f"{gear_setups(scene)[1].mesh_size * 1e3:.3g} mm, {scene.fe.mesh_grading})")
-    text = what.format(need=bytes_text(need)) + ", {} the " + bytes_text(have) + " of memory available"
-    if need > estimate.MEMORY_REFUSE * have:
-        raise BudgetError(field, text.format("more than") + ": " + lever)
-    if need > estimate.MEMORY_WARN * have:
-        return f"{field}: " + text.format("more than half of") + "; " + lever + " needs less"
-    return None
+    return estimate.check_memory(need, field, what.format(need=bytes_text(need)), lever)
 
 
 def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS, progress: bool = False):
