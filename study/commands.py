@@ -124,17 +124,13 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
 
 
 def precision_scene(scene: Scene) -> Scene:
-    """The scene a work-precision study runs: the integrators it compares (explicit, implicit
-    HHT, the scipy reference) all exist for the paper's plain model only, so the default
-    ``coupling.model = "auto"`` runs as ``"paper"``; a coupled model named by the scene is
-    refused (SceneError naming coupling.model)."""
-    from study.scene import SceneError
+    """The scene a work-precision study runs. The default ``coupling.model = "auto"`` runs as
+    ``"paper"``: every integrator the study compares (explicit, implicit HHT, the scipy peer)
+    exists for the paper's plain model. A body-coupled model named by the scene (``"compliance"``,
+    the default of a run, or ``"body-torsion"``) runs as named, with the explicit integrators and
+    the static solver, which are all it has (`study.verify.precision_cases`)."""
     if scene.coupling.model == "auto":
         return scene.replace(**{"coupling.model": "paper"})
-    if scene.coupling_model != "none":
-        raise SceneError("coupling.model", f"the work-precision study compares the explicit, implicit and scipy "
-                                           f"integrators, which exist together for the paper's model only, not for "
-                                           f"{scene.coupling.model!r}: set coupling.model = 'paper'")
     return scene
 
 
@@ -147,7 +143,7 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
     'static' or 'dynamic'. With ``output`` (BASE.nc) each study is written to BASE_static.nc and
     BASE_dynamic.nc with its plot (.png). ``hooks`` (by keyword): ``progress(i, spec, errors, wall,
     message)``, called after each run; ``model``, the model of `precision_scene` when the caller
-    has built it already. The integrators compared exist for the paper's model: `precision_scene`."""
+    has built it already. Which model runs and with which integrators: `precision_scene`."""
     from study.archive.netcdf import write_netcdf
     from study.scene_model import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
