@@ -242,10 +242,12 @@ def mesh_table(ds: xr.Dataset) -> str:
 
 def mesh_plot(ds: xr.Dataset, path) -> None:
     """Two log-log panels: each error [um] against the FE CPU time of both gears [s], and
-    against the mesh size [mm] (the finest, the reference, left out)."""
+    against the mesh size [mm] (the finest, the reference, as a dotted line)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from study.verify.precision_report import save_with_footer
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 5))
     fe = ds["fe_cpu_time"].sum("gear").values
     h = ds["mesh_size"].values
@@ -258,6 +260,8 @@ def mesh_plot(ds: xr.Dataset, path) -> None:
         if ok.any():
             a.loglog(fe[keep][ok], e[ok], "o-", label=label)
             b.loglog(h[keep][ok], e[ok], "o-", label=label)
+    a.axvline(fe[-1], color="k", ls=":", lw=1, label=f"the finest mesh (the reference): {fe[-1]:.3g} s")
+    b.axvline(h[-1], color="k", ls=":", lw=1, label=f"the finest mesh (the reference): {h[-1]:.3g} mm")
     for i in keep:
         a.annotate(f"{ds['level'].values[i]} ({h[i]:.3g} mm)", (fe[i], 0.02), xycoords=("data", "axes fraction"),
                    fontsize=7, rotation=90, va="bottom", ha="right")
@@ -267,11 +271,7 @@ def mesh_plot(ds: xr.Dataset, path) -> None:
     for ax in (a, b):
         ax.set_ylabel("error against the finest mesh [um]")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+    a.legend(fontsize=8, loc="upper right")           # the lines fall to the right: room above them
+    b.legend(handles=b.get_lines()[-1:], fontsize=8, loc="upper left")   # the colours are the left panel's
     fig.suptitle(ds.attrs["title"])
-    footer = (f"{ds.attrs['case']}\nreference: {ds.attrs['reference']}\n"
-              f"{ds.attrs['machine']}; {ds.attrs.get('software', '')}; {ds.attrs['date']}")
-    fig.text(0.01, 0.005, footer, fontsize=6, va="bottom", wrap=True)
-    fig.tight_layout(rect=(0, 0.1, 1, 0.95))
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_with_footer(fig, ds, f"reference: {ds.attrs['reference']}", path, top=0.95)

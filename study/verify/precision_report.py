@@ -81,9 +81,17 @@ def plot(ds: xr.Dataset, path, norm: str = "linf") -> None:
     ax.set_title(ds.attrs.get("title", "work-precision"))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    footer = (f"{ds.attrs.get('case', '')}\nreference: {ds.attrs['reference']}; cross-check: {ds.attrs['cross_check']}\n"
+    save_with_footer(fig, ds, f"reference: {ds.attrs['reference']}; cross-check: {ds.attrs['cross_check']}", path)
+
+
+def save_with_footer(fig, ds: xr.Dataset, reference: str, path, top: float = 1.0) -> None:
+    """Write a study's figure (PNG, 120 dpi) with its footer: the case, ``reference`` (a line
+    naming what the errors are measured against), the machine, the versions and the date;
+    ``top``: the figure fraction the axes end at (room for a suptitle). Closes the figure."""
+    import matplotlib.pyplot as plt
+    footer = (f"{ds.attrs.get('case', '')}\n{reference}\n"
               f"{ds.attrs['machine']}; {ds.attrs.get('software', '')}; {ds.attrs['date']}")
     fig.text(0.01, 0.005, footer, fontsize=6, va="bottom", wrap=True)
-    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    fig.tight_layout(rect=(0, 0.1, 1, top))
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -132,3 +132,14 @@ def test_mesh_options_are_refused_with_their_reason():
         mesh_study(None, (1.0,))
     assert model_output("r/wp.nc", "paper") == "r/wp.nc"
     assert model_output("r/wp.nc", "compliance") == "r/wp_compliance.nc"
+
+
+def test_the_estimate_of_a_coupled_models_study_counts_no_scipy_runs(models):
+    """`lightgear precision` estimates its time before any work: the compliance model has no scipy
+    runs and no implicit ladder to count, the paper model both."""
+    from study.estimate import precision_estimate
+    est = {name: precision_estimate(sc, m, 0.001, 1.0, 1) for name, (sc, m) in models.items()}
+    assert est["compliance"].seconds["dynamic: scipy reference and runs"] == 0
+    assert est["paper"].seconds["dynamic: scipy reference and runs"] > 0
+    assert est["compliance"].seconds["static"] < est["paper"].seconds["static"]
+    assert est["compliance"].seconds["dynamic: numba runs"] > 0
