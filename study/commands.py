@@ -181,6 +181,36 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
     return out
 
 
+def precision_mesh(scene: Scene, output: str | Path | None = None, factors=(2.0, 1.0, 0.5), rotation: float = 6.0,
+                   repeats: int = 2, progress=None):
+    """Work-precision of the FE mesh size: the scene's STE and DTE at fe.mesh_size = each of
+    ``factors`` x its default (a quarter of the smaller module), their errors [um] against the
+    finest, the FE CPU time of each gear [s] from an empty FE cache and the run's CPU times [s]
+    -> Dataset over ``mesh`` (`study.verify.precision_mesh`). ``rotation`` [deg]: the STE's
+    range; ``repeats``: timed runs (best kept); the DTE is the scene's own dynamic run. With
+    ``output`` (a .nc path) the archive is written there with its plot beside it (.png).
+    ``progress(i, size_mm, row)``: called after each size."""
+    from study.archive.netcdf import write_netcdf
+    from study.verify.precision_mesh import mesh_plot, mesh_study
+    check_scene_argument("precision_mesh", scene)
+    check_argument(output is None or is_path(output), "precision_mesh", "output", "an archive path ending in .nc, or None",
+                   output)
+    check_argument(isinstance(factors, tuple | list) and len(factors) >= 2 and all(
+        is_number(f) and math.isfinite(f) and f > 0 for f in factors), "precision_mesh", "factors",
+        "two or more positive multiples of the default mesh size", factors)
+    for name, value, ok, what in (("rotation", rotation, lambda v: v > 0, "a positive number of degrees"),
+                                  ("repeats", repeats, lambda v: v >= 1 and float(v).is_integer(), "an integer >= 1")):
+        check_argument(is_number(value) and math.isfinite(value) and ok(value), "precision_mesh", name, what, value)
+    ds = mesh_study(scene, tuple(factors), rotation_deg=float(rotation), repeats=int(repeats), progress=progress)
+    if output is not None:
+        path = Path(output)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_netcdf(ds, path)
+        mesh_plot(ds, path.with_suffix(".png"))
+        ds.attrs["archive"] = str(path)
+    return ds
+
+
 def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None, prefix: str = "") -> list:
     """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
     files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a

@@ -87,24 +87,17 @@ def main(argv=None) -> int:
 
 def mesh_run(scene, args) -> None:
     """The mesh study of the compliance model: archive BASE_mesh.nc, its plot and table."""
-    from study.archive.netcdf import write_netcdf
-    from study.verify.precision_mesh import default_size_mm, mesh_plot, mesh_study, mesh_table
-    h0 = default_size_mm(scene)
-    print(f"compliance model, mesh study at fe.mesh_size "
-          f"{', '.join(f'{h0 * f:.4g}' for f in sorted(args.mesh_factors, reverse=True))} mm "
+    print("compliance model, mesh study at fe.mesh_size "
+          f"{' / '.join(f'{f:g}' for f in sorted(args.mesh_factors, reverse=True))} x the default "
           "(each from an empty FE cache; the finest takes longest) ...", flush=True)
 
     def progress(i, h, row):
         print(f"  [{i + 1}] fe.mesh_size {h:.4g} mm: FE {row['fe'][0]:.3g} + {row['fe'][1]:.3g} s CPU, "
               f"STE mean {row['ste'].mean():.4g} um, dynamic run {row['dynamic_cpu']:.3g} s CPU", flush=True)
-    ds = mesh_study(scene, args.mesh_factors, rotation_deg=args.rotation, repeats=min(args.repeats, 2),
-                    progress=progress)
     base = Path(args.output)
     path = base.with_name(f"{base.stem}_mesh.nc")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_netcdf(ds, path)
-    mesh_plot(ds, path.with_suffix(".png"))
-    print(mesh_table(ds))
+    ds = study.precision_mesh(scene, path, args.mesh_factors, args.rotation, min(args.repeats, 2), progress)
+    print(study.precision_mesh_table(ds))
     print(f"  archive: {path}\n  plot: {path.with_suffix('.png')}", flush=True)
 
 

@@ -79,9 +79,8 @@ def test_the_compliance_statics_against_its_own_reference(models):
 def mesh(small):
     """The compliance model of the small pair at fe.mesh_size 1.125, 0.75 and 0.45 mm, each
     size's FE from an empty cache, STE over one mesh cycle (15 deg), DTE of 4 ms."""
-    from study.verify.precision_mesh import mesh_study
-    return mesh_study(small.replace(**{"coupling.model": "compliance"}), (1.5, 1.0, 0.6), rotation_deg=15.0,
-                      repeats=1)
+    import study
+    return study.precision_mesh(small.replace(**{"coupling.model": "compliance"}), None, (1.5, 1.0, 0.6), 15.0, 1)
 
 
 def test_the_error_falls_as_the_fe_mesh_is_refined(mesh):
@@ -117,12 +116,23 @@ def test_the_mesh_study_leaves_the_fe_cache_as_it_was_and_writes_its_archive(mes
     assert (tmp_path / "m.png").stat().st_size > 10_000
     text = mesh_table(mesh)
     assert "x0.6" in text and "errors [um] against the finest mesh" in text
+    import importlib.util
+    if importlib.util.find_spec("compliance_checker"):
+        from cf_check import cf_errors
+        assert cf_errors(tmp_path / "m.nc") == []
 
 
-def test_mesh_options_are_refused_with_their_reason():
+def test_mesh_options_are_refused_with_their_reason(small, tmp_path):
     import argparse
 
+    import study
     from study.verify.precision_mesh import mesh_study
+    for args, words in (((None,), "scene"), ((small, tmp_path / "m.nc", (1.0,)), "factors"),
+                        ((small, None, (1.0, -0.5)), "factors"), ((small, None, (2, 1), -6.0), "rotation"),
+                        ((small, None, (2, 1), 6.0, 1.5), "repeats"), ((small, 5), "output")):
+        with pytest.raises(TypeError, match=f"precision_mesh: {words}"):
+            study.precision_mesh(*args)
+    assert not list(tmp_path.iterdir())        # refused before any work
     from workflows.work_precision import mesh_factors, model_output
     assert mesh_factors("2,1,0.5") == (2.0, 1.0, 0.5)
     for bad in ("1", "2,x", "1,-1", f"1,{math.inf}"):
