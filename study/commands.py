@@ -136,7 +136,7 @@ def precision_scene(scene: Scene) -> Scene:
 
 def precision(scene: Scene, output: str | Path | None = None, duration: float = 0.002, ramp_fraction: float = 0.5,
               rotation: float = 6.0, repeats: int = 3, only: str | None = None, **hooks) -> dict:
-    """Work-precision studies of a scene: TE error [um] against wall time [s] for every solver
+    """Work-precision studies of a scene: TE error [um] against CPU and wall time [s] for every solver
     -> {"static": Dataset, "dynamic": Dataset} (`study.verify.precision`). ``duration`` [s]: the
     dynamic window, its ramps ending at ``ramp_fraction`` of it; ``rotation`` [deg]: the
     quasi-static range; ``repeats``: timed runs per setting (the best is kept); ``only``:
