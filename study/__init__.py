@@ -75,6 +75,8 @@ _OFFERED = {
     "reference": ("study.commands", "reference"),
     "precision": ("study.commands", "precision"),
     "precision_table": ("study.verify.precision_report", "table"),
+    "precision_mesh": ("study.commands", "precision_mesh"),
+    "precision_mesh_table": ("study.verify.precision_mesh", "mesh_table"),
     "stability_suite": ("study.verify.stability", "run_suite"),
     "validation": ("study.verify.validation", "validation"),
     "validate_design_space": ("study.verify.model_validation", "design_space_dataset"),

@@ -304,7 +304,7 @@ COMMANDS = {
                "with units, the model's validation, figures)", report_arguments, report_command),
     "export": ("an archive's variables as CSV (one file per dimension group, units in the header)", export_arguments,
                export_command),
-    "precision": ("work-precision study: TE error against wall time for every solver of a scene", precision_arguments,
+    "precision": ("work-precision study: TE error against CPU and wall time for every solver of a scene", precision_arguments,
                   precision_command),
     "reference": ("FE reference STE and load sharing (loaded-tooth-contact analysis)", reference_arguments,
                   reference_command),

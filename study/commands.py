@@ -124,30 +124,26 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
 
 
 def precision_scene(scene: Scene) -> Scene:
-    """The scene a work-precision study runs: the integrators it compares (explicit, implicit
-    HHT, the scipy reference) all exist for the paper's plain model only, so the default
-    ``coupling.model = "auto"`` runs as ``"paper"``; a coupled model named by the scene is
-    refused (SceneError naming coupling.model)."""
-    from study.scene import SceneError
+    """The scene a work-precision study runs. The default ``coupling.model = "auto"`` runs as
+    ``"paper"``: every integrator the study compares (explicit, implicit HHT, the scipy peer)
+    exists for the paper's plain model. A body-coupled model named by the scene (``"compliance"``,
+    the default of a run, or ``"body-torsion"``) runs as named, with the explicit integrators and
+    the static solver, which are all it has (`study.verify.precision_cases`)."""
     if scene.coupling.model == "auto":
         return scene.replace(**{"coupling.model": "paper"})
-    if scene.coupling_model != "none":
-        raise SceneError("coupling.model", f"the work-precision study compares the explicit, implicit and scipy "
-                                           f"integrators, which exist together for the paper's model only, not for "
-                                           f"{scene.coupling.model!r}: set coupling.model = 'paper'")
     return scene
 
 
 def precision(scene: Scene, output: str | Path | None = None, duration: float = 0.002, ramp_fraction: float = 0.5,
               rotation: float = 6.0, repeats: int = 3, only: str | None = None, **hooks) -> dict:
-    """Work-precision studies of a scene: TE error [um] against wall time [s] for every solver
+    """Work-precision studies of a scene: TE error [um] against CPU and wall time [s] for every solver
     -> {"static": Dataset, "dynamic": Dataset} (`study.verify.precision`). ``duration`` [s]: the
     dynamic window, its ramps ending at ``ramp_fraction`` of it; ``rotation`` [deg]: the
     quasi-static range; ``repeats``: timed runs per setting (the best is kept); ``only``:
     'static' or 'dynamic'. With ``output`` (BASE.nc) each study is written to BASE_static.nc and
     BASE_dynamic.nc with its plot (.png). ``hooks`` (by keyword): ``progress(i, spec, errors, wall,
     message)``, called after each run; ``model``, the model of `precision_scene` when the caller
-    has built it already. The integrators compared exist for the paper's model: `precision_scene`."""
+    has built it already. Which model runs and with which integrators: `precision_scene`."""
     from study.archive.netcdf import write_netcdf
     from study.scene_model import build_scene_model
     from study.verify.precision import dynamic_study, plot, static_study
@@ -183,6 +179,36 @@ def precision(scene: Scene, output: str | Path | None = None, duration: float = 
             ds.attrs["archive"] = str(path)
         out[kind] = ds
     return out
+
+
+def precision_mesh(scene: Scene, output: str | Path | None = None, factors=(2.0, 1.0, 0.5), rotation: float = 6.0,
+                   repeats: int = 2, progress=None):
+    """Work-precision of the FE mesh size: the scene's STE and DTE at fe.mesh_size = each of
+    ``factors`` x its default (a quarter of the smaller module), their errors [um] against the
+    finest, the FE CPU time of each gear [s] from an empty FE cache and the run's CPU times [s]
+    -> Dataset over ``mesh`` (`study.verify.precision_mesh`). ``rotation`` [deg]: the STE's
+    range; ``repeats``: timed runs (best kept); the DTE is the scene's own dynamic run. With
+    ``output`` (a .nc path) the archive is written there with its plot beside it (.png).
+    ``progress(i, size_mm, row)``: called after each size."""
+    from study.archive.netcdf import write_netcdf
+    from study.verify.precision_mesh import mesh_plot, mesh_study
+    check_scene_argument("precision_mesh", scene)
+    check_argument(output is None or is_path(output), "precision_mesh", "output", "an archive path ending in .nc, or None",
+                   output)
+    check_argument(isinstance(factors, tuple | list) and len(factors) >= 2 and all(
+        is_number(f) and math.isfinite(f) and f > 0 for f in factors), "precision_mesh", "factors",
+        "two or more positive multiples of the default mesh size", factors)
+    for name, value, ok, what in (("rotation", rotation, lambda v: v > 0, "a positive number of degrees"),
+                                  ("repeats", repeats, lambda v: v >= 1 and float(v).is_integer(), "an integer >= 1")):
+        check_argument(is_number(value) and math.isfinite(value) and ok(value), "precision_mesh", name, what, value)
+    ds = mesh_study(scene, tuple(factors), rotation_deg=float(rotation), repeats=int(repeats), progress=progress)
+    if output is not None:
+        path = Path(output)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_netcdf(ds, path)
+        mesh_plot(ds, path.with_suffix(".png"))
+        ds.attrs["archive"] = str(path)
+    return ds
 
 
 def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None, prefix: str = "") -> list:

@@ -343,21 +343,24 @@ PRECISION_IMPLICIT_STEPS = 2 * (1 / 8 + 1 / 4 + 1 / 2 + 1 + 2)
 
 def precision_estimate(scene, model, duration: float, rotation_deg: float, repeats: int, only=None) -> Estimate:
     """Estimated seconds of `lightgear precision`'s dynamic study over ``duration`` [s] and its
-    static study over ``rotation_deg`` [deg], ``repeats`` timed runs each (`study.verify.precision`)."""
+    static study over ``rotation_deg`` [deg], ``repeats`` timed runs each (`study.verify.precision`;
+    a body-coupled model runs the explicit ladders and the static solver only, no scipy)."""
     from solver.mbs.stability import stable_time_step
     est = Estimate()
+    coupled = bool(model.coupled)
     if only in (None, "dynamic"):
         dt_b, _w = stable_time_step(model, scene.dynamic.torque)
         steps = duration / dt_b
-        ref = steps * SCIPY_S_PER_BOUND_STEP
+        ref = 0.0 if coupled else steps * SCIPY_S_PER_BOUND_STEP
         est.seconds["dynamic: scipy reference and runs"] = ref + SCIPY_RUNS * min(SCIPY_RUN_CAP_S, ref)
         est.seconds["dynamic: numba runs"] = steps * (repeats + 1) * model.n_teeth * (
-            PRECISION_EXPLICIT_STEPS * EXPLICIT_S_PER_STEP_TOOTH + PRECISION_IMPLICIT_STEPS * IMPLICIT_S_PER_STEP_TOOTH)
+            PRECISION_EXPLICIT_STEPS * EXPLICIT_S_PER_STEP_TOOTH
+            + (0.0 if coupled else PRECISION_IMPLICIT_STEPS * IMPLICIT_S_PER_STEP_TOOTH))
         est.levers["dynamic: scipy reference and runs"] = est.levers["dynamic: numba runs"] = \
             f"a shorter --duration ({duration:g} s = {steps:.3g} stability steps of {dt_b:.3g} s)"
     if only in (None, "static"):
         angles = rotation_deg / scene.quasi_static.angle_step + 1
-        est.seconds["static"] = angles * (SCIPY_ROOT_S_PER_ANGLE
+        est.seconds["static"] = angles * ((0.0 if coupled else SCIPY_ROOT_S_PER_ANGLE)
                                           + (4 * repeats + 1) * STATIC_S_PER_ANGLE_TOOTH * model.n_teeth)
         est.levers["static"] = f"a smaller --rotation ({rotation_deg:g} deg) or a larger quasi_static.angle_step"
     return est

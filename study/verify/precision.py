@@ -1,4 +1,4 @@
-"""Work-precision study: TE error against wall time for every solver of a scene.
+"""Work-precision study: TE error against CPU and wall time for every solver of a scene.
 
 Dynamic scene (DTE): every method integrates the same equations, those of the scipy peer
 (`solver.peers.scipy_dynamics`: every tooth free, none frozen), over a shortened window (the paper's
@@ -17,11 +17,15 @@ integrators. Reference: static Newton at tol 1e-13; cross-check: `scipy.optimize
 plain-Python forces. The transient's error also holds its physical ringing (not a solver
 error): it is measured on the angles after the ramp.
 
+A body-coupled model (the default compliance model) has the explicit ladders and the static
+solver only, each against the same model's own converged answer (`study.verify.precision_cases`).
+The FE mesh size's share: `study.verify.precision_mesh`.
+
 Errors: TE minus reference TE [um] on the common output grid, as norms ``final`` (last
 sample), ``l2`` (root mean square over the samples) and ``linf`` (largest magnitude).
-Wall time [s]: best of ``repeats`` runs after a warm-up run of each numba method (compile
-time and the first call are timed apart, in ``first_call_time``); a run over 10 s is timed
-once. A failed run keeps NaN errors and its message.
+Wall and CPU time [s]: best of ``repeats`` runs after a warm-up run of each numba method
+(compile time and the first call are timed apart, in ``first_call_time``); a run over 10 s is
+timed once; runs are compared by CPU time. A failed run keeps NaN errors and its message.
 
 `lightgear precision [SCENE] [-o OUT.nc]` runs both for a scene (default: the paper example).
 

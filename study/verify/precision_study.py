@@ -3,9 +3,10 @@ measured against the reference, into one xarray Dataset with dims (run, norm).
 
 Errors: TE minus reference TE [um] on the common output grid, as norms ``final`` (last
 sample), ``l2`` (root mean square over the samples) and ``linf`` (largest magnitude).
-Wall time [s]: best of ``repeats`` runs after a warm-up run of each numba method (compile
-time and the first call are timed apart, in ``first_call_time``); a run over 10 s is timed
-once. A failed run keeps NaN errors and its message.
+Wall and CPU time [s]: best of ``repeats`` runs after a warm-up run of each numba method
+(compile time and the first call are timed apart, in ``first_call_time``); a run over 10 s is
+timed once. The CPU time (user + system of the process) is the figure to compare on a shared
+machine. A failed run keeps NaN errors and its message.
 """
 from __future__ import annotations
 
@@ -64,16 +65,18 @@ def te_error_norms(te: np.ndarray, ref: np.ndarray) -> np.ndarray:
 
 
 def _timed(fn, repeats: int):
-    """(result, best wall time [s]) of repeats calls; one call when it takes over 10 s."""
-    best = math.inf
+    """(result, best wall time [s], best CPU time [s]) of repeats calls; one call when it takes
+    over 10 s."""
+    best = best_cpu = math.inf
     out = None
     for _ in range(max(1, repeats)):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         out = fn()
+        best_cpu = min(best_cpu, time.process_time() - c0)
         best = min(best, time.perf_counter() - t0)
         if best > 10.0:
             break
-    return out, best
+    return out, best, best_cpu
 
 
 def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: tuple, repeats: int = 3,
@@ -84,6 +87,7 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
     n = len(specs)
     err = np.full((n, 3), np.nan)
     wall = np.full(n, np.nan)
+    cpu = np.full(n, np.nan)
     first = np.full(n, np.nan)
     steps = np.zeros(n, dtype=np.int64)
     status = []
@@ -96,11 +100,12 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
                 s.run()
                 first[i] = time.perf_counter() - t0
                 warmed.add(s.method)
-            (te, nst, st, msg), best = _timed(s.run, repeats)
+            (te, nst, st, msg), best, best_cpu = _timed(s.run, repeats)
             steps[i] = nst
             if st in COMPLETED:       # inaccurate: completed, its error is what the study measures
                 st = OK
                 wall[i] = best
+                cpu[i] = best_cpu
                 err[i] = te_error_norms(te[mask], ref_te[mask])
                 if not np.all(np.isfinite(err[i])):
                     st, msg = NONFINITE, "output not finite or incomplete"
@@ -117,6 +122,8 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
         {
             "te_error": (("run", "norm"), err, {"units": "um", "long_name": "TE error against the reference"}),
             "wall_time": ("run", wall, {"units": "s", "long_name": f"wall time, best of {repeats} after a warm-up run"}),
+            "cpu_time": ("run", cpu, {"units": "s", "long_name": f"CPU time (user + system) of the process, best of "
+                                                                  f"{repeats} after a warm-up run"}),
             "first_call_time": ("run", first, {"units": "s", "long_name": "wall time of the method's first call (numba compile included), NaN after the first run of a method"}),
             "steps": ("run", steps, {"units": "1", "long_name": "steps (static: Newton iterations over all angles)"}),
             "status": ("run", np.array(status, dtype=object), {"long_name": "ok or failed"}),
@@ -142,13 +149,19 @@ def run_study(specs: list[Spec], ref_te: np.ndarray, chk_te: np.ndarray, names: 
     return ds
 
 
+def model_label(scene: Scene) -> str:
+    """The model a study's scene runs, for titles: 'paper model' or '<coupling.model> model'."""
+    m = scene.coupling_model
+    return "paper model" if m == "none" else f"{m} model"
+
+
 def dynamic_study(scene: Scene, model: Model, duration: float = 0.002, ramp_fraction: float = 0.5,
                   repeats: int = 3, progress=None, **spec_kw) -> xr.Dataset:
     case = dynamic_case(scene, duration, ramp_fraction)
     specs, dt_b = dynamic_specs(model, case, **spec_kw)
     ref, chk, names = dynamic_reference(model, case, dt_b)
     return run_study(specs, ref, chk, names, repeats, progress=progress, attrs={
-        "title": "work-precision, dynamic scene (DTE)",
+        "title": f"work-precision, dynamic scene (DTE), {model_label(scene)}", "model": model_label(scene),
         "case": (f"driver 0 -> {case.speed:g} rad/s and load 0 -> {case.torque:g} N·m in {case.ramp * 1e3:g} ms, "
                  f"{case.duration * 1e3:g} ms in all (shortened window; the scene runs {scene.dynamic.duration:g} s "
                  f"with a {scene.dynamic.ramp_time * 1e3:g} ms ramp), TE every {case.output_step * 1e6:g} us"),
@@ -165,8 +178,9 @@ def static_study(scene: Scene, model: Model, rotation_deg: float = 6.0, repeats:
     settle = case.speed * 1.5 * case.ramp
     mask = case.angles >= settle
     return run_study(specs, ref, chk, names, repeats, mask=mask, progress=progress, attrs={
-        "title": "work-precision, quasi-static scene (STE)",
+        "title": f"work-precision, quasi-static scene (STE), {model_label(scene)}", "model": model_label(scene),
         "case": (f"STE under {case.torque:g} N·m over {math.degrees(case.rotation):g} deg of driver rotation "
                  f"every {math.degrees(case.angle_step):g} deg; transient: 0 -> {case.speed:g} rad/s and 0 -> "
                  f"{case.torque:g} N·m in {case.ramp * 1e3:g} ms, errors from {math.degrees(settle):.3g} deg on"),
-        "explicit_stability_step_s": dt_b, "scene": scene.to_toml()})
+        # a coupled model's transient runs at the production (implicit-damper) step bound
+        "transient_step_bound_s" if model.coupled else "explicit_stability_step_s": dt_b, "scene": scene.to_toml()})
