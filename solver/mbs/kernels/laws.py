@@ -120,7 +120,7 @@ def contact_damping_tangents(delta, ddelta, force, c, m2, m3):
 
 # a negative c_loc (the rigid tooth too soft there) is kept so small that the series spring stays
 # at most 1/(1 - SERIES_NEG_LIMIT) times as stiff as the contact law alone at its own penetration
-# delta_c: 1 + c_loc*m1*k*delta_c^(m1-1) >= SERIES_NEG_LIMIT, so that F_e(delta) is single-valued
+# delta_c: 1 + c_loc*m1*k*delta_c^(m1-1) >= 1 - SERIES_NEG_LIMIT, so that F_e(delta) is single-valued
 # and its tangent finite for every m1 (never active for FE tooth data: |c_loc| is a tenth of the
 # contact compliance at the rated load)
 SERIES_NEG_LIMIT = 0.5
