@@ -28,6 +28,7 @@ from study.inputs.gearsetup import gear_setups
 from study.plausibility import report_warnings, scene_warnings
 from study.scene import Scene
 from study.scene_model import (
+    damping_conversion,
     damping_ratios,
     dynamic_choice,
     load_table,
@@ -69,6 +70,7 @@ class RunPlan:
     warn: bool = True               # warnings to stderr too
     progress: bool = False          # bars on stderr for long parts
     springs_s: float = 0.0          # wall time of the springs and the model [s]
+    damping_at: str = ""            # where the dampers given as ratios were converted (`scene_model.damping_conversion`)
 
     def asks(self, stage: str) -> bool:
         """True when ``stage`` (`STAGES`) is asked."""
@@ -153,7 +155,8 @@ def make_plan(scene: Scene, stages, options: RunOptions = RunOptions()) -> RunPl
     est.seconds["FE bodies"] = 0.0          # done
     estimate.check_time(est, options.max_time)
     return RunPlan(scene, stages, setups, springs, model, load, ratios, equilibria, angles, table, choice, warnings,
-                   options.archive, options.warn, options.progress, springs_s)
+                   options.archive, options.warn, options.progress, springs_s,
+                   damping_conversion(scene, options.keep_model))
 
 
 # the springs, model and equilibria of the last scene run with keep_model

@@ -153,6 +153,7 @@ def run_attrs(plan: RunPlan) -> dict:
         "coupling": scene.coupling_model,
         "coupling_model": scene.coupling_model_name,
         "coupling_model_setting": scene.coupling.model,
+        "damping_conversion": plan.damping_at,
         "body_stiffness_N_m_rad": np.array([k if math.isfinite(k) else 0.0 for k in model.body_stiffness]),
         "pivot_radius_mm": model.gear_par[:, R_PV] * units.MM_PER_M,
         "teeth_coupled": int(model.teeth_coupled),

@@ -33,7 +33,8 @@ from study.scene import (
 
 __all__ = ["GearSetup", "gear_setup", "gear_setups", "coupling_fit", "scene_springs",
            "build_scene_model", "kept_scene_model", "scene_model", "geometry_model", "static_angles", "static_angle_count",
-           "check_static_memory", "dynamic_choice", "load_table", "damping_ratios", "mean_load"]
+           "check_static_memory", "dynamic_choice", "load_table", "damping_ratios", "mean_load",
+           "nominal_dampers", "damping_conversion", "study_damping_conversion", "has_flanks"]
 
 
 def coupling_fit(scene: Scene, g: int, model: str | None = None, setups: tuple | None = None, kinematics=None):
@@ -127,18 +128,91 @@ def scene_model(scene: Scene, springs, setups: tuple, keep: bool = False) -> tup
     """(model, loaded equilibria under the mean load at 12 positions, or None where the damping
     conversion needed none) of a scene whose gear setups are ``setups``: the model of
     `build_scene_model`, its dampers converted from the scene's ratios at those equilibria
-    (`damping_from_ratios`). ``keep``: kept (`kept_scene_model`), model and equilibria shared."""
+    (`damping_from_ratios`). ``keep``: a study's worker (`kept_scene_model`): the model kept,
+    model and equilibria shared, and a scene with flank deviations or pitch errors takes the
+    dampers of its nominal flanks (`nominal_dampers`) instead of converting at its own."""
     if keep:
-        return MODELS.kept(model_key(scene, springs, True),
-                           lambda: converted_damping(scene, _with_flanks(scene, springs, setups)))
+        return MODELS.kept(model_key(scene, springs, True), lambda: _study_model(scene, springs, setups))
     return converted_damping(scene, _with_flanks(scene, springs, setups))
+
+
+def has_flanks(scene: Scene) -> bool:
+    """True when a gear of the scene has a profile modification or pitch errors / runout."""
+    return any(scene.modification_spec(g) is not None or scene.errors_spec(g) is not None for g in (1, 2))
+
+
+def damping_conversion(scene: Scene, study: bool) -> str:
+    """Where the dampers the scene gives as ratios (`damping_ratios`) are converted, in words
+    for a run's or a study's attributes (``study``: a study's point, `scene_model` with keep)."""
+    if not damping_ratios(scene):
+        return "none: every damper given as a coefficient"
+    if study and has_flanks(scene):
+        return NOMINAL_NOTE
+    return "at the scene's own loaded equilibria (its flanks as given)"
+
+
+def study_damping_conversion(scenes) -> str:
+    """`damping_conversion` of a study's point scenes (None: an invalid point), for its archive."""
+    scenes = [s for s in scenes if s is not None]
+    flanked = [s for s in scenes if has_flanks(s) and damping_ratios(s)]
+    return NOMINAL_NOTE if flanked else damping_conversion(scenes[0], True) if scenes else ""
+
+
+NOMINAL_NOTE = ("once a study, at the nominal flanks (perfect involutes, no pitch errors or runout) under the "
+                "mean load: each point takes those coefficients; its own flank deviations leave its dampers alone")
+NOMINAL_SLOTS = 2
+NOMINAL = STORE.shelf("nominal dampers", NOMINAL_SLOTS)
+
+
+def nominal_dampers(scene: Scene, springs=None, setups: tuple | None = None, flankless: Model | None = None) -> tuple:
+    """(c_phi (gear 1, gear 2) [N·m·s/rad], c_con [SI, as law_par C_CON], c_body (gear 1, gear 2)
+    [N·m·s/rad]):
+    the dampers the scene gives as ratios converted at its nominal flanks, the pair with
+    perfect involutes and no pitch errors or runout (`flankless_model`), under its mean load.
+
+    A study's builds that differ in their flanks (a tolerance study's drawn pitch deviations,
+    runout and reliefs, a relief study's grid) share these: the ratio says how much the pair is
+    damped, a ratio of critical of the nominal mesh mode, and a build's deviations change its
+    mesh stiffness, not what dissipates energy in it (the materials, the lubricant, the
+    joints). Converting at each build's own equilibria would retune its dampers to its
+    deviations (by a few per cent), and would cost each build the modal searches over its 12
+    equilibria (about a tenth of a tolerance build with 0.2 s of dynamics, benchmarks/README.md).
+    Kept for the last `NOMINAL_SLOTS`
+    models by `model_key` without the flanks and the FE cache read. ``flankless``: the
+    scene's `flankless_model` when the caller has it."""
+    key = digest(model_key(scene, springs, True, flanks=False), str(FE_CACHE.folder))
+
+    def convert():
+        m, _ = converted_damping(scene, flankless or flankless_model(scene, springs, setups or gear_setups(scene)))
+        return (tuple(float(c) for c in m.gear_par[:, L.C_PHI]), float(m.law_par[L.C_CON]),
+                tuple(float(c) for c in m.gear_par[:, L.C_BODY]))
+    return NOMINAL.kept(key, convert)
+
+
+def _study_model(scene: Scene, springs, setups: tuple) -> tuple[Model, list | None]:
+    """A study point's (model, equilibria) (`scene_model` with keep): a scene with flanks and
+    damping ratios takes `nominal_dampers`; its own loaded equilibria are still solved (the
+    load check and the explicit step bound read them)."""
+    flankless = flankless_model(scene, springs, setups)
+    model = with_flank_deviations(flankless, *_flanks(scene))
+    if not damping_ratios(scene) or not has_flanks(scene):
+        return converted_damping(scene, model)
+    from solver.mbs.modes import with_damping
+    from study.plausibility import carrying_equilibria
+    c_phi, c_con, c_body = nominal_dampers(scene, springs, setups, flankless)
+    eqs = carrying_equilibria(scene, model, mean_load(scene))      # SceneError when the teeth cannot carry it
+    return with_damping(model, c_con=c_con, c_phi=c_phi, c_body=c_body), eqs
 
 
 def _with_flanks(scene: Scene, springs, setups: tuple) -> Model:
     """The scene's model, dampers as given: the kept flankless model with the scene's flank
     deviations and pitch errors written into a copy."""
-    flanks = tuple(scene.modification_spec(g) for g in (1, 2)), tuple(scene.errors_spec(g) for g in (1, 2))
-    return with_flank_deviations(flankless_model(scene, springs, setups), *flanks)
+    return with_flank_deviations(flankless_model(scene, springs, setups), *_flanks(scene))
+
+
+def _flanks(scene: Scene) -> tuple:
+    """(modification specs, errors specs) of both gears, as `with_flank_deviations` takes them."""
+    return tuple(scene.modification_spec(g) for g in (1, 2)), tuple(scene.errors_spec(g) for g in (1, 2))
 
 
 FLANKLESS_SLOTS = 2     # a tolerance study's builds share one; its geometry model a second

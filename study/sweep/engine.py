@@ -186,6 +186,9 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     per_point, lost_points = _point_records(points, of_point, results, lost, out)
     ds = study_dataset(study, points, per_point, read=store.get, lost=lost_points)
     ds.attrs["plausibility_warnings"] = sweep_warnings(points, out, progress)
+    if out.static or out.dynamic or out.modes:
+        from study.scene_model import study_damping_conversion
+        ds.attrs["damping_conversion"] = study_damping_conversion(p.scene for p in points)
     import dask
     with dask.config.set(scheduler="synchronous"):   # the curves are read from the part files here, block by block
         write_netcdf(ds, output)
