@@ -156,7 +156,7 @@ def make_plan(scene: Scene, stages, options: RunOptions = RunOptions()) -> RunPl
     estimate.check_time(est, options.max_time)
     return RunPlan(scene, stages, setups, springs, model, load, ratios, equilibria, angles, table, choice, warnings,
                    options.archive, options.warn, options.progress, springs_s,
-                   damping_conversion(scene, options.keep_model))
+                   damping_conversion(scene))
 
 
 # the springs, model and equilibria of the last scene run with keep_model

@@ -128,12 +128,13 @@ def scene_model(scene: Scene, springs, setups: tuple, keep: bool = False) -> tup
     """(model, loaded equilibria under the mean load at 12 positions, or None where the damping
     conversion needed none) of a scene whose gear setups are ``setups``: the model of
     `build_scene_model`, its dampers converted from the scene's ratios at those equilibria
-    (`damping_from_ratios`). ``keep``: a study's worker (`kept_scene_model`): the model kept,
-    model and equilibria shared, and a scene with flank deviations or pitch errors takes the
-    dampers of its nominal flanks (`nominal_dampers`) instead of converting at its own."""
+    (`damping_from_ratios`); a scene with flank deviations or pitch errors takes the dampers of
+    its nominal flanks (`nominal_dampers`), so that a run and a study's point of the same scene
+    carry the same dampers. ``keep``: a study's worker (`kept_scene_model`): the model kept,
+    model and equilibria shared."""
     if keep:
-        return MODELS.kept(model_key(scene, springs, True), lambda: _study_model(scene, springs, setups))
-    return converted_damping(scene, _with_flanks(scene, springs, setups))
+        return MODELS.kept(model_key(scene, springs, True), lambda: _damped_model(scene, springs, setups))
+    return _damped_model(scene, springs, setups)
 
 
 def has_flanks(scene: Scene) -> bool:
@@ -141,12 +142,12 @@ def has_flanks(scene: Scene) -> bool:
     return any(scene.modification_spec(g) is not None or scene.errors_spec(g) is not None for g in (1, 2))
 
 
-def damping_conversion(scene: Scene, study: bool) -> str:
+def damping_conversion(scene: Scene) -> str:
     """Where the dampers the scene gives as ratios (`damping_ratios`) are converted, in words
-    for a run's or a study's attributes (``study``: a study's point, `scene_model` with keep)."""
+    for a run's or a study's attributes."""
     if not damping_ratios(scene):
         return "none: every damper given as a coefficient"
-    if study and has_flanks(scene):
+    if has_flanks(scene):
         return NOMINAL_NOTE
     return "at the scene's own loaded equilibria (its flanks as given)"
 
@@ -155,11 +156,11 @@ def study_damping_conversion(scenes) -> str:
     """`damping_conversion` of a study's point scenes (None: an invalid point), for its archive."""
     scenes = [s for s in scenes if s is not None]
     flanked = [s for s in scenes if has_flanks(s) and damping_ratios(s)]
-    return NOMINAL_NOTE if flanked else damping_conversion(scenes[0], True) if scenes else ""
+    return NOMINAL_NOTE if flanked else damping_conversion(scenes[0]) if scenes else ""
 
 
-NOMINAL_NOTE = ("once a study, at the nominal flanks (perfect involutes, no pitch errors or runout) under the "
-                "mean load: each point takes those coefficients; its own flank deviations leave its dampers alone")
+NOMINAL_NOTE = ("at the nominal flanks (perfect involutes, no pitch errors or runout) under the mean load, once "
+                "for the scenes that differ only in their flanks: the scene's own flank deviations leave its dampers alone")
 NOMINAL_SLOTS = 2
 NOMINAL = STORE.shelf("nominal dampers", NOMINAL_SLOTS)
 
@@ -189,8 +190,8 @@ def nominal_dampers(scene: Scene, springs=None, setups: tuple | None = None, fla
     return NOMINAL.kept(key, convert)
 
 
-def _study_model(scene: Scene, springs, setups: tuple) -> tuple[Model, list | None]:
-    """A study point's (model, equilibria) (`scene_model` with keep): a scene with flanks and
+def _damped_model(scene: Scene, springs, setups: tuple) -> tuple[Model, list | None]:
+    """A scene's (model, equilibria) (`scene_model`): a scene with flanks and
     damping ratios takes `nominal_dampers`; its own loaded equilibria are still solved (the
     load check and the explicit step bound read them)."""
     flankless = flankless_model(scene, springs, setups)

@@ -134,8 +134,8 @@ class ContactSection:
     c_con: float = _f(NOT_GIVEN, "N*s/mm^(1+m3)", "contact damping coefficient (or damping_ratio)", 0.0, optional=True)
     damping_ratio: float = _f(NOT_GIVEN, "1", "mesh damping as a ratio of critical damping of the mesh mode (the "
                               "pair linearised at the mean load, mean over one mesh period), converted once per run to "
-                              "the tooth-root joint dampers c_phi of both gears (in a study, once at the nominal "
-                              "flanks for the points with flank deviations; the springs then give no damper; "
+                              "the tooth-root joint dampers c_phi of both gears (at the nominal flanks for a scene "
+                              "with flank deviations, once a study; the springs then give no damper; "
                               f"c_con = 0); or c_con; neither: {MESH_DAMPING_RATIO}",
                               0.0, 0.5, optional=True)
     EXCLUSIVE = ("c_con", "damping_ratio", MESH_DAMPING_RATIO, None)    # m2 = 1 checked where c_con carries it

@@ -1,7 +1,7 @@
 """A study's points with flank deviations take the dampers of their nominal flanks: the mesh
 ratio converted once, at the pair with perfect involutes and no pitch errors, gives that pair's
 mesh mode the requested ratio; every build of the study runs with those coefficients, whatever
-its drawn deviations; a single run still converts at its own flanks."""
+its drawn deviations; a single run of such a scene carries the same dampers as its study point."""
 import dataclasses
 
 import numpy as np
@@ -11,7 +11,7 @@ from solver.mbs.kernels import layout as L
 from solver.mbs.modes import modal_analysis
 from study import scene_model
 from study.run import run_scene
-from study.scene_model import NOMINAL_NOTE, build_scene_model, flankless_model, mean_load, nominal_dampers
+from study.scene_model import NOMINAL_NOTE, build_scene_model, converted_damping, flankless_model, mean_load, nominal_dampers
 
 SHORT = {"quasi_static.rotation": 4.0, "quasi_static.angle_step": 1.0, "dynamic.duration": 0.003,
          "dynamic.ramp_time": 0.001}
@@ -39,10 +39,12 @@ def test_the_nominal_dampers_give_the_nominal_mesh_mode_its_ratio_and_a_build_ke
     nominal = flankless_model(scene)
     from solver.mbs.modes import with_damping
     assert abs(_mesh_ratio(with_damping(nominal, c_phi=c_phi), load) - zeta) < 1e-6 * zeta
-    # the build converted at its own flanks (a single run) gets other dampers, each build its own
-    own = build_scene_model(scene)
+    # converted at the build's own flanks, its dampers would differ (each build its own)
+    own = converted_damping(scene, build_scene_model(scene, convert_damping=False))[0]
     assert abs(_mesh_ratio(own, load) - zeta) < 1e-6 * zeta
     assert not np.allclose(own.gear_par[:, L.C_PHI], c_phi, rtol=1e-3)
+    # a single run's model takes the nominal ones, as the study's point does
+    np.testing.assert_array_equal(build_scene_model(scene).gear_par[:, L.C_PHI], c_phi)
     # a study's build: its own flanks, the nominal dampers, and not the mesh ratio exactly
     kept = scene_model.kept_scene_model(scene)
     np.testing.assert_array_equal(kept.gear_par[:, L.C_PHI], c_phi)
@@ -79,6 +81,8 @@ def test_a_study_converts_once_and_says_where(tmp_path, monkeypatch):
 def test_a_run_archive_says_where_its_dampers_were_converted():
     _clear()
     ds = run_scene(solid_scene(**SHORT, **RELIEF), dynamic=False, warn=False)
-    assert ds.attrs["damping_conversion"].startswith("at the scene's own loaded equilibria")
+    assert ds.attrs["damping_conversion"] == NOMINAL_NOTE
+    assert run_scene(solid_scene(**SHORT), dynamic=False, warn=False).attrs["damping_conversion"].startswith(
+        "at the scene's own loaded equilibria")
     given = solid_scene(**SHORT, **{"contact.c_con": 3640.0, "gear1.spring.c_phi": 0.1, "gear2.spring.c_phi": 0.1})
     assert run_scene(given, dynamic=False, warn=False).attrs["damping_conversion"].startswith("none")
