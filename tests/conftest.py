@@ -37,8 +37,11 @@ LONGEST_FIRST = (
 
 def pytest_collection_modifyitems(config, items):
     """Markers of what each test reaches (FE, solver, processes): `tiers`, which ``make test-fast``
-    leaves out; the longest test files first (`LONGEST_FIRST`), each file's tests in their order."""
-    tiers.mark(items, pytest)
+    leaves out (read only where tests are chosen by marker, ``-m``: reading every test's source
+    costs some 3 s of CPU a process); the longest test files first (`LONGEST_FIRST`), each
+    file's tests in their order."""
+    if config.getoption("markexpr", ""):
+        tiers.mark(items, pytest)
     rank = {path: i for i, path in enumerate(LONGEST_FIRST)}
     items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))     # stable
 
