@@ -11,34 +11,40 @@ import tiers  # noqa: E402
 from helpers import solid_scene  # noqa: E402
 
 # The test files that take longest from a fresh clone, about longest first (CPU seconds on two
-# shared cores: benchmarks/README.md, "Test tiers"). `make test` hands whole files to its two
-# processes in the order collected (``--no-loadscope-reorder``): these first, so that neither
-# process starts a long file while the other is nearly done; the rest follow in their usual order.
-# The first two start at once, one per process: the README's first run compiles the kernels while
-# the CalculiX test meshes and runs its peer, and finds them in the kernel cache when it needs them.
+# shared cores at a load of about 15: benchmarks/README.md, "Test tiers"). `make test` hands
+# whole files to its two processes in the order collected (``--no-loadscope-reorder``): these
+# first, so that neither process starts a long file while the other is nearly done; the rest
+# follow in their usual order. The first two start at once, one per process: the README's first
+# run compiles the kernels while the CalculiX test meshes and runs its peer, and finds them in the
+# kernel cache when it needs them. The two that first use the all-teeth kernel (the scipy peer's
+# reference) stand apart, so that the second reads it from the cache instead of compiling it too.
 LONGEST_FIRST = (
-    "tests/study/test_doc_first_run.py",               # 79 s, the kernels' first compile included
-    "tests/solver/peers/test_calculix.py",             # 60 s, most of it the ccx peer
-    "tests/study/test_reliability.py",                 # 71 s, the kernels' first compile included
-    "tests/solver/mbs/test_load_profile.py",           # 56 s
-    "tests/solver/mbs/test_kernels.py",                # 47 s, two compiles in an empty kernel cache
-    "tests/study/inputs/test_body_strength.py",        # 46 s
-    "tests/study/test_interrupt.py",                   # 44 s
-    "tests/study/sweep/test_bodies.py",                # 36 s
-    "tests/study/sweep/test_cluster.py",               # 35 s, and its dask workers' start-up
-    "tests/solver/peers/test_scipy_dynamics.py",       # 32 s
-    "tests/study/test_runup_scene.py",                 # 32 s
-    "tests/study/test_doc_python_blocks.py",           # 30 s, the kernels' first compile included
-    "tests/study/report/test_figures.py",              # 29 s
-    "tests/study/archive/test_mesh_outputs.py",        # 29 s
-    "tests/study/inputs/test_springs.py",              # 26 s
+    "tests/study/test_doc_first_run.py",               # 97 s, the kernels' first compile included
+    "tests/solver/peers/test_calculix.py",             # 59 s, most of it the ccx peer
+    "tests/solver/mbs/test_kernels.py",                # 54 s, two compiles in an empty kernel cache
+    "tests/study/sweep/test_bodies.py",                # 45 s, two dask clusters and FE bodies
+    "tests/study/test_interrupt.py",                   # 36 s, most of it the commands started
+    "tests/study/sweep/test_cluster.py",               # 36 s, and its dask workers' start-up
+    "tests/solver/peers/test_scipy_dynamics.py",       # 33 s
+    "tests/study/report/test_figures.py",              # 25 s
+    "tests/study/test_runup_scene.py",                 # 21 s
+    "tests/study/archive/test_mesh_outputs.py",        # 21 s
+    "tests/study/inputs/test_body_strength.py",        # 17 s
+    "tests/study/inputs/test_springs.py",              # 17 s
+    "tests/study/sweep/test_sample.py",                # 17 s
+    "tests/workflows/test_lightest_gear.py",           # 16 s
+    "tests/study/test_reliability.py",                 # 13 s
+    "tests/solver/mbs/test_load_profile.py",           # 13 s, the implicit and all-teeth kernels' compile
 )
 
 
 def pytest_collection_modifyitems(config, items):
     """Markers of what each test reaches (FE, solver, processes): `tiers`, which ``make test-fast``
-    leaves out; the longest test files first (`LONGEST_FIRST`), each file's tests in their order."""
-    tiers.mark(items, pytest)
+    leaves out (read only where tests are chosen by marker, ``-m``: reading every test's source
+    costs some 3 s of CPU a process); the longest test files first (`LONGEST_FIRST`), each
+    file's tests in their order."""
+    if config.getoption("markexpr", ""):
+        tiers.mark(items, pytest)
     rank = {path: i for i, path in enumerate(LONGEST_FIRST)}
     items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))     # stable
 

@@ -175,7 +175,7 @@ def stored(parts: Path) -> dict:
 # ---------------------------------------------------------------- a worker killed
 
 @pytest.mark.parametrize("allowed_failures", [3, 0], ids=["computed-again", "lost"])
-def test_a_killed_worker_loses_no_point_and_the_rerun_keeps_the_finished_ones(cluster, tmp_path, allowed_failures):
+def test_a_killed_worker_loses_no_point_and_the_rerun_keeps_the_finished_ones(cluster, tmp_path, allowed_failures, capsys):
     """dask's default (3 deaths allowed a task) computes the killed worker's points on the other
     worker; with none allowed they come back lost: recorded pending with the cause, exit 1."""
     study_path, users = write_study(tmp_path)
@@ -225,10 +225,9 @@ def test_a_killed_worker_loses_no_point_and_the_rerun_keeps_the_finished_ones(cl
     pending = {p.index for key in lost_tasks for p in users[key]}
     assert pending == {idx for idx in np.ndindex(ds["status"].shape) if ds["status"].values[idx] == PENDING}
     # the rerun computes only the tasks lost, and keeps every finished one as it was
-    again = subprocess.run([*sweep_cli_args(cluster, study_path, out)], cwd=ROOT, env=cluster.env,
-                           capture_output=True, text=True, timeout=120)
-    assert again.returncode == 0, again.stderr
-    assert f"analyses computed {len(lost_tasks)}, reused {N_TASKS - len(lost_tasks)} " in again.stdout
+    code, stdout, stderr = rerun(cluster, study_path, out, capsys)
+    assert code == 0, stderr
+    assert f"analyses computed {len(lost_tasks)}, reused {N_TASKS - len(lost_tasks)} " in stdout
     with xr.open_dataset(out, engine="netcdf4") as ds2:
         assert (ds2["status"] == OK).all()
         for idx, wall in wall_times(users, finished).items():
@@ -236,9 +235,15 @@ def test_a_killed_worker_loses_no_point_and_the_rerun_keeps_the_finished_ones(cl
     assert not parts_folder(out).exists()
 
 
-def sweep_cli_args(cluster, study_path, out) -> list[str]:
-    return [sys.executable, "-m", "study.cli", "sweep", str(study_path), "-o", str(out),
-            "--scheduler", cluster.address, "--no-progress"]
+def rerun(cluster, study_path, out, capsys) -> tuple[int, str, str]:
+    """The same ``lightgear sweep`` on the cluster again, run in this process (the resumption is
+    checked here, not a process of its own: a process start costs some 3 s of CPU); (exit code,
+    stdout, stderr)."""
+    from study.cli import main
+    capsys.readouterr()
+    code = main(["sweep", str(study_path), "-o", str(out), "--scheduler", cluster.address, "--no-progress"])
+    said = capsys.readouterr()
+    return code, said.out, said.err
 
 
 # ---------------------------------------------------------------- the sweep killed
@@ -249,7 +254,7 @@ RUN_DEPENDENT = ("wall_time",)
 RUN_DEPENDENT_ATTRS = ("created", "history")
 
 
-def test_a_killed_sweep_resumes_to_the_archive_of_an_uninterrupted_run(cluster, tmp_path):
+def test_a_killed_sweep_resumes_to_the_archive_of_an_uninterrupted_run(cluster, tmp_path, capsys):
     study_path, users = write_study(tmp_path)
     cluster.live_workers(2)
     out = tmp_path / "killed_sweep.nc"
@@ -261,10 +266,9 @@ def test_a_killed_sweep_resumes_to_the_archive_of_an_uninterrupted_run(cluster, 
     finished = stored(parts_folder(out))
     assert 3 <= len(finished) < N_TASKS
 
-    again = subprocess.run(sweep_cli_args(cluster, study_path, out), cwd=ROOT, env=cluster.env,
-                           capture_output=True, text=True, timeout=120)
-    assert again.returncode == 0, again.stderr
-    assert f"analyses computed {N_TASKS - len(finished)}, reused {len(finished)} " in again.stdout
+    code, stdout, stderr = rerun(cluster, study_path, out, capsys)
+    assert code == 0, stderr
+    assert f"analyses computed {N_TASKS - len(finished)}, reused {len(finished)} " in stdout
     reference = run_sweep(load_study(study_path), tmp_path / "uninterrupted.nc", workers=0, progress=False).dataset
     with xr.open_dataset(out, engine="netcdf4") as resumed:
         resumed = resumed.load()
