@@ -187,17 +187,16 @@ def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: 
     return BodyModel(mesh, basis, thickness, free, blas1_solver(lu), material, t1 - t0, t2 - t1, c1 - c0, c2 - c1, lu)
 
 
-def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) -> np.ndarray:
+def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float, edges: tuple | None = None) -> np.ndarray:
     """Nodal forces of ``force`` [N] spread uniformly over the boundary within ``patch`` [m] of the
-    load point, along the load direction.
+    load point, along the load direction. ``edges``: the mesh's `boundary_edges`, if at hand.
 
     A uniform traction q on a straight quadratic edge of length L has the consistent nodal
     loads q L/6 at each end and 2 q L/3 at the mid-side node (exact), so no quadrature is needed.
     """
     m = model.basis.mesh
     p, d = case.point, case.direction
-    bf = m.boundary_facets()
-    mid = m.p[:, m.facets[:, bf]].mean(axis=1)
+    bf, mid = boundary_edges(model) if edges is None else edges
     dist = np.hypot(mid[0] - p[0], mid[1] - p[1])
     sel = bf[dist <= patch]
     if sel.size == 0:       # patch narrower than an element: the nearest edge carries the load
@@ -216,6 +215,13 @@ def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) ->
             np.add.at(f, nd[c, ends[0]], q * d[c] * length / 3)
             np.add.at(f, nd[c, ends[1]], q * d[c] * length / 3)
     return f
+
+
+def boundary_edges(model: BodyModel) -> tuple:
+    """(the boundary facets of the model's mesh, their midpoints (2, n) [m])."""
+    m = model.basis.mesh
+    bf = m.boundary_facets()
+    return bf, m.p[:, m.facets[:, bf]].mean(axis=1)
 
 
 def solve_load(model: BodyModel, f: np.ndarray) -> np.ndarray:
@@ -239,13 +245,17 @@ def _map_loads(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth: li
     block of some 70,000 rows)."""
     import scipy.sparse as sp
     cases = [load_case(g, i, pivot_radius) for i in teeth]
+    edges = boundary_edges(model)
+    cols = [load_vector(model, c, force, patch, edges) for c in cases]
     if free_sparse:
-        cols = [load_vector(model, c, force, patch)[model.free] for c in cases]
-        nz = [np.flatnonzero(f) for f in cols]
-        F = sp.csc_matrix((np.concatenate([f[i] for f, i in zip(cols, nz)]), np.concatenate(nz),
-                           np.cumsum([0] + [i.size for i in nz])), shape=(model.free.size, len(cases)))
+        pos = np.full(model.basis.N, -1, np.int64)
+        pos[model.free] = np.arange(model.free.size)
+        nz = [(i, pos[i]) for i in (np.flatnonzero(f) for f in cols)]
+        nz = [(i[at >= 0], at[at >= 0]) for i, at in nz]                  # (a clamped DOF takes no load)
+        F = sp.csc_matrix((np.concatenate([f[i] for f, (i, _) in zip(cols, nz)]), np.concatenate([at for _, at in nz]),
+                           np.cumsum([0] + [i.size for i, _ in nz])), shape=(model.free.size, len(cases)))
     else:
-        F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
+        F = np.column_stack(cols)
     P = model.basis.probes(np.column_stack([c.centre_point for c in cases])).tocsr()
     return cases, F, P
 
@@ -283,7 +293,8 @@ def tooth_map(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, for
     pos[model.free] = np.arange(model.free.size)
     reads = []
     for j, band in enumerate(bands):
-        dofs = np.unique(np.concatenate([ed[:, band].ravel(), P[j].indices, P[n + j].indices]))
+        probe = [P.indices[P.indptr[i]:P.indptr[i + 1]] for i in (j, n + j)]
+        dofs = np.unique(np.concatenate([ed[:, band].ravel(), *probe]))
         reads.append(dofs[pos[dofs] >= 0])                  # a clamped DOF reads 0
     cols = model.condensed.column_reads(F, [pos[r] for r in reads])
     U = np.full((model.basis.N, n), np.nan)                 # NaN: not read (would show in k or stress)
@@ -312,10 +323,14 @@ def _stiffness(teeth: list, cases: list, P, U: np.ndarray, force: float) -> np.n
 
 
 def von_mises(model: BodyModel, u: np.ndarray) -> np.ndarray:
-    """Element-mean von Mises stress [Pa] (plane stress) of displacement u."""
+    """Element-mean von Mises stress [Pa] (plane stress) of displacement u, over the points of the
+    element's default quadrature (a condensed body's basis holds one point an element)."""
+    import skfem
     from skfem.helpers import sym_grad
 
     basis = model.basis
+    if basis.X.shape[1] == 1:
+        basis = skfem.Basis(basis.mesh, basis.elem)
     w = basis.interpolate(u)
     eps = sym_grad(w)                     # (2, 2, nelem, nqp)
     lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
@@ -358,7 +373,15 @@ def _fillet_bands(model: BodyModel, g: GearGeometry, teeth) -> list:
     """Boolean element mask of each listed tooth's `fillet_band`."""
     mesh = model.mesh
     centroids = mesh.points[mesh.triangles].mean(axis=1)
-    return [fillet_band(centroids, g, int(t)) for t in teeth]
+    # each band lies within a module of the root circle: only the elements of a ring twice as
+    # wide are tested tooth by tooth (the same masks)
+    ring = np.flatnonzero(np.abs(np.hypot(centroids[:, 0], centroids[:, 1]) - g.root_radius) < 2 * g.spec.module)
+    out = []
+    for t in teeth:
+        band = np.zeros(centroids.shape[0], bool)
+        band[ring] = fillet_band(centroids[ring], g, int(t))
+        out.append(band)
+    return out
 
 
 def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind: str = "von_mises",
@@ -384,27 +407,27 @@ def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind:
     bands = _fillet_bands(model, g, teeth) if bands is None else bands
     union = np.flatnonzero(np.logical_or.reduce(bands)) if bands else np.empty(0, np.int64)
     # one basis over the bands of all teeth (a basis per tooth cost more than the rest of the
-    # stress); each tooth sums its displacement times the basis gradients on its own band only,
-    # in the order skfem's `interpolate` does (the same numbers)
-    if union.size:
-        b = skfem.Basis(model.basis.mesh, model.basis.elem, elements=union, quadrature=vertices)
-        grads = [b.basis[i][0].grad for i in range(b.Nbfun)]             # (2, 2, n_union, 3) each
-    out = np.empty(len(teeth))
-    for j, band in enumerate(bands):
-        sel = np.flatnonzero(band[union]) if union.size else union
-        if sel.size == 0:
-            out[j] = np.nan
-            continue
-        u = U[:, j]
-        grad = 0.0 * np.einsum("...,...j->...j", u[b.element_dofs[0, sel]], grads[0][:, :, sel])
-        for i, gi in enumerate(grads):
-            grad += np.einsum("...,...j->...j", u[b.element_dofs[i, sel]], gi[:, :, sel])
-        eps = sym_grad(DiscreteField(grad=grad))
-        tr = eps[0, 0] + eps[1, 1]
-        sxx, syy, sxy = lam * tr + 2 * mu * eps[0, 0], lam * tr + 2 * mu * eps[1, 1], 2 * mu * eps[0, 1]
-        if kind == "von_mises":
-            s = np.sqrt(sxx**2 - sxx * syy + syy**2 + 3 * sxy**2)
-        else:
-            s = 0.5 * (sxx + syy) + np.sqrt(0.25 * (sxx - syy) ** 2 + sxy**2)
-        out[j] = float(s.max())
+    # stress); every (tooth, band element) pair at once, each summing its tooth's displacement
+    # times the basis gradients in the order skfem's `interpolate` does (the same numbers)
+    out = np.full(len(teeth), np.nan)
+    if not union.size:
+        return out
+    b = skfem.Basis(model.basis.mesh, model.basis.elem, elements=union, quadrature=vertices)
+    sels = [np.flatnonzero(band[union]) for band in bands]
+    sel = np.concatenate(sels)
+    col = np.repeat(np.arange(len(teeth)), [x.size for x in sels])
+    grads = [b.basis[i][0].grad[:, :, sel] for i in range(b.Nbfun)]      # (2, 2, n_pairs, 3) each
+    grad = 0.0 * (U[b.element_dofs[0, sel], col][:, None] * grads[0])
+    for i, gi in enumerate(grads):
+        grad += U[b.element_dofs[i, sel], col][:, None] * gi
+    eps = sym_grad(DiscreteField(grad=grad))
+    tr = eps[0, 0] + eps[1, 1]
+    sxx, syy, sxy = lam * tr + 2 * mu * eps[0, 0], lam * tr + 2 * mu * eps[1, 1], 2 * mu * eps[0, 1]
+    if kind == "von_mises":
+        s = np.sqrt(sxx**2 - sxx * syy + syy**2 + 3 * sxy**2)
+    else:
+        s = 0.5 * (sxx + syy) + np.sqrt(0.25 * (sxx - syy) ** 2 + sxy**2)
+    peak = s.max(axis=1)                                                 # (n_pairs,)
+    has = np.flatnonzero([x.size > 0 for x in sels])
+    out[has] = np.maximum.reduceat(peak, np.cumsum([0] + [x.size for x in sels])[has])
     return out

@@ -172,18 +172,18 @@ def test_column_reads_equal_the_whole_body_solve(ring):
 
 
 def test_congruence_equals_the_solves(ring):
-    """C^T K^-1 C by one restricted solve and a symmetric product (`factor.congruence`, the
-    web's condensation onto the interface) equals C^T times the full solves of C, and is
-    symmetric; its lower triangle alone (what the Cholesky of the condensed body reads) is
-    the full result's to the bit, the upper one zero."""
+    """C^T K^-1 C by restricted solves and a product over the runs of columns each row reaches
+    (`factor.congruence`, the web's condensation onto the interface) equals C^T times the full
+    solves of C and is exactly symmetric, whatever the order of C's columns given for the runs,
+    and with its last rows solved sparse or dense."""
     from solver.fe.factor import congruence
     mesh, _ = ring
     whole = fe.assemble(mesh, T_RIM, 0.008, STEEL)
     C = sp.random(whole.free.size, 30, density=0.002, random_state=np.random.default_rng(4), format="csc")
     C = C + sp.csc_matrix(([1.0], ([5], [0])), shape=C.shape)        # no empty column
-    W = congruence(whole.factor, C)
     ref = C.T @ whole.solve(C.toarray())
-    assert W is not None and np.array_equal(W, W.T)
-    assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
-    lower = congruence(whole.factor, C, lower=True)
-    assert np.array_equal(lower, np.tril(W)) and not np.triu(lower, 1).any()
+    for order in (None, np.random.default_rng(5).permutation(30)):
+        for dense_rows in (0, 40, 10**6):
+            W = congruence(whole.factor, C, order=order, dense_rows=dense_rows)
+            assert W is not None and np.array_equal(W, W.T)
+            assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
