@@ -219,6 +219,23 @@ def rim_block(mesh: BodyMesh, face_width: float, material: Material, r_interface
     return block
 
 
+def _dense_rows(U12, share: float = 0.125) -> tuple:
+    """(position in the dense block of each row, -1 for the others; the rows of U12 (n, n_i) CSR
+    with more than ``share`` of n_i entries, dense; U12 without them, CSR): the rows of the
+    interface-last factorisation's coupling block near the interface, which every column read
+    passes through, multiplied by the interface displacements at once."""
+    import scipy.sparse as sp
+    nnz = np.diff(U12.indptr)
+    rows = np.flatnonzero(nnz > share * U12.shape[1])
+    at = np.full(U12.shape[0], -1, np.int64)
+    at[rows] = np.arange(rows.size)
+    keep = np.ones(U12.shape[0])
+    keep[rows] = 0.0
+    rest = sp.csr_matrix(sp.diags(keep) @ U12)
+    rest.eliminate_zeros()
+    return at, U12[rows].toarray(), rest
+
+
 @dataclass
 class CondensedBody:
     """A whole body solved through its condensed rim and its own web (see the module doc).
@@ -285,14 +302,19 @@ class CondensedBody:
         u_i = -self.schur_solve(rs.B)                        # interface displacement [m], rim interface order
         w2 = np.empty_like(u_i)
         w2[rim.split["pc"][n:] - n] = u_i                    # in the factorisation's interface order
-        U12, Ut11 = rim.split["U12"], rim.split["Ut11"]
+        Ut11 = rim.split["Ut11"]
         if "inv_diag" not in rim.split:
             rim.split["inv_diag"] = 1.0 / Ut11.diagonal()
+            rim.split["U12 rows"] = _dense_rows(rim.split["U12"])
+        dense, U12_dense, U12_rest = rim.split["U12 rows"]
+        with one_blas_thread():
+            u12w = U12_dense @ w2                            # U12 u_i on its rows that hold most of it
         # every column's restricted back-substitution U11 w = s - U12 u_i in one compiled call
         # (Ut11 in CSC is U11 in CSR)
         rows_ptr = np.cumsum([0] + [r.size for r in rs.rows])
-        w = back_substitute_reads(Ut11.indptr, Ut11.indices, Ut11.data, rim.split["inv_diag"], U12.indptr, U12.indices,
-                                  U12.data, np.ascontiguousarray(w2.T), np.concatenate(rs.rows), rows_ptr, np.concatenate(rs.s))
+        w = back_substitute_reads(Ut11.indptr, Ut11.indices, Ut11.data, rim.split["inv_diag"], U12_rest.indptr,
+                                  U12_rest.indices, U12_rest.data, np.ascontiguousarray(w2.T), dense, u12w,
+                                  np.concatenate(rs.rows), rows_ptr, np.concatenate(rs.s))
         return [w[rows_ptr[j] + rs.at[j]] for j in range(f.shape[1])]
 
     def influence(self, R_rim, F_rim, key) -> np.ndarray:
@@ -303,6 +325,28 @@ class CondensedBody:
         X = self.schur_solve(B)
         with one_blas_thread():
             return G0 + A @ X
+
+
+def _rim_numbering(basis, is_rim: np.ndarray, rim: RimBlock) -> np.ndarray | None:
+    """The body DOF of each DOF of the condensed rim, where the body's mesh begins with the rim's
+    vertices and elements as they are (`join_rim` makes it so): vertex DOFs alike, edge DOFs
+    through the edges' end vertices. None for a mesh numbered otherwise."""
+    m, rm = basis.mesh, rim.model.basis.mesh
+    nv, nt = rm.p.shape[1], rm.t.shape[1]
+    if (m.p.shape[1] < nv or m.t.shape[1] < nt or not np.array_equal(m.p[:, :nv], rm.p)
+            or not np.array_equal(m.t[:, :nt], rm.t) or is_rim.sum() != nt or not is_rim[:nt].all()):
+        return None
+    key = m.facets[0].astype(np.int64) * m.p.shape[1] + m.facets[1]          # edges by their (sorted) ends
+    want = rm.facets[0].astype(np.int64) * m.p.shape[1] + rm.facets[1]
+    order = np.argsort(key)
+    at = order[np.minimum(np.searchsorted(key, want, sorter=order), key.size - 1)]
+    if not np.array_equal(key[at], want):
+        return None
+    rb = rim.model.basis
+    out = np.empty(rb.N, np.int64)
+    out[rb.nodal_dofs] = basis.nodal_dofs[:, :nv]
+    out[rb.facet_dofs] = basis.facet_dofs[:, at]
+    return out
 
 
 def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material,
@@ -329,13 +373,17 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     in_web[ed[:, ~is_rim].ravel()] = True
     rim_dofs = np.flatnonzero(in_rim)
     keys = _dof_keys(basis)
-    if rim.tree is None:
-        rim.tree = cKDTree(rim.keys)
-    dist, idx = rim.tree.query(keys[rim_dofs])
-    if rim_dofs.size != rim.keys.shape[0] or np.any(dist > MATCH_TOL) or np.unique(idx).size != idx.size:
-        raise RimMismatch("the body's teeth-and-rim nodes differ from the condensed rim's")
+    from_rim = _rim_numbering(basis, is_rim, rim)         # body DOF of each rim DOF
+    if from_rim is None:                                  # another numbering: match the DOFs by location
+        if rim.tree is None:
+            rim.tree = cKDTree(rim.keys)
+        dist, idx = rim.tree.query(keys[rim_dofs])
+        if rim_dofs.size != rim.keys.shape[0] or np.any(dist > MATCH_TOL) or np.unique(idx).size != idx.size:
+            raise RimMismatch("the body's teeth-and-rim nodes differ from the condensed rim's")
+        from_rim = np.empty(rim.keys.shape[0], np.int64)
+        from_rim[idx] = rim_dofs
     to_rim = np.full(basis.N, -1)
-    to_rim[rim_dofs] = idx
+    to_rim[from_rim] = np.arange(from_rim.size)
     shared = np.flatnonzero(in_rim & in_web)
     if not np.array_equal(np.sort(to_rim[shared]), rim.interface):
         raise RimMismatch("the body's rim-web interface differs from the condensed rim's")
@@ -351,9 +399,7 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     pos[free] = np.arange(free.size)
     if np.any(pos[rim_dofs] < 0):
         raise RimMismatch("the bore clamp reaches the teeth and rim")
-    # body DOF of each rim DOF, then positions in the body's free vector
-    from_rim = np.empty(rim.keys.shape[0], np.int64)
-    from_rim[idx] = rim_dofs
+    # positions in the body's free vector
     pos_r = pos[from_rim[rim.model.free]]
     body_i = from_rim[rim.interface]
     pos_i = pos[body_i]

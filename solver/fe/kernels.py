@@ -94,13 +94,14 @@ def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top):
 
 
 @_njit
-def back_substitute_reads(u_ptr, u_idx, u_val, inv_diag, c_ptr, c_idx, c_val, w2t, rows, rows_ptr, rhs):
+def back_substitute_reads(u_ptr, u_idx, u_val, inv_diag, c_ptr, c_idx, c_val, w2t, dense, dense_w, rows, rows_ptr, rhs):
     """Column j's restricted back-substitution of an interface-last factorisation, for every j:
     U11 w = s_j - U12 w2_j on the rows ``rows[rows_ptr[j]:rows_ptr[j + 1]]`` (sorted, closed
     under U11's graph: each row's entries lie in the same rows), with U11 (n, n) upper-triangular
     in CSR (``u_*``, diagonal included), ``inv_diag`` 1 / its diagonal, U12 (n, n_i) in CSR
-    (``c_*``), the rows w2_j of ``w2t`` (k, n_i) and s_j = ``rhs`` at the same places as ``rows``. Returns w at those
-    places (the same layout)."""
+    (``c_*``), the rows w2_j of ``w2t`` (k, n_i) and s_j = ``rhs`` at the same places as ``rows``.
+    U12's rows with ``dense[i]`` >= 0 are left out of ``c_*``: their products U12 w2 are
+    ``dense_w[dense[i], j]``, made beforehand. Returns w at the places of ``rows``."""
     n = inv_diag.size
     out = np.empty(rows.size)
     w = np.zeros(n)
@@ -109,6 +110,8 @@ def back_substitute_reads(u_ptr, u_idx, u_val, inv_diag, c_ptr, c_idx, c_val, w2
         for q in range(b - 1, a - 1, -1):
             i = rows[q]
             s = rhs[q]
+            if dense[i] >= 0:
+                s -= dense_w[dense[i], j]
             for p in range(c_ptr[i], c_ptr[i + 1]):
                 s -= c_val[p] * w2t[j, c_idx[p]]
             for p in range(u_ptr[i], u_ptr[i + 1]):

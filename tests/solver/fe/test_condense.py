@@ -187,3 +187,23 @@ def test_congruence_equals_the_solves(ring):
             W = congruence(whole.factor, C, order=order, dense_rows=dense_rows)
             assert W is not None and np.array_equal(W, W.T)
             assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
+
+
+def test_a_joined_body_matches_its_rim_by_numbering(ring):
+    """A body meshed as `join_rim` makes it (the rim's vertices and elements first, as they are)
+    takes its rim DOFs from the numbering, not by a search of DOF locations, and solves as the
+    same body with its DOFs matched by location."""
+    mesh, rim = ring
+    joined = cd.join_rim(rim, mesh)
+    rim.tree = None
+    fast = cd.assemble_condensed(joined, T_RIM, 0.009, STEEL, rim)
+    assert rim.tree is None                                          # no location search made
+    rim.tree = None
+    shuffled = cd.BodyMesh(joined.points, joined.triangles[::-1].copy(), joined.region[::-1].copy(),
+                           joined.bore_radius, joined.size)
+    slow = cd.assemble_condensed(shuffled, T_RIM, 0.009, STEEL, rim)
+    assert rim.tree is not None                                      # matched by location
+    f = np.random.default_rng(8).standard_normal(fast.free.size)
+    assert np.array_equal(fast.free, slow.free)
+    u_fast, u_slow = fast.solve(f), slow.solve(f)
+    assert np.abs(u_fast - u_slow).max() < 1e-12 * np.abs(u_slow).max()

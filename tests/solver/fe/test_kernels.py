@@ -34,7 +34,8 @@ def test_lower_solve_columns_is_the_dense_solve(top):
 
 def test_back_substitute_reads_is_the_dense_solve():
     """Each column's restricted back-substitution U11 w = s - U12 w2 over rows closed under
-    U11's graph equals the dense solve of the whole system there."""
+    U11's graph equals the dense solve of the whole system there, with some rows' U12 w2 made
+    beforehand or not."""
     n, n_i, k = 50, 6, 3
     rng = np.random.default_rng(3)
     L, d = _lower(n, 0.05, 4)
@@ -59,9 +60,16 @@ def test_back_substitute_reads_is_the_dense_solve():
         rhs.append(s[r])
         want.append(full[r])
     ptr = np.cumsum([0] + [r.size for r in rows])
-    got = back_substitute_reads(U.indptr, U.indices, U.data, 1.0 / d, U12.indptr, U12.indices, U12.data,
-                                np.ascontiguousarray(w2.T), np.concatenate(rows), ptr, np.concatenate(rhs))
-    assert np.allclose(got, np.concatenate(want), rtol=1e-11, atol=1e-13)
+    for dense_rows in (np.array([], int), np.array([3, 17, 40, 49])):    # U12 w2 on these rows made beforehand
+        dense = np.full(n, -1)
+        dense[dense_rows] = np.arange(dense_rows.size)
+        keep = np.ones(n)
+        keep[dense_rows] = 0.0
+        rest = sp.csr_matrix(sp.diags(keep) @ U12)
+        got = back_substitute_reads(U.indptr, U.indices, U.data, 1.0 / d, rest.indptr, rest.indices, rest.data,
+                                    np.ascontiguousarray(w2.T), dense, U12[dense_rows] @ w2, np.concatenate(rows), ptr,
+                                    np.concatenate(rhs))
+        assert np.allclose(got, np.concatenate(want), rtol=1e-11, atol=1e-13)
 
 
 def testarc_gram_is_the_dense_product():
