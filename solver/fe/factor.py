@@ -10,7 +10,8 @@ import numpy as np
 
 _BLAS_THREADS: dict = {}     # library path -> [(get, set)] of its thread-count functions
 _BLAS_SEEN: list = []        # [the number of modules imported when last listed, the controls then]
-DENSE_ROWS = 256             # `congruence`: the last rows of a factor's order solved as one dense block
+DENSE_ROWS = 320             # `congruence`: the last rows of a factor's order solved as one dense block
+SOLVE_BLOCK = 16             # `congruence`: columns solved together (`solver.fe.kernels.lower_solve_columns`)
 
 
 def _openblas_controls() -> list:
@@ -174,14 +175,17 @@ def congruence(lu, C, order: np.ndarray | None = None, dense_rows: int = DENSE_R
     Cp.sort_indices()
     n = L.shape[0]
     top = max(n - dense_rows, 0)
-    rows, Y, R = lower_solve_columns(strict.indptr, strict.indices, strict.data, L.diagonal(),
-                                     Cp.indptr, Cp.indices, Cp.data, top)
+    rows, Yt, start, length, Rt = lower_solve_columns(strict.indptr, strict.indices, strict.data, L.diagonal(),
+                                                      Cp.indptr, Cp.indices, Cp.data, top, SOLVE_BLOCK)
     if top < n:                                      # the last rows, which most columns reach: dense
+        m = rows.size
         with one_blas_thread():
-            Y_top = solve_triangular(L[top:, top:].toarray(), R, lower=True, check_finite=False)
-        rows, Y = np.concatenate([rows, np.arange(top, n)]), np.vstack([Y, Y_top])
-    Y *= (1.0 / np.sqrt(d[rows]))[:, None]                                  # D^-1/2 L^-1 P C
-    W = arc_gram(Y, *row_arcs(Y))
+            Yt[:, m:] = solve_triangular(L[top:, top:].toarray(), Rt.T, lower=True, check_finite=False).T
+        rows = np.concatenate([rows, np.arange(top, n)])
+        s_top, l_top = row_arcs(Yt[:, m:].T)
+        start, length = np.concatenate([start, s_top]), np.concatenate([length, l_top])
+    Yt *= 1.0 / np.sqrt(d[rows])                                            # (D^-1/2 L^-1 P C)^T
+    W = arc_gram(Yt, start, length)
     if order is not None:
         back = np.empty_like(order)
         back[order] = np.arange(order.size)
@@ -189,9 +193,10 @@ def congruence(lu, C, order: np.ndarray | None = None, dense_rows: int = DENSE_R
     return W
 
 
-def arc_gram(Y: np.ndarray, start: np.ndarray, length: np.ndarray, rows_max: int = 256) -> np.ndarray:
-    """Y^T Y (n, n), exactly symmetric, for Y (m, n) whose row r is zero outside the circular
-    run of ``length[r]`` columns from ``start[r]`` (`solver.fe.kernels.row_arcs`).
+def arc_gram(Yt: np.ndarray, start: np.ndarray, length: np.ndarray, rows_max: int = 256) -> np.ndarray:
+    """Y^T Y (n, n), exactly symmetric, for Y (m, n) given as Yt = Y^T (n, m), whose row r (Yt's
+    column r) is zero outside the circular run of ``length[r]`` columns from ``start[r]``
+    (`solver.fe.kernels.row_arcs`).
 
     The rows are grouped by the size of their runs (within a factor of two) and, in each group,
     by where the run starts, into blocks whose common run is at most 1.5 times the group's
@@ -200,7 +205,7 @@ def arc_gram(Y: np.ndarray, start: np.ndarray, length: np.ndarray, rows_max: int
     about the rows' own runs squared instead of every row times n squared."""
     from scipy.linalg.blas import dsyrk
 
-    m, n = Y.shape
+    n, m = Yt.shape
     W = np.zeros((n, n))
     live = np.flatnonzero(length > 0)
     group = np.floor(np.log2(length[live])).astype(np.int64)
@@ -222,11 +227,11 @@ def arc_gram(Y: np.ndarray, start: np.ndarray, length: np.ndarray, rows_max: int
                 s0 = 0
             rows = order[i:j]
             if s0 + span <= n:
-                G = dsyrk(1.0, Y[rows, s0:s0 + span].T, lower=1)      # lower triangle of Yb^T Yb
+                G = dsyrk(1.0, Yt[s0:s0 + span][:, rows].T, trans=1, lower=1)    # lower triangle of Yb^T Yb
                 W[s0:s0 + span, s0:s0 + span] += G
             else:                                    # a run across column 0: its parts' blocks
                 a = n - s0
-                G = dsyrk(1.0, Y[rows][:, (s0 + np.arange(span)) % n].T, lower=1)
+                G = dsyrk(1.0, Yt[(s0 + np.arange(span)) % n][:, rows].T, trans=1, lower=1)
                 W[s0:, s0:] += G[:a, :a]
                 W[:span - a, :span - a] += G[a:, a:]
                 W[s0:, :span - a] += G[a:, :a].T     # (the upper part of the run's block)

@@ -22,17 +22,25 @@ def _njit(fn):
 
 
 @_njit
-def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top):
+def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top, block):
     """The rows below ``top`` of X = L^-1 B, for a lower-triangular L (n, n) given as its
     strictly lower part in CSC (``l_ptr``, ``l_idx``, ``l_val``; every entry below the diagonal)
     and its diagonal ``diag``, and a sparse B (n, k) in CSC; with what is left for the rows from
-    ``top`` on. Returns (rows, X, R): the sorted rows below ``top`` that any column reaches (each
-    of X's other rows there is zero), X (rows.size, k) on them, and R (n - top, k) = B_t - L_tb X
-    (the right-hand side of L_tt X_t = R, the rest of the solve: a dense triangular one).
+    ``top`` on. Returns (rows, Xt, start, length, Rt):
 
-    Each column first gathers the rows below ``top`` its nonzeros reach through L's graph, then
-    substitutes forward over them in L's order (the graph points to higher rows only): the
-    arithmetic of the column's own reach, no pass over the rows it does not reach."""
+    - rows: the sorted rows below ``top`` that any column reaches (X's other rows there are zero);
+    - Xt (k, rows.size + n - top): X^T on them, its last n - top columns left zero (for the rest);
+    - start, length: the shortest circular run of columns holding each of those rows' nonzeros
+      (as `row_arcs`; columns k - 1 and 0 adjacent);
+    - Rt (k, n - top): (B_t - L_tb X)^T, the right-hand side of L_tt X_t = R (the rest of the
+      solve: a dense triangular one).
+
+    The columns go in blocks of ``block`` neighbours: a block first gathers the rows below ``top``
+    its nonzeros reach through L's graph, then substitutes forward over them in L's order (the
+    graph points to higher rows only), each entry of L applied to the block's columns at once:
+    the arithmetic of the block's own reach, no pass over the rows it does not reach. (Columns
+    whose nonzeros lie close, such as DOFs along a curve in their order along it, reach nearly
+    the same rows.) A row's run counts its nonzero values."""
     n = diag.size
     k = b_ptr.size - 1
     mark = np.zeros(n, np.bool_)
@@ -52,45 +60,74 @@ def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top):
     for c in range(top):
         if pos[c] >= 0:
             rows[pos[c]] = c
-    X = np.zeros((m, k))
-    R = np.zeros((n - top, k))
-    x = np.zeros(top)
+    Xt = np.zeros((k, m + n - top))
+    Rt = np.zeros((k, n - top))
+    first = np.full(m, -1, np.int64)                  # each row's first and last column, widest gap
+    last = np.zeros(m, np.int64)
+    gap = np.full(m, -1, np.int64)
+    after = np.zeros(m, np.int64)
+    x = np.zeros((top, block))
+    xc = np.zeros(block)
     mark[:] = False
     reach = np.empty(top, np.int64)
-    for j in range(k):
-        m = 0
-        for p in range(b_ptr[j], b_ptr[j + 1]):
-            i = b_idx[p]
-            if i >= top:
-                R[i - top, j] += b_val[p]
-            else:
-                x[i] += b_val[p]
-                if not mark[i]:
-                    mark[i] = True
-                    reach[m] = i
-                    m += 1
+    for j0 in range(0, k, block):
+        nb = min(block, k - j0)
         h = 0
-        while h < m:                                  # the rows below top the column reaches
-            c = reach[h]
-            h += 1
+        for b in range(nb):
+            for p in range(b_ptr[j0 + b], b_ptr[j0 + b + 1]):
+                i = b_idx[p]
+                if i >= top:
+                    Rt[j0 + b, i - top] += b_val[p]
+                else:
+                    x[i, b] += b_val[p]
+                    if not mark[i]:
+                        mark[i] = True
+                        reach[h] = i
+                        h += 1
+        q = 0
+        while q < h:                                  # the rows below top the block's columns reach
+            c = reach[q]
+            q += 1
             for p in range(l_ptr[c], l_ptr[c + 1]):
                 i = l_idx[p]
                 if i < top and not mark[i]:
                     mark[i] = True
-                    reach[m] = i
-                    m += 1
-        for c in np.sort(reach[:m]):                 # in L's order: each row after those it needs
-            xc = x[c] / diag[c]
-            x[c] = 0.0
+                    reach[h] = i
+                    h += 1
+        for c in np.sort(reach[:h]):                 # in L's order: each row after those it needs
+            r = pos[c]
+            for b in range(nb):
+                v = x[c, b] / diag[c]
+                xc[b] = v
+                x[c, b] = 0.0
+                Xt[j0 + b, r] = v
+                if v != 0.0:
+                    j = j0 + b
+                    if first[r] < 0:
+                        first[r] = j
+                    elif j - last[r] - 1 > gap[r]:
+                        gap[r] = j - last[r] - 1
+                        after[r] = j
+                    last[r] = j
             mark[c] = False
-            X[pos[c], j] = xc
             for p in range(l_ptr[c], l_ptr[c + 1]):
                 i = l_idx[p]
+                lv = l_val[p]
                 if i >= top:
-                    R[i - top, j] -= l_val[p] * xc
+                    for b in range(nb):
+                        Rt[j0 + b, i - top] -= lv * xc[b]
                 else:
-                    x[i] -= l_val[p] * xc
-    return rows, X, R
+                    for b in range(nb):
+                        x[i, b] -= lv * xc[b]
+    start = np.zeros(m, np.int64)
+    length = np.zeros(m, np.int64)
+    for r in range(m):
+        if first[r] >= 0:
+            if first[r] + k - last[r] - 1 >= gap[r]:  # the widest gap is the one across column 0
+                start[r], length[r] = first[r], last[r] - first[r] + 1
+            else:
+                start[r], length[r] = after[r], k - gap[r]
+    return rows, Xt, start, length, Rt
 
 
 @_njit

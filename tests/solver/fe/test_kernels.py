@@ -14,22 +14,29 @@ def _lower(n, density, seed):
     return L, 1.0 + rng.random(n)
 
 
-@pytest.mark.parametrize("top", [60, 45, 0])
-def test_lower_solve_columns_is_the_dense_solve(top):
-    """The rows below ``top`` of L^-1 B, each column over the rows it reaches, and the rest's
-    right-hand side B_t - L_tb X: with the dense triangular solve of the last rows, L^-1 B."""
+@pytest.mark.parametrize("top, block", [(60, 1), (45, 3), (0, 16)])
+def test_lower_solve_columns_is_the_dense_solve(top, block):
+    """The rows below ``top`` of L^-1 B, each column over the rows it reaches, the runs of
+    columns holding each row's nonzeros, and the rest's right-hand side B_t - L_tb X: with the
+    dense triangular solve of the last rows, L^-1 B."""
     n, k = 60, 7
     L, d = _lower(n, 0.04, 1)
     B = sp.random(n, k, density=0.05, random_state=np.random.default_rng(2), format="csc")
     B.sort_indices()
     full = np.linalg.solve(L.toarray() + np.diag(d), B.toarray())
-    rows, X, R = lower_solve_columns(L.indptr, L.indices, L.data, d, B.indptr, B.indices, B.data, top)
+    rows, Xt, start, length, Rt = lower_solve_columns(L.indptr, L.indices, L.data, d, B.indptr, B.indices, B.data, top, block)
     assert np.all(np.diff(rows) > 0) and np.all(rows < top)
+    assert Xt.shape == (k, rows.size + n - top) and not Xt[:, rows.size:].any()
     off = np.setdiff1d(np.arange(top), rows)
     assert np.abs(full[off]).max(initial=0.0) == 0.0                 # rows no column reaches: zero
+    X = Xt[:, :rows.size].T
     assert np.allclose(X, full[rows], rtol=1e-12, atol=1e-14)
+    s_ref, l_ref = row_arcs(np.ascontiguousarray(X))                 # the runs, as found afterwards
+    assert np.all(length >= l_ref) and np.array_equal(length == 0, l_ref == 0)
+    for r in range(rows.size):
+        assert np.all(((np.flatnonzero(X[r]) - start[r]) % k) < length[r])
     Ltt = L.toarray()[top:, top:] + np.diag(d[top:])
-    assert np.allclose(np.linalg.solve(Ltt, R) if top < n else R, full[top:], rtol=1e-12, atol=1e-14)
+    assert np.allclose(np.linalg.solve(Ltt, Rt.T) if top < n else Rt.T, full[top:], rtol=1e-12, atol=1e-14)
 
 
 def test_back_substitute_reads_is_the_dense_solve():
@@ -86,6 +93,6 @@ def testarc_gram_is_the_dense_product():
     assert np.array_equal(length, runs)
     for r in range(m):
         assert np.all(((np.flatnonzero(Y[r]) - start[r]) % n) < length[r])
-    W = arc_gram(Y, start, length, rows_max=16)
+    W = arc_gram(np.ascontiguousarray(Y.T), start, length, rows_max=16)
     assert np.array_equal(W, W.T)
     assert np.allclose(W, Y.T @ Y, rtol=1e-12, atol=1e-12)
