@@ -35,12 +35,12 @@ def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top, blo
     - Rt (k, n - top): (B_t - L_tb X)^T, the right-hand side of L_tt X_t = R (the rest of the
       solve: a dense triangular one).
 
-    The columns go in blocks of ``block`` neighbours: a block first gathers the rows below ``top``
-    its nonzeros reach through L's graph, then substitutes forward over them in L's order (the
-    graph points to higher rows only), each entry of L applied to the block's columns at once:
-    the arithmetic of the block's own reach, no pass over the rows it does not reach. (Columns
-    whose nonzeros lie close, such as DOFs along a curve in their order along it, reach nearly
-    the same rows.) A row's run counts its nonzero values."""
+    The columns go in blocks of ``block`` neighbours: a block substitutes forward in L's order
+    (the graph points to higher rows only) from its first nonzero row, over the rows its
+    nonzeros reach (marked as they are reached), each entry of L applied to the block's columns
+    at once: the arithmetic of the block's own reach. (Columns whose nonzeros lie close, such as
+    DOFs along a curve in their order along it, reach nearly the same rows.) A row's run counts
+    its nonzero values."""
     n = diag.size
     k = b_ptr.size - 1
     mark = np.zeros(n, np.bool_)
@@ -69,10 +69,9 @@ def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top, blo
     x = np.zeros((top, block))
     xc = np.zeros(block)
     mark[:] = False
-    reach = np.empty(top, np.int64)
     for j0 in range(0, k, block):
         nb = min(block, k - j0)
-        h = 0
+        lo = top
         for b in range(nb):
             for p in range(b_ptr[j0 + b], b_ptr[j0 + b + 1]):
                 i = b_idx[p]
@@ -80,21 +79,11 @@ def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top, blo
                     Rt[j0 + b, i - top] += b_val[p]
                 else:
                     x[i, b] += b_val[p]
-                    if not mark[i]:
-                        mark[i] = True
-                        reach[h] = i
-                        h += 1
-        q = 0
-        while q < h:                                  # the rows below top the block's columns reach
-            c = reach[q]
-            q += 1
-            for p in range(l_ptr[c], l_ptr[c + 1]):
-                i = l_idx[p]
-                if i < top and not mark[i]:
                     mark[i] = True
-                    reach[h] = i
-                    h += 1
-        for c in np.sort(reach[:h]):                 # in L's order: each row after those it needs
+                    lo = min(lo, i)
+        for c in range(lo, top):                      # in L's order: each row after those it needs
+            if not mark[c]:
+                continue
             r = pos[c]
             for b in range(nb):
                 v = x[c, b] / diag[c]
@@ -117,6 +106,7 @@ def lower_solve_columns(l_ptr, l_idx, l_val, diag, b_ptr, b_idx, b_val, top, blo
                     for b in range(nb):
                         Rt[j0 + b, i - top] -= lv * xc[b]
                 else:
+                    mark[i] = True
                     for b in range(nb):
                         x[i, b] -= lv * xc[b]
     start = np.zeros(m, np.int64)
