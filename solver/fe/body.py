@@ -187,17 +187,18 @@ def assemble(mesh: BodyMesh, face_width: float, web_thickness: float, material: 
     return BodyModel(mesh, basis, thickness, free, blas1_solver(lu), material, t1 - t0, t2 - t1, c1 - c0, c2 - c1, lu)
 
 
-def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) -> np.ndarray:
+def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float, edges: tuple | None = None,
+                sparse: bool = False):
     """Nodal forces of ``force`` [N] spread uniformly over the boundary within ``patch`` [m] of the
-    load point, along the load direction.
+    load point, along the load direction. ``edges``: the mesh's `boundary_edges`, if at hand.
+    ``sparse``: (the loaded DOFs, sorted; their forces [N]) instead of the vector of every DOF.
 
     A uniform traction q on a straight quadratic edge of length L has the consistent nodal
     loads q L/6 at each end and 2 q L/3 at the mid-side node (exact), so no quadrature is needed.
     """
     m = model.basis.mesh
     p, d = case.point, case.direction
-    bf = m.boundary_facets()
-    mid = m.p[:, m.facets[:, bf]].mean(axis=1)
+    bf, mid = boundary_edges(model) if edges is None else edges
     dist = np.hypot(mid[0] - p[0], mid[1] - p[1])
     sel = bf[dist <= patch]
     if sel.size == 0:       # patch narrower than an element: the nearest edge carries the load
@@ -205,17 +206,31 @@ def load_vector(model: BodyModel, case: LoadCase, force: float, patch: float) ->
     ends = m.facets[:, sel]                                   # (2, n) vertex indices
     length = np.hypot(*(m.p[:, ends[1]] - m.p[:, ends[0]]))
     q = force / length.sum()
-    f = np.zeros(model.basis.N)
     nd = model.basis.nodal_dofs
+    dofs, loads = [], []                                      # summed in this order (`np.add.at`)
     for c in range(2):
-        np.add.at(f, nd[c, ends[0]], q * d[c] * length / 6)
-        np.add.at(f, nd[c, ends[1]], q * d[c] * length / 6)
+        dofs += [nd[c, ends[0]], nd[c, ends[1]]]
+        loads += [q * d[c] * length / 6] * 2
         if model.basis.facet_dofs.size:                       # P2: mid-side dofs
-            np.add.at(f, model.basis.facet_dofs[c, sel], 2 * q * d[c] * length / 3)
+            dofs.append(model.basis.facet_dofs[c, sel])
+            loads.append(2 * q * d[c] * length / 3)
         else:                                                 # P1: ends take half each
-            np.add.at(f, nd[c, ends[0]], q * d[c] * length / 3)
-            np.add.at(f, nd[c, ends[1]], q * d[c] * length / 3)
+            dofs += [nd[c, ends[0]], nd[c, ends[1]]]
+            loads += [q * d[c] * length / 3] * 2
+    dofs, loads = np.concatenate(dofs), np.concatenate(loads)
+    if sparse:
+        at, inv = np.unique(dofs, return_inverse=True)
+        return at, np.bincount(inv, weights=loads, minlength=at.size)
+    f = np.zeros(model.basis.N)
+    np.add.at(f, dofs, loads)
     return f
+
+
+def boundary_edges(model: BodyModel) -> tuple:
+    """(the boundary facets of the model's mesh, their midpoints (2, n) [m])."""
+    m = model.basis.mesh
+    bf = m.boundary_facets()
+    return bf, m.p[:, m.facets[:, bf]].mean(axis=1)
 
 
 def solve_load(model: BodyModel, f: np.ndarray) -> np.ndarray:
@@ -239,13 +254,19 @@ def _map_loads(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth: li
     block of some 70,000 rows)."""
     import scipy.sparse as sp
     cases = [load_case(g, i, pivot_radius) for i in teeth]
+    edges = boundary_edges(model)
     if free_sparse:
-        cols = [load_vector(model, c, force, patch)[model.free] for c in cases]
-        nz = [np.flatnonzero(f) for f in cols]
-        F = sp.csc_matrix((np.concatenate([f[i] for f, i in zip(cols, nz)]), np.concatenate(nz),
-                           np.cumsum([0] + [i.size for i in nz])), shape=(model.free.size, len(cases)))
+        pos = np.full(model.basis.N, -1, np.int64)
+        pos[model.free] = np.arange(model.free.size)
+        cols = []
+        for c in cases:
+            dofs, f = load_vector(model, c, force, patch, edges, sparse=True)
+            keep = (pos[dofs] >= 0) & (f != 0)                         # (a clamped DOF takes no load)
+            cols.append((pos[dofs[keep]], f[keep]))
+        F = sp.csc_matrix((np.concatenate([f for _, f in cols]), np.concatenate([at for at, _ in cols]),
+                           np.cumsum([0] + [at.size for at, _ in cols])), shape=(model.free.size, len(cases)))
     else:
-        F = np.column_stack([load_vector(model, c, force, patch) for c in cases])
+        F = np.column_stack([load_vector(model, c, force, patch, edges) for c in cases])
     P = model.basis.probes(np.column_stack([c.centre_point for c in cases])).tocsr()
     return cases, F, P
 
@@ -283,7 +304,8 @@ def tooth_map(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, for
     pos[model.free] = np.arange(model.free.size)
     reads = []
     for j, band in enumerate(bands):
-        dofs = np.unique(np.concatenate([ed[:, band].ravel(), P[j].indices, P[n + j].indices]))
+        probe = [P.indices[P.indptr[i]:P.indptr[i + 1]] for i in (j, n + j)]
+        dofs = np.unique(np.concatenate([ed[:, band].ravel(), *probe]))
         reads.append(dofs[pos[dofs] >= 0])                  # a clamped DOF reads 0
     cols = model.condensed.column_reads(F, [pos[r] for r in reads])
     U = np.full((model.basis.N, n), np.nan)                 # NaN: not read (would show in k or stress)
@@ -292,7 +314,7 @@ def tooth_map(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth, for
         U[r, j] = c
     k = _stiffness(teeth, cases, P, U, force)
     stress = fillet_stress(model, g, U, teeth, bands=bands)
-    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(stress) | np.array([not b.any() for b in bands]))):
+    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(stress) | np.array([b.size == 0 for b in bands]))):
         raise RuntimeError("tooth_map: a load case read a displacement it did not solve for")
     return k, stress
 
@@ -312,10 +334,14 @@ def _stiffness(teeth: list, cases: list, P, U: np.ndarray, force: float) -> np.n
 
 
 def von_mises(model: BodyModel, u: np.ndarray) -> np.ndarray:
-    """Element-mean von Mises stress [Pa] (plane stress) of displacement u."""
+    """Element-mean von Mises stress [Pa] (plane stress) of displacement u, over the points of the
+    element's default quadrature (a condensed body's basis holds one point an element)."""
+    import skfem
     from skfem.helpers import sym_grad
 
     basis = model.basis
+    if basis.X.shape[1] == 1:
+        basis = skfem.Basis(basis.mesh, basis.elem)
     w = basis.interpolate(u)
     eps = sym_grad(w)                     # (2, 2, nelem, nqp)
     lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
@@ -355,10 +381,26 @@ def body_field(model: BodyModel, g: GearGeometry, u: np.ndarray, tooth: int, for
 
 
 def _fillet_bands(model: BodyModel, g: GearGeometry, teeth) -> list:
-    """Boolean element mask of each listed tooth's `fillet_band`."""
+    """The elements (sorted indices) of each listed tooth's `fillet_band`."""
     mesh = model.mesh
     centroids = mesh.points[mesh.triangles].mean(axis=1)
-    return [fillet_band(centroids, g, int(t)) for t in teeth]
+    # each band lies within a module of the root circle and a pitch of its tooth's axis: only the
+    # elements of a ring twice as wide, within 1.5 pitches of the axis, are tested tooth by tooth
+    # (the same bands)
+    ring = np.flatnonzero(np.abs(np.hypot(centroids[:, 0], centroids[:, 1]) - g.root_radius) < 2 * g.spec.module)
+    angle = np.arctan2(centroids[ring, 1], centroids[ring, 0])
+    by_angle = np.argsort(angle)
+    angle = angle[by_angle]
+    out = []
+    for t in teeth:
+        axis = (int(t) * g.pitch_angle + math.pi) % (2 * math.pi) - math.pi
+        lo, hi = axis - 1.5 * g.pitch_angle, axis + 1.5 * g.pitch_angle
+        spans = [(lo, hi)] if -math.pi <= lo and hi <= math.pi else \
+            [(lo + 2 * math.pi, math.pi), (-math.pi, hi)] if lo < -math.pi else [(lo, math.pi), (-math.pi, hi - 2 * math.pi)]
+        near = np.sort(ring[np.concatenate([by_angle[np.searchsorted(angle, a):np.searchsorted(angle, b, "right")]
+                                            for a, b in spans])])
+        out.append(near[fillet_band(centroids[near], g, int(t))])
+    return out
 
 
 def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind: str = "von_mises",
@@ -371,7 +413,7 @@ def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind:
     surface stress; element means read some 15 % low and vary from tooth to tooth with the
     mesh). ``kind``: 'von_mises' (plane stress; both fillets, the compression side usually
     carries the peak) or 'max_principal' (the largest tensile principal stress: the loaded
-    flank's fillet, what ISO 6336-3 rates). ``bands``: the teeth's `_fillet_bands`, if at hand.
+    flank's fillet, what ISO 6336-3 rates). ``bands``: the teeth's `_fillet_bands` (element indices), if at hand.
     """
     import skfem
     from skfem.element import DiscreteField
@@ -382,29 +424,29 @@ def fillet_stress(model: BodyModel, g: GearGeometry, U: np.ndarray, teeth, kind:
     lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
     vertices = (np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), np.full(3, 1.0 / 6.0))   # reference vertices
     bands = _fillet_bands(model, g, teeth) if bands is None else bands
-    union = np.flatnonzero(np.logical_or.reduce(bands)) if bands else np.empty(0, np.int64)
+    union = np.unique(np.concatenate(bands)) if bands else np.empty(0, np.int64)
     # one basis over the bands of all teeth (a basis per tooth cost more than the rest of the
-    # stress); each tooth sums its displacement times the basis gradients on its own band only,
-    # in the order skfem's `interpolate` does (the same numbers)
-    if union.size:
-        b = skfem.Basis(model.basis.mesh, model.basis.elem, elements=union, quadrature=vertices)
-        grads = [b.basis[i][0].grad for i in range(b.Nbfun)]             # (2, 2, n_union, 3) each
-    out = np.empty(len(teeth))
-    for j, band in enumerate(bands):
-        sel = np.flatnonzero(band[union]) if union.size else union
-        if sel.size == 0:
-            out[j] = np.nan
-            continue
-        u = U[:, j]
-        grad = 0.0 * np.einsum("...,...j->...j", u[b.element_dofs[0, sel]], grads[0][:, :, sel])
-        for i, gi in enumerate(grads):
-            grad += np.einsum("...,...j->...j", u[b.element_dofs[i, sel]], gi[:, :, sel])
-        eps = sym_grad(DiscreteField(grad=grad))
-        tr = eps[0, 0] + eps[1, 1]
-        sxx, syy, sxy = lam * tr + 2 * mu * eps[0, 0], lam * tr + 2 * mu * eps[1, 1], 2 * mu * eps[0, 1]
-        if kind == "von_mises":
-            s = np.sqrt(sxx**2 - sxx * syy + syy**2 + 3 * sxy**2)
-        else:
-            s = 0.5 * (sxx + syy) + np.sqrt(0.25 * (sxx - syy) ** 2 + sxy**2)
-        out[j] = float(s.max())
+    # stress); every (tooth, band element) pair at once, each summing its tooth's displacement
+    # times the basis gradients in the order skfem's `interpolate` does (the same numbers)
+    out = np.full(len(teeth), np.nan)
+    if not union.size:
+        return out
+    b = skfem.Basis(model.basis.mesh, model.basis.elem, elements=union, quadrature=vertices)
+    sels = [np.searchsorted(union, band) for band in bands]
+    sel = np.concatenate(sels)
+    col = np.repeat(np.arange(len(teeth)), [x.size for x in sels])
+    grads = [b.basis[i][0].grad[:, :, sel] for i in range(b.Nbfun)]      # (2, 2, n_pairs, 3) each
+    grad = 0.0 * (U[b.element_dofs[0, sel], col][:, None] * grads[0])
+    for i, gi in enumerate(grads):
+        grad += U[b.element_dofs[i, sel], col][:, None] * gi
+    eps = sym_grad(DiscreteField(grad=grad))
+    tr = eps[0, 0] + eps[1, 1]
+    sxx, syy, sxy = lam * tr + 2 * mu * eps[0, 0], lam * tr + 2 * mu * eps[1, 1], 2 * mu * eps[0, 1]
+    if kind == "von_mises":
+        s = np.sqrt(sxx**2 - sxx * syy + syy**2 + 3 * sxy**2)
+    else:
+        s = 0.5 * (sxx + syy) + np.sqrt(0.25 * (sxx - syy) ** 2 + sxy**2)
+    peak = s.max(axis=1)                                                 # (n_pairs,)
+    has = np.flatnonzero([x.size > 0 for x in sels])
+    out[has] = np.maximum.reduceat(peak, np.cumsum([0] + [x.size for x in sels])[has])
     return out

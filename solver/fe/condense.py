@@ -40,7 +40,7 @@ import numpy as np
 from solver.fe.body import BodyModel, plane_stress_lame, plane_stress_p2_stiffness
 from solver.fe.factor import blas1_solver, congruence, factorise, influence, one_blas_thread
 from solver.fe.mesh import REGION_RIM, REGION_WEB, BodyMesh
-from solver.fe.rim_solves import ReadSet, _closed_block, make_read_set, rim_products
+from solver.fe.rim_solves import ReadSet, make_read_set, rim_products
 from solver.geometry import Material
 from solver.store import Shelf, digest
 
@@ -71,9 +71,15 @@ def _dof_keys(basis) -> np.ndarray:
 
 
 def _basis(points: np.ndarray, triangles: np.ndarray):
+    """The vector P2 basis of the mesh, its functions evaluated at one point an element (the
+    centroid): what the condensed bodies read of it is its DOF numbering and locations, probes and
+    the stiffness in closed form (`plane_stress_p2_stiffness`), none of its quadrature."""
     import skfem
     m = skfem.MeshTri(points.T.copy(), triangles.T.copy())
-    return skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP2()))
+    return skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP2()), quadrature=_CENTROID)
+
+
+_CENTROID = (np.array([[1.0 / 3.0], [1.0 / 3.0]]), np.array([0.5]))     # reference point and weight
 
 
 def _canonical(points: np.ndarray, triangles: np.ndarray, region: np.ndarray) -> tuple:
@@ -122,6 +128,7 @@ class RimBlock:
     blocks: tuple = field(default=(), repr=False)          # (K_rr CSC, K_ii^R CSC) [N/m], for `make_split`
     split: dict | None = field(default=None, repr=False)   # factors of the interface-last factorisation
     key: str = ""                                          # the cache's name for this rim, if any
+    tree: object = field(default=None, repr=False)         # cKDTree of ``keys``, made on a body's first match
     # kept K_rr^-1 f (`rim_solve`) and `ReadSet`s (`read_set`): shelves of the rim itself, gone with it
     solves: Shelf = field(default_factory=lambda: Shelf("rim solves", SOLVES_KEPT), repr=False)
     read_sets: Shelf = field(default_factory=lambda: Shelf("rim read sets", SOLVES_KEPT), repr=False)
@@ -212,6 +219,23 @@ def rim_block(mesh: BodyMesh, face_width: float, material: Material, r_interface
     return block
 
 
+def _dense_rows(U12, share: float = 0.125) -> tuple:
+    """(position in the dense block of each row, -1 for the others; the rows of U12 (n, n_i) CSR
+    with more than ``share`` of n_i entries, dense; U12 without them, CSR): the rows of the
+    interface-last factorisation's coupling block near the interface, which every column read
+    passes through, multiplied by the interface displacements at once."""
+    import scipy.sparse as sp
+    nnz = np.diff(U12.indptr)
+    rows = np.flatnonzero(nnz > share * U12.shape[1])
+    at = np.full(U12.shape[0], -1, np.int64)
+    at[rows] = np.arange(rows.size)
+    keep = np.ones(U12.shape[0])
+    keep[rows] = 0.0
+    rest = sp.csr_matrix(sp.diags(keep) @ U12)
+    rest.eliminate_zeros()
+    return at, U12[rows].toarray(), rest
+
+
 @dataclass
 class CondensedBody:
     """A whole body solved through its condensed rim and its own web (see the module doc).
@@ -256,7 +280,8 @@ class CondensedBody:
         cost where the loads lie in the teeth and rim and each column reads a few DOFs there (see
         the module doc). Loads or reads elsewhere (web, interface loads): the full solve."""
         import scipy.sparse as sp
-        from scipy.sparse.linalg import spsolve_triangular
+
+        from solver.fe.kernels import back_substitute_reads
 
         f = f.tocsc() if sp.issparse(f) else np.asarray(f, float).reshape(f.shape[0], -1)
         reads = [np.asarray(r, np.int64) for r in reads]
@@ -277,21 +302,20 @@ class CondensedBody:
         u_i = -self.schur_solve(rs.B)                        # interface displacement [m], rim interface order
         w2 = np.empty_like(u_i)
         w2[rim.split["pc"][n:] - n] = u_i                    # in the factorisation's interface order
-        U12, Ut11 = rim.split["U12"], rim.split["Ut11"]
+        Ut11 = rim.split["Ut11"]
         if "inv_diag" not in rim.split:
             rim.split["inv_diag"] = 1.0 / Ut11.diagonal()
-        inv_d = rim.split["inv_diag"]
-        out = []
-        for j in range(f.shape[1]):
-            rows = rs.rows[j]
-            c = (rs.s[j] - U12[rows] @ w2[:, j]) * inv_d[rows]
-            # U11[rows][:, rows] w = c' with the rows scaled to a unit diagonal (scipy's own
-            # scaling would copy the block twice more)
-            Ut = _closed_block(Ut11, rows)                   # U11[rows][:, rows]^T, lower, CSC
-            Ut.data *= np.repeat(inv_d[rows], np.diff(Ut.indptr))
-            w = spsolve_triangular(Ut.T, c, lower=False, unit_diagonal=True, overwrite_A=True, overwrite_b=True)
-            out.append(w[rs.at[j]])
-        return out
+            rim.split["U12 rows"] = _dense_rows(rim.split["U12"])
+        dense, U12_dense, U12_rest = rim.split["U12 rows"]
+        with one_blas_thread():
+            u12w = U12_dense @ w2                            # U12 u_i on its rows that hold most of it
+        # every column's restricted back-substitution U11 w = s - U12 u_i in one compiled call
+        # (Ut11 in CSC is U11 in CSR)
+        rows_ptr = np.cumsum([0] + [r.size for r in rs.rows])
+        w = back_substitute_reads(Ut11.indptr, Ut11.indices, Ut11.data, rim.split["inv_diag"], U12_rest.indptr,
+                                  U12_rest.indices, U12_rest.data, np.ascontiguousarray(w2.T), dense, u12w,
+                                  np.concatenate(rs.rows), rows_ptr, np.concatenate(rs.s))
+        return [w[rows_ptr[j] + rs.at[j]] for j in range(f.shape[1])]
 
     def influence(self, R_rim, F_rim, key) -> np.ndarray:
         """R K^-1 F [m/N for unit loads] of reads R (m, N_R) and loads F (N_R, k) on the rim's
@@ -301,6 +325,28 @@ class CondensedBody:
         X = self.schur_solve(B)
         with one_blas_thread():
             return G0 + A @ X
+
+
+def _rim_numbering(basis, is_rim: np.ndarray, rim: RimBlock) -> np.ndarray | None:
+    """The body DOF of each DOF of the condensed rim, where the body's mesh begins with the rim's
+    vertices and elements as they are (`join_rim` makes it so): vertex DOFs alike, edge DOFs
+    through the edges' end vertices. None for a mesh numbered otherwise."""
+    m, rm = basis.mesh, rim.model.basis.mesh
+    nv, nt = rm.p.shape[1], rm.t.shape[1]
+    if (m.p.shape[1] < nv or m.t.shape[1] < nt or not np.array_equal(m.p[:, :nv], rm.p)
+            or not np.array_equal(m.t[:, :nt], rm.t) or is_rim.sum() != nt or not is_rim[:nt].all()):
+        return None
+    key = m.facets[0].astype(np.int64) * m.p.shape[1] + m.facets[1]          # edges by their (sorted) ends
+    want = rm.facets[0].astype(np.int64) * m.p.shape[1] + rm.facets[1]
+    order = np.argsort(key)
+    at = order[np.minimum(np.searchsorted(key, want, sorter=order), key.size - 1)]
+    if not np.array_equal(key[at], want):
+        return None
+    rb = rim.model.basis
+    out = np.empty(rb.N, np.int64)
+    out[rb.nodal_dofs] = basis.nodal_dofs[:, :nv]
+    out[rb.facet_dofs] = basis.facet_dofs[:, at]
+    return out
 
 
 def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material,
@@ -321,15 +367,24 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     if is_rim.sum() != rim.model.mesh.n_elements:
         raise RimMismatch(f"{int(is_rim.sum())} teeth-and-rim elements, the condensed rim has {rim.model.mesh.n_elements}")
     ed = basis.element_dofs
-    rim_dofs = np.unique(ed[:, is_rim])
-    web_dofs = np.unique(ed[:, ~is_rim])
+    in_rim = np.zeros(basis.N, bool)
+    in_rim[ed[:, is_rim].ravel()] = True
+    in_web = np.zeros(basis.N, bool)
+    in_web[ed[:, ~is_rim].ravel()] = True
+    rim_dofs = np.flatnonzero(in_rim)
     keys = _dof_keys(basis)
-    dist, idx = cKDTree(rim.keys).query(keys[rim_dofs])
-    if rim_dofs.size != rim.keys.shape[0] or np.any(dist > MATCH_TOL) or np.unique(idx).size != idx.size:
-        raise RimMismatch("the body's teeth-and-rim nodes differ from the condensed rim's")
+    from_rim = _rim_numbering(basis, is_rim, rim)         # body DOF of each rim DOF
+    if from_rim is None:                                  # another numbering: match the DOFs by location
+        if rim.tree is None:
+            rim.tree = cKDTree(rim.keys)
+        dist, idx = rim.tree.query(keys[rim_dofs])
+        if rim_dofs.size != rim.keys.shape[0] or np.any(dist > MATCH_TOL) or np.unique(idx).size != idx.size:
+            raise RimMismatch("the body's teeth-and-rim nodes differ from the condensed rim's")
+        from_rim = np.empty(rim.keys.shape[0], np.int64)
+        from_rim[idx] = rim_dofs
     to_rim = np.full(basis.N, -1)
-    to_rim[rim_dofs] = idx
-    shared = np.intersect1d(rim_dofs, web_dofs)
+    to_rim[from_rim] = np.arange(from_rim.size)
+    shared = np.flatnonzero(in_rim & in_web)
     if not np.array_equal(np.sort(to_rim[shared]), rim.interface):
         raise RimMismatch("the body's rim-web interface differs from the condensed rim's")
     lam, mu = plane_stress_lame(material.youngs_modulus, material.poisson_ratio)
@@ -344,37 +399,32 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     pos[free] = np.arange(free.size)
     if np.any(pos[rim_dofs] < 0):
         raise RimMismatch("the bore clamp reaches the teeth and rim")
-    # body DOF of each rim DOF, then positions in the body's free vector
-    from_rim = np.empty(rim.keys.shape[0], np.int64)
-    from_rim[idx] = rim_dofs
+    # positions in the body's free vector
     pos_r = pos[from_rim[rim.model.free]]
     body_i = from_rim[rim.interface]
     pos_i = pos[body_i]
-    web_free = np.setdiff1d(web_dofs[keep[web_dofs]], shared)
+    web_free = np.flatnonzero(in_web & keep & ~in_rim)
     pos_w = pos[web_free]
     K_ww = K_W[web_free][:, web_free].tocsc()
     K_wi = K_W[web_free][:, body_i].tocsr()
     S = rim.S + K_W[body_i][:, body_i].toarray()
-    # the Cholesky factorisation below reads the lower triangle of 0.5 (S + S^T) only: where
-    # S_R + K_ii^W is exactly symmetric (as assembled) that is S - tril(W) itself, bit for bit
-    S_t = None if np.array_equal(S, S.T) else S.T.copy()
     t1, c1 = time.perf_counter(), time.process_time()
     web_solve = None
     if web_free.size:
         lu_w = factorise(K_ww)
         web_solve = blas1_solver(lu_w)
-        # K_iw K_ww^-1 K_wi by a triangular solve restricted to the web DOFs the interface
-        # reaches and a symmetric product (two solves and a general product if not symmetric)
-        W = Wt = congruence(lu_w, K_wi, lower=True)      # (W^T's lower triangle is W's)
+        # K_iw K_ww^-1 K_wi by triangular solves over the web DOFs each interface DOF reaches
+        # and a product over the arcs of the interface circle they couple to (interface DOFs
+        # in the order of their polar angle); two solves and a general product if the web's
+        # factorisation is not symmetric
+        around = np.lexsort((keys[body_i, 2], np.arctan2(keys[body_i, 1], keys[body_i, 0])))
+        W = congruence(lu_w, K_wi, order=around)
         if W is None:
             web = BodyModel(mesh, _Size(web_free.size), None, np.arange(web_free.size), web_solve, material, factor=lu_w)
             W = influence(web, K_wi.T.tocsr(), K_wi)
-            Wt, S_t = W.T, S.T.copy() if S_t is None else S_t
         S -= W
-        if S_t is not None:
-            S_t -= Wt
-    if S_t is not None:
-        S = 0.5 * (S + S_t)
+    if not np.array_equal(S, S.T):      # (S_R + K_ii^W - W as assembled is symmetric to the bit)
+        S = 0.5 * (S + S.T)
     with one_blas_thread():
         schur = cho_factor(S, lower=True, check_finite=False)
     cb = CondensedBody(rim, pos_r, pos_i, pos_w, web_solve, K_wi if web_free.size else sp.csr_matrix((0, body_i.size)),

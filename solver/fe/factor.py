@@ -9,16 +9,24 @@ from contextlib import contextmanager
 import numpy as np
 
 _BLAS_THREADS: dict = {}     # library path -> [(get, set)] of its thread-count functions
+_BLAS_SEEN: list = []        # [the number of modules imported when last listed, the controls then]
+DENSE_ROWS = 320             # `congruence`: the last rows of a factor's order solved as one dense block
+SOLVE_BLOCK = 16             # `congruence`: columns solved together (`solver.fe.kernels.lower_solve_columns`)
 
 
 def _openblas_controls() -> list:
     """(get_num_threads, set_num_threads) of every OpenBLAS library loaded in this process
     (numpy's and scipy's wheels each bundle one, with prefixed symbol names); empty where they
-    cannot be found (not Linux, another BLAS). The loaded libraries are listed anew each call
-    (a millisecond), so one loaded later is not missed."""
+    cannot be found (not Linux, another BLAS). The loaded libraries are listed anew whenever the
+    process has imported a module since the last call (reading the memory map costs some
+    milliseconds a call on a busy machine, and a BLAS library is loaded by an import), so one
+    loaded later is not missed."""
     import ctypes
     import re
+    import sys
 
+    if _BLAS_SEEN and _BLAS_SEEN[0] == len(sys.modules):
+        return _BLAS_SEEN[1]
     try:
         with open("/proc/self/maps") as f:
             paths = sorted(set(re.findall(r"(/\S*openblas\S*\.so\S*)", f.read())))
@@ -41,6 +49,7 @@ def _openblas_controls() -> list:
                         found.append((get, put))
             _BLAS_THREADS[path] = found
         out += _BLAS_THREADS[path]
+    _BLAS_SEEN[:] = [len(sys.modules), out]
     return out
 
 
@@ -131,39 +140,104 @@ def influence(model, R, F, block: int = 48) -> np.ndarray:
         return z.T @ y
 
 
-def congruence(lu, C, block: int = 48, lower: bool = False) -> np.ndarray | None:
-    """C^T K^-1 C (k, k), dense, for the SPD K factorised by `factorise` (``lu``) and C (n, k)
-    sparse (the condensation of a block onto the DOFs C couples to: [N/m] for stiffness).
+def congruence(lu, C, order: np.ndarray | None = None, dense_rows: int = DENSE_ROWS) -> np.ndarray | None:
+    """C^T K^-1 C (k, k), dense and exactly symmetric, for the SPD K factorised by `factorise`
+    (``lu``) and C (n, k) sparse (the condensation of a block onto the DOFs C couples to: [N/m]
+    for stiffness).
 
     Symmetric mode pivots on the diagonal in one order for rows and columns (perm_r equal to
     perm_c), so P K P^T = L U with U = D L^T, D = diag(U), and
 
-        C^T K^-1 C = Y^T D^-1 Y,   Y = L^-1 P C,
+        C^T K^-1 C = Y^T Y,   Y = D^-1/2 L^-1 P C,
 
-    one triangular solve (restricted to the rows C reaches, as in `influence`) and one
-    symmetric rank-k product: about half the work of `influence`'s two solves and general
-    product. None where the factorisation is not of that form (then use `influence`).
-    ``lower``: only the lower triangle (the upper one zero), for a caller that reads no more
-    (a Cholesky factorisation), without the copies that fill the upper one."""
+    one triangular solve and one symmetric product. Both use the sparsity of Y: each column
+    is solved over the rows it reaches only (`solver.fe.kernels.lower_solve_columns`), and the
+    product is summed over blocks of rows whose nonzeros lie on a common run of columns
+    (`arc_gram`). Where C's columns are DOFs along a curve (a web's interface circle), a row's
+    nonzeros are the DOFs of one arc of it; ``order``: C's columns in that order along the
+    curve (any order gives the same result, to rounding; this one makes the runs short).
+    None where the factorisation is not of that form (then use `influence`)."""
     import scipy.sparse as sp
-    from scipy.linalg.blas import dsyrk
+    from scipy.linalg import solve_triangular
+
+    from solver.fe.kernels import lower_solve_columns, row_arcs
 
     if not np.array_equal(lu.perm_r, lu.perm_c):
         return None
-    L = sp.csc_matrix(lu.L)
     d = lu.U.diagonal()
     if not np.all(d > 0):
         return None
-    Cf = sp.csr_matrix(C)
-    b = Cf[np.argsort(lu.perm_r)]                    # P C
-    S = np.flatnonzero(_reach(L, lu.perm_r[np.flatnonzero(np.diff(Cf.indptr))]))
-    Y = _lower_solve(L[S][:, S], b[S].toarray(), block)
-    Y *= (1.0 / np.sqrt(d[S]))[:, None]              # D^-1/2 Y
+    L = sp.csc_matrix(lu.L)
+    strict = sp.tril(L, -1, format="csc")
+    Cp = sp.csc_matrix(sp.csr_matrix(C)[np.argsort(lu.perm_r)])            # P C
+    if order is not None:
+        Cp = Cp[:, order]
+    Cp.sort_indices()
+    n = L.shape[0]
+    top = max(n - dense_rows, 0)
+    rows, Yt, start, length, Rt = lower_solve_columns(strict.indptr, strict.indices, strict.data, L.diagonal(),
+                                                      Cp.indptr, Cp.indices, Cp.data, top, SOLVE_BLOCK)
+    if top < n:                                      # the last rows, which most columns reach: dense
+        m = rows.size
+        with one_blas_thread():
+            Yt[:, m:] = solve_triangular(L[top:, top:].toarray(), Rt.T, lower=True, check_finite=False).T
+        rows = np.concatenate([rows, np.arange(top, n)])
+        s_top, l_top = row_arcs(Yt[:, m:].T)
+        start, length = np.concatenate([start, s_top]), np.concatenate([length, l_top])
+    Yt *= 1.0 / np.sqrt(d[rows])                                            # (D^-1/2 L^-1 P C)^T
+    W = arc_gram(Yt, start, length)
+    if order is not None:
+        back = np.empty_like(order)
+        back[order] = np.arange(order.size)
+        W = W[np.ix_(back, back)]
+    return W
+
+
+def arc_gram(Yt: np.ndarray, start: np.ndarray, length: np.ndarray, rows_max: int = 256) -> np.ndarray:
+    """Y^T Y (n, n), exactly symmetric, for Y (m, n) given as Yt = Y^T (n, m), whose row r (Yt's
+    column r) is zero outside the circular run of ``length[r]`` columns from ``start[r]``
+    (`solver.fe.kernels.row_arcs`).
+
+    The rows are grouped by the size of their runs (within a factor of two) and, in each group,
+    by where the run starts, into blocks whose common run is at most 1.5 times the group's
+    bound; each block adds its dense product on its run (a symmetric rank-k update)
+    to the lower triangle of the columns of that run, mirrored once at the end. The arithmetic is
+    about the rows' own runs squared instead of every row times n squared."""
+    from scipy.linalg.blas import dsyrk
+
+    n, m = Yt.shape
+    W = np.zeros((n, n))
+    live = np.flatnonzero(length > 0)
+    group = np.floor(np.log2(length[live])).astype(np.int64)
+    order = live[np.lexsort((start[live], group))]
+    group = np.floor(np.log2(length[order])).astype(np.int64)
     with one_blas_thread():                          # the same bits whatever the process's BLAS threads
-        W = dsyrk(1.0, Y.T, lower=1)                 # Y^T Y, lower triangle (Y.T: Fortran order, no copy)
-    if lower:
-        return W                                     # (dsyrk leaves the upper triangle zero)
-    return np.tril(W) + np.tril(W, -1).T
+        i = 0
+        while i < order.size:
+            g, s0 = group[i], start[order[i]]
+            cap = max(int(1.5 * 2 ** (g + 1)), 32)
+            end = s0 + length[order[i]]
+            j = i + 1
+            while (j < order.size and j - i < rows_max and group[j] == g
+                   and max(end, start[order[j]] + length[order[j]]) - s0 <= cap):
+                end = max(end, start[order[j]] + length[order[j]])
+                j += 1
+            span = min(end - s0, n)
+            if span == n:
+                s0 = 0
+            rows = order[i:j]
+            if s0 + span <= n:
+                G = dsyrk(1.0, Yt[s0:s0 + span][:, rows].T, trans=1, lower=1)    # lower triangle of Yb^T Yb
+                W[s0:s0 + span, s0:s0 + span] += G
+            else:                                    # a run across column 0: its parts' blocks
+                a = n - s0
+                G = dsyrk(1.0, Yt[(s0 + np.arange(span)) % n][:, rows].T, trans=1, lower=1)
+                W[s0:, s0:] += G[:a, :a]
+                W[:span - a, :span - a] += G[a:, a:]
+                W[s0:, :span - a] += G[a:, :a].T     # (the upper part of the run's block)
+            i = j
+    W += np.tril(W, -1).T                            # the lower triangle, summed, mirrored
+    return W
 
 
 def _reach(T, sources: np.ndarray) -> np.ndarray:

@@ -172,18 +172,38 @@ def test_column_reads_equal_the_whole_body_solve(ring):
 
 
 def test_congruence_equals_the_solves(ring):
-    """C^T K^-1 C by one restricted solve and a symmetric product (`factor.congruence`, the
-    web's condensation onto the interface) equals C^T times the full solves of C, and is
-    symmetric; its lower triangle alone (what the Cholesky of the condensed body reads) is
-    the full result's to the bit, the upper one zero."""
+    """C^T K^-1 C by restricted solves and a product over the runs of columns each row reaches
+    (`factor.congruence`, the web's condensation onto the interface) equals C^T times the full
+    solves of C and is exactly symmetric, whatever the order of C's columns given for the runs,
+    and with its last rows solved sparse or dense."""
     from solver.fe.factor import congruence
     mesh, _ = ring
     whole = fe.assemble(mesh, T_RIM, 0.008, STEEL)
     C = sp.random(whole.free.size, 30, density=0.002, random_state=np.random.default_rng(4), format="csc")
     C = C + sp.csc_matrix(([1.0], ([5], [0])), shape=C.shape)        # no empty column
-    W = congruence(whole.factor, C)
     ref = C.T @ whole.solve(C.toarray())
-    assert W is not None and np.array_equal(W, W.T)
-    assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
-    lower = congruence(whole.factor, C, lower=True)
-    assert np.array_equal(lower, np.tril(W)) and not np.triu(lower, 1).any()
+    for order in (None, np.random.default_rng(5).permutation(30)):
+        for dense_rows in (0, 40, 10**6):
+            W = congruence(whole.factor, C, order=order, dense_rows=dense_rows)
+            assert W is not None and np.array_equal(W, W.T)
+            assert np.abs(W - ref).max() < 1e-10 * np.abs(ref).max()
+
+
+def test_a_joined_body_matches_its_rim_by_numbering(ring):
+    """A body meshed as `join_rim` makes it (the rim's vertices and elements first, as they are)
+    takes its rim DOFs from the numbering, not by a search of DOF locations, and solves as the
+    same body with its DOFs matched by location."""
+    mesh, rim = ring
+    joined = cd.join_rim(rim, mesh)
+    rim.tree = None
+    fast = cd.assemble_condensed(joined, T_RIM, 0.009, STEEL, rim)
+    assert rim.tree is None                                          # no location search made
+    rim.tree = None
+    shuffled = cd.BodyMesh(joined.points, joined.triangles[::-1].copy(), joined.region[::-1].copy(),
+                           joined.bore_radius, joined.size)
+    slow = cd.assemble_condensed(shuffled, T_RIM, 0.009, STEEL, rim)
+    assert rim.tree is not None                                      # matched by location
+    f = np.random.default_rng(8).standard_normal(fast.free.size)
+    assert np.array_equal(fast.free, slow.free)
+    u_fast, u_slow = fast.solve(f), slow.solve(f)
+    assert np.abs(u_fast - u_slow).max() < 1e-12 * np.abs(u_slow).max()

@@ -32,13 +32,13 @@ def test_setup_holds_the_scene_in_si_and_the_shared_fe_load():
 def test_cache_keys_stay_those_of_the_stored_files():
     """The keys name the files of existing caches: the paper pair's driven gear, its solid
     reference and the solid driver keep their names (change them only with FE_VERSION, as for
-    version 3: the webs meshed without the outline's 1D mesh, rims condensed from a body of their
-    own); fine and graded meshes have their own."""
+    version 4: the webs condensed by compiled sparse solves); fine and graded meshes have their
+    own."""
     def keys(scene):
         g2 = gear_setups(scene)[1]
         return {FECache.key({**g.settings, "teeth": t}) for g, t in ((g2, list(range(67))), (g2.solid(), [0]))}
-    assert keys(default_scene().replace(**{"fe.mesh_grading": "fine"})) == {"fb4750d36a2864385cce", "7568f49952b8d2ff2348"}
-    assert keys(default_scene()) == {"2c4483f569b0d1ce05de", "d158aa23319d8844ac30"}
+    assert keys(default_scene().replace(**{"fe.mesh_grading": "fine"})) == {"d53efe139f0bf584cd0c", "09d2b32774445de087fb"}
+    assert keys(default_scene()) == {"bf5824bad98188be653d", "23306a44fac7d2cbb612"}
     g1, g2 = gear_setups(default_scene())
     # a solid body's hole sizes do not matter, whichever way the body was made solid
     s = default_scene().solid()
