@@ -20,7 +20,12 @@ tooth-root dampers (per gear, as a pattern per unit c_phi), the contact dampers,
 friction's slope at zero sliding.
 
 Teeth outside the candidates carry no load and sit at rest on their hub: they are rigid in
-the linearisation (their inertia is in I_TOT), as in the kernels until they are named.
+the linearisation (their inertia is in I_TOT), as in the kernels until they are named. With
+``all_teeth`` they are free instead, each on its own spring and root damper (k_phi; the
+compliance model's 1/C[a, a], as the kernels give a tooth outside the coupled set), as in a run
+with every tooth free or an active set that has grown to all teeth: the step bound of the
+all-explicit scheme needs them (`solver.mbs.stability`), since their root dampers together,
+against the rim, damp a mode faster than any one tooth's.
 
 The loaded equilibria are solved once per model and load (`solver.mbs.equilibria` keeps
 them), however many of the step bound, the modes and the damping conversion ask for them.
@@ -72,17 +77,20 @@ class LinearSystem:
         return c
 
 
-def linearize(model: Model, rim1: float, rim2: float, phi: np.ndarray) -> LinearSystem:
+def linearize(model: Model, rim1: float, rim2: float, phi: np.ndarray, all_teeth: bool = False) -> LinearSystem:
     """The pair linearised about the driver rim angle ``rim1`` [rad] (the hub in the plain
     model), the driven rim angle ``rim2`` [rad] and the tooth rotations ``phi`` [rad], at rest
-    (see the module docstring). The damping laws run as plain Python here (``.py_func``, a
-    few dozen calls): compiling them would add to the first run's compile time for nothing."""
+    (see the module docstring; ``all_teeth``: every tooth free, not only the candidates').
+    The damping laws run as plain Python here (``.py_func``, a few dozen calls): compiling
+    them would add to the first run's compile time for nothing."""
     rec, pairs = new_contact_buffer()
     zeros = np.zeros(model.n_teeth)
     gp, lp = model.gear_par, model.law_par
     nc, npair = mesh_contacts((rim1, rim2, 0.0, 0.0), phi, zeros, contact_geo(gp, model.pair_par, lp), (rec, pairs))
     tz2 = int(gp[1, L.TOOTH0])
-    teeth = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
+    cand = sorted({int(pairs[p, 0]) for p in range(npair)} | {tz2 + int(pairs[p, 1]) for p in range(npair)})
+    teeth = list(range(model.n_teeth)) if all_teeth else cand
+    coupled_set = set(cand)
     coupled = model.coupled
     body = ("r1", "theta2", "h2") if coupled else ("theta2",)
     nb = len(body)
@@ -117,13 +125,13 @@ def linearize(model: Model, rim1: float, rim2: float, phi: np.ndarray) -> Linear
         rim = th2 if g == 1 else r1         # the plain driver's hub is prescribed: no coupling row
         if rim is not None:
             M[rim, i] = M[i, rim] = gp[g, L.I_CPL]
-        if not model.teeth_coupled:
+        if not model.teeth_coupled or t not in coupled_set:     # its own spring: outside the coupled set
             K[i, i] += tooth_spring_tangent(t, phi, model.k_phi, gp)
         cj[g][i, i] += spring_damping_tangent.py_func(0.0, gp[g, L.C_PHI], gp[g, L.N_C])
         ju[g][i, i] += 1.0 if gp[g, L.N_C] == 1.0 else 0.0
     if model.teeth_coupled:     # the springs of the candidates' teeth: (C[S, S])^-1
-        idx = [pos[t] for t in teeth]
-        K[np.ix_(idx, idx)] += np.linalg.inv(model.tooth_compliance[np.ix_(teeth, teeth)])
+        idx = [pos[t] for t in cand]
+        K[np.ix_(idx, idx)] += np.linalg.inv(model.tooth_compliance[np.ix_(cand, cand)])
     mesh = np.zeros(n)
     for c in range(nc):
         ia = int(rec[c, L.C_TOOTH1])

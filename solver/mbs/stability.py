@@ -1,11 +1,18 @@
 """Step bound of the explicit integrator: the pair linearised at static equilibrium
 (`solver.mbs.linearization`: the DOFs the kernel integrates, the body modes of a coupled
-model included), its natural frequencies and modal damping.
+model included), its natural frequencies and damping.
 
-`stable_time_step` gives ``dt = safety * 2 / omega_max`` (velocity Verlet is stable for
-omega*dt < 2), reduced where the modal damping of the loaded contacts asks for it
-(`stability_limit`); the model is linearised at several positions across one mesh cycle
-under the full load.
+`stable_time_step` gives ``dt = safety * dt_crit``, the model linearised at several positions
+across one mesh cycle under the full load (`stability_limit`). dt_crit is the critical step of
+the scheme the kernel runs on that linear system:
+
+* every force explicit (dampers at the predicted velocity v + dt*a): the smallest dt at which
+  the amplification matrix of the step has the eigenvalue -1, ``verlet_damped_limit``; every
+  tooth free in the linearisation (a run with every tooth free, or an active set grown to all
+  teeth: freezing teeth only lowers the bound's frequencies, see there);
+* tooth-root dampers implicit (IMEX kicks): 2/omega_max reduced by the modal damping of the
+  explicit (contact, body, friction) dampers; the implicit dampers only raise the critical
+  step (measured 1.0-1.9 x this bound).
 """
 from __future__ import annotations
 
@@ -15,7 +22,7 @@ import numpy as np
 import scipy.linalg
 
 from solver.mbs.kernels import layout as L
-from solver.mbs.linearization import at_equilibrium, linearizations, linearize
+from solver.mbs.linearization import at_equilibrium, linearize
 from solver.mbs.model import Model
 
 
@@ -52,19 +59,21 @@ def stability_limit(model: Model, torque: float, positions: int = 12,
 
     The pair is linearised at static equilibrium under ``torque`` [N·m] (1 N·m if zero) at
     ``positions`` driver angles across one angular pitch; the generalised eigenproblem
-    K x = w² M x gives the frequencies. Each mode i, with its modal damping ratio
-    zeta_i = x_i^T C x_i / (2 w_i) (mass-normalised x_i), limits the step to
-    2/w_i * (sqrt(1 + zeta_i²) - zeta_i): velocity Verlet with damping forces evaluated at the
-    predicted velocity is stable up to there (2/w_i undamped). Flank friction enters C with
-    its slope at zero sliding (the stiffest it gets, near the pitch point). A deep, damped contact (m3 > 1)
-    can make a lower but overdamped mode the limit. The equilibria come from one static sweep
-    with continuation (tooth rotations carried from angle to angle); positions where it does
-    not converge are left out. ``implicit_dampers``: the tooth-root dampers are taken implicitly
-    (IMEX kicks, `implicit_dampers_apply`), which are stable at any damping: only the contact
-    and body dampers count then. Solved once per model and arguments (`solver.mbs.memo`: a
-    run asks for it in its method choice and again in `simulate`; a study's points of one body
-    share it). ``equilibria``: the model's loaded equilibria under ``torque`` at ``positions``
-    when already solved (`solver.mbs.equilibria.loaded_equilibria`: the same numbers).
+    K x = w² M x gives the frequencies. Every force explicit: the critical step of the scheme
+    with its dampers (`verlet_damped_limit`, every tooth free): below 2/w where the tooth-root
+    dampers take the highest modes near or beyond critical (there a modal estimate
+    2/w_i (sqrt(1 + zeta_i²) - zeta_i) read 1.1-2.4 x the step that runs). ``implicit_dampers``:
+    the tooth-root dampers are taken implicitly (IMEX kicks, `implicit_dampers_apply`), which
+    are stable at any damping: each mode i, with its modal damping ratio of the contact and
+    body dampers zeta_i = x_i^T C x_i / (2 w_i) (mass-normalised x_i), limits the step to
+    2/w_i (sqrt(1 + zeta_i²) - zeta_i) (2/w_i undamped). Flank friction enters C with its
+    slope at zero sliding (the stiffest it gets, near the pitch point). The equilibria come
+    from one static sweep with continuation (tooth rotations carried from angle to angle);
+    positions where it does not converge are left out. Solved once per model and arguments
+    (`solver.mbs.memo`: a run asks for it in its method choice and again in `simulate`; a
+    study's points of one body share it). ``equilibria``: the model's loaded equilibria under
+    ``torque`` at ``positions`` when already solved
+    (`solver.mbs.equilibria.loaded_equilibria`: the same numbers).
     """
     from solver.mbs.memo import kept
     args = (float(torque), int(positions), bool(implicit_dampers))
@@ -73,19 +82,50 @@ def stability_limit(model: Model, torque: float, positions: int = 12,
 
 def _stability_limit(model: Model, torque: float, positions: int, implicit_dampers: bool,
                      equilibria=None) -> tuple[float, float]:
+    from solver.mbs.equilibria import loaded_equilibria
     wmax = 0.0
     dt_crit = math.inf
-    systems = (linearizations(model, torque, positions) if equilibria is None
-               else [at_equilibrium(model, eq) for eq in equilibria])
-    for sy in systems:
-        M, K, C = sy.M, sy.K, sy.damping(joint=not implicit_dampers, friction=True)
-        lam, x = scipy.linalg.eigh(K, M)
-        w = np.sqrt(np.maximum(lam, 0.0))
-        h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
-        lim = 2.0 / np.maximum(np.hypot(w, h) + h, 1e-300)    # = 2/w (sqrt(1+zeta²) - zeta)
+    for eq in loaded_equilibria(model, torque, positions) if equilibria is None else equilibria:
+        if implicit_dampers:
+            sy = at_equilibrium(model, eq)
+            M, K, C = sy.M, sy.K, sy.damping(joint=False, friction=True)
+            lam, x = scipy.linalg.eigh(K, M)
+            w = np.sqrt(np.maximum(lam, 0.0))
+            h = 0.5 * np.einsum("ij,ik,kj->j", x, C, x)          # zeta_i * w_i [1/s]
+            lim = float((2.0 / np.maximum(np.hypot(w, h) + h, 1e-300)).min())   # = 2/w (sqrt(1+zeta²) - zeta)
+        else:
+            sy = linearize(model, eq.rim1, eq.rim2, eq.phi, all_teeth=True)
+            M, K = sy.M, sy.K
+            w = np.sqrt(np.maximum(scipy.linalg.eigh(K, M, eigvals_only=True), 0.0))
+            lim = verlet_damped_limit(M, K, sy.damping(friction=True))
         wmax = max(wmax, float(w.max()))
-        dt_crit = min(dt_crit, float(lim.min()))
+        dt_crit = min(dt_crit, lim)
     return dt_crit, wmax
+
+
+def verlet_damped_limit(M: np.ndarray, K: np.ndarray, C: np.ndarray) -> float:
+    """Critical step [s] of velocity Verlet with every damper at the predicted velocity
+    v + dt*a (the all-explicit kernels) on M x'' + C x' + K x = 0 (SI; M positive definite,
+    K and C symmetric positive semidefinite).
+
+    A solution that flips sign each step (x, v, a) -> -(x, v, a) needs v = 0, a = -4x/dt² and
+    (dt² K + 4 dt C - 4 M) x = 0: with mu = 1/dt, the quadratic eigenproblem
+    (4 mu² M - 4 mu C - K) x = 0. It is hyperbolic (its discriminant 16 (x'Cx)² + 16 x'Mx x'Kx
+    is positive), so its eigenvalues are real and the largest is the largest of
+    p(x) = (x'Cx + sqrt((x'Cx)² + x'Mx x'Kx)) / (2 x'Mx) over all x: the critical step is
+    1/mu_max, for one DOF 2/w (sqrt(1 + 4 zeta²) - 2 zeta) (half of the undamped 2/w for an
+    overdamped mode: 1/(2 zeta w)). As a maximum over x, it can only grow when DOFs are added
+    (free teeth) and only shrink when they are held (frozen teeth). Checked against the
+    spectral radius of the step's amplification matrix on the paper and small pairs, both
+    models: the step turns unstable at 1/mu_max to 1e-9, with no other eigenvalue leaving
+    the unit circle first (`tests/solver/mbs/test_step_bound_models.py`).
+    """
+    n = M.shape[0]
+    Mi = np.linalg.inv(M)
+    # the linearisation y = mu x: mu (x, y) = (y, M^-1 (K x / 4 + C y))
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [0.25 * Mi @ K, Mi @ C]])
+    mu = float(np.linalg.eigvals(A).real.max())
+    return 1.0 / mu if mu > 0 else math.inf
 
 
 def highest_frequency(model: Model, torque: float, positions: int = 12) -> float:
