@@ -1,9 +1,11 @@
 """First-call compile taken apart: a cold `lightgear run` (the paper example, default model;
 ``--paper``: the paper model) in a child process with an empty numba cache, each compiled
 function's CPU exclusive of the callees it compiles, split into numba's type inference, numba
-IR -> LLVM IR (the CPython wrapper apart), LLVM parse + function passes, and the finalisation
-(the callees' modules linked in, module O3, machine code). Process CPU, not wall: the figures
-stand under load. The FE cache is the user's (fill it with one run first). ``--all``: every compiled function (default: the 25 dearest).
+IR -> LLVM IR (the CPython wrapper apart: 0 for a kernel compiled without it), LLVM parse +
+function passes (numba runs them inside the two before, so this column is part of theirs, not
+added to them), and the finalisation (the callees' modules linked in, module O3, machine code).
+Process CPU, not wall: the figures stand under load. The FE cache is the user's (fill it with
+one run first). ``--all``: every compiled function (default: the 25 dearest).
 """
 import os
 import subprocess
