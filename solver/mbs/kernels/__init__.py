@@ -31,8 +31,10 @@ absent ones pruned (a plain pair's search has none of it). `layout` also holds a
 the kernels' short names and the named work tuples they carry.
 
 The disk cache sits in a folder named after a hash of every kernel source,
-``$NUMBA_CACHE_DIR/kernels-<KERNELS_FINGERPRINT>`` (without ``NUMBA_CACHE_DIR``: this package's
-``__pycache__``): numba checks only the time stamp of a kernel's own file, not those of the
+``$NUMBA_CACHE_DIR/kernels-<KERNELS_FINGERPRINT>`` (without ``NUMBA_CACHE_DIR``:
+``$LIGHTGEAR_CACHE/numba``, by default ``./.lightgear-cache/numba`` beside the FE cache, the
+folder the Makefile gives, so that the kernels ``make run`` compiled are the ones a
+``lightgear run`` in the same folder loads; `cache_root`): numba checks only the time stamp of a kernel's own file, not those of the
 kernels it calls nor the `layout` constants compiled into it, so an edit of `gearmesh` would
 otherwise leave a stepping loop cached with the old contact search. Any change to a kernel file
 compiles them all afresh; folders of older versions can be deleted (``make clean``).
@@ -94,6 +96,15 @@ def _kernel_only_class():
     return _KERNEL_ONLY
 
 
+def cache_root() -> str:
+    """The folder (absolute) under which the kernels' disk cache folder lies: numba's
+    ``NUMBA_CACHE_DIR`` where set, else ``$LIGHTGEAR_CACHE/numba`` (default
+    ``./.lightgear-cache/numba``, as the FE cache, `study.inputs.cache`)."""
+    import numba
+    return os.path.abspath(numba.config.CACHE_DIR or os.path.join(os.environ.get("LIGHTGEAR_CACHE", ".lightgear-cache"),
+                                                                   "numba"))
+
+
 def njit(**options):
     """``numba.njit(**options)`` whose disk cache (with ``cache=True``) is the fingerprinted
     folder; every kernel module decorates with it. numba fixes a function's cache location when
@@ -106,7 +117,7 @@ def njit(**options):
 
     def decorate(fn):
         user = numba.config.CACHE_DIR
-        numba.config.CACHE_DIR = os.path.join(user or str(_HERE / "__pycache__"), f"kernels-{KERNELS_FINGERPRINT}")
+        numba.config.CACHE_DIR = os.path.join(cache_root(), f"kernels-{KERNELS_FINGERPRINT}")
         try:
             if not options.get("no_cpython_wrapper") or numba.config.DISABLE_JIT:
                 return numba.njit(**options)(fn)
