@@ -14,12 +14,6 @@ plain Python (``kernel.py_func``) down to its innermost callees. The stepping lo
 the GIL (``nogil=True``), so that a progress bar can follow them from another thread. Column
 indices of the arrays are in `layout`.
 
-The kernels are compiled without LLVM's loop vectorizer (``NUMBA_LOOP_VECTORIZE=0``, set here
-unless the environment sets it): the loops run over a few active teeth through index arrays,
-so the vectorized copies of them LLVM made were compiled for nothing, and without fast-math
-LLVM does not reorder a floating-point sum either way: the same results to the bit, the same
-step time, a smaller first-run compile (benchmarks/README.md).
-
 The stepping loops (`explicit`, `explicit_coupled`, `implicit`) and the static sweep (`statics`)
 all find the contacts with `gearmesh.mesh_contacts`, which reads the flanks' profile deviations
 (gear_par DEV_*, `solver.modification`), the local compliances in series with the contact
@@ -111,9 +105,7 @@ def njit(**options):
     it is decorated, so the folder is set for that moment and the user's setting restored.
     With ``no_cpython_wrapper=True`` the dispatcher guards Python calls (`python_calls`).
     numba itself is imported here, not when the package is (`layout` is plain constants)."""
-    os.environ.setdefault("NUMBA_LOOP_VECTORIZE", "0")      # (see above; child processes inherit it)
     import numba
-    numba.core.config.reload_config()     # now, not at a later compile that would undo a setting made meanwhile
 
     def decorate(fn):
         user = numba.config.CACHE_DIR

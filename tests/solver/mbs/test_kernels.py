@@ -235,25 +235,6 @@ def test_every_kernel_python_calls_keeps_its_wrapper():
     assert checked >= 15 and not bad, bad
 
 
-def test_the_kernels_compile_without_the_loop_vectorizer_unless_the_environment_says():
-    """Importing a kernel turns numba's loop vectorizer off for the compiles of the process (and
-    its children), where the environment does not set NUMBA_LOOP_VECTORIZE itself."""
-    import os
-    import subprocess
-    import sys
-    from pathlib import Path
-    root = Path(__file__).resolve().parents[3]
-    code = ("import os, numba; from solver.mbs.kernels.explicit import verlet; "
-            "print(numba.config.LOOP_VECTORIZE, os.environ['NUMBA_LOOP_VECTORIZE'])")
-    env = {k: v for k, v in os.environ.items() if k != "NUMBA_LOOP_VECTORIZE"}
-    env["PYTHONPATH"] = str(root)
-    for given, expect in ((None, "0 0"), ("1", "1 1")):
-        if given is not None:
-            env["NUMBA_LOOP_VECTORIZE"] = given
-        out = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True, check=True)
-        assert out.stdout.split() == expect.split()
-
-
 def test_without_numba_cache_dir_the_kernels_are_cached_beside_the_fe_cache(tmp_path):
     """Without NUMBA_CACHE_DIR the kernels are cached under $LIGHTGEAR_CACHE/numba (the folder
     the Makefile gives, so that what `make run` compiled a `lightgear run` loads), and the study
