@@ -86,8 +86,17 @@ def _kernel_only_class():
                 raise TypeError(f"kernel {self.py_func.__module__}.{self.py_func.__qualname__} is compiled "
                                 "without its Python wrapper (only other kernels call it): call it from a "
                                 "compiled function, or run its source inside solver.mbs.kernels.python_calls()")
+        KernelOnlyDispatcher.__qualname__ = "KernelOnlyDispatcher"     # (see __getattr__ below)
         _KERNEL_ONLY = KernelOnlyDispatcher
     return _KERNEL_ONLY
+
+
+def __getattr__(name):
+    # the dispatcher class by its module and name, as pickle (a dask task's kernels) finds it;
+    # made on first use, so that importing the package imports no numba
+    if name == "KernelOnlyDispatcher":
+        return _kernel_only_class()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def cache_root() -> str:

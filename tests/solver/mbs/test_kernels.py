@@ -254,3 +254,23 @@ def test_without_numba_cache_dir_the_kernels_are_cached_beside_the_fe_cache(tmp_
     path, folder = out.stdout.split()
     top = tmp_path / "lc" / "numba" / f"kernels-{K.KERNELS_FINGERPRINT}"
     assert Path(path).parent == top and Path(folder) == Path(path)
+
+
+def test_kernels_pickle_for_another_process():
+    """A stepping loop and a wrapper-less kernel pickle (as a dask task that holds them is sent
+    to a worker) and load in a fresh process as the same kernels."""
+    import pickle
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from solver.mbs.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.kernels.toothcoupling import set_moment
+    blob = pickle.dumps((verlet_coupled, set_moment))
+    assert pickle.loads(blob)[1] is set_moment
+    root = Path(__file__).resolve().parents[3]
+    code = ("import pickle, sys; a, b = pickle.loads(sys.stdin.buffer.read()); "
+            "print(type(a).__name__, a.py_func.__qualname__, type(b).__name__, b.py_func.__qualname__)")
+    env = {**__import__("os").environ, "PYTHONPATH": str(root)}
+    out = subprocess.run([sys.executable, "-c", code], input=blob, env=env, cwd=root, capture_output=True, check=True)
+    assert out.stdout.decode().split() == ["CPUDispatcher", "verlet_coupled", "KernelOnlyDispatcher", "set_moment"]
