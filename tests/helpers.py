@@ -136,3 +136,15 @@ def small_scene(**kw):
 # the small pair's driven gear lightened: a web of 8 mm with 4 holes
 LIGHT = {"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hole_radius": 3.0,
          "gear2.body.hole_circle_radius": 19.5}
+
+
+def compiled_call(kernel):
+    """A compiled function that calls ``kernel`` with the arguments it is given and returns what
+    it returns: a kernel that only other kernels call is compiled without its Python wrapper,
+    so a test reaches its machine code through a compiled caller, as the loops do."""
+    import numba
+
+    @numba.njit
+    def call(*args):
+        return kernel(*args)
+    return call

@@ -115,8 +115,9 @@ def _is_base(module: str) -> bool:
 
 
 def _kernels_refuse(name: str, module: str) -> bool:
-    if module == "solver.mbs.kernels" and name in ("hashlib", "os", "pathlib"):
-        return False        # the package hashes the kernel sources for its disk-cache folder
+    if module == "solver.mbs.kernels" and name in ("hashlib", "os", "pathlib", "contextlib", "threading"):
+        return False        # the package hashes the kernel sources for its disk-cache folder (and
+        #                     switches the wrapper-less kernels' Python calls per thread, `python_calls`)
     if module == "solver.mbs.kernels.layout" and name == "collections":
         return False        # the named work tuples are namedtuples, which numba passes as tuples
     return not _under(name, "numpy", "math", "numba", "solver.mbs.kernels")

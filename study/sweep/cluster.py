@@ -168,11 +168,9 @@ def kernel_cache_folder() -> Path:
     name>_<SHA-1 of its absolute path>', so another checkout's kernels are elsewhere)."""
     import hashlib
 
-    import numba
-
     from solver.mbs import kernels
     source = Path(kernels.__file__).resolve().parent
-    top = Path(numba.config.CACHE_DIR or source / "__pycache__") / f"kernels-{kernels.KERNELS_FINGERPRINT}"
+    top = Path(kernels.cache_root()) / f"kernels-{kernels.KERNELS_FINGERPRINT}"
     return top / f"{source.name}_{hashlib.sha1(str(source).encode()).hexdigest()}"
 
 

@@ -19,13 +19,13 @@ import math
 from solver.mbs.kernels import njit
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def wrap(a):
     """Angle wrapped to [-pi, pi)."""
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def flank_flank(ca_x, ca_y, rb_a, beta_a, cb_x, cb_y, rb_b, beta_b, s):
     """Penetration of flank A (gear 1) and flank B (gear 2) of sense s along their common normal.
 
@@ -81,7 +81,7 @@ def tip_corner(c_x, c_y, rb, beta, s, u_tip):
     return c_x + rb * ct - s * rb * u_tip * st, c_y + rb * st + s * rb * u_tip * ct
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def moved_center(ox, oy, r_pv, cs_axis, axis, phi):
     """Base-circle centre [m] of a tooth whose axis is at angle ``axis`` [rad] rotated by phi
     [rad] about its pivot, and (cos, sin) of axis + phi; cs_axis: (cos, sin) of axis (the
@@ -95,6 +95,6 @@ def moved_center(ox, oy, r_pv, cs_axis, axis, phi):
     return ox + r_pv * (ca - cm), oy + r_pv * (sa - sm), cm, sm
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def cross(ax, ay, bx, by):
     return ax * by - ay * bx

@@ -49,7 +49,7 @@ from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_
 from solver.mbs.kernels.toothcoupling import set_differs, set_energy, set_springs, update_set
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def rim_accelerations(q, act, nact, gp, acc, ha):
     """Arrowhead solves of both rims: fills ha[H_R1] (r1''), ha[H_TH2] (theta2'') and the
     teeth's acc. q[0], q[1]: generalised forces on the rims (contacts + body springs)."""
@@ -77,7 +77,7 @@ def rim_accelerations(q, act, nact, gp, acc, ha):
         acc[i] = (q[2 + i] - gp[g, L.I_CPL] * ar) / gp[g, L.I_P]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def body_moments(gp, th1, w1, x, v):
     """Moments [N m] of the body springs and dampers on the driver rim and the driven hub, at
     the body angles x and rates v (columns H_*), driver hub at th1 [rad], w1 [rad/s]."""
@@ -86,7 +86,7 @@ def body_moments(gp, th1, w1, x, v):
     return mb1, mb2
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def body_dissipation(p, gp, w1, v):
     """p plus the power [W] of the body dampers at the driver hub rate w1 and the body rates
     v [rad/s]."""
@@ -95,7 +95,7 @@ def body_dissipation(p, gp, w1, v):
     return p + gp[0, L.C_BODY] * d1 * d1 + gp[1, L.C_BODY] * d2 * d2
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
     """Forces and accelerations for the contacts ws.rec[:nc], the tooth rotations teeth[0] and
     the rates teeth[1] of their root dampers, the body angles hub[POS] and rates v (columns
@@ -119,7 +119,7 @@ def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
     return gp[0, L.I_HUB] * acc1 + mb1, mb1
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth):
     """(kinetic, potential) energy [J]: hubs, rims, body springs, then `mesh_energies` with
     the teeth on the rims, and the coupled set's springs through K_S instead of their own.
@@ -141,7 +141,7 @@ def coupled_energies(mdl, ws, nc, nact, cset, ns, drv, hub, teeth):
     return ke, pe
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def new_candidates(newl, incand, pairs, npair, tz2):
     """Teeth of the candidate pairs not yet flagged in incand, in pair order, into newl (and
     flag them). Returns their number."""

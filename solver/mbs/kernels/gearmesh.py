@@ -141,7 +141,7 @@ def flank_deviation(row, u):
     return _catmull_rom(row, u, row[L.DEV_U0], row[L.DEV_DU], L.DEV0, L.N_DEV)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def local_compliance(row, u):
     """Local compliance [m/N] of the gear whose gear_par row is ``row`` at roll parameter u and
     its slope d c_loc/d u [m/N]: the same Catmull-Rom curve through the CLOC grid (a continuous
@@ -150,14 +150,14 @@ def local_compliance(row, u):
     return _catmull_rom(row, u, row[L.CLOC_U0], row[L.CLOC_DU], L.CLOC0, L.N_CLOC)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _tangent_turn(dx, dy, length, kc, ddx, ddy):
     """Change of the common tangent's angle ta [rad] of two base circles whose centre offset
     (dx, dy) [m] (length [m]) changes by (ddx, ddy) [m]; kc = (rb_a + rb_b)/(L**2 sqrt(1 - c**2))."""
     return (dx * ddy - dy * ddx) / (length * length) - kc * (dx * ddx + dy * ddy) / length
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _deviation_gradient(sa, sb, s, centres, trig, ecc, gp):
     """d(da + db)/d(theta1, phi_A, theta2, phi_B) [m] of the flank deviations whose slopes are
     sa, sb [m] per unit roll at the flank-flank contact of side s; centres = (moved base-circle
@@ -186,7 +186,7 @@ def _deviation_gradient(sa, sb, s, centres, trig, ecc, gp):
             -s * (-sa * t2 + sb * (1.0 - t2)), -s * (-sa * tb + sb * (1.0 - tb)))
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp):
     """Friction columns (`layout` C_VS .. C_HB) of contact record nc with normal force f [N]
     at the point (px, py) [m] with unit normal (nx, ny); frame, vel as `_record`."""
@@ -208,7 +208,7 @@ def _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp):
     rec[nc, L.C_HB] = hb
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, friction):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
@@ -270,7 +270,7 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, fric
         _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def pair_contacts(pair, state, phi, dphi, geo, rec, nc, deviations, series, errors, friction):
     """Detailed search for the candidate pair = (gear-1 tooth k, gear-2 tooth j, side s) at
     state = (theta1, theta2 [rad], theta1', theta2' [rad/s]) with the tooth rotations phi

@@ -60,7 +60,7 @@ K_CC = 4            # damping factor (1 + alpha) gamma/(beta dt) [1/s]
 K_ALPHA = 5         # alpha [-]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def newton_arrays(ntooth, alpha, dt):
     """Work arrays ``nw`` of the HHT-alpha Newton for ntooth teeth, alpha [-], step dt [s]."""
     beta = 0.25 * (1.0 - alpha) ** 2
@@ -72,7 +72,7 @@ def newton_arrays(ntooth, alpha, dt):
                         np.zeros(m, dtype=np.int64))
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _tooth_tangent(i, mdl, teeth, coef):
     """(diagonal entry, coupling to theta2) of tooth i in the Newton matrix."""
     gp, kphi = mdl[0], mdl[3]
@@ -82,7 +82,7 @@ def _tooth_tangent(i, mdl, teeth, coef):
     return d, (coef[K_CM] * gp[1, L.I_CPL] if g == 1 else 0.0)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _contact_rows(mdl, rec, nc, loc, A, coef):
     """Add the loaded contacts' tangents w G G^T (over theta2 and the teeth at loc) to A."""
     lp = mdl[2]
@@ -119,7 +119,7 @@ def _contact_rows(mdl, rec, nc, loc, A, coef):
                     A[idx[x], idx[y]] += hv[x] * (rf * gv[y] + cf * hv[y])
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def newton_correction(mdl, rec, nc, teeth, act, nact, nw):
     """Solve J dx = r for J = cm*M + ck*K + cc*C over (theta2, active teeth); r and dx of nw
     indexed 0: theta2, a + 1: tooth act[a].
@@ -170,7 +170,7 @@ def newton_correction(mdl, rec, nc, teeth, act, nact, nw):
         loc[cl[u]] = 0
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def driver_torque(q, act, nact, gp, acc, a1):
     """Torque the driver applies [N m] at driver acceleration a1 [rad/s²]:
     I_tot1*a1 - Q_theta1 + I_cpl1 * (sum of the gear-1 tooth accelerations)."""
@@ -182,7 +182,7 @@ def driver_torque(q, act, nact, gp, acc, a1):
     return react
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def driver_jump(react, act, nact, gp, acc, da):
     """Right limits where the driver acceleration jumps by da [rad/s²] (end of the speed ramp):
     the gear-1 tooth accelerations (their inertial coupling) and the driver torque [N m]."""
@@ -196,7 +196,7 @@ def driver_jump(react, act, nact, gp, acc, da):
     return react
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def hht_residual(mdl, q, nw, hub, acc, act, nact, a1m):
     """r = -(M a - (1+alpha) Q_{n+1} + alpha Q_n) into nw's r, over (theta2, active teeth);
     a1m [rad/s²]: the driver acceleration over the step (inertia on the gear-1 teeth)."""
@@ -218,7 +218,7 @@ def hht_residual(mdl, q, nw, hub, acc, act, nact, a1m):
         r[a + 1] = ri
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def newton_iterations(mdl, ctl, ws, nw, hub, teeth, nact, drv):
     """One HHT-alpha step: Newmark predictors, then Newton from a_{n+1} = a_n until the last
     correction moves no flank point by more than par[NEWTON_TOL] [m] and the active set stays;

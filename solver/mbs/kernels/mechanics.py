@@ -19,13 +19,13 @@ def driver_motion(t, speed, ramp):
     return speed * (t - 0.5 * ramp), speed, 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def driver_acc_left(t, speed, ramp):
     """Left limit of the driver acceleration at t [rad/s²]."""
     return speed / ramp if t <= ramp else 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def driver_speed(t, speed, ramp):
     """Driver speed [rad/s] of the ramp (continuous, with a kink at the ramp end)."""
     return speed * t / ramp if t < ramp else speed
@@ -50,7 +50,7 @@ def load_torque(t, torque, ramp, table):
     return table[n - 1, 1]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def drive(t, par, table):
     """The loads at t [s] of the controls par (`layout` SPEED, SPEED_RAMP, TORQUE, TORQUE_RAMP)
     and the load profile ``table`` (`load_torque`): driver angle [rad], speed [rad/s] and
@@ -59,7 +59,7 @@ def drive(t, par, table):
     return th1, w1, acc1, load_torque(t, par[L.TORQUE], par[L.TORQUE_RAMP], table)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def kick_gear_par(gp, dt, imex):
     """The gear_par of the Verlet kicks' arrowhead solve: a copy of gp, with the tooth inertia
     I_P + dt/4*c_phi [kg m²] where the tooth-root dampers are taken implicitly (imex; step dt
@@ -103,7 +103,7 @@ def arrowhead_accelerations(q, act, nact, gp, acc):
     return a2, s1, r1
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
     """(kinetic, potential) energy [J]: ``ke`` and ``pe`` of the bodies plus the active teeth,
     their springs and the contacts. w1, w2 [rad/s]: rates of the bodies that carry the teeth

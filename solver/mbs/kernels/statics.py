@@ -69,7 +69,7 @@ def static_work(ntooth, coupled=False):
                       np.zeros((ntooth, 2 * ntooth)) if coupled else None)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _unknown_set(sw, npair, gp, phi):
     """Number the teeth of the npair candidate pairs 1.. in sw.pos (0 is theta2; -1: not an
     unknown) and list them in sw.lst; the other teeth are unloaded (phi = 0). Returns their
@@ -91,7 +91,7 @@ def _unknown_set(sw, npair, gp, phi):
     return nt
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _unknown_forces(mdl, ks, sw, nc, nt, phi, torque):
     """Residual sw.r [N m] on theta2 and the nt unknown teeth from the contacts sw.rec[:nc]
     under the resisting torque [N m]; returns its max-norm. A coupled model's tooth springs
@@ -110,7 +110,7 @@ def _unknown_forces(mdl, ks, sw, nc, nt, phi, torque):
     return rn
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _tangent(mdl, ks, sw, nc, nt, phi):
     """Newton tangent [N m/rad] over theta2 and the nt unknown teeth: the contacts sw.rec[:nc]
     plus the tooth springs (the set stiffness ks of a coupled model, else each tooth's own
@@ -172,7 +172,7 @@ def newton_system(mdl, theta1, theta2, phi, torque, sw):
     return _tangent(mdl, None, sw, nc, nt, ph), sw.r[:nt + 1].copy(), sw.lst[:nt].copy()
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _open_gap(gp, pp):
     """How far an open mesh may be from its first touch beyond the rigid gap [m]: both flanks'
     largest deviations, the pitch errors and eccentricities (a loop, not .max(): numpy's max
@@ -189,7 +189,7 @@ def _open_gap(gp, pp):
     return open_gap
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _loaded(rec, nc):
     """Number of the contacts rec[:nc] that carry a force."""
     n = 0
@@ -199,7 +199,7 @@ def _loaded(rec, nc):
     return n
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _closing_angle(theta1, torque, open_steps, open_gap, gp, pp, lp):
     """Driven angle [rad] at driver angle theta1 [rad] of a mesh not yet in contact: the rigid
     gap closed plus the contact-only penetration under the torque [N m], and, as modified
@@ -212,7 +212,7 @@ def _closing_angle(theta1, torque, open_steps, open_gap, gp, pp, lp):
     return ((1.0 if torque >= 0.0 else -1.0) * (pp[L.JN_HALF] + dpen) - rb1 * theta1) / rb2
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _unknown_rotations(phi, lst, nt):
     """A copy of the rotations [rad] of the nt unknown teeth lst[:nt]."""
     ph = np.empty(nt)
@@ -221,7 +221,7 @@ def _unknown_rotations(phi, lst, nt):
     return ph
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _line_step(theta2, ph, dx, step, phi, lst, nt):
     """Move the unknowns from (theta2 [rad], the rotations ph [rad] of the teeth lst[:nt]) by
     step times the Newton correction dx (theta2 first): the teeth in phi; returns the new
@@ -231,7 +231,7 @@ def _line_step(theta2, ph, dx, step, phi, lst, nt):
     return theta2 + step * dx[0]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _store(out, force1, a, rec, nc, row):
     """Results at the a-th angle: row = (TE [m], theta2 [rad], signed Newton iterations) and,
     from the contacts rec[:nc], the loaded ones, the force on each gear-1 tooth [N] and the

@@ -42,7 +42,7 @@ def work_arrays(ntooth, ctooth=None):
     return L.StepWork(rec, pairs, q, vpred, tset, book, cset)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def initial_set(tset, teeth, pairs, npair, tz2):
     """Active set at t = 0: the teeth already moving and those of the npair candidate pairs,
     in tooth order. Returns its size."""
@@ -64,7 +64,7 @@ def initial_set(tset, teeth, pairs, npair, tz2):
     return nact
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def activate(tset, nact, pairs, npair, tz2):
     """Flag the teeth of the candidate pairs and append those not yet active to the set
     (gear-2 teeth offset by tz2). Returns the new size; the new ones are act[old size:]."""
@@ -79,7 +79,7 @@ def activate(tset, nact, pairs, npair, tz2):
     return nact
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     """The end of a step: guards, energy bookkeeping, and the active set.
 
@@ -128,7 +128,7 @@ def end_step(ws, teeth, nc, npair, nact, tz2, powers, par, status):
     return status, nact
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def record_contacts(out, o, rec, nc):
     """The loaded contacts of rec[:nc] into the slots of record o beyond the N_OUT columns
     (`layout` OC_*; none when ``out`` has no more columns): teeth, force [N], and moment on
@@ -151,7 +151,7 @@ def record_contacts(out, o, rec, nc):
         out[o, base + L.OC_MOMENT] = 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def record_output(out, o, row, book, rec, nc, finite, par, status):
     """Write output record o (`layout` O_* columns) and check the state; returns the status.
 

@@ -23,7 +23,7 @@ from solver.mbs.kernels import njit
 from solver.mbs.kernels.layout import MAX_CONTACTS, CoupledSet
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def set_stiffness(ctooth, lst, n, ks):
     """ks[:n, :n] = inverse of ctooth[lst[:n], lst[:n]] (Gauss-Jordan; C is SPD, no pivoting
     needed). Uses ks[:n, n:2n] as scratch, so ks needs at least 2n columns."""
@@ -46,7 +46,7 @@ def set_stiffness(ctooth, lst, n, ks):
             ks[a, b] = ks[a, n + b]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def set_moment(ks, lst, n, phi, a):
     """Elastic moment [N m] on the a-th tooth of the set: (K_S phi_S)[a] (its spring pushes
     back with minus this)."""
@@ -56,7 +56,7 @@ def set_moment(ks, lst, n, phi, a):
     return s
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def set_energy(ks, lst, n, phi):
     """Strain energy [J] of the set's springs: phi_S^T K_S phi_S / 2."""
     e = 0.0
@@ -75,7 +75,7 @@ def coupled_set(ctooth):
                       np.zeros(ntooth, dtype=np.int64), np.zeros(ntooth, dtype=np.int64), np.zeros(ms), np.zeros(ms))
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def set_differs(cset, ns, nn):
     """Whether newl[:nn] differs from the current set (ns teeth)."""
     newl, inset = cset.newl, cset.inset
@@ -87,7 +87,7 @@ def set_differs(cset, ns, nn):
     return False
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def update_set(cset, ns, nn, phi, dphi, vpred):
     """Make newl[:nn] the coupled set (``inset`` flags the old members, ns of them): teeth that
     join take their neighbours' share of rotation phi [rad] and of the rates dphi, vpred
@@ -134,7 +134,7 @@ def update_set(cset, ns, nn, phi, dphi, vpred):
     return ns
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def set_springs(cset, ns, kphi, phi, q):
     """Replace the own elastic spring torque of the set's teeth in q[2 + i] by the coupled one."""
     ks, slst = cset.ks, cset.lst

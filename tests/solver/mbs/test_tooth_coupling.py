@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import assert_energy_closes_at_second_order, slow_transient_against_statics, solid_scene
+from helpers import assert_energy_closes_at_second_order, compiled_call, slow_transient_against_statics, solid_scene
 
 from solver.identify.coupling import InfluenceSamples, tooth_compliance_fit
 from solver.identify.pivot import lever
@@ -24,8 +24,11 @@ def spd(n, scale=1e-3):
 
 @pytest.mark.parametrize("jit", [True, False])
 def test_set_stiffness_inverts_the_set_block_and_gives_moments_and_energy(jit):
-    f_inv, f_mom, f_en = ((set_stiffness, set_moment, set_energy) if jit else
-                          (set_stiffness.py_func, set_moment.py_func, set_energy.py_func))
+    """The compiled kernels (through a compiled caller: they have no Python wrapper) and their
+    sources run as plain Python (set_energy's call of set_moment too)."""
+    from solver.mbs.kernels import python_calls
+    f_inv, f_mom, f_en = ((compiled_call(set_stiffness), compiled_call(set_moment), compiled_call(set_energy)) if jit
+                          else (set_stiffness.py_func, set_moment.py_func, set_energy.py_func))
     C = spd(9)
     lst = np.array([7, 2, 4, 3, 0, 0, 0, 0, 0])
     n = 4
@@ -37,7 +40,8 @@ def test_set_stiffness_inverts_the_set_block_and_gives_moments_and_energy(jit):
     phi = RNG.normal(size=9) * 1e-4
     m = np.array([f_mom(ks, lst, n, phi, a) for a in range(n)])
     assert m == pytest.approx(K @ phi[S], rel=1e-10)
-    assert f_en(ks, lst, n, phi) == pytest.approx(0.5 * phi[S] @ K @ phi[S], rel=1e-10)
+    with python_calls():
+        assert f_en(ks, lst, n, phi) == pytest.approx(0.5 * phi[S] @ K @ phi[S], rel=1e-10)
 
 
 def with_compliance(model, c1, c2, k_body=(math.inf, math.inf), ratio=0.02):
@@ -195,6 +199,7 @@ def test_coupled_kernel_matches_its_plain_python_run(imex):
     """The compiled coupled loop against the same loop run as plain Python, set changes
     included (300 steps through a change of the candidate teeth), with the tooth-root dampers
     explicit and implicit."""
+    from solver.mbs.kernels import python_calls
     from solver.mbs.kernels.explicit_coupled import verlet_coupled
     from solver.mbs.kernels.gearmesh import contact_parts
     from solver.mbs.kernels.stepping import work_arrays
@@ -216,7 +221,8 @@ def test_coupled_kernel_matches_its_plain_python_run(imex):
         hub[L.RATE, L.H_TH2] = hub[L.RATE, L.H_H2] = -300.0
         teeth = np.zeros((3, m.n_teeth))
         mdl = (m.gear_par, m.pair_par, m.law_par, m.k_phi, m.tooth_compliance, contact_parts(m.gear_par, m.pair_par, m.law_par))
-        res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out, work_arrays(m.n_teeth, m.tooth_compliance))
+        with python_calls():     # the source run as plain Python down to its wrapper-less callees
+            res = f(mdl, (par, ipar, np.zeros((0, 2))), hub, teeth, out, work_arrays(m.n_teeth, m.tooth_compliance))
         runs.append((res, out, teeth[L.POS]))
     (r1, o1, p1), (r2, o2, p2) = runs
     assert r1 == r2 and r1[0] == 0
@@ -229,8 +235,15 @@ def test_set_changes_keep_the_spring_moments(jit):
     """A tooth that joins the coupled set unloaded (from rest, as from the frozen set) takes
     the rotation its neighbours give it and changes no moment; a tooth that leaves keeps its
     moment on its own spring."""
+    from solver.mbs.kernels import python_calls
     from solver.mbs.kernels.toothcoupling import coupled_set, update_set
-    f = update_set if jit else update_set.py_func
+    compiled = compiled_call(update_set)
+
+    def f(*args):      # compiled, or its source as plain Python with its callees'
+        if jit:
+            return compiled(*args)
+        with python_calls():
+            return update_set.py_func(*args)
     z = 9
     C = ring(z, 800.0, (0.15, 0.05))
     k_own = 1.0 / np.diag(C)
@@ -245,7 +258,7 @@ def test_set_changes_keep_the_spring_moments(jit):
         return len(teeth)
 
     def moments(ns):
-        return {int(slst[a]): set_moment(ks, slst, ns, phi, a) for a in range(ns)}
+        return {int(slst[a]): set_moment.py_func(ks, slst, ns, phi, a) for a in range(ns)}
 
     ns = f(cset, 0, joining([3, 4, 5]), phi, dphi, vpred)
     before = moments(ns)
