@@ -28,6 +28,11 @@ DECK_S = 200.0
 # (within 1.4 x of both), growing as 1/flank_size like the time.
 DECK_BYTES_PER_NODE = 3.7e4
 DECK_NODES = 1.0e5
+# The tip edge radius [mm] at which the LTCA's tip-corner contacts (`lightgear reference
+# --tip-edge-radius`) read like the peer's sharp corners meshed at 0.1 mm on the flanks: on the
+# solid and the paper pair at 50 and 100 N·m every single-contact position within 0.4 %
+# (docs/models.md). The peer's corner is sharp, so this is a property of its mesh, not of a gear.
+PEER_TIP_EDGE_RADIUS_MM = 0.035
 
 
 def peer_estimate(n_decks: int, settings: CalculixSettings, module: float):
