@@ -13,7 +13,15 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.peers.calculix import ATTEMPTS, CalculixSettings, PeerGear, deck_cpu_limit, default_settings, ste_sweep
+from solver.peers.calculix import (
+    ATTEMPTS,
+    CalculixSettings,
+    PeerGear,
+    deck_cpu_limit,
+    deck_thickness_scale,
+    default_settings,
+    ste_sweep,
+)
 from study.scene import Scene, SceneError
 from study.scene_model import geometry_model
 
@@ -117,6 +125,7 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
              "flank_mesh_size_mm": s.sizes.flank * units.MM_PER_M, "fillet_mesh_size_mm": s.sizes.fillet * units.MM_PER_M,
              "body_mesh_size_mm": s.sizes.body * units.MM_PER_M,
              "contact_stiffness_MPa_per_mm": s.contact_stiffness / units.MPA * units.MM,
+             "deck_thickness_scale": deck_thickness_scale(max(scene.gear1.face_width, scene.gear2.face_width) * units.MM, s.sizes.flank),
              "fine_teeth_each_side": s.fine_teeth, "contact_teeth_each_side": s.contact_teeth,
              "deck_cpu_limit_s": deck_cpu_limit(res.meshes, s),
              "deck_attempts": "; ".join(f"{'soft start (contact stiffness x' + format(soft, 'g') + ', then stiffened)' if soft else 'stiff contact'}"
