@@ -55,13 +55,14 @@ def case_scene(name: str, torque: float):
     return study.load_scene(base).replace(**{**over, "quasi_static.torque": torque})
 
 
-def peer(name: str, torque: float, angles_deg, flank_size: float | None, log) -> tuple[np.ndarray, np.ndarray]:
-    """(angles [deg], elastic STE [um]) of the peer, from its archive when it is there."""
+def peer(name: str, torque: float, angles_deg, flank_size: float | None, log, thin: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(angles [deg], elastic STE [um]) of the peer, from its archive when it is there; ``thin``:
+    decks as thin as the flank elements (plane stress, a separate archive)."""
     import xarray as xr
 
     import study
     from study.verify.calculix_reference import calculix_dataset, settings_for
-    tag = f"{name}_{torque:g}Nm_{'default' if flank_size is None else f'{flank_size:g}mm'}"
+    tag = f"{name}_{torque:g}Nm_{'default' if flank_size is None else f'{flank_size:g}mm'}{'_thin' if thin else ''}"
     path = OUT / "calculix" / f"{tag}.nc"
     done = {}
     if path.exists():
@@ -73,7 +74,7 @@ def peer(name: str, torque: float, angles_deg, flank_size: float | None, log) ->
         # each deck starts from the default model's approach: fewer Newton iterations, same result
         from study.verify.model_validation import model_ste
         te, off = model_ste(scene, "compliance", np.radians(todo))
-        ds = calculix_dataset(scene, np.radians(todo), settings_for(scene, flank_size), progress=True, starts=te - off)
+        ds = calculix_dataset(scene, np.radians(todo), settings_for(scene, flank_size, thin_decks=thin), progress=True, starts=te - off)
         for a, s in zip(ds["angle"].values, ds["ste"].values - ds.attrs["backlash_offset_um"]):
             done[round(float(a), 6)] = float(s)
         merged = ds
@@ -117,6 +118,7 @@ def main(argv=None) -> int:
     p.add_argument("--torques", default="50", help="N·m, comma-separated (the table: 25,50,100)")
     p.add_argument("--angles", default=",".join(f"{a:g}" for a in DEFAULT_ANGLES), help="driver angles [deg]")
     p.add_argument("--flank-size", type=float, default=None, metavar="MM", help="peer mesh at the flanks (default module/30)")
+    p.add_argument("--thin-decks", action="store_true", help="peer decks as thin as their flank elements (plane stress)")
     p.add_argument("--quick", action="store_true", help="the solid pair at 50 N·m, 0 and 4 deg, 0.1 mm at the flanks")
     args = p.parse_args(argv)
     if args.quick:
@@ -134,7 +136,7 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     for c in cases:
         for t in torques:
-            a, ste_peer = peer(c, t, angles, args.flank_size, log)
+            a, ste_peer = peer(c, t, angles, args.flank_size, log, args.thin_decks)
             ms = models(c, t, a)
             row = {"case": c, "torque_Nm": t, "angles": len(a), "peer_mean_um": ste_peer.mean(), "peer_p2p_um": np.ptp(ste_peer)}
             for m, ste in ms.items():

@@ -86,13 +86,13 @@ def fit_contact(scene: Scene, depth_fraction: float = 0.5) -> ContactFit:
 
 def reference(scene: Scene, step: float | None = None, max_time: float | None = None, progress: bool = False,
               solver: str = "ltca", flank_size: float | None = None, contact_stiffness: float | None = None,
-              tip_edge_radius: float | None = None):
+              tip_edge_radius: float | None = None, thin_decks: bool = False):
     """FE reference STE -> xarray.Dataset (``ste`` [um] over ``angle`` [degree]). ``solver``:
     "ltca" (loaded-tooth-contact analysis with FE influence coefficients of both bodies; with
     ``tip_edge_radius`` [mm] its tip corners meet the mating flanks rounded to it, see
     `study.verify.fe_reference.tip_edge`) or "calculix" (the independent FE contact peer,
-    `study.verify.calculix_reference`, with ``flank_size`` [mm] and ``contact_stiffness``
-    [MPa/mm]); ``max_time`` [s]: refuse a run estimated to take longer (BudgetError, before any
+    `study.verify.calculix_reference`, with ``flank_size`` [mm], ``contact_stiffness``
+    [MPa/mm] and ``thin_decks``: decks as thin as the flank elements, plane stress); ``max_time`` [s]: refuse a run estimated to take longer (BudgetError, before any
     work)."""
     from study.scene_model import static_angles
     from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, check_reference_memory, reference_cost, reference_dataset
@@ -115,7 +115,7 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
     angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
     if solver == "calculix":
         from study.verify.calculix_reference import calculix_dataset, peer_estimate, settings_for
-        settings = settings_for(scene, flank_size, contact_stiffness)
+        settings = settings_for(scene, flank_size, contact_stiffness, thin_decks)
         est = peer_estimate(angles.size, settings, scene.gear1.module * 1e-3)
         estimate.check_time(est, max_time)
         line = check_reference_memory(scene, est, "--flank-size", "a CalculiX deck needs about {need} (flanks at "

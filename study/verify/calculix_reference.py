@@ -18,7 +18,6 @@ from solver.peers.calculix import (
     CalculixSettings,
     PeerGear,
     deck_cpu_limit,
-    deck_thickness_scale,
     default_settings,
     ste_sweep,
 )
@@ -66,9 +65,11 @@ def peer_gears(scene: Scene) -> tuple:
     return tuple(out), model
 
 
-def settings_for(scene: Scene, flank_size_mm: float | None = None, contact_stiffness: float | None = None) -> CalculixSettings:
+def settings_for(scene: Scene, flank_size_mm: float | None = None, contact_stiffness: float | None = None,
+                 thin_decks: bool = False) -> CalculixSettings:
     """Peer settings of a scene: `solver.peers.calculix.default_settings` from gear 1's module, with
-    ``flank_size_mm`` [mm] the element size at the flanks and ``contact_stiffness`` [MPa/mm]."""
+    ``flank_size_mm`` [mm] the element size at the flanks, ``contact_stiffness`` [MPa/mm] and
+    ``thin_decks`` (`solver.peers.calculix.deck_thickness_scale`: plane stress)."""
     import dataclasses
     m = scene.gear1.module * units.MM
     if flank_size_mm is not None and not (0 < flank_size_mm <= scene.gear1.module / 2):
@@ -78,7 +79,7 @@ def settings_for(scene: Scene, flank_size_mm: float | None = None, contact_stiff
         if not contact_stiffness > 0:
             raise SceneError("--contact-stiffness", f"must be positive, got {contact_stiffness} MPa/mm")
         s = dataclasses.replace(s, contact_stiffness=contact_stiffness * units.MPA * units.MM_PER_M)
-    return s
+    return dataclasses.replace(s, thin_decks=bool(thin_decks))
 
 
 def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | None = None, progress: bool = False,
@@ -125,7 +126,7 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
              "flank_mesh_size_mm": s.sizes.flank * units.MM_PER_M, "fillet_mesh_size_mm": s.sizes.fillet * units.MM_PER_M,
              "body_mesh_size_mm": s.sizes.body * units.MM_PER_M,
              "contact_stiffness_MPa_per_mm": s.contact_stiffness / units.MPA * units.MM,
-             "deck_thickness_scale": deck_thickness_scale(max(scene.gear1.face_width, scene.gear2.face_width) * units.MM, s.sizes.flank),
+             "deck_thickness_scale": s.deck_scale(max(scene.gear1.face_width, scene.gear2.face_width) * units.MM),
              "fine_teeth_each_side": s.fine_teeth, "contact_teeth_each_side": s.contact_teeth,
              "deck_cpu_limit_s": deck_cpu_limit(res.meshes, s),
              "deck_attempts": "; ".join(f"{'soft start (contact stiffness x' + format(soft, 'g') + ', then stiffened)' if soft else 'stiff contact'}"

@@ -70,6 +70,13 @@ class CalculixSettings:
     contact_teeth: int = 2       # teeth each side whose drive flanks and tips are contact faces
     both_ways: bool = True       # a second contact pair, gear 1 the slave (`deck.write_deck`)
     deck_cpu_s: float | None = None  # CPU seconds a deck may use (None: `deck_cpu_limit`'s default)
+    thin_decks: bool = False     # decks as thin as the flank elements (`deck_thickness_scale`): plane stress
+
+    def deck_scale(self, face_width: float) -> float:
+        """Factor [1] on every thickness and load of the decks of a pair whose widest face is
+        ``face_width`` [m]: `deck_thickness_scale` with ``thin_decks``, else 1 (the full face
+        width, 2-6 % stiffer than plane stress)."""
+        return deck_thickness_scale(face_width, self.sizes.flank) if self.thin_decks else 1.0
 
 
 def default_settings(module: float, flank_size: float | None = None) -> CalculixSettings:
@@ -172,7 +179,7 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
                 why.append("no CPU time left for the next attempt")
                 break
             s = frac * start
-            thin = deck_thickness_scale(max(g1.spec.face_width, g2.spec.face_width), settings.sizes.flank)
+            thin = settings.deck_scale(max(g1.spec.face_width, g2.spec.face_width))
             placed = (GearPlacement(meshes[0], thin * g1.spec.face_width, thin * gears[0].body.web_thickness, (0.0, 0.0), th1),
                       GearPlacement(meshes[1], thin * g2.spec.face_width, thin * gears[1].body.web_thickness, (pair.center_distance, 0.0),
                                     th2 + s / rb2 + math.pi + math.pi / g2.teeth))

@@ -1,6 +1,7 @@
 """The CalculiX peer's plane stress: a deck as thick as the face width is stiffer than plane
-stress; one written as thin as its flank elements (`solver.peers.calculix.deck_thickness_scale`)
-reads the plane-stress answer of the project's own FE on the same mesh (slow, needs ccx)."""
+stress; one written as thin as its flank elements (`solver.peers.calculix.deck_thickness_scale`,
+``--thin-decks``) reads the plane-stress answer of the project's own FE on the same mesh (slow,
+needs ccx)."""
 import math
 import os
 import re
@@ -19,9 +20,22 @@ H_LOAD = 0.1e-3                    # m: element size at the load (the peer's fla
 
 
 def test_deck_thickness_scale():
-    """The thickest section goes down to the flank element size, never up."""
+    """The thickest section goes down to the flank element size, never up; the settings take it
+    with thin decks only, and the option is the peer's alone."""
+    import dataclasses
+
+    from solver.peers.calculix import default_settings
     assert deck_thickness_scale(17e-3, 0.1e-3) == pytest.approx(0.1 / 17)
     assert deck_thickness_scale(0.05e-3, 0.1e-3) == 1.0
+    s = default_settings(1.5e-3, 0.1e-3)
+    assert s.deck_scale(FACE) == 1.0
+    assert dataclasses.replace(s, thin_decks=True).deck_scale(FACE) == pytest.approx(0.1 / 17)
+
+
+def test_thin_decks_need_the_peer(capsys, tmp_path):
+    from study.cli import main
+    code = main(["reference", "small_pair", "--thin-decks", "-o", str(tmp_path / "r.nc")])
+    assert code == 2 and "--thin-decks" in capsys.readouterr().err
 
 
 def _disc_mesh():
