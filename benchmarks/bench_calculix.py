@@ -1,5 +1,7 @@
 """Validation table against the independent FE contact peer (CalculiX): the default (compliance)
-model, the paper model and the project's own reference (LTCA) against the peer's elastic STE.
+model, the paper model and the project's own reference (LTCA, with its tip corners under the
+flanks' law and, 'fe-reference-edge', rounded to the peer's equivalent edge radius) against the
+peer's elastic STE.
 
 Cases (gear 2's body; gear 1 as the scene gives it):
   solid      study/scenes/paper_solid.toml
@@ -41,7 +43,7 @@ CASES = {
     "thin_rim": ("paper", {"gear2.body.rim_height": 2.5, "gear2.body.web_height": 23.25 + 6.075 - 2.5}),
     "relief": ("paper_relief", {}),
 }
-MODELS = ("compliance", "paper", "fe-reference")
+MODELS = ("compliance", "paper", "fe-reference", "fe-reference-edge")
 # one mesh period of the 67-tooth driver, the single-pair peak (~4.0 deg) and the double-pair
 # minimum (~1.3 deg) included
 DEFAULT_ANGLES = (0.0, 0.67, 1.34, 2.01, 2.69, 3.36, 3.8, 4.0, 4.1, 4.7)
@@ -53,13 +55,14 @@ def case_scene(name: str, torque: float):
     return study.load_scene(base).replace(**{**over, "quasi_static.torque": torque})
 
 
-def peer(name: str, torque: float, angles_deg, flank_size: float | None, log) -> tuple[np.ndarray, np.ndarray]:
-    """(angles [deg], elastic STE [um]) of the peer, from its archive when it is there."""
+def peer(name: str, torque: float, angles_deg, flank_size: float | None, log, thin: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(angles [deg], elastic STE [um]) of the peer, from its archive when it is there; ``thin``:
+    decks as thin as the flank elements (plane stress, a separate archive)."""
     import xarray as xr
 
     import study
     from study.verify.calculix_reference import calculix_dataset, settings_for
-    tag = f"{name}_{torque:g}Nm_{'default' if flank_size is None else f'{flank_size:g}mm'}"
+    tag = f"{name}_{torque:g}Nm_{'default' if flank_size is None else f'{flank_size:g}mm'}{'_thin' if thin else ''}"
     path = OUT / "calculix" / f"{tag}.nc"
     done = {}
     if path.exists():
@@ -71,7 +74,7 @@ def peer(name: str, torque: float, angles_deg, flank_size: float | None, log) ->
         # each deck starts from the default model's approach: fewer Newton iterations, same result
         from study.verify.model_validation import model_ste
         te, off = model_ste(scene, "compliance", np.radians(todo))
-        ds = calculix_dataset(scene, np.radians(todo), settings_for(scene, flank_size), progress=True, starts=te - off)
+        ds = calculix_dataset(scene, np.radians(todo), settings_for(scene, flank_size, thin_decks=thin), progress=True, starts=te - off)
         for a, s in zip(ds["angle"].values, ds["ste"].values - ds.attrs["backlash_offset_um"]):
             done[round(float(a), 6)] = float(s)
         merged = ds
@@ -96,7 +99,15 @@ def models(name: str, torque: float, angles_deg) -> dict:
     scene = case_scene(name, torque)
     out = {}
     for m in MODELS:
-        te, off = model_ste(scene, m, np.radians(angles_deg))
+        if m == "fe-reference-edge":
+            # the LTCA with its tip corners rounded to the radius at which they read like the
+            # peer's sharp corners (study.verify.calculix_reference.PEER_TIP_EDGE_RADIUS_MM)
+            from study.verify.calculix_reference import PEER_TIP_EDGE_RADIUS_MM
+            from study.verify.fe_reference import reference
+            res, _, _ = reference(scene, np.radians(angles_deg), tip_edge_radius=PEER_TIP_EDGE_RADIUS_MM * units.MM)
+            te, off = res.te, res.backlash_offset
+        else:
+            te, off = model_ste(scene, m, np.radians(angles_deg))
         out[m] = (te - off) * units.UM_PER_M
     return out
 
@@ -107,6 +118,7 @@ def main(argv=None) -> int:
     p.add_argument("--torques", default="50", help="N·m, comma-separated (the table: 25,50,100)")
     p.add_argument("--angles", default=",".join(f"{a:g}" for a in DEFAULT_ANGLES), help="driver angles [deg]")
     p.add_argument("--flank-size", type=float, default=None, metavar="MM", help="peer mesh at the flanks (default module/30)")
+    p.add_argument("--thin-decks", action="store_true", help="peer decks as thin as their flank elements (plane stress)")
     p.add_argument("--quick", action="store_true", help="the solid pair at 50 N·m, 0 and 4 deg, 0.1 mm at the flanks")
     args = p.parse_args(argv)
     if args.quick:
@@ -124,7 +136,7 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     for c in cases:
         for t in torques:
-            a, ste_peer = peer(c, t, angles, args.flank_size, log)
+            a, ste_peer = peer(c, t, angles, args.flank_size, log, args.thin_decks)
             ms = models(c, t, a)
             row = {"case": c, "torque_Nm": t, "angles": len(a), "peer_mean_um": ste_peer.mean(), "peer_p2p_um": np.ptp(ste_peer)}
             for m, ste in ms.items():

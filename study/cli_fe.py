@@ -143,6 +143,13 @@ def reference_arguments(p) -> None:
                    help="calculix: element size at the flanks around the mesh [mm] (default: module/30)")
     p.add_argument("--contact-stiffness", type=float, default=None, metavar="MPA_PER_MM",
                    help="calculix: slope of the penalty contact's pressure-overclosure law [MPa/mm] (default 2e7)")
+    p.add_argument("--thin-decks", action="store_true",
+                   help="calculix: write each deck as thin as its flank elements, loads scaled alike (plane stress; "
+                        "a deck at the full face width reads 2-6 %% stiffer, docs/models.md)")
+    p.add_argument("--tip-edge-radius", type=float, default=None, metavar="MM",
+                   help="ltca: the tip corners meet the mating flanks rounded to this radius [mm] (their contact then "
+                        "carries that narrower Hertz patch's compliance; default: the flanks' law; 0.035 reads as the "
+                        "CalculiX peer's sharp corner at its 0.1 mm flank mesh)")
     max_time_argument(p)
 
 
@@ -150,9 +157,12 @@ def reference_command(args) -> int:
     import numpy as np
 
     import study
-    if args.solver == "ltca" and (args.flank_size is not None or args.contact_stiffness is not None):
-        raise UsageError("--flank-size" if args.flank_size is not None else "--contact-stiffness",
+    if args.solver == "ltca" and (args.flank_size is not None or args.contact_stiffness is not None or args.thin_decks):
+        raise UsageError("--flank-size" if args.flank_size is not None else
+                         "--contact-stiffness" if args.contact_stiffness is not None else "--thin-decks",
                          "applies to --solver calculix only")
+    if args.solver == "calculix" and args.tip_edge_radius is not None:
+        raise UsageError("--tip-edge-radius", "applies to --solver ltca only (the CalculiX peer meshes the sharp corner)")
     if args.solver == "calculix":
         from solver.peers.calculix import CalculixMissing, ccx_path
         try:
@@ -166,7 +176,8 @@ def reference_command(args) -> int:
     from solver.peers.calculix import CalculixFailed
     try:
         ds = study.reference(scene, args.step, max_time=checked_max_time(args), progress=True, solver=args.solver,
-                             flank_size=args.flank_size, contact_stiffness=args.contact_stiffness)
+                             flank_size=args.flank_size, contact_stiffness=args.contact_stiffness,
+                             tip_edge_radius=args.tip_edge_radius, thin_decks=args.thin_decks)
     except CalculixFailed as e:
         print(f"lightgear reference: the CalculiX peer stopped, no archive written: {e}", file=sys.stderr)
         return 3

@@ -85,12 +85,15 @@ def fit_contact(scene: Scene, depth_fraction: float = 0.5) -> ContactFit:
 
 
 def reference(scene: Scene, step: float | None = None, max_time: float | None = None, progress: bool = False,
-              solver: str = "ltca", flank_size: float | None = None, contact_stiffness: float | None = None):
+              solver: str = "ltca", flank_size: float | None = None, contact_stiffness: float | None = None,
+              tip_edge_radius: float | None = None, thin_decks: bool = False):
     """FE reference STE -> xarray.Dataset (``ste`` [um] over ``angle`` [degree]). ``solver``:
-    "ltca" (loaded-tooth-contact analysis with FE influence coefficients of both bodies) or
-    "calculix" (the independent FE contact peer, `study.verify.calculix_reference`, with
-    ``flank_size`` [mm] and ``contact_stiffness`` [MPa/mm]); ``max_time`` [s]: refuse a run
-    estimated to take longer (BudgetError, before any work)."""
+    "ltca" (loaded-tooth-contact analysis with FE influence coefficients of both bodies; with
+    ``tip_edge_radius`` [mm] its tip corners meet the mating flanks rounded to it, see
+    `study.verify.fe_reference.tip_edge`) or "calculix" (the independent FE contact peer,
+    `study.verify.calculix_reference`, with ``flank_size`` [mm], ``contact_stiffness``
+    [MPa/mm] and ``thin_decks``: decks as thin as the flank elements, plane stress); ``max_time`` [s]: refuse a run estimated to take longer (BudgetError, before any
+    work)."""
     from study.scene_model import static_angles
     from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, check_reference_memory, reference_cost, reference_dataset
     check_scene_argument("reference", scene)
@@ -99,10 +102,20 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
         raise SceneError("--step", f"must be positive, got {step}")
     if solver not in ("ltca", "calculix"):
         raise SceneError("--solver", f"one of ltca, calculix, got {solver!r}")
+    if tip_edge_radius is not None and solver != "ltca":
+        raise SceneError("--tip-edge-radius", "applies to --solver ltca only (the CalculiX peer meshes the sharp corner)")
+    edge_m = None
+    if tip_edge_radius is not None:
+        from study.scene_model import geometry_model
+        from study.verify.fe_reference import tip_edge
+        check_argument(is_number(tip_edge_radius), "reference", "tip_edge_radius", "a radius in mm", tip_edge_radius)
+        from solver import units
+        edge_m = tip_edge_radius * units.MM
+        tip_edge(scene, geometry_model(scene), edge_m)      # refused before any work
     angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
     if solver == "calculix":
         from study.verify.calculix_reference import calculix_dataset, peer_estimate, settings_for
-        settings = settings_for(scene, flank_size, contact_stiffness)
+        settings = settings_for(scene, flank_size, contact_stiffness, thin_decks)
         est = peer_estimate(angles.size, settings, scene.gear1.module * 1e-3)
         estimate.check_time(est, max_time)
         line = check_reference_memory(scene, est, "--flank-size", "a CalculiX deck needs about {need} (flanks at "
@@ -120,7 +133,7 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
     if line:
         from study.plausibility import report_warnings
         report_warnings([line], True)
-    return reference_dataset(scene, angles, progress=progress)
+    return reference_dataset(scene, angles, progress=progress, tip_edge_radius=edge_m)
 
 
 def precision_scene(scene: Scene) -> Scene:

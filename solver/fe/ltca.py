@@ -29,6 +29,12 @@ rolls stay those of the perfect gears (the errors shift a roll by ~1e-4 rad).
 
 Approximation: corner contacts are loaded along the line of action at the tip-corner roll
 (their true normal turns by a few degrees); their moment arm is taken as the base radius.
+Their local law is the flanks' unless a tip edge radius is given (`TipEdge`): a corner then
+meets the mating flank as a cylinder of that radius, far narrower than the two flanks the law
+was fitted to, and its contact carries the extra compliance of that narrower Hertz patch
+(`solver.identify.weber.edge_compliance`) in series. Where the corners carry load (a single
+pair beside the extended contact of its neighbours: a third of the load at 100 N·m on the
+paper pair) the STE there depends on it.
 
 Units: SI (m, N, rad, N·m).
 """
@@ -124,6 +130,40 @@ def error_approach(model: Model, theta1: float, theta2: float, tooth1, tooth2) -
     return out
 
 
+# ------------------------------------------------------------------ tip corners
+
+@dataclass(frozen=True)
+class TipEdge:
+    """A rounded tip edge of both gears, for the local law of tip-corner contacts (SI)."""
+
+    radius: float           # tip edge radius [m]
+    youngs_modulus: float   # Pa
+    face_width: float       # m
+    law_radius: float       # equivalent radius of curvature [m] the contact law describes (the pitch point's)
+
+    def compliance(self, flank_radius: float) -> float:
+        """Extra compliance [m/N] of a corner contact on a mating flank of radius of curvature
+        ``flank_radius`` [m] (`solver.identify.weber.edge_compliance`)."""
+        from solver.identify.weber import edge_compliance
+        return edge_compliance(self.youngs_modulus, self.face_width, self.law_radius, self.radius, flank_radius)
+
+
+def corner_compliance(model: Model, mp: MeshPoints, edge: TipEdge | None) -> np.ndarray:
+    """(n,) compliance [m/N] each candidate contact of ``mp`` adds in series with the law: the
+    tip edge's (`TipEdge.compliance`) on tip-corner contacts, measured on the mating flank's
+    radius of curvature rb*u at its roll; 0 on flank contacts and without ``edge``."""
+    out = np.zeros(mp.gap.size)
+    if edge is None:
+        return out
+    rb1, rb2 = model.base_radii
+    for i, kind in enumerate(mp.kind):
+        if kind == 2:        # gear 1's corner on gear 2's flank
+            out[i] = edge.compliance(rb2 * mp.u2[i])
+        elif kind == 3:      # gear 2's corner on gear 1's flank
+            out[i] = edge.compliance(rb1 * mp.u1[i])
+    return out
+
+
 # ------------------------------------------------------------------ contact problem
 
 class LTCAError(RuntimeError):
@@ -201,11 +241,13 @@ class LTCAResult:
 
 
 def ltca_sweep(model: Model, compliance: tuple, angles, torque: float, k_con: float | None = None,
-               m1: float | None = None) -> LTCAResult:
+               m1: float | None = None, edge: TipEdge | None = None) -> LTCAResult:
     """Solve the loaded contact at every driver angle [rad] under ``torque`` [N·m] on gear 2.
 
     ``compliance`` = (BodyCompliance of gear 1, of gear 2), or (None, None) for rigid bodies
-    (only the contact law deforms). The contact law defaults to the model's.
+    (only the contact law deforms). The contact law defaults to the model's. ``edge``: the tip
+    edge radius of both gears; tip-corner contacts then carry its compliance in series with the
+    law (`corner_compliance`); None: the flanks' law alone.
     """
     k_con = float(model.law_par[L.K_CON]) if k_con is None else k_con
     m1 = float(model.law_par[L.M1]) if m1 is None else m1
@@ -226,6 +268,7 @@ def ltca_sweep(model: Model, compliance: tuple, angles, torque: float, k_con: fl
             G += compliance[0].matrix(mp.tooth1, mp.u1)
         if compliance[1] is not None:
             G += compliance[1].matrix(mp.tooth2, mp.u2)
+        G[np.diag_indices_from(G)] += corner_compliance(model, mp, edge)
         try:
             F, w = solve_contact(G, mp.gap, load, k_con, m1)
         except LTCAError as e:

@@ -88,3 +88,38 @@ def fit_contact(g1: GearGeometry, g2: GearGeometry, material: Material, force_re
     res = np.log(F) - A @ np.array([m1, logk])
     return ContactFit(float(math.exp(logk)), float(m1), (float(F[0]), float(F[-1])), depths, R,
                       float(np.sqrt(np.mean(res**2))))
+
+
+def plane_stress_approach(force, face_width: float, radius: float, depth: float, youngs_modulus: float,
+                          poisson_ratio: float) -> np.ndarray:
+    """Weber's approach [m] of the contact point to a point at ``depth`` [m] below it in ONE body,
+    plane stress (the FE bodies' and the CalculiX peer's state), under a normal force ``force`` [N]
+    over ``face_width`` [m] with the pair's equivalent radius of curvature ``radius`` [m]:
+
+        u = 2 q / (pi E) * [ ln(2 h / b) - nu / 2 ],   b = sqrt(8 q R / (pi E)),   q = F / face width,
+
+    the plane-strain formula of `weber_deflection` with E -> E (1 + 2 nu) / (1 + nu)^2 and
+    nu -> nu / (1 + nu). The load enters through b as well as q: per unit force the approach
+    falls by (1 / (pi E face width)) * ln 2 per doubled load (a power law fitted at one load
+    misses that at another)."""
+    F = np.asarray(force, dtype=float)
+    q = F / face_width
+    b = np.sqrt(8.0 * q * radius / (math.pi * youngs_modulus))
+    return 2.0 * q / (math.pi * youngs_modulus) * (np.log(2.0 * depth / b) - 0.5 * poisson_ratio)
+
+
+def edge_compliance(youngs_modulus: float, face_width: float, law_radius: float, edge_radius: float,
+                    flank_radius: float = math.inf) -> float:
+    """Compliance [m/N] that a tip corner's contact adds to a contact law fitted to two flanks of
+    equivalent radius ``law_radius`` [m]: the corner, rounded to ``edge_radius`` [m], meets the
+    mating flank (radius of curvature ``flank_radius`` [m]) with the equivalent radius
+    r = 1 / (1/edge_radius + 1/flank_radius). Both bodies' plane-stress approaches
+    (`plane_stress_approach`) hold ln(1/b) with b ~ sqrt(r), so for the same force
+
+        delta(r) - delta(law_radius) = 2 F / (pi E face width) * ln(law_radius / r),
+
+    linear in F: a compliance. Zero where r >= law_radius (a corner as blunt as the flanks)."""
+    if not edge_radius > 0:
+        raise ValueError(f"tip edge radius: must be positive, got {edge_radius}")
+    r = 1.0 / (1.0 / edge_radius + 1.0 / flank_radius)
+    return max(0.0, 2.0 / (math.pi * youngs_modulus * face_width) * math.log(law_radius / r))

@@ -13,7 +13,14 @@ import numpy as np
 import xarray as xr
 
 from solver import units
-from solver.peers.calculix import ATTEMPTS, CalculixSettings, PeerGear, deck_cpu_limit, default_settings, ste_sweep
+from solver.peers.calculix import (
+    ATTEMPTS,
+    CalculixSettings,
+    PeerGear,
+    deck_cpu_limit,
+    default_settings,
+    ste_sweep,
+)
 from study.scene import Scene, SceneError
 from study.scene_model import geometry_model
 
@@ -28,6 +35,11 @@ DECK_S = 200.0
 # (within 1.4 x of both), growing as 1/flank_size like the time.
 DECK_BYTES_PER_NODE = 3.7e4
 DECK_NODES = 1.0e5
+# The tip edge radius [mm] at which the LTCA's tip-corner contacts (`lightgear reference
+# --tip-edge-radius`) read like the peer's sharp corners meshed at 0.1 mm on the flanks: on the
+# solid and the paper pair at 50 and 100 N·m every single-contact position within 0.4 %
+# (docs/models.md). The peer's corner is sharp, so this is a property of its mesh, not of a gear.
+PEER_TIP_EDGE_RADIUS_MM = 0.035
 
 
 def peer_estimate(n_decks: int, settings: CalculixSettings, module: float):
@@ -53,9 +65,11 @@ def peer_gears(scene: Scene) -> tuple:
     return tuple(out), model
 
 
-def settings_for(scene: Scene, flank_size_mm: float | None = None, contact_stiffness: float | None = None) -> CalculixSettings:
+def settings_for(scene: Scene, flank_size_mm: float | None = None, contact_stiffness: float | None = None,
+                 thin_decks: bool = False) -> CalculixSettings:
     """Peer settings of a scene: `solver.peers.calculix.default_settings` from gear 1's module, with
-    ``flank_size_mm`` [mm] the element size at the flanks and ``contact_stiffness`` [MPa/mm]."""
+    ``flank_size_mm`` [mm] the element size at the flanks, ``contact_stiffness`` [MPa/mm] and
+    ``thin_decks`` (`solver.peers.calculix.deck_thickness_scale`: plane stress)."""
     import dataclasses
     m = scene.gear1.module * units.MM
     if flank_size_mm is not None and not (0 < flank_size_mm <= scene.gear1.module / 2):
@@ -65,7 +79,7 @@ def settings_for(scene: Scene, flank_size_mm: float | None = None, contact_stiff
         if not contact_stiffness > 0:
             raise SceneError("--contact-stiffness", f"must be positive, got {contact_stiffness} MPa/mm")
         s = dataclasses.replace(s, contact_stiffness=contact_stiffness * units.MPA * units.MM_PER_M)
-    return s
+    return dataclasses.replace(s, thin_decks=bool(thin_decks))
 
 
 def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | None = None, progress: bool = False,
@@ -112,6 +126,7 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
              "flank_mesh_size_mm": s.sizes.flank * units.MM_PER_M, "fillet_mesh_size_mm": s.sizes.fillet * units.MM_PER_M,
              "body_mesh_size_mm": s.sizes.body * units.MM_PER_M,
              "contact_stiffness_MPa_per_mm": s.contact_stiffness / units.MPA * units.MM,
+             "deck_thickness_scale": s.deck_scale(max(scene.gear1.face_width, scene.gear2.face_width) * units.MM),
              "fine_teeth_each_side": s.fine_teeth, "contact_teeth_each_side": s.contact_teeth,
              "deck_cpu_limit_s": deck_cpu_limit(res.meshes, s),
              "deck_attempts": "; ".join(f"{'soft start (contact stiffness x' + format(soft, 'g') + ', then stiffened)' if soft else 'stiff contact'}"

@@ -85,12 +85,15 @@ def check_reference_memory(scene: Scene, est, field: str = "fe.mesh_size", what:
     return estimate.check_memory(need, field, what.format(need=bytes_text(need)), lever)
 
 
-def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS, progress: bool = False):
+def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE_POINTS, progress: bool = False,
+              tip_edge_radius: float | None = None):
     """(LTCAResult, model, info) of the scene at driver ``angles`` [rad] (default: quasi-static).
 
     ``rigid``: rigid bodies, only the contact law deforms (the closed-form check);
     ``n_u``: profile points per flank of the influence coefficients; ``progress``: a bar on
-    stderr (unit: the estimated second) when the run is expected to be long."""
+    stderr (unit: the estimated second) when the run is expected to be long;
+    ``tip_edge_radius`` [m]: tip corners meet the mating flanks rounded to it (`tip_edge`);
+    None: under the flanks' contact law."""
     from study import estimate
     qs = scene.quasi_static
     if not qs.torque > 0:
@@ -100,14 +103,32 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     teeth = None if rigid else teeth_in_mesh(model, angles)
     parts = reference_cost(scene, angles, teeth).seconds if not rigid else {"contact sweep": 0.0}
     bar = estimate.progress_bar(sum(parts.values()), sum(parts.values()), "FE reference", "s (estimated)", progress)
+    edge = None if tip_edge_radius is None else tip_edge(scene, model, tip_edge_radius)
     try:
-        return _reference(scene, angles, rigid, n_u, model, parts, bar, teeth)
+        return _reference(scene, angles, rigid, n_u, model, parts, bar, teeth, edge)
     finally:
         if bar is not None:
             bar.close()
 
 
-def _reference(scene, angles, rigid, n_u, model, parts, bar, teeth=None):
+def tip_edge(scene: Scene, model, radius: float):
+    """`solver.fe.ltca.TipEdge` of the scene for a tip edge radius [m]: the contact law's radius
+    is the pair's equivalent radius of curvature at the pitch point, where its Weber fit is taken
+    (`solver.identify.weber`). SceneError naming --tip-edge-radius for a radius that is not
+    positive or not below the module."""
+    import math
+
+    from solver.fe.ltca import TipEdge
+    if not (isinstance(radius, (int, float)) and math.isfinite(radius) and 0 < radius < scene.gear1.module * units.MM):
+        raise SceneError("--tip-edge-radius", f"must be a positive radius below the module ({scene.gear1.module:g} mm), "
+                                              f"got {radius * units.MM_PER_M if isinstance(radius, (int, float)) else radius!r} mm")
+    alpha = model.geometry[0].spec.pressure_angle
+    rho1, rho2 = (rb * math.tan(alpha) for rb in model.base_radii)
+    b = min(scene.gear1.face_width, scene.gear2.face_width) * units.MM
+    return TipEdge(float(radius), scene.material_spec().youngs_modulus, b, rho1 * rho2 / (rho1 + rho2))
+
+
+def _reference(scene, angles, rigid, n_u, model, parts, bar, teeth=None, edge=None):
     def stage(name):
         if bar is not None:
             bar.set_postfix_str(name)
@@ -134,18 +155,18 @@ def _reference(scene, angles, rigid, n_u, model, parts, bar, teeth=None):
     info.update(wall_time_compliance_s=time.perf_counter() - t0, cpu_time_compliance_s=time.process_time() - c0)
     t0, c0 = time.perf_counter(), time.process_time()
     stage("contact sweep")
-    res = ltca_sweep(model, comp, angles, scene.quasi_static.torque)
+    res = ltca_sweep(model, comp, angles, scene.quasi_static.torque, edge=edge)
     info.update(wall_time_contact_s=time.perf_counter() - t0, cpu_time_contact_s=time.process_time() - c0)
     return res, model, info
 
 
-def reference_dataset(scene: Scene, angles=None, progress: bool = False) -> xr.Dataset:
-    """FE reference archive: ste, load sharing and contacts over the driver angle (``progress``:
-    see `reference`)."""
+def reference_dataset(scene: Scene, angles=None, progress: bool = False, tip_edge_radius: float | None = None) -> xr.Dataset:
+    """FE reference archive: ste, load sharing and contacts over the driver angle (``progress``,
+    ``tip_edge_radius`` [m]: see `reference`)."""
     from study.archive.netcdf import cf_variable, provenance
 
     t0 = time.perf_counter()
-    res, model, info = reference(scene, angles, progress=progress)
+    res, model, info = reference(scene, angles, progress=progress, tip_edge_radius=tip_edge_radius)
     wall = time.perf_counter() - t0
     coords = {"angle": cf_variable("angle", np.degrees(res.angle), "degree", "driver rotation from the nominal position"),
               "driver_tooth": cf_variable("driver_tooth", np.arange(model.teeth[0]), "1", "driver tooth index")}
@@ -165,9 +186,13 @@ def reference_dataset(scene: Scene, angles=None, progress: bool = False) -> xr.D
              "static_torque_N_m": res.torque, "wall_time_reference_s": wall,
              "wall_time_compliance_s": info["wall_time_compliance_s"], "wall_time_contact_s": info["wall_time_contact_s"],
              "profile_points": PROFILE_POINTS,
+             **({} if tip_edge_radius is None else {"tip_edge_radius_mm": tip_edge_radius * units.MM_PER_M}),
              "fe_mesh_size_mm": info["gear2"]["mesh_size_m"] * 1e3,
              "method": "loaded-tooth-contact analysis: bulk FE compliance read at the tooth centreline (both bodies, "
                        "clamped at the bore, all loaded teeth coupled) + contact law k_con*delta^m1 in series",
+             "tip_corner_law": ("the flanks' contact law" if tip_edge_radius is None else
+                                f"the flanks' contact law + the compliance of a {tip_edge_radius * units.MM_PER_M:g} mm tip edge radius "
+                                "(Hertz patch of the edge against the mating flank instead of the two flanks')"),
              "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
              **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)
