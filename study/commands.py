@@ -84,49 +84,57 @@ def fit_contact(scene: Scene, depth_fraction: float = 0.5) -> ContactFit:
                       tuple(float(x) for x in f.force_range), f.radius * 1e3, f.rms_log_error, f_ref)
 
 
+REFERENCE_OPTIONS = {"ltca": ("tip_edge_radius",), "calculix": ("flank_size", "contact_stiffness", "thin_decks")}
+
+
 def reference(scene: Scene, step: float | None = None, max_time: float | None = None, progress: bool = False,
-              solver: str = "ltca", flank_size: float | None = None, contact_stiffness: float | None = None,
-              tip_edge_radius: float | None = None, thin_decks: bool = False):
+              solver: str = "ltca", **options):
     """FE reference STE -> xarray.Dataset (``ste`` [um] over ``angle`` [degree]). ``solver``:
-    "ltca" (loaded-tooth-contact analysis with FE influence coefficients of both bodies; with
-    ``tip_edge_radius`` [mm] its tip corners meet the mating flanks rounded to it, see
+    "ltca" (loaded-tooth-contact analysis with FE influence coefficients of both bodies; option
+    ``tip_edge_radius`` [mm]: its tip corners meet the mating flanks rounded to it, see
     `study.verify.fe_reference.tip_edge`) or "calculix" (the independent FE contact peer,
-    `study.verify.calculix_reference`, with ``flank_size`` [mm], ``contact_stiffness``
-    [MPa/mm] and ``thin_decks``: decks as thin as the flank elements, plane stress); ``max_time`` [s]: refuse a run estimated to take longer (BudgetError, before any
-    work)."""
+    `study.verify.calculix_reference`; options ``flank_size`` [mm], ``contact_stiffness``
+    [MPa/mm] and ``thin_decks``: decks as thin as the flank elements, plane stress). An option
+    None (or False) or left out: its default; one of the other solver's, given: SceneError. ``max_time`` [s]: refuse a run estimated to take longer
+    (BudgetError, before any work)."""
     from study.scene_model import static_angles
-    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR, check_reference_memory, reference_cost, reference_dataset
+    from study.verify.fe_reference import REFERENCE_MEMORY_FACTOR
     check_scene_argument("reference", scene)
     check_argument(step is None or is_number(step), "reference", "step", "a number of degrees or None", step)
     if step is not None and not step > 0:
         raise SceneError("--step", f"must be positive, got {step}")
-    if solver not in ("ltca", "calculix"):
+    if solver not in REFERENCE_OPTIONS:
         raise SceneError("--solver", f"one of ltca, calculix, got {solver!r}")
-    if tip_edge_radius is not None and solver != "ltca":
-        raise SceneError("--tip-edge-radius", "applies to --solver ltca only (the CalculiX peer meshes the sharp corner)")
-    edge_m = None
-    if tip_edge_radius is not None:
-        from study.scene_model import geometry_model
-        from study.verify.fe_reference import tip_edge
-        check_argument(is_number(tip_edge_radius), "reference", "tip_edge_radius", "a radius in mm", tip_edge_radius)
-        from solver import units
-        edge_m = tip_edge_radius * units.MM
-        tip_edge(scene, geometry_model(scene), edge_m)      # refused before any work
+    for name, value in options.items():
+        if value is not None and value is not False and name not in REFERENCE_OPTIONS[solver]:
+            other = [s for s, names in REFERENCE_OPTIONS.items() if name in names]
+            raise SceneError("--" + name.replace("_", "-"), f"applies to --solver {other[0]} only" if other else
+                             f"not an option of reference; its options: {sorted(sum(REFERENCE_OPTIONS.values(), ()))}")
+    if solver == "ltca":
+        edge_m = _tip_edge_m(scene, options.get("tip_edge_radius"))      # refused before any work
+        angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
+        return _ltca_reference(scene, angles, max_time, progress, edge_m)
     angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
-    if solver == "calculix":
-        from study.verify.calculix_reference import calculix_dataset, peer_estimate, settings_for
-        settings = settings_for(scene, flank_size, contact_stiffness, thin_decks)
-        est = peer_estimate(angles.size, settings, scene.gear1.module * 1e-3)
-        estimate.check_time(est, max_time)
-        line = check_reference_memory(scene, est, "--flank-size", "a CalculiX deck needs about {need} (flanks at "
-                                      f"{settings.sizes.flank * 1e3:.3g} mm)", "a larger --flank-size")
-        if line:
-            from study.plausibility import report_warnings
-            report_warnings([line], True)
-        if progress:
-            print(f"CalculiX contact peer: {angles.size} decks, about {estimate.duration_text(est.total_s)} "
-                  f"({est.total_s / angles.size:.0f} s a deck)", file=sys.stderr, flush=True)
-        return calculix_dataset(scene, angles, settings, progress=progress)
+    return _calculix_reference(scene, angles, max_time, progress, options)
+
+
+def _tip_edge_m(scene: Scene, tip_edge_radius) -> float | None:
+    """The LTCA's tip edge radius [m] from ``tip_edge_radius`` [mm] (None: sharp corners),
+    checked against the scene's teeth."""
+    if tip_edge_radius is None:
+        return None
+    from solver import units
+    from study.scene_model import geometry_model
+    from study.verify.fe_reference import tip_edge
+    check_argument(is_number(tip_edge_radius), "reference", "tip_edge_radius", "a radius in mm", tip_edge_radius)
+    edge_m = tip_edge_radius * units.MM
+    tip_edge(scene, geometry_model(scene), edge_m)
+    return edge_m
+
+
+def _ltca_reference(scene: Scene, angles, max_time, progress: bool, edge_m):
+    """`reference` by the project's LTCA at ``angles`` [rad]."""
+    from study.verify.fe_reference import check_reference_memory, reference_cost, reference_dataset
     est = reference_cost(scene, angles)
     estimate.check_time(est, max_time)
     line = check_reference_memory(scene, est)      # refused whatever --max-time
@@ -134,6 +142,25 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
         from study.plausibility import report_warnings
         report_warnings([line], True)
     return reference_dataset(scene, angles, progress=progress, tip_edge_radius=edge_m)
+
+
+def _calculix_reference(scene: Scene, angles, max_time, progress: bool, options: dict):
+    """`reference` by the CalculiX contact peer at ``angles`` [rad] (``options``: `reference`'s)."""
+    from study.verify.calculix_reference import calculix_dataset, peer_estimate, settings_for
+    from study.verify.fe_reference import check_reference_memory
+    settings = settings_for(scene, options.get("flank_size"), options.get("contact_stiffness"),
+                            bool(options.get("thin_decks", False)))
+    est = peer_estimate(angles.size, settings, scene.gear1.module * 1e-3)
+    estimate.check_time(est, max_time)
+    line = check_reference_memory(scene, est, "--flank-size", "a CalculiX deck needs about {need} (flanks at "
+                                  f"{settings.sizes.flank * 1e3:.3g} mm)", "a larger --flank-size")
+    if line:
+        from study.plausibility import report_warnings
+        report_warnings([line], True)
+    if progress:
+        print(f"CalculiX contact peer: {angles.size} decks, about {estimate.duration_text(est.total_s)} "
+              f"({est.total_s / angles.size:.0f} s a deck)", file=sys.stderr, flush=True)
+    return calculix_dataset(scene, angles, settings, progress=progress)
 
 
 def precision_scene(scene: Scene) -> Scene:

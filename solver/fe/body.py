@@ -2,9 +2,7 @@
 
 The body is clamped at the bore. Its thickness is the face width on the teeth, rim and hub and
 the web thickness t1 in the web; the stiffness matrix is the sum of the region matrices scaled
-by their thickness. One LU factorisation serves all Z load cases.
-
-Load case k: a force F on the drive (+) flank of tooth k at the pitch point, along the line of
+by their thickness. One LU factorisation serves all Z load cases. Load case k: a force F on the drive (+) flank of tooth k at the pitch point, along the line of
 action (pushing the tooth toward negative polar angle, as the mating gear does), spread
 uniformly over a patch of half-width ``patch`` along the profile (a 2D point load has a
 mesh-dependent log singularity).
@@ -17,10 +15,9 @@ lever = distance from Q to the load line. So
 
 Reading the deflection at the tooth centreline (not under the load) keeps the local contact
 flattening out of the spring: that part belongs to the contact law, whose Weber fit measures
-the flattening down to the same centreline (see `solver.identify.weber`). delta_C holds tooth bending
-and shear, the fillet/foundation deflection and the wind-up of the whole body to the bore.
-
-Units: SI in and out (m, N, Pa, N·m/rad).
+the flattening down to the same centreline (see `solver.identify.weber`). delta_C holds tooth
+bending and shear, the fillet/foundation deflection and the wind-up of the whole body to the
+bore. Units: SI in and out (m, N, Pa, N·m/rad).
 """
 from __future__ import annotations
 

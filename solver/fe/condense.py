@@ -40,11 +40,11 @@ import numpy as np
 from solver.fe.body import BodyModel, plane_stress_lame, plane_stress_p2_stiffness
 from solver.fe.factor import blas1_solver, congruence, factorise, influence, one_blas_thread
 from solver.fe.mesh import REGION_RIM, REGION_WEB, BodyMesh
+from solver.fe.rim_dofs import MATCH_TOL, RimMismatch, rim_dofs_in_body
 from solver.fe.rim_solves import ReadSet, make_read_set, rim_products
 from solver.geometry import Material
 from solver.store import Shelf, digest
 
-MATCH_TOL = 1e-9        # m: two DOF locations closer than this are the same node
 SOLVES_KEPT = 2         # rim solves and column-read sets kept for reuse (`RimBlock.rim_solve`, `RimBlock.read_set`)
 
 
@@ -53,10 +53,6 @@ class _Size:
 
     def __init__(self, n: int):
         self.N = n
-
-
-class RimMismatch(ValueError):
-    """The body's teeth-and-rim elements are not those of the condensed rim."""
 
 
 def _dof_keys(basis) -> np.ndarray:
@@ -327,28 +323,6 @@ class CondensedBody:
             return G0 + A @ X
 
 
-def _rim_numbering(basis, is_rim: np.ndarray, rim: RimBlock) -> np.ndarray | None:
-    """The body DOF of each DOF of the condensed rim, where the body's mesh begins with the rim's
-    vertices and elements as they are (`join_rim` makes it so): vertex DOFs alike, edge DOFs
-    through the edges' end vertices. None for a mesh numbered otherwise."""
-    m, rm = basis.mesh, rim.model.basis.mesh
-    nv, nt = rm.p.shape[1], rm.t.shape[1]
-    if (m.p.shape[1] < nv or m.t.shape[1] < nt or not np.array_equal(m.p[:, :nv], rm.p)
-            or not np.array_equal(m.t[:, :nt], rm.t) or is_rim.sum() != nt or not is_rim[:nt].all()):
-        return None
-    key = m.facets[0].astype(np.int64) * m.p.shape[1] + m.facets[1]          # edges by their (sorted) ends
-    want = rm.facets[0].astype(np.int64) * m.p.shape[1] + rm.facets[1]
-    order = np.argsort(key)
-    at = order[np.minimum(np.searchsorted(key, want, sorter=order), key.size - 1)]
-    if not np.array_equal(key[at], want):
-        return None
-    rb = rim.model.basis
-    out = np.empty(rb.N, np.int64)
-    out[rb.nodal_dofs] = basis.nodal_dofs[:, :nv]
-    out[rb.facet_dofs] = basis.facet_dofs[:, at]
-    return out
-
-
 def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, material: Material,
                        rim: RimBlock) -> BodyModel:
     """The body of ``mesh`` clamped at the bore, solved through the condensed ``rim`` (which
@@ -359,7 +333,6 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
 
     import scipy.sparse as sp
     from scipy.linalg import cho_factor
-    from scipy.spatial import cKDTree
 
     t0, c0 = time.perf_counter(), time.process_time()
     basis = _basis(mesh.points, mesh.triangles)
@@ -373,15 +346,7 @@ def assemble_condensed(mesh: BodyMesh, face_width: float, web_thickness: float, 
     in_web[ed[:, ~is_rim].ravel()] = True
     rim_dofs = np.flatnonzero(in_rim)
     keys = _dof_keys(basis)
-    from_rim = _rim_numbering(basis, is_rim, rim)         # body DOF of each rim DOF
-    if from_rim is None:                                  # another numbering: match the DOFs by location
-        if rim.tree is None:
-            rim.tree = cKDTree(rim.keys)
-        dist, idx = rim.tree.query(keys[rim_dofs])
-        if rim_dofs.size != rim.keys.shape[0] or np.any(dist > MATCH_TOL) or np.unique(idx).size != idx.size:
-            raise RimMismatch("the body's teeth-and-rim nodes differ from the condensed rim's")
-        from_rim = np.empty(rim.keys.shape[0], np.int64)
-        from_rim[idx] = rim_dofs
+    from_rim = rim_dofs_in_body(basis, is_rim, rim, rim_dofs, keys)     # body DOF of each rim DOF
     to_rim = np.full(basis.N, -1)
     to_rim[from_rim] = np.arange(from_rim.size)
     shared = np.flatnonzero(in_rim & in_web)

@@ -5,6 +5,7 @@ variable by variable. The peer itself is `solver.peers.calculix`.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 import time
@@ -105,8 +106,9 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
                   f"{(te - model.backlash_offset) * units.UM_PER_M:.4f} um ({wall:.0f} s; about "
                   f"{done / (i + 1) * (n - i - 1):.0f} s left)", file=sys.stderr, flush=True)
 
-    res = ste_sweep(gears, model.pair, scene.material_spec(), angles, torque, settings, progress=report, keep=keep,
-                    starts=starts)
+    if keep:
+        settings = dataclasses.replace(settings, keep=keep)
+    res = ste_sweep(gears, model.pair, scene.material_spec(), angles, torque, settings, progress=report, starts=starts)
     nodes = sum(m.n_nodes for m in res.meshes)
     coords = {"angle": cf_variable("angle", np.degrees(res.angle), "degree", "driver rotation from the nominal position")}
     off = res.backlash_offset

@@ -105,7 +105,7 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     bar = estimate.progress_bar(sum(parts.values()), sum(parts.values()), "FE reference", "s (estimated)", progress)
     edge = None if tip_edge_radius is None else tip_edge(scene, model, tip_edge_radius)
     try:
-        return _reference(scene, angles, rigid, n_u, model, parts, bar, teeth, edge)
+        return _reference(scene, angles, rigid, n_u, model, _Stages(bar, parts), teeth, edge)
     finally:
         if bar is not None:
             bar.close()
@@ -128,14 +128,24 @@ def tip_edge(scene: Scene, model, radius: float):
     return TipEdge(float(radius), scene.material_spec().youngs_modulus, b, rho1 * rho2 / (rho1 + rho2))
 
 
-def _reference(scene, angles, rigid, n_u, model, parts, bar, teeth=None, edge=None):
-    def stage(name):
-        if bar is not None:
-            bar.set_postfix_str(name)
+class _Stages:
+    """The progress bar's stages of one reference (None: no bar): each stage's estimated
+    seconds (``parts``) added when it is done."""
 
-    def done(name):
-        if bar is not None:
-            bar.update(parts[name])
+    def __init__(self, bar, parts: dict):
+        self.bar, self.parts = bar, parts
+
+    def stage(self, name: str):
+        if self.bar is not None:
+            self.bar.set_postfix_str(name)
+
+    def done(self, name: str):
+        if self.bar is not None:
+            self.bar.update(self.parts[name])
+
+
+def _reference(scene, angles, rigid, n_u, model, stages: _Stages, teeth=None, edge=None):
+    stage, done = stages.stage, stages.done
     info = {}
     t0, c0 = time.perf_counter(), time.process_time()
     if rigid:

@@ -139,8 +139,6 @@ def mesh_study(scene: Scene, factors=tuple(f for _, f in LEVELS), names=None, ro
     ``rotation_deg`` [deg]: the STE's range (at quasi_static.angle_step); ``repeats``: timed
     runs of the statics and the dynamics (best kept, after a warm-up); ``fresh_fe``: each size's
     FE from an empty cache (`empty_fe_cache`); ``progress(i, size_mm, row)``: after each size."""
-    from study.archive.netcdf import provenance
-    from study.verify.precision_study import machine, model_label
     factors = tuple(float(f) for f in factors)
     if len(factors) < 2 or any(not (f > 0 and math.isfinite(f)) for f in factors):
         raise ValueError(f"factors: at least two positive mesh-size factors, got {factors}")
@@ -159,6 +157,15 @@ def mesh_study(scene: Scene, factors=tuple(f for _, f in LEVELS), names=None, ro
         rows.append(level_runs(sc, rotation_deg, repeats, fresh_fe))
         if progress:
             progress(i, h0 * f, rows[-1])
+    return _mesh_dataset(scene, rows, names, [h0 * f for f in factors], h0, (rotation_deg, repeats, fresh_fe))
+
+
+def _mesh_dataset(scene: Scene, rows: list, names: list, sizes_mm: list, h0: float, how: tuple) -> xr.Dataset:
+    """`mesh_study`'s Dataset from its rows (`level_runs`, coarse first) at ``sizes_mm`` [mm]
+    (``h0`` [mm] the default size; ``how``: (rotation_deg, repeats, fresh_fe) as given to it)."""
+    from study.archive.netcdf import provenance
+    from study.verify.precision_study import machine, model_label
+    rotation_deg, repeats, fresh_fe = how
     fine = rows[-1]
     n = len(rows)
 
@@ -203,7 +210,7 @@ def mesh_study(scene: Scene, factors=tuple(f for _, f in LEVELS), names=None, ro
             "mesh": ("mesh", np.arange(n), {"long_name": "mesh level, coarse first"}),
             "gear": ("gear", [1, 2], {"long_name": "gear (1: driver)"}),
             "level": ("mesh", np.array(names, dtype=object), {"long_name": "mesh level name"}),
-            "mesh_size": ("mesh", np.array([h0 * f for f in factors]), {"units": "mm",
+            "mesh_size": ("mesh", np.array(sizes_mm), {"units": "mm",
                                                                         "long_name": "FE element size at the outline (fe.mesh_size)"}),
         },
         attrs={
@@ -212,7 +219,7 @@ def mesh_study(scene: Scene, factors=tuple(f for _, f in LEVELS), names=None, ro
                      f"{scene.quasi_static.angle_step:g} deg; DTE of the scene's {scene.dynamic.duration:g} s run "
                      f"(0 -> {scene.dynamic.speed:g} rad/s and 0 -> {scene.dynamic.torque:g} N·m in "
                      f"{scene.dynamic.ramp_time * 1e3:g} ms) from {rows[0]['steady_start']:g} s on, production step"),
-            "reference": f"the finest mesh, fe.mesh_size = {h0 * factors[-1]:.4g} mm",
+            "reference": f"the finest mesh, fe.mesh_size = {sizes_mm[-1]:.4g} mm",
             "default_mesh_size_mm": h0, "fresh_fe_cache": int(fresh_fe), "repeats": int(repeats),
             **provenance(), "machine": machine(), "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             "scene": scene.to_toml(),

@@ -71,6 +71,7 @@ class CalculixSettings:
     both_ways: bool = True       # a second contact pair, gear 1 the slave (`deck.write_deck`)
     deck_cpu_s: float | None = None  # CPU seconds a deck may use (None: `deck_cpu_limit`'s default)
     thin_decks: bool = False     # decks as thin as the flank elements (`deck_thickness_scale`): plane stress
+    keep: str | None = None      # a folder that keeps each deck's files (None: a temporary one, removed)
 
     def deck_scale(self, face_width: float) -> float:
         """Factor [1] on every thickness and load of the decks of a pair whose widest face is
@@ -150,20 +151,18 @@ def deck_cpu_limit(meshes, settings: CalculixSettings) -> float:
 
 
 def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torque: float,
-              settings: CalculixSettings, progress=None, keep: str | None = None, starts=None) -> PeerResult:
+              settings: CalculixSettings, progress=None, starts=None) -> PeerResult:
     """STE at every driver angle [rad] under the resisting ``torque`` [N·m] on gear 2, one deck
     an angle. ``progress(i, n, te_m, wall_s)``: called after each deck. Each deck starts from
     ``starts[i]`` [m] (an approach near the loaded one, e.g. a model's elastic STE: fewer Newton
     iterations; the result does not depend on it) or else from the previous deck's approach (the
     first from `start_approach`), and is tried as `ATTEMPTS` says until one converges, within
     `deck_cpu_limit` CPU seconds in all; `CalculixFailed` (one line: the angle, each attempt's
-    reason) when none does."""
+    reason) when none does. ``settings.keep``: a folder that keeps each deck's files."""
     ccx_path()
     angles = np.asarray(angles, float)
     meshes = pair_meshes(gears, pair, angles, settings)
     limit = deck_cpu_limit(meshes, settings)
-    g1, g2 = gears[0].geometry, gears[1].geometry
-    rb1, rb2 = g1.base_radius, g2.base_radius
     jn2 = 0.5 * pair.normal_backlash
     te = np.empty(angles.size)
     wall, cpu = np.empty(angles.size), np.empty(angles.size)
@@ -172,44 +171,67 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
         t0 = time.perf_counter()
         if starts is not None:
             start = float(starts[a])
-        th2 = (jn2 - rb1 * th1) / rb2
-        why, used, res = [], 0.0, None
+        deck = _Deck(gears, meshes, pair, material, torque, settings, limit)
+        res, s, used = deck.solve(a, th1, start)
+        # the ground spring took ground * U3 of the torque: back to the full torque along the
+        # pair's secant stiffness (a correction of order 1e-4 of the start error)
+        te[a] = jn2 + s + gears[1].geometry.base_radius * res.rotation * (1.0 + GROUND_FRACTION)
+        wall[a], cpu[a] = time.perf_counter() - t0, used
+        start = te[a] - jn2
+        if progress is not None:
+            progress(a, angles.size, te[a], wall[a])
+    return PeerResult(angles, te, jn2, meshes, wall, cpu, settings, ccx_version())
+
+
+@dataclass(frozen=True)
+class _Deck:
+    """What every deck of a sweep shares: the gears and their meshes, the pair, the material,
+    the torque [N·m], the settings and the CPU seconds a deck may use."""
+
+    gears: tuple
+    meshes: tuple
+    pair: PairGeometry
+    material: Material
+    torque: float
+    settings: CalculixSettings
+    limit: float
+
+    def solve(self, a: int, th1: float, start: float) -> tuple:
+        """(the converged deck's result, its start approach [m], CPU seconds used) of the deck
+        ``a`` at driver angle ``th1`` [rad] from the approach ``start`` [m], tried as `ATTEMPTS`
+        says; `CalculixFailed` when no attempt converges."""
+        gears, pair, settings, limit = self.gears, self.pair, self.settings, self.limit
+        g1, g2 = gears[0].geometry, gears[1].geometry
+        rb1, rb2 = g1.base_radius, g2.base_radius
+        th2 = (0.5 * pair.normal_backlash - rb1 * th1) / rb2
+        thin = settings.deck_scale(max(g1.spec.face_width, g2.spec.face_width))
+        why, used = [], 0.0
         for n, (frac, soft) in enumerate(ATTEMPTS):
             if limit - used < 1.0:
                 why.append("no CPU time left for the next attempt")
                 break
             s = frac * start
-            thin = settings.deck_scale(max(g1.spec.face_width, g2.spec.face_width))
-            placed = (GearPlacement(meshes[0], thin * g1.spec.face_width, thin * gears[0].body.web_thickness, (0.0, 0.0), th1),
-                      GearPlacement(meshes[1], thin * g2.spec.face_width, thin * gears[1].body.web_thickness, (pair.center_distance, 0.0),
-                                    th2 + s / rb2 + math.pi + math.pi / g2.teeth))
+            placed = (GearPlacement(self.meshes[0], thin * g1.spec.face_width, thin * gears[0].body.web_thickness, (0.0, 0.0), th1),
+                      GearPlacement(self.meshes[1], thin * g2.spec.face_width, thin * gears[1].body.web_thickness,
+                                    (pair.center_distance, 0.0), th2 + s / rb2 + math.pi + math.pi / g2.teeth))
             # a ground spring of 1e-4 of the mesh's torsional stiffness (about torque / start angle):
             # it takes 1e-4 of the torque per start error of the size of the approach
-            ground = GROUND_FRACTION * thin * torque * rb2 / max(s, 1e-9)
+            ground = GROUND_FRACTION * thin * self.torque * rb2 / max(s, 1e-9)
             # the stiff deck without cut-backs: its start overclosure is not scaled by the
             # increment, so a smaller one does not help it (a soft start's may)
             inc = (1.0, 1.0, 1.0) if soft == 0 else (1.0, 1.0)
-            text, nums = write_deck(placed, material, thin * torque, settings.contact_stiffness, inc, ground,
+            text, nums = write_deck(placed, self.material, thin * self.torque, settings.contact_stiffness, inc, ground,
                                     settings.both_ways, soft_start=soft)
             # half of what is left, all of it for the last attempt: a chattering attempt leaves
             # time for the next
             cap = (limit - used) * (1.0 if n == len(ATTEMPTS) - 1 else 0.5)
             try:
                 res = run_deck(text, nums.rot_node, nums.ref_node, timeout_s=WALL_PER_CPU * cap,
-                               keep=keep and f"{keep}/deck{a:03d}_{n}", cpu_limit_s=cap, end_time=nums.end_time)
-                used += res.cpu_time_s
-                break
+                               keep=settings.keep and f"{settings.keep}/deck{a:03d}_{n}", cpu_limit_s=cap,
+                               end_time=nums.end_time)
+                return res, s, used + res.cpu_time_s
             except CalculixFailed as e:
                 used += e.cpu_time_s
                 why.append(f"{'soft start' if soft else 'stiff contact'} from {s * 1e6:.3g} um: {e}")
-        if res is None:
-            raise CalculixFailed(f"the deck at driver angle {math.degrees(th1):.4f} deg did not converge "
-                                 f"({used:.0f} of {limit:.0f} s CPU): " + "; ".join(why))
-        # the ground spring took ground * U3 of the torque: back to the full torque along the
-        # pair's secant stiffness (a correction of order 1e-4 of the start error)
-        te[a] = jn2 + s + rb2 * res.rotation * (1.0 + GROUND_FRACTION)
-        wall[a], cpu[a] = time.perf_counter() - t0, used
-        start = te[a] - jn2
-        if progress is not None:
-            progress(a, angles.size, te[a], wall[a])
-    return PeerResult(angles, te, jn2, meshes, wall, cpu, settings, ccx_version())
+        raise CalculixFailed(f"the deck at driver angle {math.degrees(th1):.4f} deg did not converge "
+                             f"({used:.0f} of {limit:.0f} s CPU): " + "; ".join(why))

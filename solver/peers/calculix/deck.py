@@ -87,34 +87,7 @@ def write_deck(gears: tuple, material: Material, torque: float, contact_stiffnes
     out = io.StringIO()
     w = out.write
     w("** lightgear: gear pair in frictionless contact, plane stress, units N, mm, MPa\n")
-    w("*NODE, NSET=NALL\n")
-    node_off, elem_off = [], []
-    n = e = 0
-    for gp in gears:
-        node_off.append(n)
-        xy = placed_points(gp) * mm
-        ids = np.arange(n + 1, n + 1 + xy.shape[0])
-        np.savetxt(out, np.column_stack([ids, xy, np.zeros(len(ids))]), fmt="%d,%.9f,%.9f,%.1f")
-        n += xy.shape[0]
-    ref, rot = n + 1, n + 2
-    a2 = gears[1].centre
-    w(f"{ref},{a2[0] * mm:.9f},{a2[1] * mm:.9f},0.0\n{rot},{a2[0] * mm:.9f},{a2[1] * mm:.9f},0.0\n")
-    for i, gp in enumerate(gears):
-        elem_off.append(e)
-        tri = gp.mesh.triangles + node_off[i] + 1
-        ids = np.arange(e + 1, e + 1 + tri.shape[0])
-        for reg in np.unique(gp.mesh.region):
-            sel = gp.mesh.region == reg
-            w(f"*ELEMENT, TYPE=CPS6, ELSET=G{i + 1}{REGION_LABEL[int(reg)]}\n")
-            np.savetxt(out, np.column_stack([ids[sel], tri[sel]]), fmt="%d", delimiter=",")
-        e += tri.shape[0]
-    w("*MATERIAL, NAME=STEEL\n*ELASTIC\n")
-    w(f"{material.youngs_modulus / units.MPA:.9g},{material.poisson_ratio:.9g}\n")
-    for i, gp in enumerate(gears):
-        for reg in np.unique(gp.mesh.region):
-            t = gp.web_thickness if int(reg) == REGION_WEB else gp.face_width
-            w(f"** {REGION_NAMES[int(reg)]} of gear {i + 1}\n")
-            w(f"*SOLID SECTION, ELSET=G{i + 1}{REGION_LABEL[int(reg)]}, MATERIAL=STEEL\n{t * mm:.9g}\n")
+    node_off, elem_off, ref, rot, n, e = _bodies(out, gears, material)
     for i, gp in enumerate(gears):
         w(f"*NSET, NSET=BORE{i + 1}\n")
         _ids(out, gp.mesh.bore + node_off[i] + 1)
@@ -145,6 +118,43 @@ def write_deck(gears: tuple, material: Material, torque: float, contact_stiffnes
     if soft_start > 0:
         w(f"*STEP, INC=100\n{static}*CHANGE SURFACE BEHAVIOR, INTERACTION=FLANK\n{law.format(k)}{prints}*END STEP\n")
     return out.getvalue(), DeckNumbers(tuple(node_off), tuple(elem_off), ref, rot, n + 2, e, 2.0 if soft_start > 0 else 1.0)
+
+
+def _bodies(out, gears: tuple, material: Material) -> tuple:
+    """Write both gears' nodes, the driven gear's reference and rotation nodes, the elements by
+    region, the material and the sections; (node offsets, element offsets, reference node,
+    rotation node, nodes of the gears, elements)."""
+    mm = units.MM_PER_M
+    w = out.write
+    w("*NODE, NSET=NALL\n")
+    node_off, elem_off = [], []
+    n = e = 0
+    for gp in gears:
+        node_off.append(n)
+        xy = placed_points(gp) * mm
+        ids = np.arange(n + 1, n + 1 + xy.shape[0])
+        np.savetxt(out, np.column_stack([ids, xy, np.zeros(len(ids))]), fmt="%d,%.9f,%.9f,%.1f")
+        n += xy.shape[0]
+    ref, rot = n + 1, n + 2
+    a2 = gears[1].centre
+    w(f"{ref},{a2[0] * mm:.9f},{a2[1] * mm:.9f},0.0\n{rot},{a2[0] * mm:.9f},{a2[1] * mm:.9f},0.0\n")
+    for i, gp in enumerate(gears):
+        elem_off.append(e)
+        tri = gp.mesh.triangles + node_off[i] + 1
+        ids = np.arange(e + 1, e + 1 + tri.shape[0])
+        for reg in np.unique(gp.mesh.region):
+            sel = gp.mesh.region == reg
+            w(f"*ELEMENT, TYPE=CPS6, ELSET=G{i + 1}{REGION_LABEL[int(reg)]}\n")
+            np.savetxt(out, np.column_stack([ids[sel], tri[sel]]), fmt="%d", delimiter=",")
+        e += tri.shape[0]
+    w("*MATERIAL, NAME=STEEL\n*ELASTIC\n")
+    w(f"{material.youngs_modulus / units.MPA:.9g},{material.poisson_ratio:.9g}\n")
+    for i, gp in enumerate(gears):
+        for reg in np.unique(gp.mesh.region):
+            t = gp.web_thickness if int(reg) == REGION_WEB else gp.face_width
+            w(f"** {REGION_NAMES[int(reg)]} of gear {i + 1}\n")
+            w(f"*SOLID SECTION, ELSET=G{i + 1}{REGION_LABEL[int(reg)]}, MATERIAL=STEEL\n{t * mm:.9g}\n")
+    return node_off, elem_off, ref, rot, n, e
 
 
 def _ids(out, ids) -> None:

@@ -160,5 +160,10 @@ def test_tip_edge_radius_refused_where_it_has_no_meaning():
             tip_edge(s, model, bad)
     with pytest.raises(SceneError, match="--tip-edge-radius.*ltca only"):
         study.reference(s, solver="calculix", tip_edge_radius=0.035)
+    # the peer's options with the LTCA, and a name that is no option, refused the same way
+    with pytest.raises(SceneError, match="--flank-size.*calculix only"):
+        study.reference(s, flank_size=0.1)
+    with pytest.raises(SceneError, match="--flank-sise.*not an option of reference"):
+        study.reference(s, flank_sise=0.1)
     e = tip_edge(s, model, 0.035e-3)
     assert e.law_radius == pytest.approx(R_LAW, rel=1e-3) and e.face_width == pytest.approx(17.0 * units.MM)
