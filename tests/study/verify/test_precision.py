@@ -92,12 +92,16 @@ def test_static_study_and_failed_run_kept(paper_solid_scene, paper_solid_model, 
 
 def test_stability_suite_subset_ends_ok_or_named():
     """Stiff and extreme scenes (solid bodies, no FE): every run ends bounded and plausible or
-    with a failure that names its cause, time and step; never a silent NaN."""
+    with a failure that names its cause, time and step; never a silent NaN. On a 30/30-tooth
+    pair of module 3 (60 teeth against the Table 1 pair's 134): the integrators' method choice
+    solves the eigenproblems of the linearised pair, whose cost grows with the cube of the
+    teeth (about 4 s of CPU against 30 s), and ending bounded or named does not depend on them."""
     import re
 
     from study.verify import stability as S
     names = ["contact stiffness x100", "no damping", "teeth 100x lighter", "zero torque", "overload x10"]
-    ds = S.run_suite(solid_scene(), duration=0.002, methods=("explicit", "implicit alpha=-0.1", "LSODA"),
+    pair = {"gear1.module": 3.0, "gear1.teeth": 30, "gear2.module": 3.0, "gear2.teeth": 30}
+    ds = S.run_suite(solid_scene(**pair), duration=0.002, methods=("explicit", "implicit alpha=-0.1", "LSODA"),
                      scipy_wall=1.0, names=names, progress=lambda *a: None)
     assert list(ds["scene"].values) == names
     st = ds["status"].values
