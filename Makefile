@@ -19,6 +19,10 @@ FAST   := not (fe or solver or process or slow)
 run: $(STAMP)
 	$(PY) -m workflows.paper_example -o results/paper_example/paper_example.nc
 
+# one BLAS thread a test process: the two processes fill the two cores, and OpenBLAS's own threads
+# on the small eigenproblems of the step bound and the modes only spin (60 -> 10 s of CPU over three
+# solver test files, benchmarks/README.md); set OPENBLAS_NUM_THREADS to override
+test: export OPENBLAS_NUM_THREADS ?= 1
 test: $(STAMP)
 	$(VENV)/bin/ruff check --quiet .
 	$(PY) -m pytest -q -n $(JOBS) --dist loadscope --no-loadscope-reorder
