@@ -110,11 +110,10 @@ def reference(scene: Scene, step: float | None = None, max_time: float | None = 
             other = [s for s, names in REFERENCE_OPTIONS.items() if name in names]
             raise SceneError("--" + name.replace("_", "-"), f"applies to --solver {other[0]} only" if other else
                              f"not an option of reference; its options: {sorted(sum(REFERENCE_OPTIONS.values(), ()))}")
-    if solver == "ltca":
-        edge_m = _tip_edge_m(scene, options.get("tip_edge_radius"))      # refused before any work
-        angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
-        return _ltca_reference(scene, angles, max_time, progress, edge_m)
+    edge_m = _tip_edge_m(scene, options.get("tip_edge_radius"))      # refused before any work
     angles = static_angles(scene, step, REFERENCE_MEMORY_FACTOR)
+    if solver == "ltca":
+        return _ltca_reference(scene, angles, max_time, progress, edge_m)
     return _calculix_reference(scene, angles, max_time, progress, options)
 
 

@@ -161,10 +161,3 @@ def linearize(model: Model, rim1: float, rim2: float, phi: np.ndarray, all_teeth
 def at_equilibrium(model: Model, eq) -> LinearSystem:
     """`linearize` at a loaded equilibrium (`solver.mbs.equilibria.Equilibrium`)."""
     return linearize(model, eq.rim1, eq.rim2, eq.phi)
-
-
-def linearizations(model: Model, torque: float, positions: int = 12) -> list[LinearSystem]:
-    """The pair linearised at its loaded equilibria under ``torque`` [N·m] (1 N·m if zero) at
-    ``positions`` driver angles across one angular pitch (`solver.mbs.equilibria`)."""
-    from solver.mbs.equilibria import loaded_equilibria
-    return [at_equilibrium(model, eq) for eq in loaded_equilibria(model, torque, positions)]

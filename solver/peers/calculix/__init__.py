@@ -167,11 +167,11 @@ def ste_sweep(gears: tuple, pair: PairGeometry, material: Material, angles, torq
     te = np.empty(angles.size)
     wall, cpu = np.empty(angles.size), np.empty(angles.size)
     start = start_approach(gears, material, torque)
+    deck = _Deck(gears, meshes, pair, material, torque, settings, limit)
     for a, th1 in enumerate(angles):
         t0 = time.perf_counter()
         if starts is not None:
             start = float(starts[a])
-        deck = _Deck(gears, meshes, pair, material, torque, settings, limit)
         res, s, used = deck.solve(a, th1, start)
         # the ground spring took ground * U3 of the torque: back to the full torque along the
         # pair's secant stiffness (a correction of order 1e-4 of the start error)
