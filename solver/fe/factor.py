@@ -208,9 +208,9 @@ def arc_gram(Yt: np.ndarray, start: np.ndarray, length: np.ndarray, rows_max: in
     n, m = Yt.shape
     W = np.zeros((n, n))
     live = np.flatnonzero(length > 0)
-    group = np.floor(np.log2(length[live])).astype(np.int64)
-    order = live[np.lexsort((start[live], group))]
-    group = np.floor(np.log2(length[order])).astype(np.int64)
+    by_size = np.floor(np.log2(length[live])).astype(np.int64)
+    sort = np.lexsort((start[live], by_size))
+    order, group = live[sort], by_size[sort]
     with one_blas_thread():                          # the same bits whatever the process's BLAS threads
         i = 0
         while i < order.size:
