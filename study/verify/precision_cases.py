@@ -219,10 +219,11 @@ def static_specs(model: Model, case: StaticCase, tols=(1e-2, 1e-4, 1e-6, 1e-8),
             bad = int(np.sum(r.iterations < 0))
             return r.te, int(np.sum(np.abs(r.iterations))), int(bad > 0), f"not converged at {bad} angles" if bad else "ok"
         specs.append(Spec("static Newton", math.nan, tol, run))
-    dt_b, _w = stable_time_step(model, case.torque)
     if model.coupled:       # no implicit integrator; the transient at the production step
         alphas = ()
         dt_b, _w = stable_time_step(model, case.torque, implicit_dampers=implicit_dampers_apply(model))
+    else:
+        dt_b, _w = stable_time_step(model, case.torque)
     dt_out, t_end = slow_ramp_window(angles, case.angle_step, case.speed, case.ramp)
     L = (case.speed, case.ramp, case.torque, case.ramp, t_end)
 
