@@ -141,10 +141,13 @@ LIGHT = {"gear2.body.web_thickness": 8.0, "gear2.body.holes": 4, "gear2.body.hol
 def compiled_call(kernel):
     """A compiled function that calls ``kernel`` with the arguments it is given and returns what
     it returns: a kernel that only other kernels call is compiled without its Python wrapper,
-    so a test reaches its machine code through a compiled caller, as the loops do."""
-    import numba
+    so a test reaches its machine code through a compiled caller, as the loops do. The caller
+    names the kernel's own arguments (numba inlines a kernel marked ``inline="always"`` into its
+    caller, which it cannot do through ``*args``)."""
+    import inspect
 
-    @numba.njit
-    def call(*args):
-        return kernel(*args)
-    return call
+    import numba
+    names = ", ".join(inspect.signature(kernel.py_func).parameters)
+    space = {"kernel": kernel}
+    exec(f"def call({names}):\n    return kernel({names})\n", space)
+    return numba.njit(space["call"])

@@ -105,7 +105,7 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
     a = np.array(rows, dtype=float).reshape(-1, 6)
     gap = np.maximum(a[:, 4], 0.0)
     for i in range(a.shape[0]):
-        gap[i] += flank_deviation(gp[0], a[i, 2])[0] + flank_deviation(gp[1], a[i, 3])[0]
+        gap[i] += flank_deviation(gp, 0, a[i, 2])[0] + flank_deviation(gp, 1, a[i, 3])[0]
     if pp.size > L.N_PAIR_PAR:
         gap -= error_approach(model, theta1, theta2, a[:, 0].astype(int), a[:, 1].astype(int))
     return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int))

@@ -275,7 +275,7 @@ def pitch_point_stiffness(model: Model, force: float, windup=(0.0, 0.0)) -> np.n
         phi = (abs(force) * h / k) ** (1.0 / n)
         c = h**2 / (n * k * phi ** (n - 1.0)) - windup[g]
         if gp[g, L.CLOC_ON]:
-            c = c + local_compliance.py_func(gp[g], u)[0]
+            c = c + local_compliance.py_func(gp, g, u)[0]
         if not np.all(c > 0):
             raise ValueError(f"windup: gear {g + 1}'s body wind-up {windup[g]:.4g} m/N is more than its tooth springs "
                              f"hold at the pitch point ({float(np.min(c + windup[g])):.4g} m/N)")

@@ -58,7 +58,7 @@ def test_the_model_table_interpolates_the_deviation():
     slope = 8e-6 / math.radians(4.0)                              # the steeper segment [m/rad]
     assert gp[1, L.DEV_NEG] == pytest.approx(2e-6, abs=slope * h)  # the sampled low point (a kink between nodes)
     for deg, um in ((16.0, 4.0), (18.0, 1.0), (22.0, 2.0), (24.0, 6.0), (5.0, 4.0), (40.0, 6.0)):
-        dev, _ = flank_deviation(gp[1], math.radians(deg))
+        dev, _ = flank_deviation(gp, 1, math.radians(deg))
         assert dev == pytest.approx(um * 1e-6, abs=slope * h / 4 + 1e-12), deg
 
 

@@ -14,6 +14,15 @@ plain Python (``kernel.py_func``) down to its innermost callees. The stepping lo
 the GIL (``nogil=True``), so that a progress bar can follow them from another thread. Column
 indices of the arrays are in `layout`.
 
+Every kernel also takes numpy's error model (``error_model="numpy"``): a division by zero
+gives inf or nan (which the loops' finite-state guard reports) instead of raising
+ZeroDivisionError. The same arithmetic otherwise, to the bit; but without the raising branch
+numba can drop the reference counts of the arrays a kernel holds (an atomic operation each,
+through a call): with it, the contact search and its pre-search counted references to their
+arrays at every call, a third of the paper model's time step. For the same reason the contact
+search's helpers are inlined into it (``inline="always"``, `gearmesh.pair_contacts`): numba
+keeps the counts of every array live across a call of a compiled function.
+
 The stepping loops (`explicit`, `explicit_coupled`, `implicit`) and the static sweep (`statics`)
 all find the contacts with `gearmesh.mesh_contacts`, which reads the flanks' profile deviations
 (gear_par DEV_*, `solver.modification`), the local compliances in series with the contact
@@ -113,8 +122,10 @@ def njit(**options):
     folder; every kernel module decorates with it. numba fixes a function's cache location when
     it is decorated, so the folder is set for that moment and the user's setting restored.
     With ``no_cpython_wrapper=True`` the dispatcher guards Python calls (`python_calls`).
-    numba itself is imported here, not when the package is (`layout` is plain constants)."""
+    numba itself is imported here, not when the package is (`layout` is plain constants).
+    The error model is numpy's unless a kernel says otherwise (see the module docstring)."""
     import numba
+    options.setdefault("error_model", "numpy")
 
     def decorate(fn):
         user = numba.config.CACHE_DIR

@@ -32,7 +32,7 @@ import numpy as np
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
-from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
+from solver.mbs.kernels.gearmesh import generalized_forces, pair_contacts
 from solver.mbs.kernels.mechanics import (
     arrowhead_accelerations,
     dissipation_power,
@@ -72,7 +72,10 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     gpk = kick_gear_par(gp, dt, imex)
     theta2, w2 = hub[L.POS, L.H_TH2], hub[L.RATE, L.H_TH2]
     th1, w1, acc1, tl = drive(0.0, par, table)
-    nc, npair = mesh_contacts((th1, theta2, w1, w2), phi, dphi, geo, (rec, pairs))
+    # the contact search with the model's parts as arguments of their own (`gearmesh.pair_contacts`)
+    buf = (rec, pairs)
+    dev, ser, err, fric = mdl[5]
+    nc, npair = pair_contacts((th1, theta2, w1, w2), phi, dphi, geo, buf, dev, ser, err, fric)
     nact = initial_set(ws.tset, teeth, pairs, npair, tz2)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     a2, s1, r1 = arrowhead_accelerations(q, act, nact, gpk, acc)
@@ -110,7 +113,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
             if i < tz2:
                 vpred[i] -= cr1 * dw_b
         # contacts; activate the teeth the pre-search finds
-        nc, npair = mesh_contacts((th1, theta2, w1, w2p), phi, vpred, geo, (rec, pairs))
+        nc, npair = pair_contacts((th1, theta2, w1, w2p), phi, vpred, geo, buf, dev, ser, err, fric)
         n_old = nact
         nact = activate(ws.tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):
@@ -118,8 +121,11 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
             vpred[act[a]] = 0.0
         for i in range(q.shape[0]):
             q[i] = 0.0
-        # (implicit dampers: at the rates the first kick ended with, where the second starts)
-        generalized_forces(rec, nc, phi, dphi if imex else vpred, act, nact, kphi, gp, tl, q)
+        # (implicit dampers: at the rates the first kick ended with, where the second starts;
+        # chosen apart from the calls: a conditional inside a call's arguments makes numba copy,
+        # and so reference-count, every array argument before it, each step)
+        rates = dphi if imex else vpred
+        generalized_forces(rec, nc, phi, rates, act, nact, kphi, gp, tl, q)
         a2, s1, r1 = arrowhead_accelerations(q, act, nact, gpk, acc)
         react = s1 * acc1 + r1
         # second half kick
@@ -134,7 +140,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
                 q[2 + i] -= gp[1 if i >= tz2 else 0, L.C_PHI] * (dphi[i] - v0)
         # one-sided driver torques where the speed ramp ends on this instant
         p_in_left = (s1 * driver_acc_left(t, speed, ramp) + r1) * w1 + tl * w2
-        p_d = dissipation_power(dphi if imex else vpred, act, nact, mdl, rec, nc)
+        p_d = dissipation_power(rates, act, nact, mdl, rec, nc)
         status, nact = end_step(ws, teeth, nc, npair, nact, tz2, (p_in_left, react * w1 + tl * w2, p_d), par, status)
         if imex:    # the next first kick: its accelerations with the dampers at the new rates
             a2, _s, _r = arrowhead_accelerations(q, act, nact, gpk, acc)

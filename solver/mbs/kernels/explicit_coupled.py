@@ -42,14 +42,14 @@ import numpy as np
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
-from solver.mbs.kernels.gearmesh import generalized_forces, mesh_contacts
+from solver.mbs.kernels.gearmesh import generalized_forces, pair_contacts
 from solver.mbs.kernels.mechanics import dissipation_power, drive, driver_acc_left, kick_gear_par, mesh_energies
 from solver.mbs.kernels.status import OK
 from solver.mbs.kernels.stepping import activate, end_step, initial_set, record_output
 from solver.mbs.kernels.toothcoupling import set_differs, set_energy, set_springs, update_set
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
 def rim_accelerations(q, act, nact, gp, acc, ha):
     """Arrowhead solves of both rims: fills ha[H_R1] (r1''), ha[H_TH2] (theta2'') and the
     teeth's acc. q[0], q[1]: generalised forces on the rims (contacts + body springs)."""
@@ -77,7 +77,7 @@ def rim_accelerations(q, act, nact, gp, acc, ha):
         acc[i] = (q[2 + i] - gp[g, L.I_CPL] * ar) / gp[g, L.I_P]
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
 def body_moments(gp, th1, w1, x, v):
     """Moments [N m] of the body springs and dampers on the driver rim and the driven hub, at
     the body angles x and rates v (columns H_*), driver hub at th1 [rad], w1 [rad/s]."""
@@ -187,7 +187,10 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     mdl_d = (gpd, pp, lp, kphi, ctooth, parts)
     coupled = ctooth.shape[0] > 0
     th1, w1, acc1, tl = drive(0.0, par, table)
-    nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, geo, (rec, pairs))
+    # the contact search with the model's parts as arguments of their own (`gearmesh.pair_contacts`)
+    buf = (rec, pairs)
+    dev, ser, err, fric = parts
+    nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, geo, buf, dev, ser, err, fric)
     ns = np.int64(0)
     if coupled:
         nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2)
@@ -226,7 +229,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         for a in range(nact):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
-        nc, npair = mesh_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, geo, (rec, pairs))
+        nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, geo, buf, dev, ser, err, fric)
         nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2) if coupled else 0
         n_old = nact
         nact = activate(tset, nact, pairs, npair, tz2)
@@ -240,8 +243,11 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
             ke2, pe2 = coupled_energies(mdl, ws, nc, nact, cset, ns, (th1, w1), hub, teeth)
             book[L.B_SWITCH] += ke + pe - ke2 - pe2
         drv = (th1, w1, acc1, tl, acc)
-        # (implicit dampers: at the rates the first kick ended with, where the second starts)
-        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, vp, (phi, dphi if imex else vpred), gpk)
+        # (implicit dampers: at the rates the first kick ended with, where the second starts; chosen
+        # apart from the call: a conditional inside a call's arguments makes numba copy, and so
+        # reference-count, every array in the arguments before it, the work tuples' too, each step)
+        rates = dphi if imex else vpred
+        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, vp, (phi, rates), gpk)
         # second half kick
         for k in range(L.N_HUB):
             v[k] = vh[k] + 0.5 * dt * ha[k]

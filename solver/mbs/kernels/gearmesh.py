@@ -63,7 +63,7 @@ from solver.mbs.kernels.layout import contact_geo, contact_parts, new_contact_bu
 TIP_BLEND = 1e-6
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
 def candidate_pairs(theta1, theta2, gp, pp, out):
     """Pre-search: fill out[n, :] = (gear-1 tooth, gear-2 tooth, side) of pairs that may touch.
 
@@ -108,24 +108,25 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
     return n
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
-def _catmull_rom(row, u, u0, du, first, n):
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+def _catmull_rom(gp, g, u, u0, du, first, n):
     """Value and slope d/du of the cubic Hermite (Catmull-Rom) curve through the n values
-    row[first:first + n] on the grid u0 + i*du: the slope is continuous (Newton in the statics
+    gp[g, first:first + n] (gear_par row g) on the grid u0 + i*du: the slope is continuous (Newton in the statics
     does not chatter across grid nodes) and linear stretches are exact; constant beyond the
-    grid's ends."""
+    grid's ends. (The row by its index, not as a view: a view in the contact search is an
+    array whose references numba counts, with an atomic operation each.)"""
     x = (u - u0) / du
     last = n - 1
     if x <= 0.0:
-        return row[first], 0.0
+        return gp[g, first], 0.0
     if x >= last:
-        return row[first + last], 0.0
+        return gp[g, first + last], 0.0
     i = int(x)
     t = x - i
-    p1 = row[first + i]
-    p2 = row[first + i + 1]
-    m1 = p2 - p1 if i == 0 else 0.5 * (p2 - row[first + i - 1])
-    m2 = p2 - p1 if i + 1 == last else 0.5 * (row[first + i + 2] - p1)
+    p1 = gp[g, first + i]
+    p2 = gp[g, first + i + 1]
+    m1 = p2 - p1 if i == 0 else 0.5 * (p2 - gp[g, first + i - 1])
+    m2 = p2 - p1 if i + 1 == last else 0.5 * (gp[g, first + i + 2] - p1)
     t2 = t * t
     t3 = t2 * t
     dev = (2.0 * t3 - 3.0 * t2 + 1.0) * p1 + (t3 - 2.0 * t2 + t) * m1 + (3.0 * t2 - 2.0 * t3) * p2 + (t3 - t2) * m2
@@ -133,21 +134,21 @@ def _catmull_rom(row, u, u0, du, first, n):
     return dev, dx / du
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
-def flank_deviation(row, u):
-    """Deviation [m] of the flanks of the gear whose gear_par row is ``row`` at roll parameter
-    u, and its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV
-    grid (`_catmull_rom`)."""
-    return _catmull_rom(row, u, row[L.DEV_U0], row[L.DEV_DU], L.DEV0, L.N_DEV)
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+def flank_deviation(gp, g, u):
+    """Deviation [m] of the flanks of gear g (its gear_par row gp[g]) at roll parameter u, and
+    its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV grid
+    (`_catmull_rom`)."""
+    return _catmull_rom(gp, g, u, gp[g, L.DEV_U0], gp[g, L.DEV_DU], L.DEV0, L.N_DEV)
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
-def local_compliance(row, u):
-    """Local compliance [m/N] of the gear whose gear_par row is ``row`` at roll parameter u and
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
+def local_compliance(gp, g, u):
+    """Local compliance [m/N] of gear g (its gear_par row gp[g]) at roll parameter u and
     its slope d c_loc/d u [m/N]: the same Catmull-Rom curve through the CLOC grid (a continuous
     slope: the force term of c_loc's change along the profile has no jump at grid nodes, and
     the slope is the exact derivative of what is read, so the series spring stays conservative)."""
-    return _catmull_rom(row, u, row[L.CLOC_U0], row[L.CLOC_DU], L.CLOC0, L.N_CLOC)
+    return _catmull_rom(gp, g, u, gp[g, L.CLOC_U0], gp[g, L.CLOC_DU], L.CLOC0, L.N_CLOC)
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
@@ -157,7 +158,7 @@ def _tangent_turn(dx, dy, length, kc, ddx, ddy):
     return (dx * ddy - dy * ddx) / (length * length) - kc * (dx * ddx + dy * ddy) / length
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
 def _deviation_gradient(sa, sb, s, centres, trig, ecc, gp):
     """d(da + db)/d(theta1, phi_A, theta2, phi_B) [m] of the flank deviations whose slopes are
     sa, sb [m] per unit roll at the flank-flank contact of side s; centres = (moved base-circle
@@ -208,7 +209,7 @@ def _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp):
     rec[nc, L.C_HB] = hb
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
 def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, friction):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
@@ -271,120 +272,131 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, fric
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
-def pair_contacts(pair, state, phi, dphi, geo, rec, nc, deviations, series, errors, friction):
-    """Detailed search for the candidate pair = (gear-1 tooth k, gear-2 tooth j, side s) at
-    state = (theta1, theta2 [rad], theta1', theta2' [rad/s]) with the tooth rotations phi
-    [rad] and rates dphi [rad/s]; geo = (gear_par, pair_par, law_par). Appends to rec and
-    returns the new number of contacts. Each record holds the penetration, its rate, the
-    force and the gradient G = d delta/d(theta1, phi_k, theta2, phi_j). deviations, series,
-    errors, friction: the model's `ContactParts` (geo[3]) as arguments of their own, so that
-    numba prunes the code of each part that is None (it prunes on an argument's type only).
+def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, friction):
+    """`mesh_contacts` with the model's `ContactParts` (geo[3]) as arguments of their own:
+    deviations, series, errors, friction, so that numba prunes the code of each part that is
+    None (it prunes on an argument's type only); the stepping loops call it so, with the parts
+    taken out of geo once a run. The pre-search (`candidate_pairs`), then the detailed search
+    of each candidate pair (gear-1 tooth k, gear-2 tooth j, side s) at state = (theta1,
+    theta2 [rad], theta1', theta2' [rad/s]) with the tooth rotations phi [rad] and rates dphi
+    [rad/s]. Fills rec (buf = (rec, pairs)) and returns (n_contacts, n_pairs). Each record
+    holds the penetration, its rate, the force and the gradient G = d delta/d(theta1, phi_k,
+    theta2, phi_j).
 
     One function on purpose, its stages (gap bound, the teeth's poses, flank-flank contact,
-    tip corners) marked by comments: split into small kernels, even inlined by numba
-    (``inline="always"``), the same search made the paper model's dynamic step about a fifth
-    dearer (the 0.2 s case 0.50 -> 0.39-0.44 s CPU when joined again, identical results).
+    tip corners) marked by comments, with its helpers inlined by numba (``inline="always"``:
+    the pre-search, the record, the local compliances, the deviations' gradient, the series
+    law): a call of a compiled function that holds arrays makes numba count references to
+    every array live across it (an atomic operation each, a call apart for the error it may
+    return), which cost the step more than the arithmetic (about 90 a step of the paper
+    model, 180 of the compliance model, before). Split into small kernels that were called,
+    the same search made the paper model's dynamic step about a fifth dearer.
     """
-    k, j, side = pair[0], pair[1], pair[2]
     theta1, theta2, w1, w2 = state
     gp, pp, lp, _parts = geo
-    s = float(side)
-    ia = int(gp[0, L.TOOTH0]) + k
-    ib = int(gp[1, L.TOOTH0]) + j
-    pa = phi[ia]
-    pb = phi[ib]
-    # phase 1b: rigid gap bound
-    te = gp[0, L.RB] * theta1 + gp[1, L.RB] * theta2
-    bound = s * te - pp[L.JN_HALF] + abs(pa) * gp[0, L.R_BND] + abs(pb) * gp[1, L.R_BND]
-    if deviations is not None:
-        bound += gp[0, L.DEV_NEG] + gp[1, L.DEV_NEG]
-    if errors is not None:
-        bound += pp[L.E_BOUND]
-    if bound <= 0.0:
-        return nc
-    o1x, o1y = gp[0, L.CX], gp[0, L.CY]
-    o2x, o2y = gp[1, L.CX], gp[1, L.CY]
-    axa = theta1 + gp[0, L.GAMMA0] + k * gp[0, L.PITCH]
-    axb = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
-    # the teeth's centres: off the bearing axes O by the eccentricity (the moment arms stay about O)
-    e1x, e1y, e2x, e2y = 0.0, 0.0, 0.0, 0.0
-    if errors is not None:
-        axa += pp[L.E_EPS + ia]
-        axb += pp[L.E_EPS + ib]
-        c1 = theta1 + gp[0, L.GAMMA0] + pp[L.E_ECC + 1]
-        c2 = theta2 + gp[1, L.GAMMA0] + pp[L.E_ECC + 3]
-        e1x, e1y = pp[L.E_ECC] * math.cos(c1), pp[L.E_ECC] * math.sin(c1)
-        e2x, e2y = pp[L.E_ECC + 2] * math.cos(c2), pp[L.E_ECC + 2] * math.sin(c2)
-    # the sines and cosines of the tooth axes, once for the moved centres, the pivots and the
-    # deviations' gradient
-    ca, sna = math.cos(axa), math.sin(axa)
-    cb, snb = math.cos(axb), math.sin(axb)
-    cax, cay, cpa, spa = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], (ca, sna), axa, pa)
-    cbx, cby, cpb, spb = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], (cb, snb), axb, pb)
-    trig = (ca, sna, cpa, spa, cb, snb, cpb, spb)
-    rba = gp[0, L.RB]
-    rbb = gp[1, L.RB]
-    ba = axa + pa + s * gp[0, L.PSI_B]
-    bb = axb + pb + s * gp[1, L.PSI_B]
-    frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * ca, o1y + e1y + gp[0, L.R_PV] * sna,
-             o2x, o2y, o2x + e2x + gp[1, L.R_PV] * cb, o2y + e2y + gp[1, L.R_PV] * snb)
-    vel = (w1, dphi[ia], w2, dphi[ib])
-    delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
-    if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
-        dg = (0.0, 0.0, 0.0, 0.0)
+    rec, pairs = buf
+    npair = candidate_pairs(theta1, theta2, gp, pp, pairs)
+    nc = np.int64(0)
+    for i in range(npair):
+        k, j, side = pairs[i, 0], pairs[i, 1], pairs[i, 2]
+        s = float(side)
+        ia = int(gp[0, L.TOOTH0]) + k
+        ib = int(gp[1, L.TOOTH0]) + j
+        pa = phi[ia]
+        pb = phi[ib]
+        # phase 1b: rigid gap bound
+        te = gp[0, L.RB] * theta1 + gp[1, L.RB] * theta2
+        bound = s * te - pp[L.JN_HALF] + abs(pa) * gp[0, L.R_BND] + abs(pb) * gp[1, L.R_BND]
         if deviations is not None:
-            da, sa = flank_deviation(gp[0], ua)
-            db, sb = flank_deviation(gp[1], ub)
-            delta -= da + db
-            dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
-        if delta > 0.0 and nc < rec.shape[0]:
-            ser = (0.0, (0.0, 0.0, 0.0, 0.0))
-            if series is not None:
-                c1, s1 = local_compliance(gp[0], ua)
-                c2, s2 = local_compliance(gp[1], ub)
-                ser = (c1 + c2, _deviation_gradient(s1, s2, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
-            # owner A (gear 1)
-            _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg), ser, series,
-                    friction)
-            nc += 1
-        return nc
-    flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
-    u = (ua, ub)
-    for g in range(2):
-        if u[g] > gp[g, L.U_HI]:
-            # tip corner of gear g against the other gear's flank (owner: the flank's gear)
-            f = 1 - g
-            cx, cy, rb, b = flanks[g]
-            qx, qy = tip_corner(cx, cy, rb, b, s, gp[g, L.U_HI])
-            cx, cy, rb, b = flanks[f]
-            d, uf, mx, my = point_flank(qx, qy, cx, cy, rb, b, s)
+            bound += gp[0, L.DEV_NEG] + gp[1, L.DEV_NEG]
+        if errors is not None:
+            bound += pp[L.E_BOUND]
+        if bound <= 0.0:
+            continue
+        o1x, o1y = gp[0, L.CX], gp[0, L.CY]
+        o2x, o2y = gp[1, L.CX], gp[1, L.CY]
+        axa = theta1 + gp[0, L.GAMMA0] + k * gp[0, L.PITCH]
+        axb = theta2 + gp[1, L.GAMMA0] + j * gp[1, L.PITCH]
+        # the teeth's centres: off the bearing axes O by the eccentricity (the moment arms stay about O)
+        e1x, e1y, e2x, e2y = 0.0, 0.0, 0.0, 0.0
+        if errors is not None:
+            axa += pp[L.E_EPS + ia]
+            axb += pp[L.E_EPS + ib]
+            c1 = theta1 + gp[0, L.GAMMA0] + pp[L.E_ECC + 1]
+            c2 = theta2 + gp[1, L.GAMMA0] + pp[L.E_ECC + 3]
+            e1x, e1y = pp[L.E_ECC] * math.cos(c1), pp[L.E_ECC] * math.sin(c1)
+            e2x, e2y = pp[L.E_ECC + 2] * math.cos(c2), pp[L.E_ECC + 2] * math.sin(c2)
+        # the sines and cosines of the tooth axes, once for the moved centres, the pivots and the
+        # deviations' gradient
+        ca, sna = math.cos(axa), math.sin(axa)
+        cb, snb = math.cos(axb), math.sin(axb)
+        cax, cay, cpa, spa = moved_center(o1x + e1x, o1y + e1y, gp[0, L.R_PV], (ca, sna), axa, pa)
+        cbx, cby, cpb, spb = moved_center(o2x + e2x, o2y + e2y, gp[1, L.R_PV], (cb, snb), axb, pb)
+        trig = (ca, sna, cpa, spa, cb, snb, cpb, spb)
+        rba = gp[0, L.RB]
+        rbb = gp[1, L.RB]
+        ba = axa + pa + s * gp[0, L.PSI_B]
+        bb = axb + pb + s * gp[1, L.PSI_B]
+        frame = (o1x, o1y, o1x + e1x + gp[0, L.R_PV] * ca, o1y + e1y + gp[0, L.R_PV] * sna,
+                 o2x, o2y, o2x + e2x + gp[1, L.R_PV] * cb, o2y + e2y + gp[1, L.R_PV] * snb)
+        vel = (w1, dphi[ia], w2, dphi[ib])
+        delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
+        if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
             dg = (0.0, 0.0, 0.0, 0.0)
-            du = (0.0, 0.0, 0.0, 0.0)
-            blend = 0.0
             if deviations is not None:
-                # the tip's deviation, blended C1 into the flank's beyond the tip (TIP_BLEND)
-                last = L.DEV0 + L.N_DEV - 1
-                slope = (gp[g, last] - gp[g, last - 1]) / gp[g, L.DEV_DU]
-                w = math.exp(-(u[g] - gp[g, L.U_HI]) / TIP_BLEND)
-                d -= gp[g, last] + slope * TIP_BLEND * (1.0 - w) + flank_deviation(gp[f], uf)[0]
-                sw = slope * w
-                if w > 1e-12:
-                    # d delta/dq gains -sw*du/dq, d2 delta/dq2 gains (sw/TIP_BLEND)*(du/dq)(du/dq)^T
-                    du = _deviation_gradient(1.0 if g == 0 else 0.0, 1.0 if g == 1 else 0.0, s,
-                                             (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
-                    dg = (sw * du[0], sw * du[1], sw * du[2], sw * du[3])
-                    blend = sw / TIP_BLEND
-            if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
+                da, sa = flank_deviation(gp, 0, ua)
+                db, sb = flank_deviation(gp, 1, ub)
+                delta -= da + db
+                dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
+            if delta > 0.0 and nc < rec.shape[0]:
                 ser = (0.0, (0.0, 0.0, 0.0, 0.0))
                 if series is not None:
-                    cf, sf = local_compliance(gp[f], uf)
-                    ser = (local_compliance(gp[g], gp[g, L.U_HI])[0] + cf,
-                           _deviation_gradient(sf if f == 0 else 0.0, sf if f == 1 else 0.0, s,
-                                               (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
-                _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
-                        frame, vel, lp, dg, (blend, du), ser, series, friction)
+                    c1, s1 = local_compliance(gp, 0, ua)
+                    c2, s2 = local_compliance(gp, 1, ub)
+                    ser = (c1 + c2, _deviation_gradient(s1, s2, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
+                # owner A (gear 1)
+                _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg), ser, series,
+                        friction)
                 nc += 1
-    return nc
+            continue
+        flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
+        u = (ua, ub)
+        for g in range(2):
+            if u[g] > gp[g, L.U_HI]:
+                # tip corner of gear g against the other gear's flank (owner: the flank's gear)
+                f = 1 - g
+                cx, cy, rb, b = flanks[g]
+                qx, qy = tip_corner(cx, cy, rb, b, s, gp[g, L.U_HI])
+                cx, cy, rb, b = flanks[f]
+                d, uf, mx, my = point_flank(qx, qy, cx, cy, rb, b, s)
+                dg = (0.0, 0.0, 0.0, 0.0)
+                du = (0.0, 0.0, 0.0, 0.0)
+                blend = 0.0
+                if deviations is not None:
+                    # the tip's deviation, blended C1 into the flank's beyond the tip (TIP_BLEND)
+                    last = L.DEV0 + L.N_DEV - 1
+                    slope = (gp[g, last] - gp[g, last - 1]) / gp[g, L.DEV_DU]
+                    w = math.exp(-(u[g] - gp[g, L.U_HI]) / TIP_BLEND)
+                    d -= gp[g, last] + slope * TIP_BLEND * (1.0 - w) + flank_deviation(gp, f, uf)[0]
+                    sw = slope * w
+                    if w > 1e-12:
+                        # d delta/dq gains -sw*du/dq, d2 delta/dq2 gains (sw/TIP_BLEND)*(du/dq)(du/dq)^T
+                        ta, tb = (1.0, 0.0) if g == 0 else (0.0, 1.0)
+                        du = _deviation_gradient(ta, tb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
+                        dg = (sw * du[0], sw * du[1], sw * du[2], sw * du[3])
+                        blend = sw / TIP_BLEND
+                if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
+                    ser = (0.0, (0.0, 0.0, 0.0, 0.0))
+                    if series is not None:
+                        cf, sf = local_compliance(gp, f, uf)
+                        sfa, sfb = (sf, 0.0) if f == 0 else (0.0, sf)
+                        ser = (local_compliance(gp, g, gp[g, L.U_HI])[0] + cf,
+                               _deviation_gradient(sfa, sfb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
+                    own = 1.0 if f == 0 else -1.0
+                    _record(rec, nc, (d, qx, qy, mx, my), own, (k, j, (2.0 + g) * s), frame, vel, lp, dg, (blend, du), ser,
+                            series, friction)
+                    nc += 1
+    return nc, npair
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -394,17 +406,11 @@ def mesh_contacts(state, phi, dphi, geo, buf):
     law_par, `ContactParts`) (`contact_geo`), buf = (rec, pairs) (`new_contact_buffer`).
     Returns (n_contacts, n_pairs); pairs holds the candidates. Compiled once for each
     combination of the parts a model has (the types of geo[3])."""
-    rec, pairs = buf
-    gp, pp, _lp, parts = geo
-    npair = candidate_pairs(state[0], state[1], gp, pp, pairs)
-    nc = np.int64(0)    # not a literal 0: numba would compile pair_contacts once more for Literal[int](0)
-    for i in range(npair):
-        nc = pair_contacts(pairs[i], state, phi, dphi, geo, rec, nc, parts.deviations, parts.series, parts.errors,
-                           parts.friction)
-    return nc, npair
+    parts = geo[3]
+    return pair_contacts(state, phi, dphi, geo, buf, parts.deviations, parts.series, parts.errors, parts.friction)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, inline="always")
 def generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, torque2, q):
     """Generalised forces: q[0] on theta1, q[1] on theta2, q[2 + i] on tooth i.
 

@@ -46,7 +46,7 @@ def set_stiffness(ctooth, lst, n, ks):
             ks[a, b] = ks[a, n + b]
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
 def set_moment(ks, lst, n, phi, a):
     """Elastic moment [N m] on the a-th tooth of the set: (K_S phi_S)[a] (its spring pushes
     back with minus this)."""

@@ -157,11 +157,9 @@ def test_contact_search_variant_holds_the_parts_the_model_has(present):
         rec, pairs = new_contact_buffer()
         nc, npair = mesh_contacts(state, phi, dphi, geo, (rec, pairs))
         ref = np.zeros_like(rec)
-        n = 0
         with python_calls():     # the search's source and its wrapper-less callees as plain Python
-            for i in range(npair):
-                n = pair_contacts.py_func(pairs[i], state, phi, dphi, geo, ref, n, *parts)
-        assert n == nc >= 1
+            n, npair_ref = pair_contacts.py_func(state, phi, dphi, geo, (ref, np.zeros_like(pairs)), *parts)
+        assert n == nc >= 1 and npair_ref == npair
         np.testing.assert_array_equal(rec[:nc], ref[:nc])
         kinds |= {abs(int(rec[c, L.C_KIND])) for c in range(nc)}
         if "friction" in present:
