@@ -19,9 +19,11 @@ gives inf or nan (which the loops' finite-state guard reports) instead of raisin
 ZeroDivisionError. The same arithmetic otherwise, to the bit; but without the raising branch
 numba can drop the reference counts of the arrays a kernel holds (an atomic operation each,
 through a call): with it, the contact search and its pre-search counted references to their
-arrays at every call, a third of the paper model's time step. For the same reason the contact
-search's helpers are inlined into it (``inline="always"``, `gearmesh.pair_contacts`): numba
-keeps the counts of every array live across a call of a compiled function.
+arrays at every call, a third of the paper model's time step. For the same reason the
+coupled loop's force helpers are inlined into `explicit_coupled.coupled_forces` (``inline=
+"always"``: numba keeps the counts of every array live across a call of a compiled function,
+and that helper holds the loop's work tuples), and the contact search is called once a step
+(`gearmesh.pair_contacts`), not once a candidate pair.
 
 The stepping loops (`explicit`, `explicit_coupled`, `implicit`) and the static sweep (`statics`)
 all find the contacts with `gearmesh.mesh_contacts`, which reads the flanks' profile deviations

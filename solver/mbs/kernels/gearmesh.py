@@ -63,7 +63,7 @@ from solver.mbs.kernels.layout import contact_geo, contact_parts, new_contact_bu
 TIP_BLEND = 1e-6
 
 
-@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True)
 def candidate_pairs(theta1, theta2, gp, pp, out):
     """Pre-search: fill out[n, :] = (gear-1 tooth, gear-2 tooth, side) of pairs that may touch.
 
@@ -108,7 +108,7 @@ def candidate_pairs(theta1, theta2, gp, pp, out):
     return n
 
 
-@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True)
 def _catmull_rom(gp, g, u, u0, du, first, n):
     """Value and slope d/du of the cubic Hermite (Catmull-Rom) curve through the n values
     gp[g, first:first + n] (gear_par row g) on the grid u0 + i*du: the slope is continuous (Newton in the statics
@@ -134,7 +134,7 @@ def _catmull_rom(gp, g, u, u0, du, first, n):
     return dev, dx / du
 
 
-@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True)
 def flank_deviation(gp, g, u):
     """Deviation [m] of the flanks of gear g (its gear_par row gp[g]) at roll parameter u, and
     its slope d deviation / d u [m]: a cubic Hermite (Catmull-Rom) curve through the DEV grid
@@ -142,7 +142,7 @@ def flank_deviation(gp, g, u):
     return _catmull_rom(gp, g, u, gp[g, L.DEV_U0], gp[g, L.DEV_DU], L.DEV0, L.N_DEV)
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def local_compliance(gp, g, u):
     """Local compliance [m/N] of gear g (its gear_par row gp[g]) at roll parameter u and
     its slope d c_loc/d u [m/N]: the same Catmull-Rom curve through the CLOC grid (a continuous
@@ -158,7 +158,7 @@ def _tangent_turn(dx, dy, length, kc, ddx, ddy):
     return (dx * ddy - dy * ddx) / (length * length) - kc * (dx * ddx + dy * ddy) / length
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _deviation_gradient(sa, sb, s, centres, trig, ecc, gp):
     """d(da + db)/d(theta1, phi_A, theta2, phi_B) [m] of the flank deviations whose slopes are
     sa, sb [m] per unit roll at the flank-flank contact of side s; centres = (moved base-circle
@@ -209,7 +209,7 @@ def _friction(rec, nc, f, px, py, nx, ny, frame, vel, lp):
     rec[nc, L.C_HB] = hb
 
 
-@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
 def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, friction):
     """Write contact record nc (`layout` C_* columns) for hit = (penetration [m], contact
     point x, y [m], normal x, y); own = +1 when gear 1 owns the normal (its flank, or the
@@ -284,18 +284,19 @@ def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, fricti
     theta2, phi_j).
 
     One function on purpose, its stages (gap bound, the teeth's poses, flank-flank contact,
-    tip corners) marked by comments, with its helpers inlined by numba (``inline="always"``:
-    the pre-search, the record, the local compliances, the deviations' gradient, the series
-    law): a call of a compiled function that holds arrays makes numba count references to
-    every array live across it (an atomic operation each, a call apart for the error it may
-    return), which cost the step more than the arithmetic (about 90 a step of the paper
-    model, 180 of the compliance model, before). Split into small kernels that were called,
-    the same search made the paper model's dynamic step about a fifth dearer.
+    tip corners) marked by comments, and one call a step: numba counts the references to every
+    array a kernel holds across a call of a compiled function (an atomic operation each, at
+    its entry and its exit), so a search called once per candidate pair, through
+    `mesh_contacts`, counted them some 60 times a step, a third of the paper model's step.
+    Split into small kernels, the same search made the paper model's dynamic step about a
+    fifth dearer.
     """
     theta1, theta2, w1, w2 = state
     gp, pp, lp, _parts = geo
     rec, pairs = buf
     npair = candidate_pairs(theta1, theta2, gp, pp, pairs)
+    # the gears' rows by index, not as literals (numba would compile a callee once per literal)
+    gear1, gear2 = np.int64(0), np.int64(1)
     nc = np.int64(0)
     for i in range(npair):
         k, j, side = pairs[i, 0], pairs[i, 1], pairs[i, 2]
@@ -344,15 +345,15 @@ def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, fricti
         if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
             dg = (0.0, 0.0, 0.0, 0.0)
             if deviations is not None:
-                da, sa = flank_deviation(gp, 0, ua)
-                db, sb = flank_deviation(gp, 1, ub)
+                da, sa = flank_deviation(gp, gear1, ua)
+                db, sb = flank_deviation(gp, gear2, ub)
                 delta -= da + db
                 dg = _deviation_gradient(sa, sb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
             if delta > 0.0 and nc < rec.shape[0]:
                 ser = (0.0, (0.0, 0.0, 0.0, 0.0))
                 if series is not None:
-                    c1, s1 = local_compliance(gp, 0, ua)
-                    c2, s2 = local_compliance(gp, 1, ub)
+                    c1, s1 = local_compliance(gp, gear1, ua)
+                    c2, s2 = local_compliance(gp, gear2, ub)
                     ser = (c1 + c2, _deviation_gradient(s1, s2, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
                 # owner A (gear 1)
                 _record(rec, nc, (delta, px, py, nx, ny), 1.0, (k, j, 1.0 * s), frame, vel, lp, dg, (0.0, dg), ser, series,

@@ -132,7 +132,7 @@ SERIES_NEG_CHECK = -SERIES_NEG_LIMIT * math.exp(-SERIES_NEG_LIMIT)
 SERIES_TOL3 = 2.0 ** -56
 
 
-@njit(cache=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cfunc_wrapper=True)
 def series_contact(delta, c_loc, k, m1):
     """(delta_c [m], F_e [N], dF_e/d delta [N/m]) of the contact law in series with the local
     compliance c_loc [m/N] at the penetration delta [m] of both; c_loc = 0: the plain law,
