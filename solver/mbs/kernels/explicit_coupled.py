@@ -100,14 +100,14 @@ def coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, teeth, gpk):
     """Forces and accelerations for the contacts ws.rec[:nc], the tooth rotations teeth[0] and
     the rates teeth[1] of their root dampers, the body angles hub[POS] and rates v (columns
     H_*): fills q, the teeth's and the bodies' accelerations (row ACC of hub, and of the teeth
-    through ``acc``); drv = (theta1 [rad], theta1' [rad/s], theta1'' [rad/s²], load torque
-    [N m], acc); gpk: gear_par of the arrowhead solve (with implicit tooth-root dampers the
+    teeth[2]); drv = (theta1 [rad], theta1' [rad/s], theta1'' [rad/s²], load torque [N m])
+    (scalars: a tuple holding an array, built each step, would be reference-counted); gpk: gear_par of the arrowhead solve (with implicit tooth-root dampers the
     tooth inertia I_P + dt/4 c_phi, `explicit.py`). Returns (driver torque [N m], body-spring
     moment on the driver rim [N m])."""
     gp, kphi = mdl[0], mdl[3]
     q, act = ws.q, ws.tset[L.T_ACT]
-    th1, w1, acc1, tl, acc = drv
-    phi = teeth[0]
+    th1, w1, acc1, tl = drv
+    phi, acc = teeth[0], teeth[2]
     q[:] = 0.0
     generalized_forces(ws.rec, nc, phi, teeth[1], act, nact, kphi, gp, 0.0, q)
     set_springs(cset, ns, kphi, phi, q)
@@ -186,6 +186,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
             gpd[g, L.C_PHI] = 0.0
     mdl_d = (gpd, pp, lp, kphi, ctooth, parts)
     coupled = ctooth.shape[0] > 0
+    newl, incand = cset.newl, tset[L.T_INCAND]
     th1, w1, acc1, tl = drive(0.0, par, table)
     # the contact search with the model's parts as arguments of their own (`gearmesh.pair_contacts`)
     buf = (rec, pairs)
@@ -193,14 +194,18 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, geo, buf, dev, ser, err, fric)
     ns = np.int64(0)
     if coupled:
-        nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2)
+        nn = new_candidates(newl, incand, pairs, npair, tz2)
         ns = update_set(cset, ns, nn, phi, dphi, dphi)
         tset[L.T_INCAND, :] = 0
     nact = initial_set(tset, teeth, pairs, npair, tz2)
     for i in range(dphi.shape[0]):     # (a loop: an array copied into a slice compiles numba's shape-error message)
         vpred[i] = dphi[i]
-    drv = (th1, w1, acc1, tl, acc)
-    react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, v, (phi, dphi), gpk)
+    react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, (th1, w1, acc1, tl), hub, v, (phi, dphi, acc), gpk)
+    # the arrays the steps pass on, taken out once: a view, an attribute or a tuple of arrays made
+    # in the loop is reference-counted each step (an atomic operation each), and a conditional
+    # inside a call's arguments copies, and counts, every array before it. The forces' tooth
+    # rates: with implicit dampers the rates the first kick ended with, where the second starts
+    kicked = (phi, dphi if imex else vpred, acc)
     ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, (th1, w1), hub, teeth)
     book[L.B_E0] = ke + pe
     book[L.B_P_IN] = react * w1 + tl * v[L.H_H2]
@@ -230,7 +235,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
         nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, geo, buf, dev, ser, err, fric)
-        nn = new_candidates(cset.newl, tset[L.T_INCAND], pairs, npair, tz2) if coupled else 0
+        nn = new_candidates(newl, incand, pairs, npair, tz2) if coupled else 0
         n_old = nact
         nact = activate(tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):
@@ -242,12 +247,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
             ns = update_set(cset, ns, nn, phi, dphi, vpred)
             ke2, pe2 = coupled_energies(mdl, ws, nc, nact, cset, ns, (th1, w1), hub, teeth)
             book[L.B_SWITCH] += ke + pe - ke2 - pe2
-        drv = (th1, w1, acc1, tl, acc)
-        # (implicit dampers: at the rates the first kick ended with, where the second starts; chosen
-        # apart from the call: a conditional inside a call's arguments makes numba copy, and so
-        # reference-count, every array in the arguments before it, the work tuples' too, each step)
-        rates = dphi if imex else vpred
-        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, drv, hub, vp, (phi, rates), gpk)
+        react, mb1 = coupled_forces(mdl, ws, nc, nact, cset, ns, (th1, w1, acc1, tl), hub, vp, kicked, gpk)
         # second half kick
         for k in range(L.N_HUB):
             v[k] = vh[k] + 0.5 * dt * ha[k]
