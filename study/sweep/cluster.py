@@ -91,10 +91,13 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
     n = workers or os.cpu_count() or 1
     # the scheduler's HTTP endpoint (health, metrics; no dashboard) moves to a free port when
     # 8787 is taken, another user's cluster say: not worth a warning
+    # the workers' own log lines are connection news (a heartbeat that found the scheduler gone
+    # while a stopped sweep closes it, on a loaded machine): what a point did, failed or lost
+    # is recorded from its future, with its cause, so nothing below CRITICAL goes to the terminal
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Port 8787 is already in use", category=UserWarning)
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR, env=dict(WORKER_ENV))
+                               silence_logs=logging.CRITICAL, env=dict(WORKER_ENV))
     with cluster, Client(cluster) as client:
         client.register_plugin(stop_kernels_plugin(), name="lightgear-stop-kernels")
         yield client
