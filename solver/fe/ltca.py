@@ -134,7 +134,7 @@ def error_approach(model: Model, theta1: float, theta2: float, tooth1, tooth2) -
 
 @dataclass(frozen=True)
 class TipEdge:
-    """A rounded tip edge of both gears, for the local law of tip-corner contacts (SI)."""
+    """A rounded tip edge of a gear, for the local law of its tip-corner contacts (SI)."""
 
     radius: float           # tip edge radius [m]
     youngs_modulus: float   # Pa
@@ -148,19 +148,30 @@ class TipEdge:
         return edge_compliance(self.youngs_modulus, self.face_width, self.law_radius, self.radius, flank_radius)
 
 
-def corner_compliance(model: Model, mp: MeshPoints, edge: TipEdge | None) -> np.ndarray:
+def gear_edges(edge) -> tuple:
+    """(gear 1's, gear 2's) `TipEdge` or None of ``edge``: one TipEdge (both gears), a pair, or None."""
+    if edge is None or isinstance(edge, TipEdge):
+        return edge, edge
+    e1, e2 = edge
+    return e1, e2
+
+
+def corner_compliance(model: Model, mp: MeshPoints, edge) -> np.ndarray:
     """(n,) compliance [m/N] each candidate contact of ``mp`` adds in series with the law: the
-    tip edge's (`TipEdge.compliance`) on tip-corner contacts, measured on the mating flank's
-    radius of curvature rb*u at its roll; 0 on flank contacts and without ``edge``."""
+    tip edge's (`TipEdge.compliance`) of the corner's gear on tip-corner contacts, measured on
+    the mating flank's radius of curvature rb*u at its roll; 0 on flank contacts and where the
+    corner's gear has no edge. ``edge``: a `TipEdge` of both gears, (gear 1's, gear 2's) each a
+    TipEdge or None, or None."""
     out = np.zeros(mp.gap.size)
-    if edge is None:
+    e1, e2 = gear_edges(edge)
+    if e1 is None and e2 is None:
         return out
     rb1, rb2 = model.base_radii
     for i, kind in enumerate(mp.kind):
-        if kind == 2:        # gear 1's corner on gear 2's flank
-            out[i] = edge.compliance(rb2 * mp.u2[i])
-        elif kind == 3:      # gear 2's corner on gear 1's flank
-            out[i] = edge.compliance(rb1 * mp.u1[i])
+        if kind == 2 and e1 is not None:        # gear 1's corner on gear 2's flank
+            out[i] = e1.compliance(rb2 * mp.u2[i])
+        elif kind == 3 and e2 is not None:      # gear 2's corner on gear 1's flank
+            out[i] = e2.compliance(rb1 * mp.u1[i])
     return out
 
 
@@ -241,13 +252,14 @@ class LTCAResult:
 
 
 def ltca_sweep(model: Model, compliance: tuple, angles, torque: float, k_con: float | None = None,
-               m1: float | None = None, edge: TipEdge | None = None) -> LTCAResult:
+               m1: float | None = None, edge=None) -> LTCAResult:
     """Solve the loaded contact at every driver angle [rad] under ``torque`` [N·m] on gear 2.
 
     ``compliance`` = (BodyCompliance of gear 1, of gear 2), or (None, None) for rigid bodies
     (only the contact law deforms). The contact law defaults to the model's. ``edge``: the tip
-    edge radius of both gears; tip-corner contacts then carry its compliance in series with the
-    law (`corner_compliance`); None: the flanks' law alone.
+    edge of both gears (a `TipEdge`) or of each ((gear 1's, gear 2's), TipEdge or None);
+    tip-corner contacts then carry its compliance in series with the law (`corner_compliance`);
+    None: the flanks' law alone.
     """
     k_con = float(model.law_par[L.K_CON]) if k_con is None else k_con
     m1 = float(model.law_par[L.M1]) if m1 is None else m1

@@ -253,6 +253,7 @@ def with_flank_deviations(model: Model, modifications, errors) -> Model:
         if mod is not None:
             mod.check(g.u_form, g.u_tip, name)
         sample_deviation(mod, g.u_form, g.u_tip, gp[i])
+    write_tip_edges(model, [0.0 if mod is None else mod.tip_edge_radius for mod in modifications], gp)
     for name, e, g in zip(("gear1", "gear2"), errors, geos):
         if e is not None:
             # limited to 0.1 module: a few % of a pitch, well inside the pre-search margin
@@ -264,6 +265,23 @@ def with_flank_deviations(model: Model, modifications, errors) -> Model:
                        for gi, mod, e in zip(inputs[:2], modifications, errors)) + tuple(inputs[2:])
     return dataclasses.replace(model, gear_par=gp, pair_par=pp, law_par=model.law_par.copy(), k_phi=model.k_phi.copy(),
                                tooth_compliance=model.tooth_compliance.copy(), inputs=inputs)
+
+
+def write_tip_edges(model: Model, radii, gp: np.ndarray) -> None:
+    """Write the EDGE_* columns of ``gp`` (the model's gear_par or its copy) for the tip edge radii
+    (gear 1, gear 2) [m] (`solver.tip_edge.edge_columns`; 0: a sharp corner). The edge's law takes
+    the model's Young's modulus, the narrower face and the contact law's radius of curvature."""
+    from solver.tip_edge import edge_columns, law_radius
+    if not any(radii):
+        gp[:, L.EDGE_INV_R:L.EDGE_INV_R + 3] = 0.0
+        return
+    if len(model.inputs) < 4:
+        raise ValueError("gearN.modification.tip_edge_radius: the model has no material to take the edge's law from")
+    material = model.inputs[3]
+    b = min(g.spec.face_width for g in model.geometry)
+    law_r = law_radius(*model.geometry)
+    for i, r in enumerate(radii):
+        gp[i, L.EDGE_INV_R:L.EDGE_INV_R + 3] = edge_columns(float(r), material.youngs_modulus, b, law_r)
 
 
 def _check_compliance(gi: GearInput, z: int, name: str) -> None:

@@ -54,15 +54,17 @@ def peer_estimate(n_decks: int, settings: CalculixSettings, module: float):
 
 
 def peer_gears(scene: Scene) -> tuple:
-    """(PeerGear, PeerGear) of the scene: geometry, body and profile modification of each gear."""
+    """(PeerGear, PeerGear) of the scene: geometry, body, profile modification and tip edge
+    radius of each gear."""
     model = geometry_model(scene)
     out = []
     for g, gi in zip(model.geometry, model.inputs[:2]):
-        dev = None
+        dev, edge = None, 0.0
         if gi.modification is not None:
             mod, uf, ut = gi.modification, g.u_form, g.u_tip
             dev = (lambda u, mod=mod, uf=uf, ut=ut: mod.deviation(u, uf, ut))
-        out.append(PeerGear(g, gi.body, dev))
+            edge = mod.tip_edge_radius
+        out.append(PeerGear(g, gi.body, dev, edge))
     return tuple(out), model
 
 

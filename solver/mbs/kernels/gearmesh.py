@@ -33,6 +33,12 @@ fixed penetration, so the recorded gradient is G - F_e**2/(2F) * d c_loc/dq (exa
 contacts; a tip corner takes the roll derivative of the flank contact it continues, its own
 differs by the corner's slide along the flank, a small energy leak where c_loc's slope is).
 
+A rounded tip edge (gear_par EDGE_*, with the local compliances only): a tip corner of a gear
+whose EDGE_INV_R > 0 meets the mating flank as a cylinder of the edge radius, far narrower than
+the two flanks the contact law was fitted to, and adds the compliance of that narrower Hertz
+patch to its c_loc (`edge_compliance`); it changes with the mating flank's roll as its radius of
+curvature does, and that slope joins the flank's c_loc slope in the gradient (conservative).
+
 Pitch errors and eccentricity (`solver.pitch_errors`, the pair_par block E_*, present only when a
 gear has them): each tooth's axis turns by its offset eps about the teeth's centre, which sits
 off the bearing axis by the eccentricity; the flanks follow exactly, the moment arms of the hub
@@ -148,6 +154,21 @@ def local_compliance(row, u):
     slope: the force term of c_loc's change along the profile has no jump at grid nodes, and
     the slope is the exact derivative of what is read, so the series spring stays conservative)."""
     return _catmull_rom(row, u, row[L.CLOC_U0], row[L.CLOC_DU], L.CLOC0, L.N_CLOC)
+
+
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+def edge_compliance(row, rb_f, u_f):
+    """Compliance [m/N] that the rounded tip edge of the gear whose gear_par row is ``row`` adds
+    in series with the contact law where it meets the mating flank (base radius ``rb_f`` [m]) at
+    roll u_f, and its slope d c/d u_f [m/N]: the edge against the flank's radius of curvature
+    rho = rb_f*u_f has the equivalent radius 1/(1/r + 1/rho), and
+    c = EDGE_A ln(EDGE_R_LAW/r_eq) (`solver.identify.weber.edge_compliance`), 0 where negative."""
+    rho = rb_f * max(u_f, 1e-6)
+    x = row[L.EDGE_INV_R] + 1.0 / rho      # 1/r_eq [1/m]
+    c = row[L.EDGE_A] * math.log(row[L.EDGE_R_LAW] * x)
+    if c <= 0.0:
+        return 0.0, 0.0
+    return c, -row[L.EDGE_A] / (x * rho * max(u_f, 1e-6))
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
@@ -271,13 +292,13 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, fric
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
-def pair_contacts(pair, state, phi, dphi, geo, rec, nc, deviations, series, errors, friction):
+def pair_contacts(pair, state, phi, dphi, geo, rec, nc, deviations, series, errors, friction, edges):
     """Detailed search for the candidate pair = (gear-1 tooth k, gear-2 tooth j, side s) at
     state = (theta1, theta2 [rad], theta1', theta2' [rad/s]) with the tooth rotations phi
     [rad] and rates dphi [rad/s]; geo = (gear_par, pair_par, law_par). Appends to rec and
     returns the new number of contacts. Each record holds the penetration, its rate, the
     force and the gradient G = d delta/d(theta1, phi_k, theta2, phi_j). deviations, series,
-    errors, friction: the model's `ContactParts` (geo[3]) as arguments of their own, so that
+    errors, friction, edges: the model's `ContactParts` (geo[3]) as arguments of their own, so that
     numba prunes the code of each part that is None (it prunes on an argument's type only).
 
     One function on purpose, its stages (gap bound, the teeth's poses, flank-flank contact,
@@ -378,7 +399,12 @@ def pair_contacts(pair, state, phi, dphi, geo, rec, nc, deviations, series, erro
                 ser = (0.0, (0.0, 0.0, 0.0, 0.0))
                 if series is not None:
                     cf, sf = local_compliance(gp[f], uf)
-                    ser = (local_compliance(gp[g], gp[g, L.U_HI])[0] + cf,
+                    cg = local_compliance(gp[g], gp[g, L.U_HI])[0]
+                    if edges is not None and gp[g, L.EDGE_INV_R] > 0.0:
+                        ce, se = edge_compliance(gp[g], rb, uf)
+                        cg += ce
+                        sf += se
+                    ser = (cg + cf,
                            _deviation_gradient(sf if f == 0 else 0.0, sf if f == 1 else 0.0, s,
                                                (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
                 _record(rec, nc, (d, qx, qy, mx, my), 1.0 if f == 0 else -1.0, (k, j, (2.0 + g) * s),
@@ -400,7 +426,7 @@ def mesh_contacts(state, phi, dphi, geo, buf):
     nc = np.int64(0)    # not a literal 0: numba would compile pair_contacts once more for Literal[int](0)
     for i in range(npair):
         nc = pair_contacts(pairs[i], state, phi, dphi, geo, rec, nc, parts.deviations, parts.series, parts.errors,
-                           parts.friction)
+                           parts.friction, parts.edges)
     return nc, npair
 
 
