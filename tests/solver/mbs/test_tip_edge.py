@@ -1,0 +1,197 @@
+"""A rounded tip edge (``gearN.modification.tip_edge_radius``, `solver.tip_edge`): the scene key's
+checks, the default model's tip-corner contacts with the edge's compliance in series (the kernel
+against the series law and the Hertz edge compliance computed on their own), nothing changed
+by a sharp corner, and the default model against the LTCA with the edge."""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from helpers import small_scene, solid_scene
+
+from solver.identify.weber import edge_compliance as weber_edge
+from solver.mbs.kernels import layout as L
+from solver.mbs.kernels import python_calls
+from solver.mbs.kernels.gearmesh import contact_parts, mesh_contacts, new_contact_buffer, pair_contacts
+from solver.mbs.model import sample_local_compliance, with_flank_deviations
+from solver.modification import ProfileModification
+from solver.tip_edge import edge_limit, law_radius, tangent_length, tip_round
+from study import SceneError
+
+
+def _series_force(delta: float, c: float, k: float, m1: float) -> float:
+    """F [N] with (F/k)^(1/m1) + c F = delta [m] (bisection, independent of the kernel's Halley)."""
+    lo, hi = 0.0, k * delta**m1 if c >= 0 else 10 * k * delta**m1
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if (mid / k) ** (1 / m1) + c * mid < delta:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def _with_series(m):
+    """The plain model with a local compliance on both gears (-5e-11 to 1e-9 m/N along the
+    profile): the series law the tip edge joins, without the FE."""
+    gp = m.gear_par.copy()
+    for g in range(2):
+        u = np.linspace(gp[g, L.U_LO], gp[g, L.U_HI], 8)
+        x = (u - u[0]) / (u[-1] - u[0])
+        sample_local_compliance((u, -5e-11 + 1.05e-9 * x**3), gp[g, L.U_LO], gp[g, L.U_HI], gp[g], "gear")
+    return dataclasses.replace(m, gear_par=gp)
+
+
+def _edged(m, r1: float, r2: float):
+    return with_flank_deviations(m, (ProfileModification(tip_edge_radius=r1), ProfileModification(tip_edge_radius=r2)),
+                                 (None, None))
+
+
+def _records(m, deg: float, approach: float, python: bool = False):
+    """Contact records (sorted by teeth and kind) of model ``m`` at driver angle ``deg``, rigid
+    teeth ``approach`` [m] into the mesh; ``python``: the search run as plain Python."""
+    th1 = math.radians(deg)
+    state = (th1, m.theta2_for_te(th1, m.backlash_offset + approach), 0.0, 0.0)
+    phi = np.zeros(m.n_teeth)
+    geo = (m.gear_par, m.pair_par, m.law_par, contact_parts(m.gear_par, m.pair_par, m.law_par))
+    rec, pairs = new_contact_buffer()
+    nc, npair = mesh_contacts(state, phi, phi, geo, (rec, pairs))
+    if python:
+        ref = np.zeros_like(rec)
+        n = 0
+        with python_calls():
+            for i in range(npair):
+                n = pair_contacts.py_func(pairs[i], state, phi, phi, geo, ref, n, *geo[3])
+        assert n == nc
+        np.testing.assert_array_equal(ref[:nc], rec[:nc])
+    out = rec[:nc]
+    return out[np.lexsort((out[:, L.C_KIND], out[:, L.C_TOOTH2], out[:, L.C_TOOTH1]))]
+
+
+def test_scene_key_checked_before_any_work():
+    """Negative, not finite, a round wider than half the tip land, and an edge under a model
+    without the series law are refused naming the field; 0 is a sharp corner (no modification)."""
+    s = solid_scene(**{"coupling.model": "compliance"})
+    for bad, why in ((-0.05, ">= 0"), (float("nan"), "finite"), (float("inf"), "finite"), ("a", "number"),
+                     (0.9, "tip land")):
+        with pytest.raises(SceneError, match=f"gear2.modification.tip_edge_radius.*{why}"):
+            s.replace(**{"gear2.modification.tip_edge_radius": bad})
+    for model in ("paper", "body-torsion"):
+        with pytest.raises(SceneError, match=f"gear1.modification.tip_edge_radius.*{model} model"):
+            s.replace(**{"gear1.modification.tip_edge_radius": 0.1, "coupling.model": model})
+    assert s.modification_spec(1) is None
+    assert s.replace(**{"gear1.modification.tip_edge_radius": 0.1}).modification_spec(1).tip_edge_radius == pytest.approx(1e-4)
+    # the limit: the two rounds of a tooth (module 1.5, 67 teeth) meet on its 1.15 mm tip land
+    g = s.geometry(1)
+    limit, why = edge_limit(g)
+    assert "tip land" in why and limit * tangent_length(g, 1.0) == pytest.approx(g.tip_radius * g.tip_half_angle)
+
+
+def test_round_is_tangent_to_the_flank_and_the_tip_circle():
+    """The round's centre lies r inside the tip circle and r from the flank along the flank's
+    normal at the tangent point; the tip tangent point is on the tip circle, both tangent points
+    about r tan((90 deg - alpha_a)/2) from the sharp corner."""
+    g = solid_scene().geometry(1)
+    r = 0.1e-3
+    t = tip_round(g, r)
+    c = np.array(t.centre)
+    assert np.hypot(*c) == pytest.approx(g.tip_radius - r, rel=1e-12)
+    assert np.hypot(*t.tip_point) == pytest.approx(g.tip_radius, rel=1e-12)
+    p = np.array(g.flank_point(t.u_flank, 1))
+    tau = g.psi_base - t.u_flank
+    assert np.allclose(t.flank_point, p, atol=1e-15, rtol=0)
+    v = c - p
+    assert np.hypot(*v) == pytest.approx(r, rel=1e-9)
+    assert abs(v @ [math.cos(tau), math.sin(tau)]) < 1e-9 * r       # along the flank's normal
+    corner = np.array(g.flank_point(g.u_tip, 1))
+    for q in (t.flank_point, t.tip_point):
+        assert np.hypot(*(np.array(q) - corner)) == pytest.approx(tangent_length(g, r), rel=0.02)
+    with pytest.raises(ValueError, match="tip edge radius"):
+        tip_round(g, 2 * edge_limit(g)[0])
+
+
+def test_sharp_corner_changes_nothing(paper_solid_model):
+    """r = 0 on both gears: the same gear_par and no edge part in the contact search (its code
+    left out), the same contact records to the bit; an edge on gear 2 alone leaves every contact
+    but gear 2's tip corners alone."""
+    m = _with_series(paper_solid_model)
+    m0 = _edged(m, 0.0, 0.0)
+    np.testing.assert_array_equal(m0.gear_par, m.gear_par)
+    assert contact_parts(m0.gear_par, m0.pair_par, m0.law_par).edges is None
+    m2 = _edged(m, 0.0, 0.1e-3)
+    assert contact_parts(m2.gear_par, m2.pair_par, m2.law_par).edges is m2.gear_par
+    # the plain model (no series law) has no edge part either: it refuses the key in a scene
+    p2 = _edged(paper_solid_model, 0.1e-3, 0.1e-3)
+    assert contact_parts(p2.gear_par, p2.pair_par, p2.law_par).edges is None
+    for deg in (3.9, 4.3, 1.2):
+        a, b = _records(m, deg, 12e-6), _records(m2, deg, 12e-6)
+        np.testing.assert_array_equal(_records(m0, deg, 12e-6), a)
+        same = np.abs(a[:, L.C_KIND]) != 3
+        np.testing.assert_array_equal(a[same], b[same])
+        assert np.all(b[~same, L.C_FORCE] < a[~same, L.C_FORCE])
+
+
+@pytest.mark.parametrize("deg", [3.9, 4.3])
+def test_corner_contact_is_the_series_law_with_the_edge(paper_solid_model, deg):
+    """At single contact, 12 um into the mesh, the neighbours' tip corners touch; with tip edges of
+    0.1 mm (gear 1) and 0.05 mm (gear 2) each corner contact's c_loc grows by the Hertz edge
+    compliance 2/(pi E b) ln(R_law / r_eq) against the mating flank's radius of curvature there
+    (read from the contact point: sqrt(|P - O|^2 - rb^2)), and its force is the law in series
+    with that compliance at the recorded penetration; the compiled search equals its plain-Python
+    source."""
+    m = _with_series(paper_solid_model)
+    radii = (0.1e-3, 0.05e-3)
+    me = _edged(m, *radii)
+    a, b = _records(m, deg, 12e-6), _records(me, deg, 12e-6, python=True)
+    corners = np.abs(b[:, L.C_KIND]) != 1
+    assert corners.any() and (~corners).any()
+    E = m.inputs[3].youngs_modulus
+    width = min(g.spec.face_width for g in m.geometry)
+    law_r = law_radius(*m.geometry)
+    k, m1 = m.law_par[L.K_CON], m.law_par[L.M1]
+    for ra, rb in zip(a, b):
+        kind = int(abs(rb[L.C_KIND]))
+        assert ra[L.C_DELTA] == rb[L.C_DELTA]
+        if kind == 1:
+            np.testing.assert_array_equal(ra, rb)
+            continue
+        g, f = kind - 2, 3 - kind                   # the corner's gear, the flank's
+        centre = m.gear_par[f, [L.CX, L.CY]]
+        rho = math.sqrt(np.hypot(*(rb[[L.C_PX, L.C_PY]] - centre)) ** 2 - m.base_radii[f] ** 2)
+        extra = weber_edge(E, width, law_r, radii[g], rho)
+        assert extra > 0.5e-9
+        assert rb[L.C_CLOC] - ra[L.C_CLOC] == pytest.approx(extra, rel=1e-6)
+        assert rb[L.C_FORCE] == pytest.approx(_series_force(rb[L.C_DELTA], rb[L.C_CLOC], k, m1), rel=1e-9)
+        assert rb[L.C_FORCE] < ra[L.C_FORCE]
+
+
+# the teeth coupled through coarse FE bodies (the model closest to the LTCA), 300 N·m: beside the
+# single pair the neighbours' tip corners carry a third of the load and more
+FE_SPRINGS = {"coupling.model": "compliance", "fe.mesh_size": 1.8, "quasi_static.torque": 300.0}
+SINGLE = (8.5, 9.0, 13.5)
+
+
+@pytest.mark.usefixtures("private_fe_cache")
+def test_default_and_ltca_agree_with_a_tip_edge():
+    """The small pair at 300 N·m with 0.2 mm tip edges: where the corners carry load the edge
+    raises both models' STE by the same amount, so that the default model stays as close to the
+    LTCA (within 0.3 % of the STE) as with sharp corners; in double contact without corner load
+    nothing changes."""
+    from solver.mbs.statics import solve_static
+    from study.scene_model import build_scene_model
+    from study.verify import fe_reference as ref_mod
+    angles = np.radians((0.0, *SINGLE))
+    out = {}
+    for r in (0.0, 0.2):
+        s = small_scene(**FE_SPRINGS, **{f"gear{g}.modification.tip_edge_radius": r for g in (1, 2)})
+        ref, _, _ = ref_mod.reference(s, angles)
+        st = solve_static(build_scene_model(s), angles, 300.0)
+        assert st.converged.all()
+        out[r] = (ref.te - ref.backlash_offset, st.te - ref.backlash_offset, ref.extended)
+    (l0, d0, x0), (l1, d1, x1) = out[0.0], out[0.2]
+    assert x0[0] == 0 and np.all(x0[1:] > 0)
+    assert np.all(x1[1:] > 0) and np.all(x1[1:] < x0[1:])          # the softer corners carry less
+    assert l1[0] == pytest.approx(l0[0], rel=1e-12) and d1[0] == pytest.approx(d0[0], rel=1e-12)
+    rise = (l1 - l0) / l0
+    assert np.all(rise[1:] > 0.003)                                   # the edge matters there ...
+    assert np.all(np.abs((d1 - l1) / l1 - (d0 - l0) / l0) < 0.003)    # ... and both models see it alike
