@@ -146,3 +146,17 @@ def _tip_edge(m: ModificationSection, g: GearGeometry, prefix: str) -> float:
             raise SceneError(f"{prefix}.tip_edge_radius", f"must be below {why}: {limit / units.MM:.4g} mm, got "
                              f"{m.tip_edge_radius:g} mm")
     return r
+
+
+def tip_edge_radii(gears) -> tuple[float, float]:
+    """(gear 1, gear 2) tip edge radius [m] of the scene's gear sections ``gears`` (0: sharp)."""
+    return tuple(gs.modification.tip_edge_radius * units.MM for gs in gears)
+
+
+def tip_edge_attrs(radii) -> dict:
+    """The archive attribute ``tip_edge_radius_mm`` (gear 1, gear 2) [mm] of tip edge radii
+    (gear 1, gear 2) [m]; none where both corners are sharp (the archives of sharp-cornered
+    pairs stay as they were)."""
+    if not any(radii):
+        return {}
+    return {"tip_edge_radius_mm": np.array([r * units.MM_PER_M for r in radii])}

@@ -22,6 +22,8 @@ from solver.peers.calculix import (
     default_settings,
     ste_sweep,
 )
+from solver.peers.calculix.mesh import round_size
+from study.modification import tip_edge_attrs, tip_edge_radii
 from study.scene import Scene, SceneError
 from study.scene_model import geometry_model
 
@@ -127,6 +129,10 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
              "mesh_order": float(scene.gear2.teeth), "hole_order": float(scene.gear2.body.holes),
              "static_torque_N_m": float(torque),
              "element_type": "CPS6 (6-node plane-stress triangle; thickness = face width, web thickness in the web)",
+             **tip_edge_attrs(tip_edge_radii((scene.gear1, scene.gear2))),
+             **({"tip_edge_mesh_size_mm": np.array([round_size(g.edge_radius, s.sizes.flank) * units.MM_PER_M
+                                                    if g.edge_radius > 0 else 0.0 for g in gears])}
+                if any(g.edge_radius > 0 for g in gears) else {}),
              "flank_mesh_size_mm": s.sizes.flank * units.MM_PER_M, "fillet_mesh_size_mm": s.sizes.fillet * units.MM_PER_M,
              "body_mesh_size_mm": s.sizes.body * units.MM_PER_M,
              "contact_stiffness_MPa_per_mm": s.contact_stiffness / units.MPA * units.MM,

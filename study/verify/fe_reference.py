@@ -22,6 +22,7 @@ from solver.fe.ltca import ltca_sweep, teeth_in_mesh
 from study.archive.run_variables import opening_attrs
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
+from study.modification import tip_edge_attrs, tip_edge_radii
 from study.scene import Scene, SceneError, opening_text
 from study.scene_model import geometry_model, static_angles
 
@@ -134,7 +135,7 @@ def edge_radii(scene: Scene, tip_edge_radius: float | None = None) -> tuple[floa
     ``gearN.modification.tip_edge_radius`` (0: a sharp corner)."""
     if tip_edge_radius is not None:
         return float(tip_edge_radius), float(tip_edge_radius)
-    return tuple(scene.gear(g).modification.tip_edge_radius * units.MM for g in (1, 2))
+    return tip_edge_radii((scene.gear1, scene.gear2))
 
 
 def scene_edges(scene: Scene, model, tip_edge_radius: float | None = None):
@@ -144,15 +145,6 @@ def scene_edges(scene: Scene, model, tip_edge_radius: float | None = None):
     if not any(radii):
         return None
     return tuple(tip_edge(scene, model, r) if r > 0 else None for r in radii)
-
-
-def tip_edge_attrs(radii) -> dict:
-    """The archive attribute ``tip_edge_radius_mm`` (gear 1, gear 2) [mm] of tip edge radii
-    (gear 1, gear 2) [m]; none where both corners are sharp (the archives of sharp-cornered
-    pairs stay as they were)."""
-    if not any(radii):
-        return {}
-    return {"tip_edge_radius_mm": np.array([r * units.MM_PER_M for r in radii])}
 
 
 def tip_corner_law(radii) -> str:
