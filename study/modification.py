@@ -4,7 +4,10 @@ conversion to `solver.modification.ProfileModification` (SI, roll parameters in 
 A relief starts at one of: a roll angle (deg), a diameter (mm) or a length along the path of
 contact from the flank end (mm: the tip relief's length is rb*(u_tip - u_start), the root
 relief's rb*(u_start - u_form)). A deviation table gives its positions as roll angles or
-diameters, and the deviations in um (positive: material removed).
+diameters, and the deviations in um (positive: material removed). ``tip_edge_radius`` (mm; 0: a
+sharp corner) rounds the tip corners (`solver.tip_edge`): below the module and the tip land's
+share of each round (`solver.tip_edge.edge_limit`); the models without a series contact law
+refuse it (`study.scene_checks.check_tip_edges`).
 """
 from __future__ import annotations
 
