@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import small_scene, solid_scene
+from helpers import series_force, small_scene, solid_scene
 
 from solver.identify.weber import edge_compliance as weber_edge
 from solver.mbs.kernels import layout as L
@@ -17,18 +17,6 @@ from solver.mbs.model import sample_local_compliance, with_flank_deviations
 from solver.modification import ProfileModification
 from solver.tip_edge import edge_limit, law_radius, tangent_length, tip_round
 from study import SceneError
-
-
-def _series_force(delta: float, c: float, k: float, m1: float) -> float:
-    """F [N] with (F/k)^(1/m1) + c F = delta [m] (bisection, independent of the kernel's Halley)."""
-    lo, hi = 0.0, k * delta**m1 if c >= 0 else 10 * k * delta**m1
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if (mid / k) ** (1 / m1) + c * mid < delta:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
 
 
 def _with_series(m):
@@ -161,7 +149,7 @@ def test_corner_contact_is_the_series_law_with_the_edge(paper_solid_model, deg):
         extra = weber_edge(E, width, law_r, radii[g], rho)
         assert extra > 0.5e-9
         assert rb[L.C_CLOC] - ra[L.C_CLOC] == pytest.approx(extra, rel=1e-6)
-        assert rb[L.C_FORCE] == pytest.approx(_series_force(rb[L.C_DELTA], rb[L.C_CLOC], k, m1), rel=1e-9)
+        assert rb[L.C_FORCE] == pytest.approx(series_force(rb[L.C_DELTA], rb[L.C_CLOC], k, m1), rel=1e-9)
         assert rb[L.C_FORCE] < ra[L.C_FORCE]
 
 
