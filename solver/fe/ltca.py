@@ -34,7 +34,12 @@ meets the mating flank as a cylinder of that radius, far narrower than the two f
 was fitted to, and its contact carries the extra compliance of that narrower Hertz patch
 (`solver.identify.weber.edge_compliance`) in series. Where the corners carry load (a single
 pair beside the extended contact of its neighbours: a third of the load at 100 N·m on the
-paper pair) the STE there depends on it.
+paper pair) the STE there depends on it. A gear whose model has a rounded tip (gear_par
+EDGE_*, the scene's ``gearN.modification.tip_edge_radius``) also has the round's geometry: its
+flank ends at the round's tangent roll and its corner contact is the round's circle, whose
+centre lies r inside that point (`_corner_flank`, as the contact search of the models); a
+`TipEdge` without it (`lightgear reference --tip-edge-radius` on a sharp-cornered scene) is the
+compliance alone, on the sharp corner's geometry.
 
 Units: SI (m, N, rad, N·m).
 """
@@ -79,6 +84,9 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
     alpha = pp[L.ALPHA]
     rb1, rb2 = gp[0, L.RB], gp[1, L.RB]
     line = model.pair.center_distance * math.sin(alpha)
+    # a rounded tip (gear_par EDGE_*): the flank ends at the round's tangent roll, beyond it the
+    # round meets the mating flank (as in `solver.mbs.kernels.gearmesh.pair_contacts`)
+    hi = [gp[g, L.EDGE_U] if gp[g, L.EDGE_INV_R] > 0 else gp[g, L.U_HI] for g in range(2)]
     rows = []
     for k, j, side in pairs[:n]:
         if side != 1:
@@ -89,26 +97,45 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
         u2 = (line - rb1 * u1) / rb2
         b1 = ax1 + gp[0, L.PSI_B]
         b2 = ax2 + gp[1, L.PSI_B]
-        if u1 <= gp[0, L.U_HI] and u2 <= gp[1, L.U_HI]:
+        if u1 <= hi[0] and u2 <= hi[1]:
             if u1 >= gp[0, L.U_LO] and u2 >= gp[1, L.U_LO]:
                 rows.append((k, j, u1, u2, 0.0, 1))
-        elif u1 > gp[0, L.U_HI]:
-            qx, qy = tip_corner(gp[0, L.CX], gp[0, L.CY], rb1, b1, 1.0, gp[0, L.U_HI])
-            d, uf, _, _ = point_flank(qx, qy, gp[1, L.CX], gp[1, L.CY], rb2, b2, 1.0)
-            if gp[1, L.U_LO] <= uf <= gp[1, L.U_HI] and -d < max_gap:
+        elif u1 > hi[0]:
+            d, uf = _corner_flank(gp, 0, b1, b2)
+            if gp[1, L.U_LO] <= uf <= hi[1] and -d < max_gap:
                 rows.append((k, j, gp[0, L.U_HI], uf, -d, 2))
         else:
-            qx, qy = tip_corner(gp[1, L.CX], gp[1, L.CY], rb2, b2, 1.0, gp[1, L.U_HI])
-            d, uf, _, _ = point_flank(qx, qy, gp[0, L.CX], gp[0, L.CY], rb1, b1, 1.0)
-            if gp[0, L.U_LO] <= uf <= gp[0, L.U_HI] and -d < max_gap:
+            d, uf = _corner_flank(gp, 1, b2, b1)
+            if gp[0, L.U_LO] <= uf <= hi[0] and -d < max_gap:
                 rows.append((k, j, uf, gp[1, L.U_HI], -d, 3))
     a = np.array(rows, dtype=float).reshape(-1, 6)
     gap = np.maximum(a[:, 4], 0.0)
     for i in range(a.shape[0]):
-        gap[i] += flank_deviation(gp[0], a[i, 2])[0] + flank_deviation(gp[1], a[i, 3])[0]
+        # a round's own deviation is in its centre (`_corner_flank`)
+        own = [not (a[i, 5] == 2 + g and gp[g, L.EDGE_INV_R] > 0) for g in range(2)]
+        gap[i] += own[0] * flank_deviation(gp[0], a[i, 2])[0] + own[1] * flank_deviation(gp[1], a[i, 3])[0]
     if pp.size > L.N_PAIR_PAR:
         gap -= error_approach(model, theta1, theta2, a[:, 0].astype(int), a[:, 1].astype(int))
     return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int))
+
+
+def _corner_flank(gp, g: int, b_g: float, b_f: float) -> tuple[float, float]:
+    """(penetration [m], mating flank's roll [-]) of gear g's tip corner into the other gear's +
+    flank, rigid bodies; b_g, b_f: the flanks' base angles [rad]. A rounded tip (EDGE_INV_R > 0)
+    meets it with its circle: the centre (r plus the deviation inside the flank point at EDGE_U)
+    penetrates r less."""
+    f = 1 - g
+    rb_g, rb_f = gp[g, L.RB], gp[f, L.RB]
+    if gp[g, L.EDGE_INV_R] > 0:
+        ue = gp[g, L.EDGE_U]
+        qx, qy = tip_corner(gp[g, L.CX], gp[g, L.CY], rb_g, b_g, 1.0, ue)
+        off = gp[g, L.EDGE_R] + gp[g, L.EDGE_DEV]
+        qx, qy = qx + off * math.sin(b_g - ue), qy - off * math.cos(b_g - ue)
+        d, uf, _, _ = point_flank(qx, qy, gp[f, L.CX], gp[f, L.CY], rb_f, b_f, 1.0)
+        return d + gp[g, L.EDGE_R], uf
+    qx, qy = tip_corner(gp[g, L.CX], gp[g, L.CY], rb_g, b_g, 1.0, gp[g, L.U_HI])
+    d, uf, _, _ = point_flank(qx, qy, gp[f, L.CX], gp[f, L.CY], rb_f, b_f, 1.0)
+    return d, uf
 
 
 def error_approach(model: Model, theta1: float, theta2: float, tooth1, tooth2) -> np.ndarray:

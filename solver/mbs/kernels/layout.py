@@ -104,14 +104,20 @@ CLOC_U0 = CLOC_ON + 1   # roll parameter of the first grid point [-]
 CLOC_DU = CLOC_ON + 2   # grid step [-]
 CLOC0 = CLOC_ON + 3     # first of the N_CLOC compliances [m/N]
 N_CLOC = 33
-# a rounded tip edge (`solver.tip_edge`; compliance model: the series law): a tip-corner contact of
-# this gear on a mating flank of radius of curvature rho_f carries, in series with the contact law,
+# a rounded tip edge (`solver.tip_edge`; compliance model: the series law): the flank ends at the
+# round's tangent roll EDGE_U, beyond it the tooth meets the mating flank with the round, a circle
+# of radius r whose centre lies EDGE_R + EDGE_DEV inside the flank point at EDGE_U (along its
+# normal), and that contact carries, in series with the contact law (rho_f the mating flank's
+# radius of curvature)
 #   c_edge = EDGE_A * ln(EDGE_R_LAW * (EDGE_INV_R + 1/rho_f)),  0 where that is negative
 # (`solver.identify.weber.edge_compliance`, `gearmesh.edge_compliance`)
 EDGE_INV_R = CLOC0 + N_CLOC  # 1 / tip edge radius [1/m]; 0: a sharp corner (the flanks' law alone)
 EDGE_A = EDGE_INV_R + 1      # 2 / (pi E b) [m/N]
 EDGE_R_LAW = EDGE_INV_R + 2  # equivalent radius of curvature the contact law was fitted to [m]
-N_GEAR_PAR = EDGE_INV_R + 3
+EDGE_R = EDGE_INV_R + 3      # tip edge radius r [m]
+EDGE_U = EDGE_INV_R + 4      # roll parameter of the round's tangent point on the flank [-] (< U_HI)
+EDGE_DEV = EDGE_INV_R + 5    # the flank's deviation (profile modification) at EDGE_U [m]
+N_GEAR_PAR = EDGE_INV_R + 6
 
 # law_par (contact law, eq. 1.3)
 K_CON = 0       # [N/m^m1]

@@ -1,7 +1,8 @@
 """A rounded tip edge (``gearN.modification.tip_edge_radius``, `solver.tip_edge`): the scene key's
-checks, the default model's tip-corner contacts with the edge's compliance in series (the kernel
-against the series law and the Hertz edge compliance computed on their own), nothing changed
-by a sharp corner, and the default model against the LTCA with the edge."""
+checks, the round's geometry, the default model's round contacts (their penetration against the
+round's distance to the mating flank, their force against the series law with the Hertz edge
+compliance, each computed on its own), nothing changed by a sharp corner, and the default model
+against the LTCA with the edge."""
 import dataclasses
 import math
 
@@ -120,37 +121,53 @@ def test_sharp_corner_changes_nothing(paper_solid_model):
 
 
 @pytest.mark.parametrize("deg", [3.9, 4.3])
-def test_corner_contact_is_the_series_law_with_the_edge(paper_solid_model, deg):
-    """At single contact, 12 um into the mesh, the neighbours' tip corners touch; with tip edges of
-    0.1 mm (gear 1) and 0.05 mm (gear 2) each corner contact's c_loc grows by the Hertz edge
-    compliance 2/(pi E b) ln(R_law / r_eq) against the mating flank's radius of curvature there
-    (read from the contact point: sqrt(|P - O|^2 - rb^2)), and its force is the law in series
-    with that compliance at the recorded penetration; the compiled search equals its plain-Python
-    source."""
+def test_round_contact_is_the_series_law_with_the_edge(paper_solid_model, deg):
+    """At single contact, 25 um into the mesh, the neighbours' tips touch; with tip edges of
+    0.1 mm (gear 1) and 0.05 mm (gear 2) each round's contact has the penetration of its circle
+    into the mating flank (checked against the distance of the round's centre, placed from
+    `solver.tip_edge.tip_round`, to a densely sampled flank), its c_loc is the plain corner's plus
+    the Hertz edge compliance 2/(pi E b) ln(R_law / r_eq) against the mating flank's radius of
+    curvature there, and its force is the law in series with that compliance at the recorded
+    penetration; flank contacts below the rounds are unchanged; the compiled search equals its
+    plain-Python source."""
+    from solver.mbs.kernels.gearmesh import local_compliance
     m = _with_series(paper_solid_model)
     radii = (0.1e-3, 0.05e-3)
     me = _edged(m, *radii)
-    a, b = _records(m, deg, 12e-6), _records(me, deg, 12e-6, python=True)
+    th1 = math.radians(deg)
+    th2 = m.theta2_for_te(th1, m.backlash_offset + 25e-6)
+    a, b = _records(m, deg, 25e-6), _records(me, deg, 25e-6, python=True)
     corners = np.abs(b[:, L.C_KIND]) != 1
     assert corners.any() and (~corners).any()
+    flank_a = a[np.abs(a[:, L.C_KIND]) == 1]
+    np.testing.assert_array_equal(flank_a, b[~corners])
     E = m.inputs[3].youngs_modulus
     width = min(g.spec.face_width for g in m.geometry)
     law_r = law_radius(*m.geometry)
     k, m1 = m.law_par[L.K_CON], m.law_par[L.M1]
-    for ra, rb in zip(a, b):
-        kind = int(abs(rb[L.C_KIND]))
-        assert ra[L.C_DELTA] == rb[L.C_DELTA]
-        if kind == 1:
-            np.testing.assert_array_equal(ra, rb)
-            continue
-        g, f = kind - 2, 3 - kind                   # the corner's gear, the flank's
-        centre = m.gear_par[f, [L.CX, L.CY]]
-        rho = math.sqrt(np.hypot(*(rb[[L.C_PX, L.C_PY]] - centre)) ** 2 - m.base_radii[f] ** 2)
+    gp = m.gear_par
+    for rb_ in b[corners]:
+        g = int(abs(rb_[L.C_KIND])) - 2
+        f = 1 - g
+        tooth = (int(rb_[L.C_TOOTH1]), int(rb_[L.C_TOOTH2]))
+        axis = [th + gp[i, L.GAMMA0] + tooth[i] * gp[i, L.PITCH] for i, th in enumerate((th1, th2))]
+
+        def place(i, p):
+            c, s_ = math.cos(axis[i]), math.sin(axis[i])
+            p = np.atleast_2d(p)
+            return np.column_stack([gp[i, L.CX] + c * p[:, 0] - s_ * p[:, 1], gp[i, L.CY] + s_ * p[:, 0] + c * p[:, 1]])
+        centre = place(g, tip_round(m.geometry[g], radii[g]).centre)[0]
+        uu = np.linspace(m.geometry[f].u_form, m.geometry[f].u_tip, 200001)
+        flank = place(f, np.column_stack(m.geometry[f].flank_point(uu, 1)))
+        dist = np.hypot(*(flank - centre).T)
+        n = int(np.argmin(dist))
+        assert rb_[L.C_DELTA] == pytest.approx(radii[g] - dist[n], abs=2e-9)      # 2 nm of 25 um
+        rho = m.base_radii[f] * uu[n]
         extra = weber_edge(E, width, law_r, radii[g], rho)
+        plain = local_compliance.py_func(gp[g], gp[g, L.U_HI])[0] + local_compliance.py_func(gp[f], uu[n])[0]
         assert extra > 0.5e-9
-        assert rb[L.C_CLOC] - ra[L.C_CLOC] == pytest.approx(extra, rel=1e-6)
-        assert rb[L.C_FORCE] == pytest.approx(series_force(rb[L.C_DELTA], rb[L.C_CLOC], k, m1), rel=1e-9)
-        assert rb[L.C_FORCE] < ra[L.C_FORCE]
+        assert rb_[L.C_CLOC] == pytest.approx(plain + extra, rel=1e-5)
+        assert rb_[L.C_FORCE] == pytest.approx(series_force(rb_[L.C_DELTA], rb_[L.C_CLOC], k, m1), rel=1e-9)
 
 
 # the teeth coupled through coarse FE bodies (the model closest to the LTCA), 300 N·m: beside the
@@ -161,10 +178,12 @@ SINGLE = (8.5, 9.0, 13.5)
 
 @pytest.mark.usefixtures("private_fe_cache")
 def test_default_and_ltca_agree_with_a_tip_edge():
-    """The small pair at 300 N·m with 0.2 mm tip edges: where the corners carry load the edge
-    raises both models' STE by the same amount, so that the default model stays as close to the
-    LTCA (within 0.3 % of the STE) as with sharp corners; in double contact without corner load
-    nothing changes."""
+    """The small pair at 300 N·m with 0.2 mm tip edges: where the neighbours' tips carry load
+    the rounds keep them off (the round lies up to 0.15 r = 30 um inside the sharp corner) and
+    raise both models' STE by 4-8 % alike: the default model's difference to the LTCA changes by
+    less than 0.5 % of the STE (measured 0.38 / 0.01 / 0.29 % at 8.5 / 9 / 13.5 deg on this
+    coarse FE mesh; on the paper pair at 100 N·m with 0.1 mm edges it stays within 0.32 %:
+    docs/models.md); in double contact without corner load nothing changes."""
     from solver.mbs.statics import solve_static
     from study.scene_model import build_scene_model
     from study.verify import fe_reference as ref_mod
@@ -185,8 +204,8 @@ def test_default_and_ltca_agree_with_a_tip_edge():
             assert "tip_edge_radius_mm" not in ds.attrs and ds.attrs["tip_corner_law"] == "the flanks' contact law"
     (l0, d0, x0), (l1, d1, x1) = out[0.0], out[0.2]
     assert x0[0] == 0 and np.all(x0[1:] > 0)
-    assert np.all(x1[1:] > 0) and np.all(x1[1:] < x0[1:])          # the softer corners carry less
+    assert np.all(x1[1:] < x0[1:])                                    # the rounds carry less
     assert l1[0] == pytest.approx(l0[0], rel=1e-12) and d1[0] == pytest.approx(d0[0], rel=1e-12)
     rise = (l1 - l0) / l0
-    assert np.all(rise[1:] > 0.003)                                   # the edge matters there ...
-    assert np.all(np.abs((d1 - l1) / l1 - (d0 - l0) / l0) < 0.003)    # ... and both models see it alike
+    assert np.all(rise[1:] > 0.03)                                    # the edge matters there ...
+    assert np.all(np.abs((d1 - l1) / l1 - (d0 - l0) / l0) < 0.005)    # ... and both models see it alike
