@@ -12,10 +12,10 @@ from the base circle's tangent point). Both flanks of every tooth of the gear ca
 * Table: deviation [m] against roll [rad], linear between its points, constant beyond its ends;
   added to the reliefs.
 * Tip edge radius [m]: the tip corner rounded by a circular arc of that radius, tangent to the
-  flank and to the tip circle (0: a sharp corner). Not a deviation of the flank: the contact
-  search keeps the involute to the tip circle and gives a tip-corner contact the compliance of
-  the rounded edge in series with the contact law (gear_par EDGE_*, the compliance model's
-  series law); the CalculiX peer meshes the round.
+  flank and to the tip circle (0: a sharp corner). The contact search ends the flank at the
+  round's tangent point and meets the mating flank with the round's circle beyond it, with the
+  compliance of its narrower Hertz patch in series with the contact law (gear_par EDGE_*, the
+  compliance model's series law; `solver.tip_edge`); the CalculiX peer meshes the round.
 
 The contact search reads it as a table sampled on a fixed roll grid from the form circle to the
 tip (`sample`), through which it passes a cubic with a continuous slope

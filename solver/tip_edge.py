@@ -1,10 +1,14 @@
 """A rounded tip edge: the tip corner of a tooth replaced by a circular arc of radius r, tangent
 to the flank and to the tip circle (SI: m, rad).
 
-The models keep the involute up to the tip circle and give a tip-corner contact the extra
-compliance of the narrower contact patch of such an edge (`solver.identify.weber.edge_compliance`,
-`edge_law`); the CalculiX peer meshes the arc itself (`round_points`, used by
-`solver.fe.mesh.tooth_pieces`).
+The models end the flank at the round's tangent point and meet the mating flank beyond it with
+the round's circle (gear_par EDGE_*: `solver.mbs.kernels.gearmesh.pair_contacts`,
+`solver.fe.ltca.mesh_points`), whose contact carries the extra compliance of its narrower
+Hertz patch (`solver.identify.weber.edge_compliance`, `edge_columns`); the CalculiX peer meshes
+the arc itself (`TipRound.points`, used by `solver.fe.mesh.tooth_pieces`). Against a sharp
+corner the round lies up to r (1/cos(theta/2) - 1) inside it (theta = pi/2 - alpha_a: 0.15 r on
+the paper's pair, 15 um for r = 0.1 mm), which keeps the neighbouring pairs' tips off at single
+contact: a short, steep tip relief.
 
 Geometry of the + flank of a tooth in its frame (`solver.geometry.GearGeometry.flank_point`): the
 flank point P(u) at roll u, t = psi_base - u, has the tangent (cos t, sin t) and the outward
