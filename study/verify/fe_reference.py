@@ -93,9 +93,11 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     ``rigid``: rigid bodies, only the contact law deforms (the closed-form check);
     ``n_u``: profile points per flank of the influence coefficients; ``progress``: a bar on
     stderr (unit: the estimated second) when the run is expected to be long;
-    ``tip_edge_radius`` [m]: both gears' tip corners meet the mating flanks rounded to it
-    (`tip_edge`); None: each gear's ``modification.tip_edge_radius`` (`scene_edges`; 0: under the
-    flanks' contact law)."""
+    ``tip_edge_radius`` [m]: both gears' tip-corner contacts carry the compliance of an edge of
+    that radius (`tip_edge`), on the corners' geometry as the scene has it; None: each gear's
+    ``modification.tip_edge_radius`` (`scene_edges`; 0: under the flanks' contact law). The
+    scene's radius also rounds the corners' geometry (the model's gear_par EDGE_*,
+    `solver.fe.ltca.mesh_points`)."""
     from study import estimate
     qs = scene.quasi_static
     if not qs.torque > 0:
