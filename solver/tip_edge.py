@@ -6,8 +6,8 @@ the round's circle (gear_par EDGE_*: `solver.mbs.kernels.gearmesh.pair_contacts`
 `solver.fe.ltca.mesh_points`), whose contact carries the extra compliance of its narrower
 Hertz patch (`solver.identify.weber.edge_compliance`, `edge_columns`); the CalculiX peer meshes
 the arc itself (`TipRound.points`, used by `solver.fe.mesh.tooth_pieces`). Against a sharp
-corner the round lies up to r (1/cos(theta/2) - 1) inside it (theta = pi/2 - alpha_a: 0.15 r on
-the paper's pair, 15 um for r = 0.1 mm), which keeps the neighbouring pairs' tips off at single
+corner the round lies up to r (1/cos(theta/2) - 1) inside it (theta = pi/2 - alpha_a: 0.19 r on
+the paper's pair, 19 um for r = 0.1 mm), which keeps the neighbouring pairs' tips off at single
 contact: a short, steep tip relief.
 
 Geometry of the + flank of a tooth in its frame (`solver.geometry.GearGeometry.flank_point`): the

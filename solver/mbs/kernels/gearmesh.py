@@ -39,7 +39,7 @@ flank with the round, a circle of radius r: its penetration is its centre's plus
 mating flank's normal through the centre (the round's normal there), so that the contact passes
 from the flank onto the round without a jump (they share the point and the normal at EDGE_U),
 and the round keeps the neighbouring pairs' tips off by up to r (1/cos(theta/2) - 1) more than a
-sharp corner (theta = 90 deg - alpha_a: 0.15 r). The contact carries the compliance of the
+sharp corner (theta = 90 deg - alpha_a: 0.16-0.19 r on the pairs of the scenes). The contact carries the compliance of the
 round's narrower Hertz patch in its c_loc (`edge_compliance`); it changes with the mating flank's
 roll as its radius of curvature does, and that slope joins the flank's c_loc slope in the
 gradient (conservative). The round's centre is a material point of its tooth, so the moments and
