@@ -213,6 +213,28 @@ def test_peer_meshes_the_round_fine_and_on_its_circle():
             assert np.isin(on_outline[sel], face_nodes).all()
 
 
+def test_peer_archive_names_the_tip_edges_only_where_there_are_some(monkeypatch):
+    """The peer's archive carries each gear's tip edge radius and the element size on its round
+    (a quarter radius) where a gear has one, and neither attribute for sharp corners (the sweep
+    itself replaced: no ccx)."""
+    import study.verify.calculix_reference as cr
+    from solver.peers.calculix import PeerResult
+
+    class Mesh:
+        n_nodes, n_elements = 10, 5
+
+    def sweep(gears, pair, material, angles, torque, settings, progress=None, starts=None):
+        n = len(angles)
+        return PeerResult(np.asarray(angles), np.zeros(n), 0.0, (Mesh(), Mesh()), np.ones(n), np.ones(n), settings, "x")
+    monkeypatch.setattr(cr, "ste_sweep", sweep)
+    edged = small_scene(**{"gear1.modification.tip_edge_radius": 0.2})
+    ds = cr.calculix_dataset(edged, np.radians([0.0]), cr.settings_for(edged, 0.3))
+    np.testing.assert_allclose(ds.attrs["tip_edge_radius_mm"], [0.2, 0.0])
+    np.testing.assert_allclose(ds.attrs["tip_edge_mesh_size_mm"], [0.05, 0.0])
+    sharp = cr.calculix_dataset(small_scene(), np.radians([0.0]), cr.settings_for(small_scene(), 0.3))
+    assert "tip_edge_radius_mm" not in sharp.attrs and "tip_edge_mesh_size_mm" not in sharp.attrs
+
+
 def test_soft_start_deck_stiffens_the_contact_in_a_second_step(small_light_meshes):
     """A soft start carries the torque at 1/8 of the contact stiffness in a first step, then
     stiffens the contact under the same torque; the result is read at the end of the second."""
