@@ -155,7 +155,8 @@ def tip_corner_law(radii) -> str:
         return "the flanks' contact law"
     r1, r2 = (r * units.MM_PER_M for r in radii)
     return (f"the flanks' contact law + in series the compliance of the rounded tip edge (radius {r1:g} mm on gear 1, "
-            f"{r2:g} mm on gear 2; 0: a sharp corner): its Hertz patch against the mating flank instead of the two flanks'")
+            f"{r2:g} mm on gear 2; 0: a sharp corner): its Hertz patch against the mating flank instead of the two flanks'; "
+            "a corner the scene rounds (gearN.modification.tip_edge_radius) meets the flank with the round's circle")
 
 
 class _Stages:
