@@ -138,7 +138,7 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code(first_run, mode
     slice compiles its shape-error message); nor the contact search's parts the scene lacks:
     no friction, flank deviation or pitch error in either, no series compliance in the plain
     model (the compliance model's identification reads the flank deviations from Python, in its
-    FE contact)."""
+    FE contact), no tip edge in either (sharp corners)."""
     run = first_run[model]
     added = run.get("new", [])
     new = {ln.split()[0] for ln in added}                     # compiled in this model's run
@@ -150,6 +150,7 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code(first_run, mode
     assert not [ln for ln in added if int(ln.split()[1]) > 1]
     assert not [c for c in compiled if "raise_with_shape_context" in c or "unicode" in c or "str_generic" in c]
     assert "_friction" not in names
+    assert "edge_compliance" not in names                     # sharp tip corners: the edge's code left out
     if model == "paper":
         assert new == names                                   # the first run: all it has, it compiled
         assert {"end_step", "record_output", "verlet", "arrowhead_accelerations"} <= new
