@@ -103,3 +103,27 @@ def compiling_ahead(scene: Scene, dynamic: bool | None = None):
     started when the cache holds them all; it is always stopped on leaving)."""
     from solver.precompile import precompiling
     return precompiling(entry_jobs(scene, dynamic))
+
+
+def compile_kernels(scenes) -> list[str]:
+    """Compile in this process (into the disk cache) the entry kernels of runs of ``scenes``
+    (`entry_jobs`, each kernel and set of types once); returns their names. A study's first
+    task on a cold kernel cache, before any FE (`study.sweep.cluster`). Never raises: a
+    kernel that cannot be compiled here is left to the run that calls it."""
+    from solver.precompile import kernel_name
+    done, names = set(), []
+    for scene in scenes:
+        try:
+            jobs = entry_jobs(scene)
+        except Exception:  # noqa: BLE001 - the run says what is wrong with the scene, not this
+            continue
+        for kernel, types in jobs:
+            if (kernel_name(kernel), types) in done:
+                continue
+            done.add((kernel_name(kernel), types))
+            try:
+                kernel.compile(types)
+            except Exception:  # noqa: BLE001 - compiled (or refused) by the run itself
+                continue
+            names.append(kernel_name(kernel))
+    return names
