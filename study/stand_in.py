@@ -100,9 +100,14 @@ def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:
 def compiling_ahead(scene: Scene, dynamic: bool | None = None):
     """Context manager: within, the scene's entry kernels (`entry_jobs`) that numba's disk
     cache lacks compiled by a second process (`solver.precompile.precompiling`: none is
-    started when the cache holds them all; it is always stopped on leaving)."""
+    started when the cache holds them all; it is always stopped on leaving). A scene whose
+    stand-in cannot be built starts none: the run itself then says what is wrong."""
     from solver.precompile import precompiling
-    return precompiling(entry_jobs(scene, dynamic))
+    try:
+        jobs = entry_jobs(scene, dynamic)
+    except Exception:  # noqa: BLE001 - the run reports the scene's problem, with its field
+        jobs = []
+    return precompiling(jobs)
 
 
 def compile_kernels(scenes) -> list[str]:
