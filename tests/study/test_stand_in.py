@@ -78,3 +78,22 @@ def test_a_run_without_dynamics_leaves_the_time_stepping_out():
     assert list(kernel_name(k) for k, _ in entry_jobs(scene, dynamic=False)) == ["solver.mbs.kernels.statics.static_sweep"]
     implicit = study.load_scene(None, {**SMALL, "dynamic.method": "implicit"})
     assert list(stand_in_types(implicit))[0] == "solver.mbs.kernels.implicit.hht"
+
+
+def test_a_study_s_compile_task_never_fails_its_pilot(monkeypatch):
+    """What cannot be compiled ahead (a stand-in that cannot be built, a kernel numba refuses)
+    is left to the runs, which then compile it or say what is wrong: the task itself returns."""
+    import study.stand_in as stand_in
+
+    def broken(scene, dynamic=None):
+        raise ValueError("gear2.body: no stand-in")
+    monkeypatch.setattr(stand_in, "entry_jobs", broken)
+    assert stand_in.compile_kernels((study.load_scene(None, SMALL),)) == []
+
+    class Refusing:
+        py_func = stand_in_model
+
+        def compile(self, types):
+            raise TypeError("refused")
+    monkeypatch.setattr(stand_in, "entry_jobs", lambda scene, dynamic=None: [(Refusing(), ())])
+    assert stand_in.compile_kernels((study.load_scene(None, SMALL),)) == []
