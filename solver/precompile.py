@@ -61,10 +61,15 @@ def argument_types(kernel, args: tuple) -> tuple:
 
 class Precompiler:
     """A child process compiling ``jobs`` [(kernel dispatcher, argument types)] in that order
-    into the disk cache, and what the parent knows of it (see the module docstring)."""
+    into the disk cache, and what the parent knows of it (see the module docstring).
+    ``shared``: the kernels of the jobs that the parent's entry kernels call (the contact
+    search, which the statics and the time stepping both link): before its first call of any
+    kernel of the jobs, the parent waits for those the child is compiling, and loads them from
+    the cache when it compiles its caller, instead of compiling them too."""
 
-    def __init__(self, jobs: list):
+    def __init__(self, jobs: list, shared=()):
         self.names = [kernel_name(k) for k, _ in jobs]
+        self.shared = [n for n in map(kernel_name, shared) if n in self.names]
         self.state = dict.fromkeys(self.names, "queued")      # -> started, done, fail, skipped, gone
         self.waited_s = 0.0
         self._cond = threading.Condition()
@@ -102,8 +107,16 @@ class Precompiler:
 
     def ready(self, kernel) -> None:
         """Before this process's first call of ``kernel``: wait while the child compiles it;
-        tell the child to skip it when it has not begun it (this process compiles it)."""
+        tell the child to skip it when it has not begun it (this process compiles it). The
+        shared callees first, alike."""
         name = kernel_name(kernel)
+        if name not in self.state:
+            return
+        for callee in self.shared:
+            self._ready(callee)
+        self._ready(name)
+
+    def _ready(self, name: str) -> None:
         with self._cond:
             st = self.state.get(name)
             if st == "queued":
@@ -142,16 +155,17 @@ def ready(kernel) -> None:
 
 
 @contextlib.contextmanager
-def precompiling(jobs: list):
+def precompiling(jobs: list, shared=()):
     """Within: the kernels of ``jobs`` [(dispatcher, argument types)] not yet in the disk
-    cache compiled by a child process (`Precompiler`; yields it, or None when the cache holds
-    them all and no process was started). The child is always stopped on leaving."""
+    cache compiled by a child process (`Precompiler`, with its ``shared`` callees; yields it,
+    or None when the cache holds them all and no process was started). The child is always
+    stopped on leaving."""
     todo = [(k, t) for k, t in jobs if not cached(k, t)]
     if not todo:
         yield None
         return
     try:
-        p = Precompiler(todo)
+        p = Precompiler(todo, shared)
     except OSError:         # no process could be started: this one compiles
         yield None
         return

@@ -73,17 +73,23 @@ def stepping_kernel(scene: Scene, model):
 
 
 def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:
-    """[(kernel dispatcher, argument types)] of the entry kernels a run of the scene calls,
-    the dearest to compile and latest called first: the time stepping (when the run has a
-    dynamic run, ``dynamic`` None: as the scene says, or the slow-ramp transient statics),
-    then the static sweep (the statics and the loaded equilibria of the damping conversion)."""
+    """[(kernel dispatcher, argument types)] of the kernels a run of the scene calls, in the
+    order to compile them ahead: the contact search (`gearmesh.mesh_contacts`, the dearest
+    part of both loops, which link it; the run waits for it rather than compile it twice: `solver.precompile`), the time stepping (when the run has a
+    dynamic run, ``dynamic`` None: as the scene says, or the slow-ramp transient statics;
+    the dearest, and the latest called), then the static sweep (the statics and the loaded
+    equilibria of the damping conversion)."""
     from solver.mbs.dynamics import kernel_arguments
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
     from solver.mbs.kernels.statics import static_sweep
     from solver.mbs.statics import sweep_arguments
     from solver.precompile import argument_types
     from study.scene_model import load_table
     model = stand_in_model(scene)
-    jobs = []
+    rates = np.zeros(model.n_teeth)
+    args = ((0.0, 0.0, 0.0, 0.0), rates, rates, contact_geo(model.gear_par, model.pair_par, model.law_par),
+            new_contact_buffer())       # as the loops call it (and `solver.mbs.dynamics.start_te`)
+    jobs = [(mesh_contacts, argument_types(mesh_contacts, args))]
     if (scene.dynamic.enabled if dynamic is None else dynamic) or scene.quasi_static.method == "transient":
         from solver.mbs.dynamics import run_loads
         kernel = stepping_kernel(scene, model)
@@ -102,12 +108,13 @@ def compiling_ahead(scene: Scene, dynamic: bool | None = None):
     cache lacks compiled by a second process (`solver.precompile.precompiling`: none is
     started when the cache holds them all; it is always stopped on leaving). A scene whose
     stand-in cannot be built starts none: the run itself then says what is wrong."""
+    from solver.mbs.kernels.gearmesh import mesh_contacts
     from solver.precompile import precompiling
     try:
         jobs = entry_jobs(scene, dynamic)
     except Exception:  # noqa: BLE001 - the run reports the scene's problem, with its field
         jobs = []
-    return precompiling(jobs)
+    return precompiling(jobs, shared=(mesh_contacts,))
 
 
 def compile_kernels(scenes) -> list[str]:

@@ -32,8 +32,8 @@ class Compiles(event.Listener):
     def on_end(self, ev):
         pass
 init = precompile.Precompiler.__init__
-def recorded(self, jobs):
-    init(self, jobs)
+def recorded(self, *args):
+    init(self, *args)
     helpers.append(self)
 precompile.Precompiler.__init__ = recorded
 from study.cli import main
@@ -74,6 +74,10 @@ def test_a_cold_run_loads_the_time_stepping_the_second_process_compiled(tmp_path
     assert cold["helper"][stepping] == "done", cold["helper"]
     assert stepping not in cold["compiled"] and sweep in cold["compiled"]
     assert cold["exit"] is not None             # stopped and reaped when the run ended
+    # the contact search, compiled ahead from the stand-in as the loops call it: one signature
+    # in the cache (a second would be the loops' own, compiled again)
+    assert cold["helper"]["solver.mbs.kernels.gearmesh.mesh_contacts"] in ("done", "skipped")
+    assert len(list((tmp_path / "numba").rglob("gearmesh.mesh_contacts-*.nbc"))) == 1
     # warm: no second process, no entry kernel compiled, the same numbers to the bit
     warm = run(tmp_path, "warm.nc")
     assert warm["rc"] == 0 and warm["helper"] is None
