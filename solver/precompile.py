@@ -17,6 +17,10 @@ operating system closes it when the parent dies, so that no child outlives its p
 Protocol (lines): parent -> child, first the jobs [(name, module, qualname, argument types)],
 pickled and base64-encoded, then ``skip NAME`` for each kernel the parent compiles itself;
 child -> parent: ``start NAME``, ``done NAME`` or ``fail NAME`` for each kernel.
+
+The child is started only when a core is idle (`spare_core`): on a machine busy with other
+work it would compile on the same cores, and the duplicated work of the inner kernels both
+processes compile (a few seconds of CPU) would make the run slower, not faster.
 """
 from __future__ import annotations
 
@@ -32,6 +36,7 @@ from pathlib import Path
 HELPER = [sys.executable, "-m", "solver.precompile"]      # the child's command (the tests replace it)
 CLOSE_WAIT_S = 2.0      # s, how long a child told to stop may take before it is killed
 POLL_S = 0.1            # s, how often a waiting parent wakes (Ctrl-C is delivered between waits)
+LOADAVG = Path("/proc/loadavg")     # Linux: its 4th field, processes ready to run / all
 
 _active: list = []      # the `Precompiler`s of this process now
 
@@ -51,6 +56,25 @@ def cached(kernel, argtypes: tuple) -> bool:
         return key in cache._cache_file._load_index()
     except (AttributeError, OSError, EOFError, pickle.UnpicklingError):
         return False        # no disk cache (or one that cannot be read): counts as not compiled
+
+
+def spare_core() -> bool:
+    """True when a core is idle now: fewer processes ready to run (Linux's count in
+    /proc/loadavg, this one included; the least of three looks 10 ms apart) than the cores
+    this process may run on. On a machine busy with other work a second process would only
+    take its share of the same cores: the compile then stays in this process. Elsewhere than
+    on Linux: True."""
+    import time
+    try:
+        running = []
+        for i in range(3):
+            running.append(int(LOADAVG.read_text().split()[3].split("/")[0]))
+            if i < 2:
+                time.sleep(0.01)
+    except (OSError, ValueError, IndexError):
+        return True
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return min(running) < cores
 
 
 def argument_types(kernel, args: tuple) -> tuple:
@@ -158,10 +182,10 @@ def ready(kernel) -> None:
 def precompiling(jobs: list, shared=()):
     """Within: the kernels of ``jobs`` [(dispatcher, argument types)] not yet in the disk
     cache compiled by a child process (`Precompiler`, with its ``shared`` callees; yields it,
-    or None when the cache holds them all and no process was started). The child is always
-    stopped on leaving."""
+    or None when the cache holds them all, or no core is idle (`spare_core`), and no process was
+    started). The child is always stopped on leaving."""
     todo = [(k, t) for k, t in jobs if not cached(k, t)]
-    if not todo:
+    if not todo or not spare_core():
         yield None
         return
     try:

@@ -31,6 +31,7 @@ def toy(tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setenv("PYTHONPATH", str(tmp_path))
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba"))
+    monkeypatch.setattr(precompile, "spare_core", lambda: True)     # (the test machine may be busy)
     sys.modules.pop("toy_kernels", None)
     import toy_kernels
     yield toy_kernels.twice
@@ -68,6 +69,24 @@ def test_the_child_compiles_into_the_disk_cache_and_the_parent_loads_it(toy):
     # warm: no process at all
     with precompile.precompiling(JOBS(toy)) as p2:
         assert p2 is None
+
+
+def test_no_child_on_a_machine_without_an_idle_core(toy, monkeypatch):
+    monkeypatch.setattr(precompile, "spare_core", lambda: False)
+    with precompile.precompiling(JOBS(toy)) as p:
+        assert p is None
+        assert toy(1.0) == 2.0
+    assert toy.stats.cache_misses
+
+
+def test_an_idle_core_is_one_no_process_is_ready_to_run_on(monkeypatch, tmp_path):
+    """(read from Linux's count of the processes ready to run)"""
+    cores = len(os.sched_getaffinity(0))
+    loadavg = tmp_path / "loadavg"
+    monkeypatch.setattr(precompile, "LOADAVG", loadavg)
+    for running, spare in ((cores - 1, True), (cores, False), (cores + 5, False)):
+        loadavg.write_text(f"0.50 0.40 0.30 {running}/200 12345\n")
+        assert precompile.spare_core() is spare
 
 
 def test_a_child_that_fails_leaves_the_parent_compiling(toy, tmp_path, monkeypatch):
