@@ -3,12 +3,13 @@
 A process whose disk cache lacks the kernels it will call hands the dearest of them (given by
 their argument types, `study.stand_in`) to a child process (`Precompiler`), which compiles
 them one after the other into the cache on another core while the parent goes on (FE,
-statics). Before the first call of an entry kernel (`ready`, from `solver.mbs.interrupt.call`
-and the FE's compiled solves) the parent asks where the child stands with it: done, the call
-loads it from the disk cache; being compiled, the parent waits for it instead of compiling it
-a second time; not begun yet, the child is told to skip it and the parent compiles it itself;
-the child gone (failed, killed), the parent compiles as it would without one. Nothing changes
-in what is computed: the kernels are the same machine code, from the cache.
+statics). Before the first call of an entry kernel (`ready`, from `solver.mbs.interrupt.call`:
+the static sweep and the stepping loops) the parent asks where the child stands with it:
+done, the call loads it from the disk cache; being compiled, the parent waits for it instead
+of compiling it a second time; not begun yet, the child is told to skip it and the parent
+compiles it itself; the child gone (failed, killed), the parent compiles as it would without
+one. Nothing changes in what is computed: the kernels are the same machine code, from the
+cache.
 
 The child ends when its list is done, or at once when its standard input closes: the parent
 closes it when it leaves `precompiling` (normally, on an error, on Ctrl-C or SIGTERM), and the
