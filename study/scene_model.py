@@ -233,12 +233,14 @@ def flankless_model(scene: Scene, springs=None, setups: tuple | None = None) -> 
     return FLANKLESS.kept(key, lambda: _build_flankless(scene, springs, setups or gear_setups(scene)))
 
 
-def _build_flankless(scene: Scene, springs, setups: tuple) -> Model:
+def _build_flankless(scene: Scene, springs, setups: tuple, fit_of=None) -> Model:
+    """The flankless model (`flankless_model`) built; ``fit_of``: a function of a gear setup
+    giving its foundation coupling in place of `coupling_fit` (`study.stand_in`: no FE)."""
     springs = springs or scene_springs(scene, setups)
     gears = []
     for setup, (k_phi, _) in zip(setups, springs):
         sp = setup.spring
-        fit = coupling_fit(scene, setup.gear, setups=setups)
+        fit = coupling_fit(scene, setup.gear, setups=setups) if fit_of is None else fit_of(setup)
         cmat = cloc = None
         if fit is not None:
             k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
