@@ -66,10 +66,13 @@ def test_the_stand_in_types_the_kernels_as_the_paper_model(overrides, monkeypatc
         assert a.shape == b.shape and a.dtype == b.dtype
 
 
-def test_the_stand_in_types_the_kernels_as_the_compliance_model_from_its_fe(private_fe_cache, monkeypatch):
+@pytest.mark.parametrize("edges", [{}, {"gear1.modification.tip_edge_radius": 0.2, "gear2.modification.tip_edge_radius": 0.2}],
+                         ids=["sharp", "rounded tips"])
+def test_the_stand_in_types_the_kernels_as_the_compliance_model_from_its_fe(edges, monkeypatch):
     """The default model: teeth coupled through the body, body springs, the local compliance
-    in series (from the coarse FE bodies of the small pair)."""
-    scene = study.load_scene(None, {**SMALL, "coupling.model": "compliance"})
+    in series (from the coarse FE bodies of the small pair); with rounded tip edges, the
+    contact search's variant that has them."""
+    scene = study.load_scene(None, {**SMALL, "coupling.model": "compliance", **edges})
     model = build_scene_model(scene, convert_damping=False)
     assert model.coupled and model.teeth_coupled
     stand_in = stand_in_model(scene)
