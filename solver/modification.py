@@ -11,6 +11,11 @@ from the base circle's tangent point). Both flanks of every tooth of the gear ca
   amount is the deviation at the form circle (the lowest flank point of the model).
 * Table: deviation [m] against roll [rad], linear between its points, constant beyond its ends;
   added to the reliefs.
+* Tip edge radius [m]: the tip corner rounded by a circular arc of that radius, tangent to the
+  flank and to the tip circle (0: a sharp corner). The contact search ends the flank at the
+  round's tangent point and meets the mating flank with the round's circle beyond it, with the
+  compliance of its narrower Hertz patch in series with the contact law (gear_par EDGE_*, the
+  compliance model's series law; `solver.tip_edge`); the CalculiX peer meshes the round.
 
 The contact search reads it as a table sampled on a fixed roll grid from the form circle to the
 tip (`sample`), through which it passes a cubic with a continuous slope
@@ -34,12 +39,14 @@ class Relief:
 
 @dataclass(frozen=True)
 class ProfileModification:
-    """Tip and root relief and a deviation table of one gear's flanks (SI, rolls in rad)."""
+    """Tip and root relief, a deviation table and the tip edge radius of one gear's flanks (SI,
+    rolls in rad)."""
 
     tip: Relief = Relief()
     root: Relief = Relief()
     table_roll: tuple = ()      # rad, increasing
     table_deviation: tuple = () # m
+    tip_edge_radius: float = 0.0  # m; 0: a sharp tip corner
 
     def deviation(self, u, u_form: float, u_tip: float) -> np.ndarray:
         """Deviation [m] along the flank normal at roll parameters u [rad] (positive: material removed)."""

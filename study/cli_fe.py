@@ -147,9 +147,10 @@ def reference_arguments(p) -> None:
                    help="calculix: write each deck as thin as its flank elements, loads scaled alike (plane stress; "
                         "a deck at the full face width reads 2-6 %% stiffer, docs/models.md)")
     p.add_argument("--tip-edge-radius", type=float, default=None, metavar="MM",
-                   help="ltca: the tip corners meet the mating flanks rounded to this radius [mm] (their contact then "
-                        "carries that narrower Hertz patch's compliance; default: the flanks' law; 0.035 reads as the "
-                        "CalculiX peer's sharp corner at its 0.1 mm flank mesh)")
+                   help="ltca: both gears' tip-corner contacts carry the compliance of an edge of this radius [mm] (its "
+                        "narrower Hertz patch), on the corners as the scene shapes them (sharp, or rounded by "
+                        "gearN.modification.tip_edge_radius, whose compliance it replaces); 0.035 reads as the CalculiX "
+                        "peer's sharp corner at its 0.1 mm flank mesh")
     max_time_argument(p)
 
 
@@ -162,7 +163,8 @@ def reference_command(args) -> int:
                          "--contact-stiffness" if args.contact_stiffness is not None else "--thin-decks",
                          "applies to --solver calculix only")
     if args.solver == "calculix" and args.tip_edge_radius is not None:
-        raise UsageError("--tip-edge-radius", "applies to --solver ltca only (the CalculiX peer meshes the sharp corner)")
+        raise UsageError("--tip-edge-radius", "applies to --solver ltca only (the CalculiX peer meshes the scene's tip "
+                         "edges: gearN.modification.tip_edge_radius)")
     if args.solver == "calculix":
         from solver.peers.calculix import CalculixMissing, ccx_path
         try:

@@ -250,15 +250,17 @@ def precision_mesh(scene: Scene, output: str | Path | None = None, factors=(2.0,
     return ds
 
 
-def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None, prefix: str = "") -> list:
+def render(archive, out_dir=None, renders: bool = True, limits: dict | None = None, prefix: str = "",
+           reuse_after: float | None = None) -> list:
     """Plots (and, unless ``renders=False``, pyvista renders) of a run or study archive as PNG
     files in ``out_dir`` (default: beside the archive file) -> their paths. ``archive``: a
     path or an xarray.Dataset; ``limits`` ({output: value}, sampled studies): the probability
     of exceeding each; ``prefix``: put before every file name (`lightgear render` gives the
     archive's stem, ``h3_ste.png``). The renders of a lightened body draw its FE fields from
-    the FE cache (solved and cached once when missing)."""
+    the FE cache (solved and cached once when missing). ``reuse_after`` (a file time [s]): a
+    run's figures written since are kept as they are (`study.report.figures.make_figures`)."""
     from study.archive.netcdf import read_netcdf
-    from study.report.figures import make_figures
+    from study.report.figures import fresh, make_figures, render_paths
     check_argument(isinstance(prefix, str), "render", "prefix", "a string put before every file name", prefix)
     if not hasattr(archive, "data_vars"):
         check_argument(is_path(archive), "render", "archive", "an archive's path or an xarray.Dataset", archive)
@@ -270,10 +272,12 @@ def render(archive, out_dir=None, renders: bool = True, limits: dict | None = No
     elif out_dir is None:
         raise ValueError("render: out_dir is needed for a dataset")
     fields = None
-    if renders and "scene" in archive.attrs and "tooth_stiffness" in archive and "status" not in archive:
+    if (renders and "scene" in archive.attrs and "tooth_stiffness" in archive and "status" not in archive
+            and not all(fresh(p, reuse_after) for p in render_paths(archive, out_dir, prefix))):
         from study.inputs.springs import archive_body_fields
         fields = archive_body_fields(archive)      # what the renders of a lightened body draw: FE cache, else solved
-    return make_figures(archive, Path(out_dir), prefix=prefix, renders=renders, limits=limits, fields=fields)
+    return make_figures(archive, Path(out_dir), prefix=prefix, renders=renders, limits=limits, fields=fields,
+                        reuse_after=reuse_after)
 
 
 def write_report(archive, out_dir=None, renders: bool = True) -> list:
@@ -281,7 +285,8 @@ def write_report(archive, out_dir=None, renders: bool = True) -> list:
     HTML page (figures embedded as base64 PNG) and its Markdown twin, with the scene or study as
     run, the summary table with units, the validation status of the model used and the figures,
     written into ``out_dir`` (default: beside the archive) as ``STEM_report.html`` and
-    ``STEM_report.md`` (the figures beside them, ``STEM_*.png``) -> [html, md] paths."""
+    ``STEM_report.md`` (the figures beside them, ``STEM_*.png``; a run's figures that
+    `render` already wrote there since the archive was written are taken as they are) -> [html, md] paths."""
     from study.archive.netcdf import read_netcdf
     from study.report.report_page import write_report as write
     from study.sweep.outputs import report_rows
@@ -291,7 +296,8 @@ def write_report(archive, out_dir=None, renders: bool = True) -> list:
         raise FileNotFoundError(f"no such archive: {path}")
     out_dir = Path(out_dir) if out_dir is not None else path.parent
     ds = read_netcdf(path)
-    figures = [p for p in render(ds, out_dir, renders=renders, prefix=f"{path.stem}_") if p.suffix == ".png"]
+    figures = [p for p in render(ds, out_dir, renders=renders, prefix=f"{path.stem}_", reuse_after=path.stat().st_mtime)
+               if p.suffix == ".png"]
     summary, extra = report_rows(ds)
     return write(ds, path.stem, out_dir, figures, summary, extra)
 

@@ -4,7 +4,10 @@ conversion to `solver.modification.ProfileModification` (SI, roll parameters in 
 A relief starts at one of: a roll angle (deg), a diameter (mm) or a length along the path of
 contact from the flank end (mm: the tip relief's length is rb*(u_tip - u_start), the root
 relief's rb*(u_start - u_form)). A deviation table gives its positions as roll angles or
-diameters, and the deviations in um (positive: material removed).
+diameters, and the deviations in um (positive: material removed). ``tip_edge_radius`` (mm; 0: a
+sharp corner) rounds the tip corners (`solver.tip_edge`): below the module and the tip land's
+share of each round (`solver.tip_edge.edge_limit`); the models without a series contact law
+refuse it (`study.scene_checks.check_tip_edges`).
 """
 from __future__ import annotations
 
@@ -48,10 +51,14 @@ class ModificationSection:
     profile_diameter: tuple[float, ...] = _f((), "mm", "positions of the profile deviation table as diameters")
     profile_deviation: tuple[float, ...] = _f((), "um", "profile deviation at those positions (positive: material removed), "
                                               "linear between them, constant beyond; added to the reliefs")
+    tip_edge_radius: float = _f(0.0, "mm", "radius of the rounded tip edge (an arc tangent to the flank and the tip circle; "
+                                "0: a sharp corner): a tip-corner contact carries its narrower Hertz patch's compliance in "
+                                "series with the contact law (compliance model, LTCA); the CalculiX peer meshes the round", 0.0)
 
     @property
     def is_zero(self) -> bool:
-        return self.tip_relief == 0.0 and self.root_relief == 0.0 and not any(self.profile_deviation)
+        return (self.tip_relief == 0.0 and self.root_relief == 0.0 and not any(self.profile_deviation)
+                and self.tip_edge_radius == 0.0)
 
 
 def _roll_of_diameter(d_mm: float, g: GearGeometry) -> float:
@@ -129,4 +136,30 @@ def modification_spec(m: ModificationSection, g: GearGeometry, prefix: str) -> P
     if m.tip_relief > 0 and m.root_relief > 0 and reliefs["root"].start > reliefs["tip"].start:
         raise SceneError(f"{prefix}.root_relief", "the root relief starts above the tip relief's start")
     roll, dev = _table(m, g, prefix)
-    return ProfileModification(reliefs["tip"], reliefs["root"], roll, dev)
+    return ProfileModification(reliefs["tip"], reliefs["root"], roll, dev, _tip_edge(m, g, prefix))
+
+
+def _tip_edge(m: ModificationSection, g: GearGeometry, prefix: str) -> float:
+    """The tip edge radius [m]; SceneError where the tooth cannot hold it (`solver.tip_edge.edge_limit`)."""
+    from solver.tip_edge import edge_limit
+    r = m.tip_edge_radius * units.MM
+    if r > 0:
+        limit, why = edge_limit(g)
+        if not r < limit:
+            raise SceneError(f"{prefix}.tip_edge_radius", f"must be below {why}: {limit / units.MM:.4g} mm, got "
+                             f"{m.tip_edge_radius:g} mm")
+    return r
+
+
+def tip_edge_radii(gears) -> tuple[float, float]:
+    """(gear 1, gear 2) tip edge radius [m] of the scene's gear sections ``gears`` (0: sharp)."""
+    return tuple(gs.modification.tip_edge_radius * units.MM for gs in gears)
+
+
+def tip_edge_attrs(radii) -> dict:
+    """The archive attribute ``tip_edge_radius_mm`` (gear 1, gear 2) [mm] of tip edge radii
+    (gear 1, gear 2) [m]; none where both corners are sharp (the archives of sharp-cornered
+    pairs stay as they were)."""
+    if not any(radii):
+        return {}
+    return {"tip_edge_radius_mm": np.array([r * units.MM_PER_M for r in radii])}

@@ -17,6 +17,7 @@ from solver.mbs.kernels.layout import R_PV
 from study.archive import run_variables
 from study.archive.netcdf import provenance
 from study.errors import check_argument, check_scene_argument, is_number
+from study.modification import tip_edge_attrs, tip_edge_radii
 from study.plan import STAGES, RunOptions, RunPlan, kept_springs_and_model, make_plan, scene_stages
 from study.plausibility import critical_speed_warning
 from study.scene import Scene
@@ -156,6 +157,7 @@ def run_attrs(plan: RunPlan) -> dict:
         "damping_conversion": plan.damping_at,
         "body_stiffness_N_m_rad": np.array([k if math.isfinite(k) else 0.0 for k in model.body_stiffness]),
         "pivot_radius_mm": model.gear_par[:, R_PV] * units.MM_PER_M,
+        **tip_edge_attrs(tip_edge_radii((scene.gear1, scene.gear2))),
         "teeth_coupled": int(model.teeth_coupled),
         "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
         **(provenance() if plan.archive else {}),

@@ -35,6 +35,7 @@ def check_scene(scene: Scene) -> None:
     except GeometryError as e:
         raise SceneError(e.field, e.reason) from None
     check_damping(scene)
+    check_tip_edges(scene)
     d = scene.dynamic
     if d.output_step > d.duration:
         raise SceneError("dynamic.output_step", f"longer than dynamic.duration ({d.duration} s)")
@@ -50,6 +51,20 @@ def check_scene(scene: Scene) -> None:
     check_integrator_model(scene)
     from study.plausibility import check_plausibility  # mesh, steady window and load bounds
     check_plausibility(scene)
+
+
+def check_tip_edges(scene: Scene) -> None:
+    """A rounded tip edge (``gearN.modification.tip_edge_radius`` > 0) adds its compliance to the
+    series law of the compliance model's contacts; the paper model and body-torsion coupling have
+    no compliance in series with the contact law to add it to: SceneError naming the field."""
+    if scene.coupling_model == "compliance":
+        return
+    for g in (1, 2):
+        if scene.gear(g).modification.tip_edge_radius > 0:
+            raise SceneError(f"gear{g}.modification.tip_edge_radius",
+                             f"a rounded tip edge needs the compliance model's contact law (coupling.model = 'compliance' "
+                             f"or 'auto'); the {scene.coupling_model_name} model has no compliance in series with the "
+                             f"contact law to add the edge's to (0: a sharp corner)")
 
 
 def error_period(scene: Scene) -> float:

@@ -233,12 +233,14 @@ def flankless_model(scene: Scene, springs=None, setups: tuple | None = None) -> 
     return FLANKLESS.kept(key, lambda: _build_flankless(scene, springs, setups or gear_setups(scene)))
 
 
-def _build_flankless(scene: Scene, springs, setups: tuple) -> Model:
+def _build_flankless(scene: Scene, springs, setups: tuple, fit_of=None) -> Model:
+    """The flankless model (`flankless_model`) built; ``fit_of``: a function of a gear setup
+    giving its foundation coupling in place of `coupling_fit` (`study.stand_in`: no FE)."""
     springs = springs or scene_springs(scene, setups)
     gears = []
     for setup, (k_phi, _) in zip(setups, springs):
         sp = setup.spring
-        fit = coupling_fit(scene, setup.gear, setups=setups)
+        fit = coupling_fit(scene, setup.gear, setups=setups) if fit_of is None else fit_of(setup)
         cmat = cloc = None
         if fit is not None:
             k_body, n_k, pivot = fit.k_body, 1.0, fit.pivot_radius
@@ -351,10 +353,14 @@ def geometry_model(scene: Scene, setups: tuple | None = None) -> Model:
     the scene's k_phi, no foundation coupling and the dampers given as ratios left at zero. For what needs the kinematics and the
     contact law only (the mesh positions, the FE reference), not the tooth springs. ``setups``:
     the scene's gear setups when already made (they do not depend on the coupling model)."""
-    plain = scene.replace(**{"coupling.model": "none"})
+    # the tip edges, refused by the plain model's contact law (`study.scene_checks.check_tip_edges`),
+    # come with the scene's own flanks: its model carries them (the LTCA and the CalculiX peer
+    # read them there), its plain contact law leaves them out (`layout.contact_parts`)
+    plain = scene.replace(**{"coupling.model": "none", "gear1.modification.tip_edge_radius": 0.0,
+                             "gear2.modification.tip_edge_radius": 0.0})
     z1, z2 = scene.gear1.teeth, scene.gear2.teeth
     springs = ((np.full(z1, scene.gear1.spring.k_phi), np.ones(z1)), (np.full(z2, scene.gear2.spring.k_phi), np.ones(z2)))
-    return _with_flanks(plain, springs, setups or gear_setups(plain))
+    return with_flank_deviations(flankless_model(plain, springs, setups or gear_setups(plain)), *_flanks(scene))
 
 
 def static_angle_count(scene: Scene, step_deg: float | None = None) -> float:

@@ -151,3 +151,16 @@ def compiled_call(kernel):
     space = {"kernel": kernel}
     exec(f"def call({names}):\n    return kernel({names})\n", space)
     return numba.njit(space["call"])
+
+
+def series_force(delta: float, c: float, k: float, m1: float) -> float:
+    """F [N] with (F/k)^(1/m1) + c F = delta [m] (bisection: independent of the kernels' Halley
+    iteration; c >= 0)."""
+    lo, hi = 0.0, k * delta**m1
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if (mid / k) ** (1 / m1) + c * mid < delta:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)

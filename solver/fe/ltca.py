@@ -34,7 +34,12 @@ meets the mating flank as a cylinder of that radius, far narrower than the two f
 was fitted to, and its contact carries the extra compliance of that narrower Hertz patch
 (`solver.identify.weber.edge_compliance`) in series. Where the corners carry load (a single
 pair beside the extended contact of its neighbours: a third of the load at 100 N·m on the
-paper pair) the STE there depends on it.
+paper pair) the STE there depends on it. A gear whose model has a rounded tip (gear_par
+EDGE_*, the scene's ``gearN.modification.tip_edge_radius``) also has the round's geometry: its
+flank ends at the round's tangent roll and its corner contact is the round's circle, whose
+centre lies r inside that point (`_corner_flank`, as the contact search of the models); a
+`TipEdge` without it (`lightgear reference --tip-edge-radius` on a sharp-cornered scene) is the
+compliance alone, on the sharp corner's geometry.
 
 Units: SI (m, N, rad, N·m).
 """
@@ -79,6 +84,9 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
     alpha = pp[L.ALPHA]
     rb1, rb2 = gp[0, L.RB], gp[1, L.RB]
     line = model.pair.center_distance * math.sin(alpha)
+    # a rounded tip (gear_par EDGE_*): the flank ends at the round's tangent roll, beyond it the
+    # round meets the mating flank (as in `solver.mbs.kernels.gearmesh.pair_contacts`)
+    hi = [gp[g, L.EDGE_U] if gp[g, L.EDGE_INV_R] > 0 else gp[g, L.U_HI] for g in range(2)]
     rows = []
     for k, j, side in pairs[:n]:
         if side != 1:
@@ -89,26 +97,45 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
         u2 = (line - rb1 * u1) / rb2
         b1 = ax1 + gp[0, L.PSI_B]
         b2 = ax2 + gp[1, L.PSI_B]
-        if u1 <= gp[0, L.U_HI] and u2 <= gp[1, L.U_HI]:
+        if u1 <= hi[0] and u2 <= hi[1]:
             if u1 >= gp[0, L.U_LO] and u2 >= gp[1, L.U_LO]:
                 rows.append((k, j, u1, u2, 0.0, 1))
-        elif u1 > gp[0, L.U_HI]:
-            qx, qy = tip_corner(gp[0, L.CX], gp[0, L.CY], rb1, b1, 1.0, gp[0, L.U_HI])
-            d, uf, _, _ = point_flank(qx, qy, gp[1, L.CX], gp[1, L.CY], rb2, b2, 1.0)
-            if gp[1, L.U_LO] <= uf <= gp[1, L.U_HI] and -d < max_gap:
+        elif u1 > hi[0]:
+            d, uf = _corner_flank(gp, 0, b1, b2)
+            if gp[1, L.U_LO] <= uf <= hi[1] and -d < max_gap:
                 rows.append((k, j, gp[0, L.U_HI], uf, -d, 2))
         else:
-            qx, qy = tip_corner(gp[1, L.CX], gp[1, L.CY], rb2, b2, 1.0, gp[1, L.U_HI])
-            d, uf, _, _ = point_flank(qx, qy, gp[0, L.CX], gp[0, L.CY], rb1, b1, 1.0)
-            if gp[0, L.U_LO] <= uf <= gp[0, L.U_HI] and -d < max_gap:
+            d, uf = _corner_flank(gp, 1, b2, b1)
+            if gp[0, L.U_LO] <= uf <= hi[0] and -d < max_gap:
                 rows.append((k, j, uf, gp[1, L.U_HI], -d, 3))
     a = np.array(rows, dtype=float).reshape(-1, 6)
     gap = np.maximum(a[:, 4], 0.0)
     for i in range(a.shape[0]):
-        gap[i] += flank_deviation(gp, 0, a[i, 2])[0] + flank_deviation(gp, 1, a[i, 3])[0]
+        # a round's own deviation is in its centre (`_corner_flank`)
+        own = [not (a[i, 5] == 2 + g and gp[g, L.EDGE_INV_R] > 0) for g in range(2)]
+        gap[i] += own[0] * flank_deviation(gp, 0, a[i, 2])[0] + own[1] * flank_deviation(gp, 1, a[i, 3])[0]
     if pp.size > L.N_PAIR_PAR:
         gap -= error_approach(model, theta1, theta2, a[:, 0].astype(int), a[:, 1].astype(int))
     return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int))
+
+
+def _corner_flank(gp, g: int, b_g: float, b_f: float) -> tuple[float, float]:
+    """(penetration [m], mating flank's roll [-]) of gear g's tip corner into the other gear's +
+    flank, rigid bodies; b_g, b_f: the flanks' base angles [rad]. A rounded tip (EDGE_INV_R > 0)
+    meets it with its circle: the centre (r plus the deviation inside the flank point at EDGE_U)
+    penetrates r less."""
+    f = 1 - g
+    rb_g, rb_f = gp[g, L.RB], gp[f, L.RB]
+    if gp[g, L.EDGE_INV_R] > 0:
+        ue = gp[g, L.EDGE_U]
+        qx, qy = tip_corner(gp[g, L.CX], gp[g, L.CY], rb_g, b_g, 1.0, ue)
+        off = gp[g, L.EDGE_R] + gp[g, L.EDGE_DEV]
+        qx, qy = qx + off * math.sin(b_g - ue), qy - off * math.cos(b_g - ue)
+        d, uf, _, _ = point_flank(qx, qy, gp[f, L.CX], gp[f, L.CY], rb_f, b_f, 1.0)
+        return d + gp[g, L.EDGE_R], uf
+    qx, qy = tip_corner(gp[g, L.CX], gp[g, L.CY], rb_g, b_g, 1.0, gp[g, L.U_HI])
+    d, uf, _, _ = point_flank(qx, qy, gp[f, L.CX], gp[f, L.CY], rb_f, b_f, 1.0)
+    return d, uf
 
 
 def error_approach(model: Model, theta1: float, theta2: float, tooth1, tooth2) -> np.ndarray:
@@ -134,7 +161,7 @@ def error_approach(model: Model, theta1: float, theta2: float, tooth1, tooth2) -
 
 @dataclass(frozen=True)
 class TipEdge:
-    """A rounded tip edge of both gears, for the local law of tip-corner contacts (SI)."""
+    """A rounded tip edge of a gear, for the local law of its tip-corner contacts (SI)."""
 
     radius: float           # tip edge radius [m]
     youngs_modulus: float   # Pa
@@ -148,19 +175,30 @@ class TipEdge:
         return edge_compliance(self.youngs_modulus, self.face_width, self.law_radius, self.radius, flank_radius)
 
 
-def corner_compliance(model: Model, mp: MeshPoints, edge: TipEdge | None) -> np.ndarray:
+def gear_edges(edge) -> tuple:
+    """(gear 1's, gear 2's) `TipEdge` or None of ``edge``: one TipEdge (both gears), a pair, or None."""
+    if edge is None or isinstance(edge, TipEdge):
+        return edge, edge
+    e1, e2 = edge
+    return e1, e2
+
+
+def corner_compliance(model: Model, mp: MeshPoints, edge) -> np.ndarray:
     """(n,) compliance [m/N] each candidate contact of ``mp`` adds in series with the law: the
-    tip edge's (`TipEdge.compliance`) on tip-corner contacts, measured on the mating flank's
-    radius of curvature rb*u at its roll; 0 on flank contacts and without ``edge``."""
+    tip edge's (`TipEdge.compliance`) of the corner's gear on tip-corner contacts, measured on
+    the mating flank's radius of curvature rb*u at its roll; 0 on flank contacts and where the
+    corner's gear has no edge. ``edge``: a `TipEdge` of both gears, (gear 1's, gear 2's) each a
+    TipEdge or None, or None."""
     out = np.zeros(mp.gap.size)
-    if edge is None:
+    e1, e2 = gear_edges(edge)
+    if e1 is None and e2 is None:
         return out
     rb1, rb2 = model.base_radii
     for i, kind in enumerate(mp.kind):
-        if kind == 2:        # gear 1's corner on gear 2's flank
-            out[i] = edge.compliance(rb2 * mp.u2[i])
-        elif kind == 3:      # gear 2's corner on gear 1's flank
-            out[i] = edge.compliance(rb1 * mp.u1[i])
+        if kind == 2 and e1 is not None:        # gear 1's corner on gear 2's flank
+            out[i] = e1.compliance(rb2 * mp.u2[i])
+        elif kind == 3 and e2 is not None:      # gear 2's corner on gear 1's flank
+            out[i] = e2.compliance(rb1 * mp.u1[i])
     return out
 
 
@@ -241,13 +279,14 @@ class LTCAResult:
 
 
 def ltca_sweep(model: Model, compliance: tuple, angles, torque: float, k_con: float | None = None,
-               m1: float | None = None, edge: TipEdge | None = None) -> LTCAResult:
+               m1: float | None = None, edge=None) -> LTCAResult:
     """Solve the loaded contact at every driver angle [rad] under ``torque`` [N·m] on gear 2.
 
     ``compliance`` = (BodyCompliance of gear 1, of gear 2), or (None, None) for rigid bodies
     (only the contact law deforms). The contact law defaults to the model's. ``edge``: the tip
-    edge radius of both gears; tip-corner contacts then carry its compliance in series with the
-    law (`corner_compliance`); None: the flanks' law alone.
+    edge of both gears (a `TipEdge`) or of each ((gear 1's, gear 2's), TipEdge or None);
+    tip-corner contacts then carry its compliance in series with the law (`corner_compliance`);
+    None: the flanks' law alone.
     """
     k_con = float(model.law_par[L.K_CON]) if k_con is None else k_con
     m1 = float(model.law_par[L.M1]) if m1 is None else m1

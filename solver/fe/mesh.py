@@ -82,7 +82,7 @@ def _arc(r: float, a0: float, a1: float, n: int):
     return np.column_stack([r * np.cos(a), r * np.sin(a)])
 
 
-def tooth_pieces(g: GearGeometry, n: int = 12, deviation=None) -> list[tuple[np.ndarray, bool]]:
+def tooth_pieces(g: GearGeometry, n: int = 12, deviation=None, edge_radius: float = 0.0) -> list[tuple[np.ndarray, bool]]:
     """One tooth's outline as pieces from mid-space -pi/z to +pi/z, counter-clockwise.
 
     Returns a list of (points (k, 2) [m], is_fillet). Consecutive pieces share end points; the
@@ -90,17 +90,27 @@ def tooth_pieces(g: GearGeometry, n: int = 12, deviation=None) -> list[tuple[np.
     ``deviation``: None (perfect involutes) or a function of the roll parameter u [-] giving the
     flank's deviation along its normal [m], positive where material is removed (a profile
     modification, `solver.modification.ProfileModification.deviation`); the tip arc then ends at
-    the modified tip corners.
+    the modified tip corners. ``edge_radius`` [m] > 0: each tip corner rounded by an arc of that
+    radius tangent to the flank and the tip circle (`solver.tip_edge.tip_round`), a piece of its
+    own between the flank and the tip arc (two pieces more a tooth, 17 points each).
     """
     rf, ra = g.root_radius, g.tip_radius
     half_pitch = math.pi / g.teeth
     plus = []  # + half from the tip corner down to mid-space, as (points, is_fillet)
-    u = np.linspace(g.u_tip, g.u_form, n)
+    u_top = g.u_tip
+    if edge_radius > 0:
+        from solver.tip_edge import tip_round
+        rnd = tip_round(g, edge_radius, deviation)
+        plus.append((rnd.points(17), False))
+        u_top = rnd.u_flank
+    u = np.linspace(u_top, g.u_form, n)
     flank = np.column_stack(g.flank_point(u, 1))
     if deviation is not None:
         t = g.psi_base - u   # the + flank's outward normal is (-sin t, cos t)
         d = np.asarray(deviation(u), float)
         flank = flank - d[:, None] * np.column_stack([-np.sin(t), np.cos(t)])
+    if plus:
+        flank[0] = plus[0][0][-1]       # the round's tangent point, exactly
     plus.append((flank, False))
     if g.radial_flank:
         rho = g.spec.fillet_radius
@@ -118,8 +128,9 @@ def tooth_pieces(g: GearGeometry, n: int = 12, deviation=None) -> list[tuple[np.
         plus.append((np.column_stack([cx + rho * np.cos(a), cy + rho * np.sin(a)]), True))
     plus.append((_arc(rf, g.fillet_root_angle, half_pitch, 4), False))
     minus = [(p[::-1] * np.array([1.0, -1.0]), f) for p, f in reversed(plus)]
-    tip = _arc(ra, -g.tip_half_angle, g.tip_half_angle, 5)
-    tip[0], tip[-1] = minus[-1][0][-1], plus[0][0][0]   # the (modified) tip corners
+    a_tip = g.tip_half_angle if edge_radius <= 0 else math.atan2(plus[0][0][0, 1], plus[0][0][0, 0])
+    tip = _arc(ra, -a_tip, a_tip, 5)
+    tip[0], tip[-1] = minus[-1][0][-1], plus[0][0][0]   # the (modified) tip corners, or the rounds' ends
     return minus + [(tip, False)] + plus
 
 
@@ -180,16 +191,17 @@ class Outline:
 
 
 def build_outline(gmsh, g: GearGeometry, body: BodySpec, h: float, rim: bool = True, deviation=None,
-                  n_flank: int = 12) -> Outline:
+                  n_flank: int = 12, edge_radius: float = 0.0) -> Outline:
     """Add the gear body to the current gmsh model (gear frame, tooth k's axis at 2*pi*k/z):
     the outline of all teeth with points of size ``h`` [m] (``h/2`` on the fillets), the
     rim, web (pierced by the holes) and hub as plane surfaces; ``rim=False``: web and hub only
     (see `mesh_body`); ``deviation``: the flanks' profile modification (`tooth_pieces`);
     ``n_flank``: points of each flank's spline (12: the involute within a few um, enough for a
-    body loaded at given points; a contact analysis needs ~150, within 0.01 um)."""
+    body loaded at given points; a contact analysis needs ~150, within 0.01 um); ``edge_radius``
+    [m]: the tip corners rounded (`tooth_pieces`)."""
     geo = gmsh.model.geo
     h_body = 5.0 * h
-    pieces = tooth_pieces(g, n=n_flank, deviation=deviation)
+    pieces = tooth_pieces(g, n=n_flank, deviation=deviation, edge_radius=edge_radius)
     # ---- outline: one spline per piece, shared end points between pieces and teeth
     first_tag = None
     prev_tag = None

@@ -217,6 +217,20 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     Ctrl-C or SIGTERM (`solver.mbs.interrupt`: KeyboardInterrupt raised here).
     """
     from solver.mbs import interrupt
+    args = kernel_arguments(model, loads, grid, par, all_teeth)
+    p, out = args[1][0], args[4]
+    poll = None if progress is None else (lambda: progress(float(out[last_record(out), L.O_TIME])))
+    ret = interrupt.call(kernel, args, p, L.ABORT, poll, PROGRESS_PERIOD_S)
+    return ret, out[:min(grid[3], ret[1] // grid[1] + 1)]
+
+
+def kernel_arguments(model: Model, loads: tuple, grid: tuple, par: dict, all_teeth: bool = False,
+                     theta2: float | None = None) -> tuple:
+    """The arguments of a stepping kernel (`run_kernel`'s ``loads``, ``grid``, ``par``,
+    ``all_teeth``): (mdl, (par, ipar, load table), hub, teeth, out, work arrays), the run
+    from rest, the driven hub at ``theta2`` [rad] (None: where the flanks touch, `start_te`).
+    What a model's stepping kernel is compiled for (the `layout.ContactParts` variant, the
+    work tuples) is in their types, which `study.stand_in` reads without a run."""
     speed, speed_ramp, torque, torque_ramp, table, side = loads
     dt, out_every, n_steps, n_out = grid
     phi_quiet = 0.0 if all_teeth else par["PHI_QUIET"]
@@ -232,7 +246,9 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     ip = np.zeros(L.N_IPAR, dtype=np.int64)
     ip[[L.N_STEPS, L.OUT_EVERY, L.MAX_ITER]] = n_steps, out_every, par.get("MAX_ITER", 0)
     hub = np.zeros((3, L.N_HUB))
-    hub[L.POS, L.H_TH2] = hub[L.POS, L.H_H2] = model.theta2_for_te(0.0, start_te(model, side))
+    if theta2 is None:
+        theta2 = model.theta2_for_te(0.0, start_te(model, side))
+    hub[L.POS, L.H_TH2] = hub[L.POS, L.H_H2] = theta2
     teeth = np.zeros((3, model.n_teeth))
     if all_teeth:
         teeth[L.POS] = 1e-300
@@ -240,11 +256,8 @@ def run_kernel(kernel, model: Model, loads: tuple, grid: tuple, par: dict, all_t
     # contact_parts: which parts of the contact search the model has, so which compiled variant runs
     mdl = (model.gear_par, model.pair_par, model.law_par, model.k_phi, model.tooth_compliance,
            contact_parts(model.gear_par, model.pair_par, model.law_par))
-    args = (mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out,
+    return (mdl, (p, ip, np.ascontiguousarray(table, dtype=float)), hub, teeth, out,
             work_arrays(model.n_teeth, model.tooth_compliance))
-    poll = None if progress is None else (lambda: progress(float(out[last_record(out), L.O_TIME])))
-    ret = interrupt.call(kernel, args, p, L.ABORT, poll, PROGRESS_PERIOD_S)
-    return ret, out[:min(n_out, ret[1] // out_every + 1)]
 
 
 PROGRESS_PERIOD_S = 0.25

@@ -48,9 +48,12 @@ def call(kernel, args: tuple, flag, index: int, poll=None, period_s: float = 0.2
     interrupt is raised again (`Interrupted` after `stop_all`). ``poll``: None, or a
     callable (no arguments) called about every ``period_s`` [s] while the kernel runs and
     once when it ends (a progress bar's update). An exception of the kernel is raised in this thread.
+    A kernel that a second process is compiling (`solver.precompile`) is waited for first.
     """
     if _stopping.is_set():
         raise Interrupted("stopped: the process is closing")
+    from solver import precompile
+    precompile.ready(kernel)        # (compiled by a second process: wait for it rather than compile it here)
     ret, err = [], []
 
     def target():

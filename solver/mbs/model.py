@@ -253,6 +253,7 @@ def with_flank_deviations(model: Model, modifications, errors) -> Model:
         if mod is not None:
             mod.check(g.u_form, g.u_tip, name)
         sample_deviation(mod, g.u_form, g.u_tip, gp[i])
+    write_tip_edges(model, modifications, gp)
     for name, e, g in zip(("gear1", "gear2"), errors, geos):
         if e is not None:
             # limited to 0.1 module: a few % of a pitch, well inside the pre-search margin
@@ -264,6 +265,33 @@ def with_flank_deviations(model: Model, modifications, errors) -> Model:
                        for gi, mod, e in zip(inputs[:2], modifications, errors)) + tuple(inputs[2:])
     return dataclasses.replace(model, gear_par=gp, pair_par=pp, law_par=model.law_par.copy(), k_phi=model.k_phi.copy(),
                                tooth_compliance=model.tooth_compliance.copy(), inputs=inputs)
+
+
+def write_tip_edges(model: Model, modifications, gp: np.ndarray) -> None:
+    """Write the EDGE_* columns of ``gp`` (the model's gear_par or its copy) for the gears'
+    modifications ((ProfileModification | None) x 2): the round of each tip edge radius
+    (`solver.tip_edge.tip_round` on the modified flank: its tangent roll and the deviation there)
+    and its compliance's law (`solver.tip_edge.edge_columns`: the model's Young's modulus, the
+    narrower face, the contact law's radius of curvature); all 0 for a sharp corner."""
+    from solver.tip_edge import edge_columns, law_radius, tip_round
+    gp[:, L.EDGE_INV_R:L.N_GEAR_PAR] = 0.0
+    radii = [0.0 if mod is None else float(mod.tip_edge_radius) for mod in modifications]
+    if not any(radii):
+        return
+    if len(model.inputs) < 4:
+        raise ValueError("gearN.modification.tip_edge_radius: the model has no material to take the edge's law from")
+    material = model.inputs[3]
+    b = min(g.spec.face_width for g in model.geometry)
+    law_r = law_radius(*model.geometry)
+    for i, (r, mod, g) in enumerate(zip(radii, modifications, model.geometry)):
+        if r == 0.0:
+            continue
+        dev = (lambda u, mod=mod, g=g: mod.deviation(u, g.u_form, g.u_tip))
+        rnd = tip_round(g, r, dev)
+        gp[i, L.EDGE_INV_R:L.EDGE_INV_R + 3] = edge_columns(r, material.youngs_modulus, b, law_r)
+        gp[i, L.EDGE_R] = r
+        gp[i, L.EDGE_U] = rnd.u_flank
+        gp[i, L.EDGE_DEV] = float(dev(np.array([rnd.u_flank]))[0])
 
 
 def _check_compliance(gi: GearInput, z: int, name: str) -> None:

@@ -89,28 +89,16 @@ def solve_static(model: Model, angles, torque: float, phi0: np.ndarray | None = 
     return StaticSolver(**settings).run(model, angles, torque, phi0, te0)
 
 
-def _solve(settings: StaticSolver, model: Model, angles, torque: float, phi0, te0) -> StaticResult:
-    """`StaticSolver.run`."""
-    tol, max_iter = settings.tol, settings.max_iter
-    raise_on_failure, friction_speed = settings.raise_on_failure, settings.friction_speed
-    angles = np.ascontiguousarray(angles, dtype=float)
-    if angles.ndim != 1 or angles.size == 0:
-        raise ValueError("angles: need a non-empty 1-D array of driver angles")
+def sweep_arguments(model: Model, angles: np.ndarray, torque: float, theta2: float, tol: float = StaticSolver.tol,
+                    max_iter: int = StaticSolver.max_iter, friction_speed: float = StaticSolver.friction_speed,
+                    phi: np.ndarray | None = None) -> tuple:
+    """The arguments of `kernels.statics.static_sweep` for ``model`` at the rim angles
+    ``angles`` [rad] under ``torque`` [N·m], from the driven rim angle ``theta2`` [rad] and the
+    tooth rotations ``phi`` [rad] (None: zeros; changed in place by the sweep): (mdl, ctooth,
+    ctl, angles, phi, out, f1, sw). What a model's static sweep is compiled for (the
+    `layout.ContactParts` variant, a coupled set or None) is in their types, which
+    `study.stand_in` reads without running the sweep."""
     n = angles.size
-    z1 = model.teeth[0]
-    out = np.zeros((n, L.N_S_OUT))
-    f1 = np.zeros((n, z1))
-    phi = np.zeros(model.n_teeth) if phi0 is None else np.array(phi0, dtype=float)
-    sgn = 1.0 if torque >= 0 else -1.0
-    te_start = sgn * model.backlash_offset if te0 is None else te0
-    theta2 = float(model.theta2_for_te(angles[0], te_start))
-    kb1, kb2 = model.body_stiffness
-    rb1, rb2 = model.base_radii
-    windup1 = torque * rb1 / rb2 / kb1          # driver rim lags its hub [rad]
-    windup2 = torque / kb2                      # driven hub lags its rim [rad]
-    rim_angles = angles - windup1 if model.coupled else angles
-    if model.coupled:
-        theta2 -= windup2
     # teeth coupled through the bodies: their springs act through the compliance matrix alone
     kphi = np.zeros_like(model.k_phi) if model.teeth_coupled else model.k_phi
     ctooth = model.tooth_compliance if model.teeth_coupled else None    # None: the plain kernel
@@ -122,9 +110,34 @@ def _solve(settings: StaticSolver, model: Model, angles, torque: float, phi0, te
         lp[L.C_CON] = 0.0
     mdl = (model.gear_par, model.pair_par, lp, kphi, contact_parts(model.gear_par, model.pair_par, lp))
     ctl = (np.array([float(torque), theta2, tol, w1, 0.0]), np.array([max_iter], dtype=np.int64))
-    # stoppable by Ctrl-C / SIGTERM before the next angle (KeyboardInterrupt raised here)
+    phi = np.zeros(model.n_teeth) if phi is None else phi
     sw = static_work(model.n_teeth, ctooth is not None)
-    interrupt.call(static_sweep, (mdl, ctooth, ctl, rim_angles, phi, out, f1, sw), ctl[0], L.S_ABORT)
+    return mdl, ctooth, ctl, angles, phi, np.zeros((n, L.N_S_OUT)), np.zeros((n, model.teeth[0])), sw
+
+
+def _solve(settings: StaticSolver, model: Model, angles, torque: float, phi0, te0) -> StaticResult:
+    """`StaticSolver.run`."""
+    tol, max_iter = settings.tol, settings.max_iter
+    raise_on_failure, friction_speed = settings.raise_on_failure, settings.friction_speed
+    angles = np.ascontiguousarray(angles, dtype=float)
+    if angles.ndim != 1 or angles.size == 0:
+        raise ValueError("angles: need a non-empty 1-D array of driver angles")
+    n = angles.size
+    phi = np.zeros(model.n_teeth) if phi0 is None else np.array(phi0, dtype=float)
+    sgn = 1.0 if torque >= 0 else -1.0
+    te_start = sgn * model.backlash_offset if te0 is None else te0
+    theta2 = float(model.theta2_for_te(angles[0], te_start))
+    kb1, kb2 = model.body_stiffness
+    rb1, rb2 = model.base_radii
+    windup1 = torque * rb1 / rb2 / kb1          # driver rim lags its hub [rad]
+    windup2 = torque / kb2                      # driven hub lags its rim [rad]
+    rim_angles = angles - windup1 if model.coupled else angles
+    if model.coupled:
+        theta2 -= windup2
+    args = sweep_arguments(model, rim_angles, torque, theta2, tol, max_iter, friction_speed, phi)
+    ctl, out, f1 = args[2], args[5], args[6]
+    # stoppable by Ctrl-C / SIGTERM before the next angle (KeyboardInterrupt raised here)
+    interrupt.call(static_sweep, args, ctl[0], L.S_ABORT)
     te, th2 = out[:, L.S_TE].copy(), out[:, L.S_TH2].copy()
     nc, it = out[:, L.S_NC].astype(np.int64), out[:, L.S_ITER].astype(np.int64)
     if model.coupled:

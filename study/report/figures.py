@@ -66,13 +66,29 @@ def order_map_missing(ds: xr.Dataset) -> str:
     return "not a run-up (dynamic.speed_end = 0)"
 
 
+def fresh(path: Path, after: float | None) -> bool:
+    """True when the figure ``path`` was written at or after ``after`` (a file time [s], that of
+    the archive it shows; None: never)."""
+    return after is not None and path.is_file() and path.stat().st_mtime >= after
+
+
+def render_paths(ds: xr.Dataset, outdir, prefix: str = "") -> list[Path]:
+    """The files of a run archive's pyvista renders: the gear pair, each lightened gear's FE stress."""
+    from study.report.render_inputs import required_scene
+    sc = required_scene(ds)
+    return [Path(outdir) / f"{prefix}{stem}.png"
+            for stem in ["gear_pair", *(f"fe_stress_gear{g}" for g in (1, 2) if sc.is_lightened(g))]]
+
+
 def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True, limits: dict | None = None,
-                 fields: dict | None = None) -> list[Path]:
+                 fields: dict | None = None, reuse_after: float | None = None) -> list[Path]:
     """Write every plot and render ``ds`` supports into ``outdir``; return the PNG paths.
     ``limits`` ({output: value}): the probability of exceeding each, for a sampled study.
     ``fields`` ({gear: [BodyField under the stiffest tooth's load, under the softest's]},
     `study.inputs.springs.archive_body_fields`): what the renders of a lightened gear draw;
-    without them those renders are skipped (the pictures start no FE solve)."""
+    without them those renders are skipped (the pictures start no FE solve).
+    ``reuse_after`` (a run archive's file time [s]): a run's figure already in ``outdir`` and
+    written since is taken as it is, not drawn again (`lightgear report` after `render`)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     out: list[Path] = []
@@ -95,6 +111,9 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True,
         if not any(v in ds for v in variables):
             skip(what, why(ds) if callable(why) else why)
             continue
+        if fresh(name(stem), reuse_after):
+            out.append(name(stem))
+            continue
         try:
             out.append(plot(ds, name(stem)))
         except (ValueError, KeyError, IndexError) as e:
@@ -111,6 +130,10 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True,
     if "scene" not in ds.attrs or "tooth_stiffness" not in ds:
         skip("renders", "the archive has no scene attribute or no tooth_stiffness")
         return out
+    done = render_paths(ds, outdir, prefix)
+    if all(fresh(p, reuse_after) for p in done):
+        print(f"  renders: the {len(done)} already beside the archive")
+        return out + done
     out += _renders(ds, name, skip, fields or {})
     return out
 

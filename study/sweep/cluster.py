@@ -91,10 +91,13 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
     n = workers or os.cpu_count() or 1
     # the scheduler's HTTP endpoint (health, metrics; no dashboard) moves to a free port when
     # 8787 is taken, another user's cluster say: not worth a warning
+    # the workers' own log lines are connection news (a heartbeat that found the scheduler gone
+    # while a stopped sweep closes it, on a loaded machine): what a point did, failed or lost
+    # is recorded from its future, with its cause, so nothing below CRITICAL goes to the terminal
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Port 8787 is already in use", category=UserWarning)
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR, env=dict(WORKER_ENV))
+                               silence_logs=logging.CRITICAL, env=dict(WORKER_ENV))
     with cluster, Client(cluster) as client:
         client.register_plugin(stop_kernels_plugin(), name="lightgear-stop-kernels")
         yield client
@@ -194,6 +197,7 @@ def kernels_cached(coupled: bool | None = None) -> bool:
 def with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | None, parts: Path | None = None):
     from distributed import as_completed
 
+    from study.stand_in import compile_kernels
     from study.sweep.bodies import compute_body, fe_jobs, job_rim
     from study.sweep.tasks import Task, batches
     with dask_client(scheduler, workers) as client:
@@ -202,6 +206,12 @@ def with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | N
         dynamic = [todo[k] for k in todo if outputs[k].dynamic]
         coupled = any(sc.coupling_model != "none" for sc in dynamic) if dynamic else None
         pilot = pilot_tasks(todo, outputs) if scheduler is None and not kernels_cached(coupled) else ()
+        if pilot:
+            # the pilot's entry kernels compiled from a stand-in of its scenes first, without
+            # their FE (`study.stand_in`): the compile overlaps the rims and bodies on the other
+            # workers, and the pilot, once its FE is there, loads them from the disk cache
+            ahead = client.submit(compile_kernels, tuple(todo[k] for k in pilot), key=f"lightgear-compile-{pilot[0]}",
+                                  pure=False, priority=4)
         jobs, reads = {}, {}            # FE job key -> (function, arguments, priority); task key -> its jobs
         for key in sorted(todo, key=lambda k: k not in pilot):      # the pilot's jobs first
             for fe_key, func, args in fe_jobs(todo[key]):
@@ -220,7 +230,7 @@ def with_dask(todo: dict, outputs: dict, scheduler: str | None, workers: int | N
         def stored_here(keys):      # a local cluster's workers store a batch's tasks as each finishes (`run_after`)
             return str(parts) if parts is not None and scheduler is None and len(keys) > 1 else None
         if pilot:       # compiles the kernels into the disk cache; the other tasks load them
-            waits = list(dict.fromkeys(f for k in pilot for f in after.get(k, ())))
+            waits = [ahead, *dict.fromkeys(f for k in pilot for f in after.get(k, ()))]
             first = client.submit(run_after, tuple((k, todo[k], outputs[k]) for k in pilot), *waits,
                                   key=f"lightgear-pilot-{pilot[0]}", pure=False, priority=3, parts=stored_here(pilot))
             futures[first] = pilot

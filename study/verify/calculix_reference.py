@@ -22,6 +22,8 @@ from solver.peers.calculix import (
     default_settings,
     ste_sweep,
 )
+from solver.peers.calculix.mesh import round_size
+from study.modification import tip_edge_attrs, tip_edge_radii
 from study.scene import Scene, SceneError
 from study.scene_model import geometry_model
 
@@ -54,15 +56,17 @@ def peer_estimate(n_decks: int, settings: CalculixSettings, module: float):
 
 
 def peer_gears(scene: Scene) -> tuple:
-    """(PeerGear, PeerGear) of the scene: geometry, body and profile modification of each gear."""
+    """(PeerGear, PeerGear) of the scene: geometry, body, profile modification and tip edge
+    radius of each gear."""
     model = geometry_model(scene)
     out = []
     for g, gi in zip(model.geometry, model.inputs[:2]):
-        dev = None
+        dev, edge = None, 0.0
         if gi.modification is not None:
             mod, uf, ut = gi.modification, g.u_form, g.u_tip
             dev = (lambda u, mod=mod, uf=uf, ut=ut: mod.deviation(u, uf, ut))
-        out.append(PeerGear(g, gi.body, dev))
+            edge = mod.tip_edge_radius
+        out.append(PeerGear(g, gi.body, dev, edge))
     return tuple(out), model
 
 
@@ -125,6 +129,10 @@ def calculix_dataset(scene: Scene, angles=None, settings: CalculixSettings | Non
              "mesh_order": float(scene.gear2.teeth), "hole_order": float(scene.gear2.body.holes),
              "static_torque_N_m": float(torque),
              "element_type": "CPS6 (6-node plane-stress triangle; thickness = face width, web thickness in the web)",
+             **tip_edge_attrs(tip_edge_radii((scene.gear1, scene.gear2))),
+             **({"tip_edge_mesh_size_mm": np.array([round_size(g.edge_radius, s.sizes.flank) * units.MM_PER_M
+                                                    if g.edge_radius > 0 else 0.0 for g in gears])}
+                if any(g.edge_radius > 0 for g in gears) else {}),
              "flank_mesh_size_mm": s.sizes.flank * units.MM_PER_M, "fillet_mesh_size_mm": s.sizes.fillet * units.MM_PER_M,
              "body_mesh_size_mm": s.sizes.body * units.MM_PER_M,
              "contact_stiffness_MPa_per_mm": s.contact_stiffness / units.MPA * units.MM,

@@ -22,6 +22,7 @@ from solver.fe.ltca import ltca_sweep, teeth_in_mesh
 from study.archive.run_variables import opening_attrs
 from study.inputs.compliance import PROFILE_POINTS, gear_compliance
 from study.inputs.gearsetup import gear_setups
+from study.modification import tip_edge_attrs, tip_edge_radii
 from study.scene import Scene, SceneError, opening_text
 from study.scene_model import geometry_model, static_angles
 
@@ -92,8 +93,11 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     ``rigid``: rigid bodies, only the contact law deforms (the closed-form check);
     ``n_u``: profile points per flank of the influence coefficients; ``progress``: a bar on
     stderr (unit: the estimated second) when the run is expected to be long;
-    ``tip_edge_radius`` [m]: tip corners meet the mating flanks rounded to it (`tip_edge`);
-    None: under the flanks' contact law."""
+    ``tip_edge_radius`` [m]: both gears' tip-corner contacts carry the compliance of an edge of
+    that radius (`tip_edge`), on the corners' geometry as the scene has it; None: each gear's
+    ``modification.tip_edge_radius`` (`scene_edges`; 0: under the flanks' contact law). The
+    scene's radius also rounds the corners' geometry (the model's gear_par EDGE_*,
+    `solver.fe.ltca.mesh_points`)."""
     from study import estimate
     qs = scene.quasi_static
     if not qs.torque > 0:
@@ -103,7 +107,7 @@ def reference(scene: Scene, angles=None, rigid: bool = False, n_u: int = PROFILE
     teeth = None if rigid else teeth_in_mesh(model, angles)
     parts = reference_cost(scene, angles, teeth).seconds if not rigid else {"contact sweep": 0.0}
     bar = estimate.progress_bar(sum(parts.values()), sum(parts.values()), "FE reference", "s (estimated)", progress)
-    edge = None if tip_edge_radius is None else tip_edge(scene, model, tip_edge_radius)
+    edge = scene_edges(scene, model, tip_edge_radius)
     try:
         return _reference(scene, angles, rigid, n_u, model, _Stages(bar, parts), teeth, edge)
     finally:
@@ -119,13 +123,40 @@ def tip_edge(scene: Scene, model, radius: float):
     import math
 
     from solver.fe.ltca import TipEdge
+    from solver.tip_edge import law_radius
     if not (isinstance(radius, (int, float)) and math.isfinite(radius) and 0 < radius < scene.gear1.module * units.MM):
         raise SceneError("--tip-edge-radius", f"must be a positive radius below the module ({scene.gear1.module:g} mm), "
                                               f"got {radius * units.MM_PER_M if isinstance(radius, (int, float)) else radius!r} mm")
-    alpha = model.geometry[0].spec.pressure_angle
-    rho1, rho2 = (rb * math.tan(alpha) for rb in model.base_radii)
     b = min(scene.gear1.face_width, scene.gear2.face_width) * units.MM
-    return TipEdge(float(radius), scene.material_spec().youngs_modulus, b, rho1 * rho2 / (rho1 + rho2))
+    return TipEdge(float(radius), scene.material_spec().youngs_modulus, b, law_radius(*model.geometry))
+
+
+def edge_radii(scene: Scene, tip_edge_radius: float | None = None) -> tuple[float, float]:
+    """(gear 1, gear 2) tip edge radius [m] the LTCA takes: ``tip_edge_radius`` [m] for both
+    where given (`lightgear reference --tip-edge-radius`), else the scene's
+    ``gearN.modification.tip_edge_radius`` (0: a sharp corner)."""
+    if tip_edge_radius is not None:
+        return float(tip_edge_radius), float(tip_edge_radius)
+    return tip_edge_radii((scene.gear1, scene.gear2))
+
+
+def scene_edges(scene: Scene, model, tip_edge_radius: float | None = None):
+    """(gear 1's, gear 2's) `solver.fe.ltca.TipEdge` or None (a sharp corner) of `edge_radii`;
+    None where neither gear has one."""
+    radii = edge_radii(scene, tip_edge_radius)
+    if not any(radii):
+        return None
+    return tuple(tip_edge(scene, model, r) if r > 0 else None for r in radii)
+
+
+def tip_corner_law(radii) -> str:
+    """In words, the local law of the tip-corner contacts of tip edge radii (gear 1, gear 2) [m]."""
+    if not any(radii):
+        return "the flanks' contact law"
+    r1, r2 = (r * units.MM_PER_M for r in radii)
+    return (f"the flanks' contact law + in series the compliance of the rounded tip edge (radius {r1:g} mm on gear 1, "
+            f"{r2:g} mm on gear 2; 0: a sharp corner): its Hertz patch against the mating flank instead of the two flanks'; "
+            "a corner the scene rounds (gearN.modification.tip_edge_radius) meets the flank with the round's circle")
 
 
 class _Stages:
@@ -196,13 +227,11 @@ def reference_dataset(scene: Scene, angles=None, progress: bool = False, tip_edg
              "static_torque_N_m": res.torque, "wall_time_reference_s": wall,
              "wall_time_compliance_s": info["wall_time_compliance_s"], "wall_time_contact_s": info["wall_time_contact_s"],
              "profile_points": PROFILE_POINTS,
-             **({} if tip_edge_radius is None else {"tip_edge_radius_mm": tip_edge_radius * units.MM_PER_M}),
+             **tip_edge_attrs(edge_radii(scene, tip_edge_radius)),
              "fe_mesh_size_mm": info["gear2"]["mesh_size_m"] * 1e3,
              "method": "loaded-tooth-contact analysis: bulk FE compliance read at the tooth centreline (both bodies, "
                        "clamped at the bore, all loaded teeth coupled) + contact law k_con*delta^m1 in series",
-             "tip_corner_law": ("the flanks' contact law" if tip_edge_radius is None else
-                                f"the flanks' contact law + the compliance of a {tip_edge_radius * units.MM_PER_M:g} mm tip edge radius "
-                                "(Hertz patch of the edge against the mating flank instead of the two flanks')"),
+             "tip_corner_law": tip_corner_law(edge_radii(scene, tip_edge_radius)),
              "te_convention": "TE = rb1*theta1 + rb2*theta2, positive when the driven gear lags, zero at the zero-backlash conjugate position",
              **provenance()}
     return xr.Dataset(data, coords=coords, attrs=attrs)

@@ -11,11 +11,17 @@ from test_doc_blocks import ROOT, blocks, commands
 @pytest.mark.slow
 @pytest.mark.parametrize("section", ["## A first run", "## A first study"])
 def test_the_readme_commands_run_in_order(section, tmp_path, monkeypatch, capsys):
-    """Each command of a README section, as written, from an empty directory: exit 0."""
+    """Each command of a README section, as written, from an empty directory: exit 0. The FE
+    cache is the suite's (the default's folder is relative to where a command runs): the bodies
+    the commands compute serve the other tests, which check the FE, and theirs these."""
+    import os
+    from pathlib import Path
+
     from study.cli import main
     text = (ROOT / "README.md").read_text()
     start = text.index(section)
     block = next(b for b in blocks("sh") if b.page == "README.md" and b.line > text.count("\n", 0, start))
+    monkeypatch.setenv("LIGHTGEAR_CACHE", str(Path(os.environ.get("LIGHTGEAR_CACHE", ".lightgear-cache")).resolve()))
     monkeypatch.chdir(tmp_path)
     ran = []
     for cmd in commands(block):

@@ -110,13 +110,19 @@ def __getattr__(name):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+# the root the first kernel was filed under (None before): numba fixes a kernel's folder when it
+# is decorated, so a later change of LIGHTGEAR_CACHE in the same process moves the FE cache only
+_filed_root: str | None = None
+
+
 def cache_root() -> str:
     """The folder (absolute) under which the kernels' disk cache folder lies: numba's
     ``NUMBA_CACHE_DIR`` where set, else ``$LIGHTGEAR_CACHE/numba`` (default
-    ``./.lightgear-cache/numba``, as the FE cache, `study.inputs.cache`)."""
+    ``./.lightgear-cache/numba``, as the FE cache, `study.inputs.cache`) as it was when this
+    process decorated its first kernel."""
     import numba
-    return os.path.abspath(numba.config.CACHE_DIR or os.path.join(os.environ.get("LIGHTGEAR_CACHE", ".lightgear-cache"),
-                                                                   "numba"))
+    return os.path.abspath(numba.config.CACHE_DIR or _filed_root
+                           or os.path.join(os.environ.get("LIGHTGEAR_CACHE", ".lightgear-cache"), "numba"))
 
 
 def njit(**options):
@@ -130,8 +136,12 @@ def njit(**options):
     options.setdefault("error_model", "numpy")
 
     def decorate(fn):
+        global _filed_root
         user = numba.config.CACHE_DIR
-        numba.config.CACHE_DIR = os.path.join(cache_root(), f"kernels-{KERNELS_FINGERPRINT}")
+        root = cache_root()
+        if not user and _filed_root is None:
+            _filed_root = root
+        numba.config.CACHE_DIR = os.path.join(root, f"kernels-{KERNELS_FINGERPRINT}")
         try:
             if not options.get("no_cpython_wrapper") or numba.config.DISABLE_JIT:
                 return numba.njit(**options)(fn)

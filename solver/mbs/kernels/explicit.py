@@ -74,8 +74,8 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
     th1, w1, acc1, tl = drive(0.0, par, table)
     # the contact search with the model's parts as arguments of their own (`gearmesh.pair_contacts`)
     buf = (rec, pairs)
-    dev, ser, err, fric = mdl[5]
-    nc, npair = pair_contacts((th1, theta2, w1, w2), phi, dphi, geo, buf, dev, ser, err, fric)
+    dev, ser, err, fric, edg = mdl[5]
+    nc, npair = pair_contacts((th1, theta2, w1, w2), phi, dphi, geo, buf, dev, ser, err, fric, edg)
     nact = initial_set(ws.tset, teeth, pairs, npair, tz2)
     generalized_forces(rec, nc, phi, dphi, act, nact, kphi, gp, tl, q)
     a2, s1, r1 = arrowhead_accelerations(q, act, nact, gpk, acc)
@@ -113,7 +113,7 @@ def verlet(mdl, ctl, hub, teeth, out, ws):
             if i < tz2:
                 vpred[i] -= cr1 * dw_b
         # contacts; activate the teeth the pre-search finds
-        nc, npair = pair_contacts((th1, theta2, w1, w2p), phi, vpred, geo, buf, dev, ser, err, fric)
+        nc, npair = pair_contacts((th1, theta2, w1, w2p), phi, vpred, geo, buf, dev, ser, err, fric, edg)
         n_old = nact
         nact = activate(ws.tset, nact, pairs, npair, tz2)
         for a in range(n_old, nact):

@@ -190,8 +190,8 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     th1, w1, acc1, tl = drive(0.0, par, table)
     # the contact search with the model's parts as arguments of their own (`gearmesh.pair_contacts`)
     buf = (rec, pairs)
-    dev, ser, err, fric = parts
-    nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, geo, buf, dev, ser, err, fric)
+    dev, ser, err, fric, edg = parts
+    nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], v[L.H_R1], v[L.H_TH2]), phi, dphi, geo, buf, dev, ser, err, fric, edg)
     ns = np.int64(0)
     if coupled:
         nn = new_candidates(newl, incand, pairs, npair, tz2)
@@ -234,7 +234,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
         for a in range(nact):
             i = act[a]
             vpred[i] = dphi[i] + 0.5 * dt * acc[i]
-        nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, geo, buf, dev, ser, err, fric)
+        nc, npair = pair_contacts((x[L.H_R1], x[L.H_TH2], vp[L.H_R1], vp[L.H_TH2]), phi, vpred, geo, buf, dev, ser, err, fric, edg)
         nn = new_candidates(newl, incand, pairs, npair, tz2) if coupled else 0
         n_old = nact
         nact = activate(tset, nact, pairs, npair, tz2)

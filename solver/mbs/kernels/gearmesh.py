@@ -33,6 +33,18 @@ fixed penetration, so the recorded gradient is G - F_e**2/(2F) * d c_loc/dq (exa
 contacts; a tip corner takes the roll derivative of the flank contact it continues, its own
 differs by the corner's slide along the flank, a small energy leak where c_loc's slope is).
 
+A rounded tip edge (gear_par EDGE_*, with the local compliances only): the flank of a gear whose
+EDGE_INV_R > 0 ends at the round's tangent roll EDGE_U, and beyond it the tooth meets the mating
+flank with the round, a circle of radius r: its penetration is its centre's plus r, along the
+mating flank's normal through the centre (the round's normal there), so that the contact passes
+from the flank onto the round without a jump (they share the point and the normal at EDGE_U),
+and the round keeps the neighbouring pairs' tips off by up to r (1/cos(theta/2) - 1) more than a
+sharp corner (theta = 90 deg - alpha_a: 0.16-0.19 r on the pairs of the scenes). The contact carries the compliance of the
+round's narrower Hertz patch in its c_loc (`edge_compliance`); it changes with the mating flank's
+roll as its radius of curvature does, and that slope joins the flank's c_loc slope in the
+gradient (conservative). The round's centre is a material point of its tooth, so the moments and
+the gradient are those of a tip corner at the centre.
+
 Pitch errors and eccentricity (`solver.pitch_errors`, the pair_par block E_*, present only when a
 gear has them): each tooth's axis turns by its offset eps about the teeth's centre, which sits
 off the bearing axis by the eccentricity; the flanks follow exactly, the moment arms of the hub
@@ -149,6 +161,21 @@ def local_compliance(gp, g, u):
     slope: the force term of c_loc's change along the profile has no jump at grid nodes, and
     the slope is the exact derivative of what is read, so the series spring stays conservative)."""
     return _catmull_rom(gp, g, u, gp[g, L.CLOC_U0], gp[g, L.CLOC_DU], L.CLOC0, L.N_CLOC)
+
+
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+def edge_compliance(gp, g, rb_f, u_f):
+    """Compliance [m/N] that the rounded tip edge of gear g (gear_par row gp[g]) adds in series
+    with the contact law where it meets the mating flank (base radius ``rb_f`` [m]) at roll u_f,
+    and its slope d c/d u_f [m/N]: the edge against the flank's radius of curvature
+    rho = rb_f*u_f has the equivalent radius 1/(1/r + 1/rho), and
+    c = EDGE_A ln(EDGE_R_LAW/r_eq) (`solver.identify.weber.edge_compliance`), 0 where negative."""
+    rho = rb_f * max(u_f, 1e-6)
+    x = gp[g, L.EDGE_INV_R] + 1.0 / rho      # 1/r_eq [1/m]
+    c = gp[g, L.EDGE_A] * math.log(gp[g, L.EDGE_R_LAW] * x)
+    if c <= 0.0:
+        return 0.0, 0.0
+    return c, -gp[g, L.EDGE_A] / (x * rho * max(u_f, 1e-6))
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
@@ -272,9 +299,9 @@ def _record(rec, nc, hit, own, ids, frame, vel, lp, dg, blend, ser, series, fric
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
-def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, friction):
+def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, friction, edges):
     """`mesh_contacts` with the model's `ContactParts` (geo[3]) as arguments of their own:
-    deviations, series, errors, friction, so that numba prunes the code of each part that is
+    deviations, series, errors, friction, edges, so that numba prunes the code of each part that is
     None (it prunes on an argument's type only); the stepping loops call it so, with the parts
     taken out of geo once a run. The pre-search (`candidate_pairs`), then the detailed search
     of each candidate pair (gear-1 tooth k, gear-2 tooth j, side s) at state = (theta1,
@@ -342,7 +369,15 @@ def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, fricti
                  o2x, o2y, o2x + e2x + gp[1, L.R_PV] * cb, o2y + e2y + gp[1, L.R_PV] * snb)
         vel = (w1, dphi[ia], w2, dphi[ib])
         delta, ua, ub, nx, ny, px, py = flank_flank(cax, cay, rba, ba, cbx, cby, rbb, bb, s)
-        if gp[0, L.U_LO] <= ua <= gp[0, L.U_HI] and gp[1, L.U_LO] <= ub <= gp[1, L.U_HI]:
+        hi_a = gp[0, L.U_HI]
+        hi_b = gp[1, L.U_HI]
+        if edges is not None:
+            # a rounded tip: the flank ends where the round leaves it
+            if gp[0, L.EDGE_INV_R] > 0.0:
+                hi_a = gp[0, L.EDGE_U]
+            if gp[1, L.EDGE_INV_R] > 0.0:
+                hi_b = gp[1, L.EDGE_U]
+        if gp[0, L.U_LO] <= ua <= hi_a and gp[1, L.U_LO] <= ub <= hi_b:
             dg = (0.0, 0.0, 0.0, 0.0)
             if deviations is not None:
                 da, sa = flank_deviation(gp, gear1, ua)
@@ -362,18 +397,40 @@ def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, fricti
             continue
         flanks = ((cax, cay, rba, ba), (cbx, cby, rbb, bb))
         u = (ua, ub)
+        hi = (hi_a, hi_b)
         for g in range(2):
-            if u[g] > gp[g, L.U_HI]:
+            if u[g] > hi[g]:
                 # tip corner of gear g against the other gear's flank (owner: the flank's gear)
                 f = 1 - g
+                rounded = False
+                if edges is not None:
+                    if gp[g, L.EDGE_INV_R] > 0.0:
+                        rounded = True
                 cx, cy, rb, b = flanks[g]
-                qx, qy = tip_corner(cx, cy, rb, b, s, gp[g, L.U_HI])
+                if rounded:
+                    # the round's centre, r (and the flank's deviation there) inside its tangent point
+                    ue = gp[g, L.EDGE_U]
+                    qx, qy = tip_corner(cx, cy, rb, b, s, ue)
+                    off = gp[g, L.EDGE_R] + gp[g, L.EDGE_DEV]
+                    qx += off * s * math.sin(b - s * ue)
+                    qy -= off * s * math.cos(b - s * ue)
+                else:
+                    qx, qy = tip_corner(cx, cy, rb, b, s, gp[g, L.U_HI])
                 cx, cy, rb, b = flanks[f]
                 d, uf, mx, my = point_flank(qx, qy, cx, cy, rb, b, s)
+                if rounded:
+                    # the circle reaches r beyond its centre along the flank's normal: its deepest
+                    # point, on the force line through the centre (the same moments)
+                    d += gp[g, L.EDGE_R]
+                    qx -= gp[g, L.EDGE_R] * mx
+                    qy -= gp[g, L.EDGE_R] * my
                 dg = (0.0, 0.0, 0.0, 0.0)
                 du = (0.0, 0.0, 0.0, 0.0)
                 blend = 0.0
-                if deviations is not None:
+                if deviations is not None and rounded:
+                    # the round's own deviation is in its centre; the flank's at the contact
+                    d -= flank_deviation(gp, f, uf)[0]
+                elif deviations is not None:
                     # the tip's deviation, blended C1 into the flank's beyond the tip (TIP_BLEND)
                     last = L.DEV0 + L.N_DEV - 1
                     slope = (gp[g, last] - gp[g, last - 1]) / gp[g, L.DEV_DU]
@@ -386,12 +443,18 @@ def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, fricti
                         du = _deviation_gradient(ta, tb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp)
                         dg = (sw * du[0], sw * du[1], sw * du[2], sw * du[3])
                         blend = sw / TIP_BLEND
-                if d > 0.0 and gp[f, L.U_LO] <= uf <= gp[f, L.U_HI] and nc < rec.shape[0]:
+                if d > 0.0 and gp[f, L.U_LO] <= uf <= hi[f] and nc < rec.shape[0]:
                     ser = (0.0, (0.0, 0.0, 0.0, 0.0))
                     if series is not None:
                         cf, sf = local_compliance(gp, f, uf)
+                        cg = local_compliance(gp, g, gp[g, L.U_HI])[0]
+                        if edges is not None:
+                            if gp[g, L.EDGE_INV_R] > 0.0:
+                                ce, se = edge_compliance(gp, g, rb, uf)
+                                cg += ce
+                                sf += se
                         sfa, sfb = (sf, 0.0) if f == 0 else (0.0, sf)
-                        ser = (local_compliance(gp, g, gp[g, L.U_HI])[0] + cf,
+                        ser = (cg + cf,
                                _deviation_gradient(sfa, sfb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
                     own = 1.0 if f == 0 else -1.0
                     _record(rec, nc, (d, qx, qy, mx, my), own, (k, j, (2.0 + g) * s), frame, vel, lp, dg, (blend, du), ser,
@@ -408,7 +471,8 @@ def mesh_contacts(state, phi, dphi, geo, buf):
     Returns (n_contacts, n_pairs); pairs holds the candidates. Compiled once for each
     combination of the parts a model has (the types of geo[3])."""
     parts = geo[3]
-    return pair_contacts(state, phi, dphi, geo, buf, parts.deviations, parts.series, parts.errors, parts.friction)
+    return pair_contacts(state, phi, dphi, geo, buf, parts.deviations, parts.series, parts.errors, parts.friction,
+                         parts.edges)
 
 
 @njit(cache=True, no_cfunc_wrapper=True, inline="always")

@@ -104,7 +104,20 @@ CLOC_U0 = CLOC_ON + 1   # roll parameter of the first grid point [-]
 CLOC_DU = CLOC_ON + 2   # grid step [-]
 CLOC0 = CLOC_ON + 3     # first of the N_CLOC compliances [m/N]
 N_CLOC = 33
-N_GEAR_PAR = CLOC0 + N_CLOC
+# a rounded tip edge (`solver.tip_edge`; compliance model: the series law): the flank ends at the
+# round's tangent roll EDGE_U, beyond it the tooth meets the mating flank with the round, a circle
+# of radius r whose centre lies EDGE_R + EDGE_DEV inside the flank point at EDGE_U (along its
+# normal), and that contact carries, in series with the contact law (rho_f the mating flank's
+# radius of curvature)
+#   c_edge = EDGE_A * ln(EDGE_R_LAW * (EDGE_INV_R + 1/rho_f)),  0 where that is negative
+# (`solver.identify.weber.edge_compliance`, `gearmesh.edge_compliance`)
+EDGE_INV_R = CLOC0 + N_CLOC  # 1 / tip edge radius [1/m]; 0: a sharp corner (the flanks' law alone)
+EDGE_A = EDGE_INV_R + 1      # 2 / (pi E b) [m/N]
+EDGE_R_LAW = EDGE_INV_R + 2  # equivalent radius of curvature the contact law was fitted to [m]
+EDGE_R = EDGE_INV_R + 3      # tip edge radius r [m]
+EDGE_U = EDGE_INV_R + 4      # roll parameter of the round's tangent point on the flank [-] (< U_HI)
+EDGE_DEV = EDGE_INV_R + 5    # the flank's deviation (profile modification) at EDGE_U [m]
+N_GEAR_PAR = EDGE_INV_R + 6
 
 # law_par (contact law, eq. 1.3)
 K_CON = 0       # [N/m^m1]
@@ -277,11 +290,12 @@ CoupledSet = namedtuple("CoupledSet", "C ks lst newl inset innew mo dmo")
 CoupledSet.__doc__ = """The coupled set S of teeth (`toothcoupling.coupled_set`): the compliance C
 [rad/(N m)], the set's stiffness K_S [N m/rad] (with as many scratch columns), its teeth, the
 next set's teeth, per-tooth 0/1 flags of the current and the next set, scratch moments [N m]."""
-ContactParts = namedtuple("ContactParts", "deviations series errors friction")
+ContactParts = namedtuple("ContactParts", "deviations series errors friction edges")
 ContactParts.__doc__ = """The optional parts of the contact search a model has, each the array
 that holds its data or None where the model lacks it (`gearmesh.contact_parts`): flank
 deviations (gear_par DEV_*), local compliances in series with the contact (gear_par CLOC_*),
-pitch errors and eccentricity (the pair_par block E_*), sliding friction (law_par MU > 0).
+pitch errors and eccentricity (the pair_par block E_*), sliding friction (law_par MU > 0),
+rounded tip edges (gear_par EDGE_*; only with the series compliances, whose law they join).
 numba types a None apart from an array and prunes the branches under ``x is None`` (for an
 argument of the compiled function), so each combination compiles its own contact search with
 only the code it runs."""
@@ -292,12 +306,15 @@ only the code it runs."""
 def contact_parts(gp, pp, lp):
     """The `ContactParts` of the model arrays gear_par, pair_par, law_par: each part's array
     where the model has the part (a gear with a flank deviation, a gear with a local
-    compliance table, the pitch-error block, a friction coefficient above zero), else None.
+    compliance table, the pitch-error block, a friction coefficient above zero, a rounded tip
+    edge on a gear of a model with local compliances), else None.
     Plain Python: what it returns picks the compiled variant of the contact search."""
+    series = gp if gp[0, CLOC_ON] + gp[1, CLOC_ON] > 0.0 else None
     return ContactParts(gp if gp[0, DEV_ON] + gp[1, DEV_ON] > 0.0 else None,
-                        gp if gp[0, CLOC_ON] + gp[1, CLOC_ON] > 0.0 else None,
+                        series,
                         pp if pp.shape[0] > N_PAIR_PAR else None,
-                        lp if lp[MU] > 0.0 else None)
+                        lp if lp[MU] > 0.0 else None,
+                        gp if series is not None and gp[0, EDGE_INV_R] + gp[1, EDGE_INV_R] > 0.0 else None)
 
 
 def contact_geo(gp, pp, lp):

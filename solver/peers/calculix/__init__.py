@@ -1,6 +1,7 @@
 """Independent FE contact peer: the static transmission error of a gear pair solved by CalculiX.
 
-Both gears are meshed in full (`mesh`: the FE body's outline, holes, web and relief; quadratic
+Both gears are meshed in full (`mesh`: the FE body's outline, holes, web, relief and rounded tip
+edges; quadratic
 plane-stress triangles, fine on the flanks and fillets of the teeth around the mesh), placed at
 each driver angle at their nominal positions with the driven gear turned into its rigid drive
 contact (TE = jn/2) plus a start approach, and pressed together by the resisting torque on the
@@ -96,6 +97,7 @@ class PeerGear:
     geometry: GearGeometry
     body: BodySpec
     deviation: object = None     # None or u -> flank deviation [m] (profile modification)
+    edge_radius: float = 0.0     # tip edge radius [m] (`solver.tip_edge`); 0: sharp tip corners
 
 
 @dataclass
@@ -128,7 +130,8 @@ def pair_meshes(gears: tuple, pair: PairGeometry, angles, settings: CalculixSett
         g = pg.geometry
         fine = teeth_near(g.pitch_angle, axis0, target, th, settings.fine_teeth)
         contact = teeth_near(g.pitch_angle, axis0, target, th, settings.contact_teeth)
-        out.append(mesh_gear(g, pg.body, settings.sizes, fine, contact, pg.deviation, prefix=f"gear{i + 1}.body"))
+        out.append(mesh_gear(g, pg.body, settings.sizes, fine, contact, pg.deviation, prefix=f"gear{i + 1}.body",
+                             edge_radius=pg.edge_radius))
     return tuple(out)
 
 

@@ -66,24 +66,30 @@ def teeth_near(pitch: float, axis0: float, target: float, angles, half_width: in
 
 
 def mesh_gear(g: GearGeometry, body: BodySpec, sizes: MeshSizes, fine_teeth, contact_teeth,
-              deviation=None, prefix: str = "gear.body") -> GearMesh:
+              deviation=None, prefix: str = "gear.body", edge_radius: float = 0.0) -> GearMesh:
     """Mesh the whole gear: ``fine_teeth`` get the flank and fillet sizes, the drive (+) flanks
     and tip arcs of ``contact_teeth`` become contact faces; ``deviation`` is the flanks' profile
-    modification u -> m (`solver.fe.mesh.tooth_pieces`)."""
+    modification u -> m (`solver.fe.mesh.tooth_pieces`); ``edge_radius`` [m] > 0: every tooth's
+    tip corners rounded to it (`solver.tip_edge`), the rounds of the fine teeth meshed at
+    `round_size`, graded into the flank size."""
     validate_body(g, body, prefix)
     gmsh = start_gmsh()     # the process's SIGINT/SIGTERM handlers kept (gmsh's library replaces them)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("gear_peer")
-        outline = build_outline(gmsh, g, body, sizes.body, deviation=deviation, n_flank=FLANK_POINTS)
+        outline = build_outline(gmsh, g, body, sizes.body, deviation=deviation, n_flank=FLANK_POINTS,
+                                edge_radius=edge_radius)
         n_pieces = len(outline.pieces)
-        tip = (n_pieces - 1) // 2          # the pieces run -side, tip arc, +side
-        fine_flanks, fine_fillets = [], []
+        tip = (n_pieces - 1) // 2          # the pieces run -side, (round,) tip arc, (round,) +side
+        near = 2 if edge_radius > 0 else 1
+        fine_flanks, fine_fillets, rounds = [], [], []
         for k in fine_teeth:
             c = outline.curves[k * n_pieces:(k + 1) * n_pieces]
-            fine_flanks += [c[tip - 1], c[tip], c[tip + 1]]
+            fine_flanks += c[tip - near:tip + near + 1]
             fine_fillets += [t for t, (_, f) in zip(c, outline.pieces) if f]
-        _size_field(gmsh, g, outline.curves, fine_flanks, fine_fillets, sizes)
+            if edge_radius > 0:
+                rounds += [c[tip - 1], c[tip + 1]]
+        _size_field(gmsh, g, outline.curves, fine_flanks, fine_fillets, sizes, rounds, edge_radius)
         generate(gmsh, order=2)
         bm = _collect(gmsh, outline.surfaces, outline.bore_radius, sizes.flank, order=2)
     finally:
@@ -93,10 +99,20 @@ def mesh_gear(g: GearGeometry, body: BodySpec, sizes: MeshSizes, fine_teeth, con
     return GearMesh(bm.points, bm.triangles, bm.region, bore, faces, bool(np.any(bm.region == REGION_WEB)))
 
 
-def _size_field(gmsh, g: GearGeometry, curves, flanks, fillets, sizes: MeshSizes) -> None:
+def round_size(edge_radius: float, flank_size: float) -> float:
+    """Element size [m] on a rounded tip edge of radius ``edge_radius`` [m]: a quarter of the
+    radius (the arc, a quarter turn or less, spans at least two quadratic elements and its contact
+    patch several nodes), never coarser than the flanks."""
+    return min(0.25 * edge_radius, flank_size)
+
+
+def _size_field(gmsh, g: GearGeometry, curves, flanks, fillets, sizes: MeshSizes, rounds=(),
+                edge_radius: float = 0.0) -> None:
     """``flank`` within a quarter module of the fine flanks, growing to ``body`` over a module;
     ``fillet`` within two of its sizes of their fillets, growing to ``body`` over a module;
-    ``body`` at the outline growing to 5 ``body`` over 4 modules inside."""
+    ``body`` at the outline growing to 5 ``body`` over 4 modules inside; on the ``rounds`` (tip
+    edges of radius ``edge_radius`` [m]) `round_size` within a quarter radius, growing by half
+    the distance beyond."""
     m = g.spec.module
     f = gmsh.model.mesh.field
 
@@ -125,6 +141,10 @@ def _size_field(gmsh, g: GearGeometry, curves, flanks, fillets, sizes: MeshSizes
         fields.append(graded(flanks, sizes.flank, 0.25 * m, 1.25 * m, max(200, int(8 * m / sizes.flank))))
     if fillets:
         fields.append(graded(fillets, sizes.fillet, 2 * sizes.fillet, 1.0 * m, max(50, int(4 * m / sizes.fillet))))
+    if rounds:
+        h_r = round_size(edge_radius, sizes.flank)
+        d_min = 0.25 * edge_radius
+        fields.append(threshold(rounds, h_r, h_body, d_min, d_min + 2.0 * (h_body - h_r), 40))
     fm = f.add("Min")
     f.setNumbers(fm, "FieldsList", fields)
     f.setAsBackgroundMesh(fm)

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import solid_scene
+from helpers import series_force, solid_scene
 
 from solver import units
 from solver.fe.ltca import corner_compliance, ltca_sweep, mesh_points
@@ -133,20 +133,8 @@ def test_tip_edge_moves_load_off_the_corners_and_keeps_the_balance():
         # each closed contact carries the force of the law and the edge in series,
         # (F/k)^(1/m1) + c F = w - gap, and these forces sum to the load
         w = rounded.approach[a]
-        total = sum(_series_force(w - g, ci, k, m1) for g, ci in zip(mp.gap, c) if w > g)
+        total = sum(series_force(w - g, ci, k, m1) for g, ci in zip(mp.gap, c) if w > g)
         assert total == pytest.approx(load, rel=1e-6)
-
-
-def _series_force(delta: float, c: float, k: float, m1: float) -> float:
-    """F [N] with (F/k)^(1/m1) + c F = delta [m] (bisection)."""
-    lo, hi = 0.0, k * delta**m1
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if (mid / k) ** (1 / m1) + c * mid < delta:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
 
 
 def test_tip_edge_radius_refused_where_it_has_no_meaning():

@@ -142,7 +142,8 @@ def test_contact_search_variant_holds_the_parts_the_model_has(present):
     m = build_scene_model(solid_scene(**over))
     gp, pp, lp = m.gear_par, m.pair_par, m.law_par
     parts = contact_parts(gp, pp, lp)
-    arrays = {"deviations": gp, "series": gp, "errors": pp, "friction": lp}
+    # (the series compliances and the tip edges that join them: `test_tip_edge`)
+    arrays = {"deviations": gp, "series": gp, "errors": pp, "friction": lp, "edges": gp}
     for name in L.ContactParts._fields:
         assert (getattr(parts, name) is arrays[name]) == (name in present), name
     geo = (gp, pp, lp, parts)

@@ -15,7 +15,8 @@ from study.scene import SceneError
 from study.scene_model import build_scene_model
 from study.verify import fe_reference as ref_mod
 
-pytestmark = pytest.mark.usefixtures("private_fe_cache")
+# (the shared FE cache: what these tests check reads the FE bodies, not how they were cached,
+# and a body's bits do not depend on which test filled the cache, tests/study/inputs/test_condensed_inputs.py)
 
 
 def with_body_springs(model, k_body, ratio=0.02):

@@ -138,7 +138,7 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code(first_run, mode
     slice compiles its shape-error message); nor the contact search's parts the scene lacks:
     no friction, flank deviation or pitch error in either, no series compliance in the plain
     model (the compliance model's identification reads the flank deviations from Python, in its
-    FE contact)."""
+    FE contact), no tip edge in either (sharp corners)."""
     run = first_run[model]
     added = run.get("new", [])
     new = {ln.split()[0] for ln in added}                     # compiled in this model's run
@@ -150,6 +150,7 @@ def test_first_run_compiles_each_kernel_once_and_no_coupled_code(first_run, mode
     assert not [ln for ln in added if int(ln.split()[1]) > 1]
     assert not [c for c in compiled if "raise_with_shape_context" in c or "unicode" in c or "str_generic" in c]
     assert "_friction" not in names
+    assert "edge_compliance" not in names                     # sharp tip corners: the edge's code left out
     if model == "paper":
         assert new == names                                   # the first run: all it has, it compiled
         assert {"end_step", "record_output", "verlet", "arrowhead_accelerations"} <= new
@@ -263,7 +264,7 @@ def test_every_kernel_python_calls_keeps_its_wrapper():
 def test_without_numba_cache_dir_the_kernels_are_cached_beside_the_fe_cache(tmp_path):
     """Without NUMBA_CACHE_DIR the kernels are cached under $LIGHTGEAR_CACHE/numba (the folder
     the Makefile gives, so that what `make run` compiled a `lightgear run` loads), and the study
-    engine looks for them there."""
+    engine looks for them there, also after the process moved its FE cache elsewhere."""
     import os
     import subprocess
     import sys
@@ -271,14 +272,15 @@ def test_without_numba_cache_dir_the_kernels_are_cached_beside_the_fe_cache(tmp_
 
     import solver.mbs.kernels as K
     root = Path(__file__).resolve().parents[3]
-    code = ("from solver.mbs.kernels.explicit import verlet; from study.sweep.engine import kernel_cache_folder; "
-            "print(verlet._cache._cache_path); print(kernel_cache_folder())")
+    code = ("import os; from solver.mbs.kernels.explicit import verlet; from study.sweep.engine import kernel_cache_folder; "
+            "print(verlet._cache._cache_path); print(kernel_cache_folder()); "
+            f"os.environ['LIGHTGEAR_CACHE'] = {str(tmp_path / 'moved')!r}; print(kernel_cache_folder())")
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env.update(PYTHONPATH=str(root), LIGHTGEAR_CACHE=str(tmp_path / "lc"))
     out = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True, check=True)
-    path, folder = out.stdout.split()
+    path, folder, after_move = out.stdout.split()
     top = tmp_path / "lc" / "numba" / f"kernels-{K.KERNELS_FINGERPRINT}"
-    assert Path(path).parent == top and Path(folder) == Path(path)
+    assert Path(path).parent == top and Path(folder) == Path(path) == Path(after_move)
 
 
 def test_kernels_pickle_for_another_process():

@@ -142,6 +142,99 @@ def test_relief_moves_the_flank_by_its_deviation_along_the_normal():
     assert np.allclose(relieved[len(relieved) // 2][0][-1], moved[0])
 
 
+def test_rounded_tip_edge_is_tangent_to_the_flank_and_the_tip_circle():
+    """With a tip edge radius the tooth outline runs flank, round, tip arc, round, flank: each
+    round's points lie on a circle of that radius, and it meets the flank and the tip arc without
+    a kink (the chords next to each junction turn by the same small angle as the chords along
+    the curve), the flank below it on the involute; the tip arc is shorter by the rounds."""
+    from solver.tip_edge import tip_round
+    from study.verify.calculix_reference import peer_gears
+    (pg, pg2), _ = peer_gears(small_scene(**{"gear1.modification.tip_edge_radius": 0.2}))
+    assert pg.edge_radius == pytest.approx(0.2e-3) and pg2.edge_radius == 0.0
+    g, r = pg.geometry, pg.edge_radius
+    sharp, pieces = tooth_pieces(g, n=150), tooth_pieces(g, n=150, edge_radius=r)
+    assert len(pieces) == len(sharp) + 2
+    mid = len(pieces) // 2
+    tip, rnd, flank = pieces[mid][0], pieces[mid + 1][0], pieces[mid + 2][0]
+    t = tip_round(g, r)
+    assert np.hypot(*(rnd - t.centre).T) == pytest.approx(r, rel=1e-12)
+    assert np.allclose(rnd[0], tip[-1], rtol=0, atol=1e-15) and np.allclose(rnd[-1], flank[0], rtol=0, atol=1e-15)
+    assert np.hypot(*tip.T) == pytest.approx(g.tip_radius, rel=1e-12)
+    assert math.atan2(tip[-1, 1], tip[-1, 0]) < g.tip_half_angle
+    # the flank below the round on the involute (rel. polar angle of the + flank at its radius)
+    rr, a = np.hypot(*flank.T), np.arctan2(flank[:, 1], flank[:, 0])
+    u = g.roll_at(rr)
+    assert np.abs(a - (g.psi_base - (u - np.arctan(u)))).max() * g.base_radius < 1e-12
+
+    def heading(p):
+        d = np.diff(p, axis=0)
+        return np.arctan2(d[:, 1], d[:, 0])
+    # no kink: the turn across each junction is no larger than the turn between chords inside
+    for before, after in ((tip, rnd), (rnd, flank)):
+        step = abs((heading(after)[0] - heading(before)[-1] + math.pi) % (2 * math.pi) - math.pi)
+        inside = max(np.abs(np.diff(heading(before))).max(), np.abs(np.diff(heading(after))).max())
+        assert step <= inside * 1.01
+    # the whole round turns from the tip circle's direction to the flank's, about 90 deg - alpha_a
+    # (its 16 chords' headings span 15/16 of the turn)
+    turn = (heading(rnd)[-1] - heading(rnd)[0] + math.pi) % (2 * math.pi) - math.pi
+    assert abs(turn) * 16 / 15 == pytest.approx(0.5 * math.pi - math.acos(g.base_radius / g.tip_radius), rel=0.02)
+
+
+def test_peer_meshes_the_round_fine_and_on_its_circle():
+    """The peer's mesh of a gear with 0.2 mm tip edges (flanks at 0.3 mm): on each fine tooth's
+    drive round the boundary nodes (mid-sides included) lie on the round's circle and no further
+    apart than a quarter radius (its element size, `round_size`); the drive round is contact
+    face, as the flank below it."""
+    from solver.peers.calculix.mesh import boundary_edges, round_size
+    from solver.tip_edge import tip_round
+    from study.verify.calculix_reference import peer_gears
+    (pg, _), _ = peer_gears(small_scene(**{"gear1.modification.tip_edge_radius": 0.2}))
+    g, r = pg.geometry, pg.edge_radius
+    sizes = MeshSizes(flank=0.3e-3, fillet=0.6e-3, body=1.5e-3)
+    m = mesh_gear(g, pg.body, sizes, [0, 1, 23], [0, 1], edge_radius=r)
+    assert round_size(r, sizes.flank) == pytest.approx(r / 4)
+    t = tip_round(g, r)
+    b = boundary_edges(m.triangles)
+    on_outline = np.unique(m.triangles[b[:, 0][:, None], EDGES[b[:, 1]]])
+    face_nodes = np.unique(m.triangles[m.contact_faces[:, 0][:, None], EDGES[m.contact_faces[:, 1]]])
+    a_tip = math.atan2(t.tip_point[1] - t.centre[1], t.tip_point[0] - t.centre[0])
+    a_flank = math.atan2(t.flank_point[1] - t.centre[1], t.flank_point[0] - t.centre[0])
+    for k in (0, 1, 23):
+        c = np.array(t.centre) @ np.array([[math.cos(k * g.pitch_angle), math.sin(k * g.pitch_angle)],
+                                          [-math.sin(k * g.pitch_angle), math.cos(k * g.pitch_angle)]])
+        p = m.points[on_outline] - c
+        ang = (np.arctan2(p[:, 1], p[:, 0]) - k * g.pitch_angle - a_tip + math.pi) % (2 * math.pi) - math.pi
+        span = (a_flank - a_tip + math.pi) % (2 * math.pi) - math.pi
+        sel = (np.hypot(*p.T) < 1.5 * r) & (ang >= -1e-9) & (ang <= span + 1e-9)
+        assert np.abs(np.hypot(*p[sel].T) - r).max() < 1e-3 * r        # on the circle (the spline's 17 points)
+        gaps = np.diff(np.sort(ang[sel])) * r
+        assert sel.sum() >= 9 and gaps.max() <= 0.5 * round_size(r, sizes.flank) * 1.3   # mid-sides: half an element
+        if k in (0, 1):
+            assert np.isin(on_outline[sel], face_nodes).all()
+
+
+def test_peer_archive_names_the_tip_edges_only_where_there_are_some(monkeypatch):
+    """The peer's archive carries each gear's tip edge radius and the element size on its round
+    (a quarter radius) where a gear has one, and neither attribute for sharp corners (the sweep
+    itself replaced: no ccx)."""
+    import study.verify.calculix_reference as cr
+    from solver.peers.calculix import PeerResult
+
+    class Mesh:
+        n_nodes, n_elements = 10, 5
+
+    def sweep(gears, pair, material, angles, torque, settings, progress=None, starts=None):
+        n = len(angles)
+        return PeerResult(np.asarray(angles), np.zeros(n), 0.0, (Mesh(), Mesh()), np.ones(n), np.ones(n), settings, "x")
+    monkeypatch.setattr(cr, "ste_sweep", sweep)
+    edged = small_scene(**{"gear1.modification.tip_edge_radius": 0.2})
+    ds = cr.calculix_dataset(edged, np.radians([0.0]), cr.settings_for(edged, 0.3))
+    np.testing.assert_allclose(ds.attrs["tip_edge_radius_mm"], [0.2, 0.0])
+    np.testing.assert_allclose(ds.attrs["tip_edge_mesh_size_mm"], [0.05, 0.0])
+    sharp = cr.calculix_dataset(small_scene(), np.radians([0.0]), cr.settings_for(small_scene(), 0.3))
+    assert "tip_edge_radius_mm" not in sharp.attrs and "tip_edge_mesh_size_mm" not in sharp.attrs
+
+
 def test_soft_start_deck_stiffens_the_contact_in_a_second_step(small_light_meshes):
     """A soft start carries the torque at 1/8 of the contact stiffness in a first step, then
     stiffens the contact under the same torque; the result is read at the end of the second."""

@@ -106,3 +106,26 @@ def test_a_tolerance_study_report_has_its_statistics_table(tmp_path):
     assert f"{np.nanmax(res.dataset['ste_p2p'].values):.4g}" in row and "| um |" in row
     assert (tmp_path / "out" / "runout_distribution_ste_p2p.png").is_file()
     assert html.read_text().count("data:image/png;base64,") == len(list((tmp_path / "out").glob("*.png")))
+
+
+def test_a_report_after_render_takes_its_figures_and_draws_them_again_for_a_newer_archive(run_archive, tmp_path):
+    """`lightgear report` beside `lightgear render`'s figures of the same archive embeds those
+    files as they are; once the archive is written again, its figures are drawn again."""
+    import os
+    import shutil
+    _, source = run_archive
+    path = tmp_path / source.name
+    shutil.copy2(source, path)
+    assert main(["render", str(path), "--no-renders"]) == 0
+    pngs = sorted(tmp_path.glob("small_*.png"))
+    assert {p.name for p in pngs} >= {"small_ste.png", "small_dte.png", "small_spectrum.png"}
+    written = {p.name: p.stat().st_mtime_ns for p in pngs}
+    assert main(["report", str(path), "--no-renders"]) == 0
+    assert {p.name: p.stat().st_mtime_ns for p in pngs} == written
+    html = (tmp_path / "small_report.html").read_text()
+    embedded = re.findall(r'src="data:image/png;base64,([^"]+)"', html)
+    assert sorted(base64.b64decode(e) for e in embedded) == sorted(p.read_bytes() for p in pngs)
+    later = max(written.values()) / 1e9 + 10.0          # the archive written again after the figures
+    os.utime(path, (later, later))
+    assert main(["report", str(path), "--no-renders"]) == 0
+    assert all(p.stat().st_mtime_ns != written[p.name] for p in pngs)

@@ -1,5 +1,6 @@
-"""A local dask sweep on a machine whose numba cache lacks the kernels compiles them once: one
-task (the pilot) first, the others after it."""
+"""A local dask sweep on a machine whose numba cache lacks the kernels compiles them once: the
+pilot's entry kernels from a stand-in of its scenes at once, then one task (the pilot), then the
+others after it."""
 from pathlib import Path
 
 import numba
@@ -57,23 +58,31 @@ def test_the_kernel_cache_counts_as_warm_only_with_kernels_of_this_checkout(tmp_
 def test_a_cold_kernel_cache_runs_one_pilot_task_before_the_others(tmp_path, monkeypatch):
     import distributed
     st = loads_study(STUDY)
-    submitted, batches = [], []
+    submitted, batches, compiled = [], [], []
     real = distributed.Client.submit
 
     def submit(self, func, *args, **kw):
         future = real(self, func, *args, **kw)
         submitted.append((future.key, [a.key for a in args if isinstance(a, distributed.Future)]))
         batches.append(args[0])
+        if future.key.startswith("lightgear-compile-"):
+            future.add_done_callback(lambda f: compiled.append(f.result()))
         return future
     monkeypatch.setattr(distributed.Client, "submit", submit)
     monkeypatch.setattr(cluster, "kernels_cached", lambda coupled=None: False)
     res = run_sweep(st, tmp_path / "cold.nc", workers=2, progress=False)
-    (pilot, before), *rest = submitted
-    assert before == [] and len(rest) == len(submitted) - 1 >= 2
+    # first the pilot's kernels, compiled from a stand-in of its scenes without waiting for anything
+    # (no FE: it overlaps a study's FE jobs), then the pilot after it, then the rest after the pilot
+    (ahead, first), (pilot, before), *rest = submitted
+    assert ahead.startswith("lightgear-compile-") and first == []
+    assert before == [ahead] and len(rest) == len(submitted) - 2 >= 2
     assert all(after == [pilot] for _, after in rest)
+    assert batches[0] == tuple(scene for _, scene, _ in batches[1])
+    assert compiled == [["solver.mbs.kernels.gearmesh.mesh_contacts", "solver.mbs.kernels.explicit.verlet",
+                         "solver.mbs.kernels.statics.static_sweep"]]
     # the pilot runs the statics and a dynamic run of one body: every kernel compiled before the fan-out
-    assert sorted(outputs.dynamic for _, _, outputs in batches[0]) == [False, True]
-    assert len({scene.dynamic.speed for _, scene, _ in batches[0]}) == 1
+    assert sorted(outputs.dynamic for _, _, outputs in batches[1]) == [False, True]
+    assert len({scene.dynamic.speed for _, scene, _ in batches[1]}) == 1
     assert (res.dataset["status"] == STATUS.index("ok")).all()
     # a warm cache: no pilot, no waiting, the same numbers
     submitted.clear()

@@ -1,0 +1,109 @@
+"""The stand-in model (`study.stand_in`) types a scene's entry kernels as its real model does:
+the static sweep and the time stepping are called with the same numba types by the solver on
+the model built from the FE, for each part of the contact search and each coupling model."""
+import numpy as np
+import pytest
+from helpers import scene_overrides
+
+import study
+from solver.mbs import interrupt
+from solver.mbs.dynamics import simulate
+from solver.mbs.statics import solve_static
+from solver.precompile import argument_types, kernel_name
+from study.scene_model import build_scene_model
+from study.stand_in import entry_jobs, stand_in_model
+
+SMALL = {**scene_overrides("small_pair"), "coupling.model": "paper"}
+
+
+class Called(Exception):
+    pass
+
+
+def called_types(model, monkeypatch) -> dict:
+    """{kernel name: argument types} of the static sweep and the time stepping as the solver
+    calls them on ``model`` (stopped at the call: nothing is compiled)."""
+    seen = {}
+
+    def call(kernel, args, *_a, **_k):
+        seen[kernel_name(kernel)] = argument_types(kernel, args)
+        raise Called
+    monkeypatch.setattr(interrupt, "call", call)
+    for run in (lambda: solve_static(model, np.zeros(2), 50.0),
+                lambda: simulate(model, 100.0, 0.01, 50.0, 0.01, 0.001, dt=1e-6)):
+        with pytest.raises(Called):
+            run()
+    return seen
+
+
+CONTACTS = "solver.mbs.kernels.gearmesh.mesh_contacts"
+
+
+def stand_in_types(scene) -> dict:
+    """{kernel name: argument types} of the stand-in's entry kernels (the contact search,
+    compiled ahead as the loops call it, apart: tests/study/test_compile_ahead.py)."""
+    jobs = entry_jobs(scene)
+    assert kernel_name(jobs[0][0]) == CONTACTS
+    return {kernel_name(k): types for k, types in jobs[1:]}
+
+
+@pytest.mark.parametrize("overrides", [
+    {},                                                        # the plain search
+    {"contact.friction": 0.05},                                # friction
+    {"gear2.modification.tip_relief": 2.0, "gear2.modification.tip_length": 3.0},     # a flank deviation
+    {"gear1.errors.grade": 6, "gear1.errors.eccentricity": 5.0},   # pitch errors
+], ids=["plain", "friction", "relief", "errors"])
+def test_the_stand_in_types_the_kernels_as_the_paper_model(overrides, monkeypatch):
+    scene = study.load_scene(None, {**SMALL, **overrides})
+    model = build_scene_model(scene, convert_damping=False)
+    types = stand_in_types(scene)
+    assert types == called_types(model, monkeypatch)
+    if overrides:       # a variant of its own (another ContactParts): not the plain search's types
+        assert types != stand_in_types(study.load_scene(None, SMALL))
+    # and the parts the variant compiles are the model's
+    stand_in = stand_in_model(scene)
+    for a, b in ((stand_in.gear_par, model.gear_par), (stand_in.pair_par, model.pair_par)):
+        assert a.shape == b.shape and a.dtype == b.dtype
+
+
+@pytest.mark.parametrize("edges", [{}, {"gear1.modification.tip_edge_radius": 0.2, "gear2.modification.tip_edge_radius": 0.2}],
+                         ids=["sharp", "rounded tips"])
+def test_the_stand_in_types_the_kernels_as_the_compliance_model_from_its_fe(edges, monkeypatch):
+    """The default model: teeth coupled through the body, body springs, the local compliance
+    in series (from the coarse FE bodies of the small pair); with rounded tip edges, the
+    contact search's variant that has them."""
+    scene = study.load_scene(None, {**SMALL, "coupling.model": "compliance", **edges})
+    model = build_scene_model(scene, convert_damping=False)
+    assert model.coupled and model.teeth_coupled
+    stand_in = stand_in_model(scene)
+    assert stand_in.coupled and stand_in.teeth_coupled and stand_in.tooth_compliance.shape == model.tooth_compliance.shape
+    types = stand_in_types(scene)
+    assert set(types) == {"solver.mbs.kernels.explicit_coupled.verlet_coupled", "solver.mbs.kernels.statics.static_sweep"}
+    assert types == called_types(model, monkeypatch)
+
+
+def test_a_run_without_dynamics_leaves_the_time_stepping_out():
+    scene = study.load_scene(None, SMALL)
+    assert list(stand_in_types(scene)) == ["solver.mbs.kernels.explicit.verlet", "solver.mbs.kernels.statics.static_sweep"]
+    assert list(kernel_name(k) for k, _ in entry_jobs(scene, dynamic=False)) == [CONTACTS, "solver.mbs.kernels.statics.static_sweep"]
+    implicit = study.load_scene(None, {**SMALL, "dynamic.method": "implicit"})
+    assert list(stand_in_types(implicit))[0] == "solver.mbs.kernels.implicit.hht"
+
+
+def test_a_study_s_compile_task_never_fails_its_pilot(monkeypatch):
+    """What cannot be compiled ahead (a stand-in that cannot be built, a kernel numba refuses)
+    is left to the runs, which then compile it or say what is wrong: the task itself returns."""
+    import study.stand_in as stand_in
+
+    def broken(scene, dynamic=None):
+        raise ValueError("gear2.body: no stand-in")
+    monkeypatch.setattr(stand_in, "entry_jobs", broken)
+    assert stand_in.compile_kernels((study.load_scene(None, SMALL),)) == []
+
+    class Refusing:
+        py_func = stand_in_model
+
+        def compile(self, types):
+            raise TypeError("refused")
+    monkeypatch.setattr(stand_in, "entry_jobs", lambda scene, dynamic=None: [(Refusing(), ())])
+    assert stand_in.compile_kernels((study.load_scene(None, SMALL),)) == []
