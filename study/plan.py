@@ -129,6 +129,8 @@ def make_plan(scene: Scene, stages, options: RunOptions = RunOptions()) -> RunPl
         if line:
             report_warnings([line], options.warn)
             warnings.append(line)
+    from study.stand_in import start_ahead
+    start_ahead(scene)          # a second process compiling the kernels while the FE is built, when asked
     t0 = time.perf_counter()
     if springs is None:
         from study.stages import compute_fe_bodies

@@ -17,6 +17,7 @@ them in the disk cache. A second process compiles them there while a cold run bu
 """
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -103,18 +104,42 @@ def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:
     return jobs
 
 
+# the runs asking for their kernels compiled ahead (`compiling_ahead`), each started by its
+# plan once the checks made before any work have passed (`start_ahead`)
+_ASKED: list = []
+
+
+@contextlib.contextmanager
 def compiling_ahead(scene: Scene, dynamic: bool | None = None):
     """Context manager: within, the scene's entry kernels (`entry_jobs`) that numba's disk
     cache lacks compiled by a second process (`solver.precompile.precompiling`: none is
-    started when the cache holds them all; it is always stopped on leaving). A scene whose
-    stand-in cannot be built starts none: the run itself then says what is wrong."""
+    started when the cache holds them all; it is always stopped on leaving). Nothing is built
+    until the run's plan has made its checks (`start_ahead`): a run refused before any work
+    (memory, time) builds no stand-in either. A scene whose stand-in cannot be built starts
+    none: the run itself then says what is wrong."""
+    ask = {"scene": scene, "dynamic": dynamic, "started": None}
+    _ASKED.append(ask)
+    try:
+        yield
+    finally:
+        _ASKED.remove(ask)
+        if ask["started"] is not None:
+            ask["started"].__exit__(None, None, None)       # the child stopped
+
+
+def start_ahead(scene: Scene) -> None:
+    """Start the compile ahead that `compiling_ahead` asked for ``scene`` (the plan of its run,
+    its checks passed, before the FE): nothing when none was asked."""
     from solver.mbs.kernels.gearmesh import mesh_contacts
     from solver.precompile import precompiling
-    try:
-        jobs = entry_jobs(scene, dynamic)
-    except Exception:  # noqa: BLE001 - the run reports the scene's problem, with its field
-        jobs = []
-    return precompiling(jobs, shared=(mesh_contacts,))
+    for ask in _ASKED:
+        if ask["scene"] is scene and ask["started"] is None:
+            try:
+                jobs = entry_jobs(scene, ask["dynamic"])
+            except Exception:  # noqa: BLE001 - the run reports the scene's problem, with its field
+                jobs = []
+            ask["started"] = precompiling(jobs, shared=(mesh_contacts,))
+            ask["started"].__enter__()
 
 
 def compile_kernels(scenes) -> list[str]:

@@ -107,3 +107,24 @@ def test_a_study_s_compile_task_never_fails_its_pilot(monkeypatch):
             raise TypeError("refused")
     monkeypatch.setattr(stand_in, "entry_jobs", lambda scene, dynamic=None: [(Refusing(), ())])
     assert stand_in.compile_kernels((study.load_scene(None, SMALL),)) == []
+
+
+def test_a_run_refused_before_any_work_builds_no_stand_in(monkeypatch):
+    """The compile ahead starts from the run's plan once its checks passed: a run whose FE
+    bodies cannot fit in memory is refused without a stand-in of its 10000-tooth gear (whose
+    tooth compliance alone would take 800 MB)."""
+    import study.stand_in as si
+    from study import estimate
+    from study.stand_in import compiling_ahead
+    built = []
+    monkeypatch.setattr(si, "entry_jobs", lambda *a, **k: built.append(a) or [])
+    monkeypatch.setattr(estimate, "available_memory", lambda: 16.0 * 2 ** 30)
+    scene = study.load_scene(None, {**SMALL, "coupling.model": "compliance", "gear2.teeth": 10000})
+    with pytest.raises(study.BudgetError, match="fe.mesh_size"):
+        with compiling_ahead(scene):
+            study.run_scene(scene)
+    assert built == []
+    small = study.load_scene(None, SMALL)
+    with compiling_ahead(small):             # asked, and started by the plan of its own run
+        si.start_ahead(small)
+    assert len(built) == 1 and built[0][0] is small
