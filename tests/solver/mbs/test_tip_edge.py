@@ -284,3 +284,25 @@ def test_energy_balance_with_rounded_edges_as_with_sharp_corners():
             assert errs[r_edge, dt] < 1e-6 * np.max(np.abs(r.work))
     for dt in (dt0, dt0 / 2):
         assert errs[0.1e-3, dt] < 1.5 * errs[0.0, dt]
+
+
+def test_static_ste_has_no_jump_where_a_round_takes_over(paper_solid_model):
+    """100 N·m, 0.1 mm edges, driver 3.0-3.8 deg in steps of 0.02 deg, where the leaving tooth's
+    contact passes from its flank onto its round (3.4 deg): the default model's static STE (series
+    law without the FE) and the LTCA's (rigid bodies, the law and the edge) change by at most
+    60 nm a step, as steep as the curve gets (56 / 50 nm); the edge compliance taken in full from
+    the round's tangent roll on made both jump by 205 / 270 nm in one step."""
+    from solver.fe.ltca import ltca_sweep
+    from solver.mbs.statics import solve_static
+    from study.scene_model import geometry_model
+    from study.verify.fe_reference import scene_edges
+    angles = np.radians(np.arange(3.0, 3.8, 0.02))
+    m = _edged(_with_series(paper_solid_model), 0.1e-3, 0.1e-3)
+    st = solve_static(m, angles, 100.0)
+    assert st.converged.all()
+    s = solid_scene(**{"coupling.model": "compliance", **{f"gear{g}.modification.tip_edge_radius": 0.1 for g in (1, 2)}})
+    g = geometry_model(s)
+    lt = ltca_sweep(g, (None, None), angles, 100.0, edge=scene_edges(s, g))
+    for te in (st.te, lt.te):
+        assert np.ptp(te) > 0.3e-6                       # the rise to single contact
+        assert np.max(np.abs(np.diff(te))) < 60e-9
