@@ -37,7 +37,8 @@ pair beside the extended contact of its neighbours: a third of the load at 100 N
 paper pair) the STE there depends on it. A gear whose model has a rounded tip (gear_par
 EDGE_*, the scene's ``gearN.modification.tip_edge_radius``) also has the round's geometry: its
 flank ends at the round's tangent roll and its corner contact is the round's circle, whose
-centre lies r inside that point (`_corner_flank`, as the contact search of the models); a
+centre lies r inside that point (`_corner_flank`, as the contact search of the models), and the
+edge's compliance ramps in from the round's tangent roll to the tip's (`corner_compliance`); a
 `TipEdge` without it (`lightgear reference --tip-edge-radius` on a sharp-cornered scene) is the
 compliance alone, on the sharp corner's geometry.
 
@@ -52,7 +53,7 @@ import numpy as np
 
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels.contact import point_flank, tip_corner
-from solver.mbs.kernels.gearmesh import candidate_pairs, flank_deviation
+from solver.mbs.kernels.gearmesh import EDGE_BLEND, candidate_pairs, edge_ramp, flank_deviation
 from solver.mbs.model import Model
 
 # ------------------------------------------------------------------ mesh kinematics
@@ -67,6 +68,9 @@ class MeshPoints:
     u2: np.ndarray          # roll parameter of the gear-2 load point [-]
     gap: np.ndarray         # initial separation e at rigid drive contact [m] (0 in the path of contact)
     kind: np.ndarray        # 1 flank-flank, 2 gear-1 tip corner, 3 gear-2 tip corner
+    # roll parameter [-] of the corner's gear on the line of action (its flank contact's, were its
+    # flank longer; u1 on flank contacts), where a round's edge compliance ramps in (`corner_compliance`)
+    u_line: np.ndarray | None = None
 
 
 def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoints:
@@ -99,16 +103,16 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
         b2 = ax2 + gp[1, L.PSI_B]
         if u1 <= hi[0] and u2 <= hi[1]:
             if u1 >= gp[0, L.U_LO] and u2 >= gp[1, L.U_LO]:
-                rows.append((k, j, u1, u2, 0.0, 1))
+                rows.append((k, j, u1, u2, 0.0, 1, u1))
         elif u1 > hi[0]:
             d, uf = _corner_flank(gp, 0, b1, b2)
             if gp[1, L.U_LO] <= uf <= hi[1] and -d < max_gap:
-                rows.append((k, j, gp[0, L.U_HI], uf, -d, 2))
+                rows.append((k, j, gp[0, L.U_HI], uf, -d, 2, u1))
         else:
             d, uf = _corner_flank(gp, 1, b2, b1)
             if gp[0, L.U_LO] <= uf <= hi[0] and -d < max_gap:
-                rows.append((k, j, uf, gp[1, L.U_HI], -d, 3))
-    a = np.array(rows, dtype=float).reshape(-1, 6)
+                rows.append((k, j, uf, gp[1, L.U_HI], -d, 3, u2))
+    a = np.array(rows, dtype=float).reshape(-1, 7)
     gap = np.maximum(a[:, 4], 0.0)
     for i in range(a.shape[0]):
         # a round's own deviation is in its centre (`_corner_flank`)
@@ -116,7 +120,7 @@ def mesh_points(model: Model, theta1: float, max_gap: float = 50e-6) -> MeshPoin
         gap[i] += own[0] * flank_deviation(gp, 0, a[i, 2])[0] + own[1] * flank_deviation(gp, 1, a[i, 3])[0]
     if pp.size > L.N_PAIR_PAR:
         gap -= error_approach(model, theta1, theta2, a[:, 0].astype(int), a[:, 1].astype(int))
-    return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int))
+    return MeshPoints(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3], gap, a[:, 5].astype(int), a[:, 6])
 
 
 def _corner_flank(gp, g: int, b_g: float, b_f: float) -> tuple[float, float]:
@@ -188,17 +192,25 @@ def corner_compliance(model: Model, mp: MeshPoints, edge) -> np.ndarray:
     tip edge's (`TipEdge.compliance`) of the corner's gear on tip-corner contacts, measured on
     the mating flank's radius of curvature rb*u at its roll; 0 on flank contacts and where the
     corner's gear has no edge. ``edge``: a `TipEdge` of both gears, (gear 1's, gear 2's) each a
-    TipEdge or None, or None."""
+    TipEdge or None, or None. On a gear whose model has the round's geometry (gear_par EDGE_*) the
+    compliance ramps in from 0 at the round's tangent roll to the tip's roll, along the corner
+    gear's line-of-action roll ``mp.u_line`` (`gearmesh.edge_ramp`, as the default model's c_loc:
+    no jump where a contact passes from the flank onto the round)."""
     out = np.zeros(mp.gap.size)
     e1, e2 = gear_edges(edge)
     if e1 is None and e2 is None:
         return out
     rb1, rb2 = model.base_radii
+    gp = model.gear_par
     for i, kind in enumerate(mp.kind):
         if kind == 2 and e1 is not None:        # gear 1's corner on gear 2's flank
             out[i] = e1.compliance(rb2 * mp.u2[i])
         elif kind == 3 and e2 is not None:      # gear 2's corner on gear 1's flank
             out[i] = e2.compliance(rb1 * mp.u1[i])
+        g = int(kind) - 2
+        if g >= 0 and gp[g, L.EDGE_INV_R] > 0 and mp.u_line is not None:
+            span = EDGE_BLEND * (gp[g, L.U_HI] - gp[g, L.EDGE_U])
+            out[i] *= edge_ramp.py_func(mp.u_line[i], gp[g, L.EDGE_U], span)[0]
     return out
 
 

@@ -42,8 +42,16 @@ and the round keeps the neighbouring pairs' tips off by up to r (1/cos(theta/2) 
 sharp corner (theta = 90 deg - alpha_a: 0.16-0.19 r on the pairs of the scenes). The contact carries the compliance of the
 round's narrower Hertz patch in its c_loc (`edge_compliance`); it changes with the mating flank's
 roll as its radius of curvature does, and that slope joins the flank's c_loc slope in the
-gradient (conservative). The round's centre is a material point of its tooth, so the moments and
-the gradient are those of a tip corner at the centre.
+gradient (conservative). c_loc is also continuous where the contact leaves the flank: the round's
+contact takes its tooth's own compliance at the roll u_g the flank contact would have
+(`flank_flank`'s, EDGE_U at the switch; the tip's value beyond U_HI), and the edge's times a C1
+ramp from 0 at EDGE_U to 1 at U_HI (`edge_ramp`: the Hertz patch straddles the tangent point
+there), both slopes in u_g in its tooth's part of the gradient. (The edge's full compliance from
+EDGE_U on made c_loc, and with it the series spring's force and energy, jump by about its own
+size at every switch: a dynamic run's energy balance failed at any step, and the static STE
+jumped by 0.27 um at 100 N m where a tooth's round took over at 3.35 deg on the paper pair.) The
+round's centre is a material point of its tooth, so the moments and the gradient are those of a
+tip corner at the centre.
 
 Pitch errors and eccentricity (`solver.pitch_errors`, the pair_par block E_*, present only when a
 gear has them): each tooth's axis turns by its offset eps about the teeth's centre, which sits
@@ -73,6 +81,8 @@ from solver.mbs.kernels.layout import contact_geo, contact_parts, new_contact_bu
 
 # roll-parameter length [-] over which a modified tip corner blends into its flank (see above)
 TIP_BLEND = 1e-6
+# the roll span [-] over which a round's edge compliance ramps in, as a fraction of U_HI - EDGE_U
+EDGE_BLEND = 1.0
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -176,6 +186,21 @@ def edge_compliance(gp, g, rb_f, u_f):
     if c <= 0.0:
         return 0.0, 0.0
     return c, -gp[g, L.EDGE_A] / (x * rho * max(u_f, 1e-6))
+
+
+@njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
+def edge_ramp(u, u0, span):
+    """Weight [-] of a round's edge compliance at its tooth's flank-contact roll u [-], and its
+    slope d w/d u [-]: 0 up to the round's tangent roll u0, the C1 cubic 3t^2 - 2t^3 of
+    t = (u - u0)/span over the roll span ``span`` [-], 1 beyond (c_loc and its slope continuous:
+    no jump of the series force, and none of its generalised forces, as a contact passes from
+    the flank onto the round)."""
+    t = (u - u0) / span
+    if t <= 0.0:
+        return 0.0, 0.0
+    if t >= 1.0:
+        return 1.0, 0.0
+    return t * t * (3.0 - 2.0 * t), 6.0 * t * (1.0 - t) / span
 
 
 @njit(cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=True)
@@ -447,13 +472,19 @@ def pair_contacts(state, phi, dphi, geo, buf, deviations, series, errors, fricti
                     ser = (0.0, (0.0, 0.0, 0.0, 0.0))
                     if series is not None:
                         cf, sf = local_compliance(gp, f, uf)
-                        cg = local_compliance(gp, g, gp[g, L.U_HI])[0]
+                        cg, sg = local_compliance(gp, g, gp[g, L.U_HI])[0], 0.0
                         if edges is not None:
-                            if gp[g, L.EDGE_INV_R] > 0.0:
+                            if rounded:
+                                # continuous with the flank contact it continues (see the docstring):
+                                # the tooth's own compliance at the roll that contact would have, the
+                                # edge's ramped in over EDGE_BLEND of the round's roll span
+                                cg, sg = local_compliance(gp, g, u[g])
                                 ce, se = edge_compliance(gp, g, rb, uf)
-                                cg += ce
-                                sf += se
-                        sfa, sfb = (sf, 0.0) if f == 0 else (0.0, sf)
+                                w, dw = edge_ramp(u[g], gp[g, L.EDGE_U], EDGE_BLEND * (gp[g, L.U_HI] - gp[g, L.EDGE_U]))
+                                cg += w * ce
+                                sg += dw * ce
+                                sf += w * se
+                        sfa, sfb = (sf, sg) if f == 0 else (sg, sf)
                         ser = (cg + cf,
                                _deviation_gradient(sfa, sfb, s, (cax, cay, cbx, cby, rba, rbb), trig, (e1x, e1y, e2x, e2y), gp))
                     own = 1.0 if f == 0 else -1.0
