@@ -194,7 +194,7 @@ def corner_compliance(model: Model, mp: MeshPoints, edge) -> np.ndarray:
     corner's gear has no edge. ``edge``: a `TipEdge` of both gears, (gear 1's, gear 2's) each a
     TipEdge or None, or None. On a gear whose model has the round's geometry (gear_par EDGE_*) the
     compliance ramps in from 0 at the round's tangent roll to the tip's roll, along the corner
-    gear's line-of-action roll ``mp.u_line`` (`gearmesh.edge_ramp`, as the default model's c_loc:
+    gear's line-of-action roll ``mp.u_line`` (the ramp of `solver.mbs.kernels.gearmesh`, as the default model's c_loc:
     no jump where a contact passes from the flank onto the round)."""
     out = np.zeros(mp.gap.size)
     e1, e2 = gear_edges(edge)
