@@ -209,7 +209,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
     ke, pe = coupled_energies(mdl, ws, nc, nact, cset, ns, (th1, w1), hub, teeth)
     book[L.B_E0] = ke + pe
     book[L.B_P_IN] = react * w1 + tl * v[L.H_H2]
-    book[L.B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl_d, rec, nc), gp, w1, v)
+    book[L.B_P_D] = body_dissipation(dissipation_power(dphi, act, nact, mdl_d, rec, nc, ser), gp, w1, v)
     o = max_act = np.int64(0)
     row = (0.0, gp[0, L.RB] * th1 + gp[1, L.RB] * x[L.H_H2], x[L.H_H2], react, ke, pe)
     status = record_output(out, o, row, book, rec, nc, math.isfinite(row[1]), par, np.int64(OK))
@@ -261,7 +261,7 @@ def verlet_coupled(mdl, ctl, hub, teeth, out, ws):
                 e_damp += c * (0.5 * (v0 + dphi[i])) ** 2
         # the driver's hub inertia sees the one-sided acceleration where the ramp ends
         p_in_left = (gp[0, L.I_HUB] * driver_acc_left(t, speed, ramp) + mb1) * w1 + tl * v[L.H_H2]
-        p_d = body_dissipation(dissipation_power(vpred, act, nact, mdl_d, rec, nc), gp, w1, vp)
+        p_d = body_dissipation(dissipation_power(vpred, act, nact, mdl_d, rec, nc, ser), gp, w1, vp)
         # each kick of h = dt/2 takes the damper at its mean rate v: M dv = h (Q - C v) - so
         # the kinetic energy it removes is h c v² exactly (the trapezoidal rule on the end
         # rates' power misreads it where the joint is damped beyond critical and the

@@ -7,7 +7,7 @@ tooth_compliance, `layout.ContactParts`) as the stepping kernels take them. SI u
 """
 from solver.mbs.kernels import layout as L
 from solver.mbs.kernels import njit
-from solver.mbs.kernels.laws import contact_energy, series_energy, signed_pow, spring_energy
+from solver.mbs.kernels.laws import contact_energy, series_contact, series_energy, signed_pow, spring_energy
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -128,9 +128,12 @@ def mesh_energies(ke, pe, w1, w2, teeth, act, nact, mdl, rec, nc):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def dissipation_power(dphi, act, nact, mdl, rec, nc):
+def dissipation_power(dphi, act, nact, mdl, rec, nc, series=None):
     """Power [W] of the tooth-spring dampers at the rates dphi, of the contact dampers and of
-    the flank friction (F_t*v_s >= 0, where a friction force F_t is recorded)."""
+    the flank friction (F_t*v_s >= 0, where a friction force F_t is recorded). ``series``: the
+    model's `ContactParts` series part (the contact law in series with a local compliance,
+    whose elastic force then is the series law's); None or left out: the plain law (numba
+    compiles no series code for it)."""
     gp, lp = mdl[0], mdl[2]
     tz2 = int(gp[1, L.TOOTH0])
     p = 0.0
@@ -144,6 +147,10 @@ def dissipation_power(dphi, act, nact, mdl, rec, nc):
         d = rec[c, L.C_DELTA]
         if damped and d > 0.0:
             fel = lp[L.K_CON] * d ** lp[L.M1]
+            if series is not None:
+                # the elastic part of a contact in series with the local compliance: the series law's
+                if rec[c, L.C_CLOC] != 0.0:
+                    fel = series_contact(d, rec[c, L.C_CLOC], lp[L.K_CON], lp[L.M1])[1]
             p += (rec[c, L.C_FORCE] - fel) * rec[c, L.C_DDELTA]
         ft = rec[c, L.C_FT]
         if ft != 0.0:

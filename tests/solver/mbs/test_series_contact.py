@@ -90,3 +90,28 @@ def test_series_compliance_softens_the_static_mesh(paper_solid_model):
     extra = s1.te - s0.te
     assert np.all(extra > 4e-10 * force / s1.n_contacts * 0.999)
     assert np.all(extra < 4e-10 * force)
+
+
+def test_dissipated_power_of_damped_series_contacts_is_their_dampers_alone(paper_solid_model):
+    """With a contact damper (c_con) on contacts in series with a local compliance, the power
+    the energy balance counts as dissipated is the dampers' c_con |d'|^m2 d^m3 d' alone: the
+    elastic part taken out is the series law's force, not the plain law's."""
+    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.laws import signed_pow
+    from solver.mbs.kernels.mechanics import dissipation_power
+    m = _with_local_compliance(paper_solid_model)
+    lp = m.law_par.copy()
+    lp[L.C_CON] = 5.0e4
+    m = dataclasses.replace(m, law_par=lp)
+    th1, th2, phi, teeth, rec, nc = loaded_mesh_state(m, 2.0, 2e-4)
+    dphi = np.zeros_like(phi)
+    dphi[teeth] = np.random.default_rng(5).normal(scale=0.5, size=len(teeth))      # rad/s
+    rec, pairs = new_contact_buffer()
+    nc, _ = mesh_contacts((th1, th2, 1.0, -1.0), phi, dphi, contact_geo(m.gear_par, m.pair_par, m.law_par), (rec, pairs))
+    assert nc > 0 and np.all(rec[:nc, L.C_CLOC] != 0.0) and np.any(rec[:nc, L.C_DDELTA] != 0.0)
+    d, dd = rec[:nc, L.C_DELTA], rec[:nc, L.C_DDELTA]
+    dampers = sum(lp[L.C_CON] * signed_pow(dd[i], lp[L.M2]) * d[i] ** lp[L.M3] * dd[i] for i in range(nc) if d[i] > 0)
+    act = np.zeros(1, dtype=np.int64)
+    series = contact_geo(m.gear_par, m.pair_par, lp)[3].series
+    p = dissipation_power(dphi, act, 0, (m.gear_par, m.pair_par, lp), rec, nc, series)
+    assert dampers > 0.0 and p == pytest.approx(dampers, rel=1e-9)
