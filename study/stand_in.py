@@ -63,14 +63,11 @@ def stand_in_model(scene: Scene):
 def stepping_kernel(scene: Scene, model):
     """The time-stepping kernel a dynamic run of the scene calls (`study.scene_model.dynamic_choice`:
     'auto' takes the explicit integrator, `solver.mbs.method.choose_method`)."""
-    if model.coupled:
-        from solver.mbs.kernels.explicit_coupled import verlet_coupled
-        return verlet_coupled
-    if scene.dynamic.method == "implicit":
+    from solver.mbs.dynamics import explicit_kernel
+    if not model.coupled and scene.dynamic.method == "implicit":
         from solver.mbs.kernels.implicit import hht
         return hht
-    from solver.mbs.kernels.explicit import verlet
-    return verlet
+    return explicit_kernel(model)
 
 
 def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:

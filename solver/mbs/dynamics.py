@@ -378,6 +378,15 @@ def simulate(model: Model, speed: float, speed_ramp: float, torque: float, torqu
     return ExplicitIntegrator(**settings).run(model, drive, progress)
 
 
+def explicit_kernel(model: Model):
+    """The explicit stepping loop of ``model``: `verlet_coupled` where the teeth are coupled
+    through the bodies (`Model.coupled`), else `verlet`."""
+    if model.coupled:
+        from solver.mbs.kernels.explicit_coupled import verlet_coupled
+        return verlet_coupled
+    return verlet
+
+
 def _run_explicit(settings: ExplicitIntegrator, model: Model, drive: Drive, progress) -> DynamicResult:
     """`ExplicitIntegrator.run`."""
     speed, speed_ramp, torque, torque_ramp = drive.speed, drive.speed_ramp, drive.torque, drive.torque_ramp
@@ -408,10 +417,7 @@ def _run_explicit(settings: ExplicitIntegrator, model: Model, drive: Drive, prog
     if model.teeth_coupled and not model.coupled:
         raise ValueError("tooth_compliance: the dynamics of teeth coupled through the body need the body "
                          "springs too (coupling.model = 'compliance' identifies both)")
-    if model.coupled:
-        from solver.mbs.kernels.explicit_coupled import verlet_coupled as kernel
-    else:
-        kernel = verlet
+    kernel = explicit_kernel(model)
     par = dict(DELTA_MAX=float(delta_max), PHI_QUIET=phi_quiet, ENERGY_TOL=float(energy_tol), IMEX=float(imex), **rate)
     fraction = safety if safety is not None else (IMEX_SAFETY if imex else SAFETY)
     for attempt in range(4):
