@@ -260,7 +260,7 @@ def render(archive, out_dir=None, renders: bool = True, limits: dict | None = No
     the FE cache (solved and cached once when missing). ``reuse_after`` (a file time [s]): a
     run's figures written since are kept as they are (`study.report.figures.make_figures`)."""
     from study.archive.netcdf import read_netcdf
-    from study.report.figures import fresh, make_figures, render_paths
+    from study.report.figures import make_figures, renders_fresh
     check_argument(isinstance(prefix, str), "render", "prefix", "a string put before every file name", prefix)
     if not hasattr(archive, "data_vars"):
         check_argument(is_path(archive), "render", "archive", "an archive's path or an xarray.Dataset", archive)
@@ -273,7 +273,7 @@ def render(archive, out_dir=None, renders: bool = True, limits: dict | None = No
         raise ValueError("render: out_dir is needed for a dataset")
     fields = None
     if (renders and "scene" in archive.attrs and "tooth_stiffness" in archive and "status" not in archive
-            and not all(fresh(p, reuse_after) for p in render_paths(archive, out_dir, prefix))):
+            and not renders_fresh(archive, out_dir, prefix, reuse_after)):
         from study.inputs.springs import archive_body_fields
         fields = archive_body_fields(archive)      # what the renders of a lightened body draw: FE cache, else solved
     return make_figures(archive, Path(out_dir), prefix=prefix, renders=renders, limits=limits, fields=fields,

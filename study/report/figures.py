@@ -80,6 +80,12 @@ def render_paths(ds: xr.Dataset, outdir, prefix: str = "") -> list[Path]:
             for stem in ["gear_pair", *(f"fe_stress_gear{g}" for g in (1, 2) if sc.is_lightened(g))]]
 
 
+def renders_fresh(ds: xr.Dataset, outdir, prefix: str, after: float | None) -> bool:
+    """True when every render of the run archive ``ds`` (`render_paths`) was written at or
+    after ``after`` (`fresh`): they are taken as they are, and need no FE fields."""
+    return all(fresh(p, after) for p in render_paths(ds, outdir, prefix))
+
+
 def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True, limits: dict | None = None,
                  fields: dict | None = None, reuse_after: float | None = None) -> list[Path]:
     """Write every plot and render ``ds`` supports into ``outdir``; return the PNG paths.
@@ -130,8 +136,8 @@ def make_figures(ds: xr.Dataset, outdir, prefix: str = "", renders: bool = True,
     if "scene" not in ds.attrs or "tooth_stiffness" not in ds:
         skip("renders", "the archive has no scene attribute or no tooth_stiffness")
         return out
-    done = render_paths(ds, outdir, prefix)
-    if all(fresh(p, reuse_after) for p in done):
+    if renders_fresh(ds, outdir, prefix, reuse_after):
+        done = render_paths(ds, outdir, prefix)
         print(f"  renders: the {len(done)} already beside the archive")
         return out + done
     out += _renders(ds, name, skip, fields or {})
