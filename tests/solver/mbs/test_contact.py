@@ -119,7 +119,7 @@ def test_gradient_matches_finite_differences(paper_solid_model):
 
 
 # flank deviations, pitch errors and friction on the paper pair (the series compliance needs the
-# FE springs of the compliance model: `test_kernels.test_first_run_compiles_each_kernel_once...`)
+# FE springs of the compliance model: `test_compile_ahead.test_the_default_models_first_run_...`)
 PARTS = {"deviations": {"gear1.modification.tip_relief": 10.0, "gear1.modification.tip_length": 3.0,
                         "gear2.modification.tip_relief": 10.0, "gear2.modification.tip_length": 3.0},
          "errors": {"gear1.errors.grade": 6, "gear1.errors.seed": 1, "gear2.errors.eccentricity": 5.0},
