@@ -21,7 +21,7 @@ from helpers import solid_scene  # noqa: E402
 LONGEST_FIRST = (
     "tests/study/test_doc_first_run.py",               # 97 s, the kernels' first compile included
     "tests/solver/peers/test_calculix.py",             # 59 s, most of it the ccx peer
-    "tests/solver/mbs/test_kernels.py",                # 54 s, two compiles in an empty kernel cache
+    "tests/study/test_compile_ahead.py",               # 45 s, a cold run, a warm one and the default model in one empty kernel cache
     "tests/study/sweep/test_bodies.py",                # 45 s, two dask clusters and FE bodies
     "tests/study/test_interrupt.py",                   # 36 s, most of it the commands started
     "tests/study/sweep/test_cluster.py",               # 36 s, and its dask workers' start-up
