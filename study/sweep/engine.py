@@ -24,7 +24,8 @@ This module is the driver; the point is `study.sweep.point`, the part files and 
 reading `study.sweep.store`, the dask side `study.sweep.cluster`, the order of the work
 `study.sweep.schedule` (their names stay importable from here).
 
-Execution: ``workers=0`` runs in this process (debugging, tests); otherwise a dask
+Execution: ``workers=0`` runs in this process (debugging, tests, small studies), the tasks of
+one model in a row (`by_model`: its kept model serves them); otherwise a dask
 `LocalCluster` (processes, one thread each, NUMBA_NUM_THREADS=1; workers = cores by default)
 that is always closed, or an existing scheduler (``scheduler="tcp://host:8786"``) whose workers
 can import this package. On dask the FE spring maps the tasks read go first, each once
@@ -74,7 +75,7 @@ from study.sweep.cluster import (  # noqa: F401 - the dask side, importable from
 from study.sweep.grid import Point, Study, check_points
 from study.sweep.outputs import Outputs
 from study.sweep.point import invalid_result, point_values, run_point  # noqa: F401 - importable from here
-from study.sweep.schedule import body_group, interleave, pilot_tasks, rims_first  # noqa: F401
+from study.sweep.schedule import body_group, by_model, interleave, pilot_tasks, rims_first  # noqa: F401
 from study.sweep.store import (  # noqa: F401 - the part files, importable from here as before
     PartStore,
     complete_archive,
@@ -180,9 +181,10 @@ def run_sweep(study: Study, output: str | Path, workers: int | None = None, sche
     if max_time is not None and todo:
         estimate.check_time(cost.sweep_estimate([tasks[k] for k in todo]), max_time)
     lost = {}
-    todo = interleave(todo)
+    how = _Execution(workers, scheduler, progress)
+    todo = by_model(todo) if how.in_process else interleave(todo)
     if todo:
-        lost = _compute(study.title, todo, tasks, of_point, store, _Execution(workers, scheduler, progress), results)
+        lost = _compute(study.title, todo, tasks, of_point, store, how, results)
     per_point, lost_points = _point_records(points, of_point, results, lost, out)
     ds = study_dataset(study, points, per_point, read=store.get, lost=lost_points)
     ds.attrs["plausibility_warnings"] = sweep_warnings(points, out, progress)

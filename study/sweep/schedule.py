@@ -1,6 +1,7 @@
 """The order in which a study's tasks and FE jobs go to the workers: points of one body apart
-(`interleave`), the pilot that compiles the kernels first (`pilot_tasks`), each condensed rim's
-first FE job before its others (`rims_first`). Pure functions of the tasks; no dask here.
+(`interleave`), or together in one process (`by_model`), the pilot that compiles the kernels
+first (`pilot_tasks`), each condensed rim's first FE job before its others (`rims_first`).
+Pure functions of the tasks; no dask here.
 """
 from __future__ import annotations
 
@@ -30,6 +31,20 @@ def interleave(todo: dict) -> dict:
         groups.setdefault(body_group(scene), []).append(key)
     order = [k for round_ in itertools.zip_longest(*groups.values()) for k in round_ if k is not None]
     return {k: todo[k] for k in order}
+
+
+def by_model(todo: dict) -> dict:
+    """Reorder {key: scene} so that the tasks of one model (`study.sweep.tasks.model_group`)
+    follow each other, groups in the order of their first task: the order of a study run in
+    one process, whose kept model (`study.plan.kept_springs_and_model`: the springs, the
+    model and its damping conversion) then serves a model's tasks in a row instead of being
+    built again for each (`interleave` spreads a body's points for workers that would
+    otherwise compute its FE maps at once; one process has no such race)."""
+    from study.sweep.tasks import model_group
+    groups: dict[tuple, list] = {}
+    for key, scene in todo.items():
+        groups.setdefault(model_group(scene), []).append(key)
+    return {k: todo[k] for keys in groups.values() for k in keys}
 
 
 def pilot_tasks(todo: dict, outputs: dict) -> tuple:

@@ -231,6 +231,31 @@ def test_sensitivity_workflow_shrunk_to_a_tiny_grid(tmp_path, capsys):
         assert ds["time"].values[-1] == pytest.approx(0.008)
 
 
+def test_in_one_process_the_tasks_of_a_model_follow_each_other_and_build_it_once(tmp_path, monkeypatch):
+    """A study run in this process takes its tasks model by model (`by_model`), whatever the
+    grid's order: the kept model (springs, model, damping conversion) serves them in a row.
+    Spread over the queue (`interleave`, for dask workers), more bodies than the process keeps
+    models for (`scene_model.MODEL_SLOTS`) had each task build its model again."""
+    import study.scene_model as scene_model
+    from study.sweep.schedule import by_model
+    from study.sweep.tasks import model_group
+    holes = [0, 2, 4, 6, 8]
+    assert len(holes) > scene_model.MODEL_SLOTS
+    st = tiny_study(f'[grid]\n"dynamic.speed" = [50.0, 60.0]\ngear2.body.holes = {holes}\n')
+    todo = {p.index: p.scene for p in st.points()}
+    assert [s.gear2.body.holes for s in todo.values()] == holes * 2      # the grid's order alternates
+    ordered = by_model(todo)
+    assert [s.gear2.body.holes for s in ordered.values()] == sorted(holes * 2)
+    assert list(ordered)[:2] == [(0, 0), (1, 0)]           # first seen first, the grid's order within
+    assert len({model_group(s) for s in ordered.values()}) == len(holes)
+    built = []
+    real = scene_model._damped_model
+    monkeypatch.setattr(scene_model, "_damped_model", lambda *a: built.append(a[0]) or real(*a))
+    res = run_sweep(st, tmp_path / "s.nc", workers=0, progress=False)
+    assert res.computed == 3 * len(holes)       # a static task (shared by the speeds) and two dynamic ones a body
+    assert sorted(s.gear2.body.holes for s in built) == holes
+
+
 def test_points_sharing_a_body_are_queued_apart():
     st = tiny_study("[grid]\ngear2.body.holes = [0, 4]\n\"dynamic.speed\" = [50.0, 60.0, 70.0]")
     todo = {str(p.index): p.scene for p in st.points()}
