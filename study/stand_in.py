@@ -72,22 +72,20 @@ def stepping_kernel(scene: Scene, model):
 
 def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:
     """[(kernel dispatcher, argument types)] of the kernels a run of the scene calls, in the
-    order to compile them ahead: the contact search (`gearmesh.mesh_contacts`, the dearest
-    part of both loops, which link it; the run waits for it rather than compile it twice: `solver.precompile`), the time stepping (when the run has a
-    dynamic run, ``dynamic`` None: as the scene says, or the slow-ramp transient statics;
-    the dearest, and the latest called), then the static sweep (the statics and the loaded
-    equilibria of the damping conversion)."""
+    order to compile them ahead: the time stepping (when the run has a dynamic run, ``dynamic``
+    None: as the scene says, or the slow-ramp transient statics; the dearest, and the latest
+    called), the contact search (`gearmesh.pair_contacts`, which the loops call and the
+    statics through `mesh_contacts`, with the model's parts as its own arguments: compiled by
+    whichever process reaches it first, `solver.precompile`), then the static sweep (the
+    statics and the loaded equilibria of the damping conversion)."""
     from solver.mbs.dynamics import kernel_arguments
-    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, new_contact_buffer, pair_contacts
     from solver.mbs.kernels.statics import static_sweep
     from solver.mbs.statics import sweep_arguments
     from solver.precompile import argument_types
     from study.scene_model import load_table
     model = stand_in_model(scene)
-    rates = np.zeros(model.n_teeth)
-    args = ((0.0, 0.0, 0.0, 0.0), rates, rates, contact_geo(model.gear_par, model.pair_par, model.law_par),
-            new_contact_buffer())       # as the loops call it (and `solver.mbs.dynamics.start_te`)
-    jobs = [(mesh_contacts, argument_types(mesh_contacts, args))]
+    jobs = []
     if (scene.dynamic.enabled if dynamic is None else dynamic) or scene.quasi_static.method == "transient":
         from solver.mbs.dynamics import run_loads
         kernel = stepping_kernel(scene, model)
@@ -96,6 +94,10 @@ def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:
                    MAX_ITER=20)
         args = kernel_arguments(model, (1.0, 1e-3, 1.0, 1e-3, table, 1.0), (1e-6, 1, 1, 2), par, theta2=0.0)
         jobs.append((kernel, argument_types(kernel, args)))
+    rates = np.zeros(model.n_teeth)
+    geo = contact_geo(model.gear_par, model.pair_par, model.law_par)
+    args = ((0.0, 0.0, 0.0, 0.0), rates, rates, geo, new_contact_buffer(), *geo[3])     # as the loops call it
+    jobs.append((pair_contacts, argument_types(pair_contacts, args)))
     args = sweep_arguments(model, np.zeros(1), 1.0, 0.0)
     jobs.append((static_sweep, argument_types(static_sweep, args)))
     return jobs
@@ -127,7 +129,7 @@ def compiling_ahead(scene: Scene, dynamic: bool | None = None):
 def start_ahead(scene: Scene) -> None:
     """Start the compile ahead that `compiling_ahead` asked for ``scene`` (the plan of its run,
     its checks passed, before the FE): nothing when none was asked."""
-    from solver.mbs.kernels.gearmesh import mesh_contacts
+    from solver.mbs.kernels.gearmesh import pair_contacts
     from solver.precompile import precompiling
     for ask in _ASKED:
         if ask["scene"] is scene and ask["started"] is None:
@@ -135,7 +137,7 @@ def start_ahead(scene: Scene) -> None:
                 jobs = entry_jobs(scene, ask["dynamic"])
             except Exception:  # noqa: BLE001 - the run reports the scene's problem, with its field
                 jobs = []
-            ask["started"] = precompiling(jobs, shared=(mesh_contacts,))
+            ask["started"] = precompiling(jobs, shared=(pair_contacts,))
             ask["started"].__enter__()
 
 
