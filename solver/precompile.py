@@ -11,15 +11,16 @@ compiles it itself; the child gone (failed, killed), the parent compiles as it w
 one. Nothing changes in what is computed: the kernels are the same machine code, from the
 cache.
 
-A *shared* kernel (the contact search, which the statics and the stepping loops both link) is
-compiled by whichever process reaches it first, the other waiting for it and loading it from
-the cache: the child when its compile of a loop reaches it before the parent's first entry
-kernel call, else the parent, at that call (the child, its loop's compile reaching the kernel,
-then waits for the parent's word). The child compiles the stepping loop first and the shared
-search within it: with the FE read from its cache the parent reaches its statics first and
-compiles the search with them, so that the two processes compile about as much each (the
-stepping loop there, the search and the static sweep here) instead of the parent waiting for
-the search the child compiled before its loop.
+A *shared* kernel (the contact search, which the statics and the stepping loops both link; an
+inner kernel of the loop that the parent can compile ahead) is compiled by whichever process
+reaches it first, the other waiting for it and loading it from the cache: the child when its
+compile of a loop reaches it before the parent's first entry kernel call, else the parent, at
+that call (the child, its loop's compile reaching the kernel, then waits for the parent's word).
+The child compiles the stepping loop first and the shared kernels within it: with the FE read
+from its cache the parent reaches its statics first and compiles them before its static sweep,
+so that the two processes compile about as much each (the stepping loop there, the search, a
+few of the loop's helpers and the static sweep here) instead of the parent waiting for the
+search the child compiled before its loop.
 
 The child ends when its list is done, or at once when its standard input closes: the parent
 closes it when it leaves `precompiling` (normally, on an error, on Ctrl-C or SIGTERM), and the
