@@ -11,13 +11,25 @@ compiles it itself; the child gone (failed, killed), the parent compiles as it w
 one. Nothing changes in what is computed: the kernels are the same machine code, from the
 cache.
 
+A *shared* kernel (the contact search, which the statics and the stepping loops both link; an
+inner kernel of the loop that the parent can compile ahead) is compiled by whichever process
+reaches it first, the other waiting for it and loading it from the cache: the child when its
+compile of a loop reaches it before the parent's first entry kernel call, else the parent, at
+that call (the child, its loop's compile reaching the kernel, then waits for the parent's word).
+The child compiles the stepping loop first and the shared kernels within it: with the FE read
+from its cache the parent reaches its statics first and compiles them before its static sweep,
+so that the two processes compile about as much each (the stepping loop there, the search, a
+few of the loop's helpers and the static sweep here) instead of the parent waiting for the
+search the child compiled before its loop.
+
 The child ends when its list is done, or at once when its standard input closes: the parent
 closes it when it leaves `precompiling` (normally, on an error, on Ctrl-C or SIGTERM), and the
 operating system closes it when the parent dies, so that no child outlives its parent.
 
-Protocol (lines): parent -> child, first the jobs [(name, module, qualname, argument types)],
-pickled and base64-encoded, then ``skip NAME`` for each kernel the parent compiles itself;
-child -> parent: ``start NAME``, ``done NAME`` or ``fail NAME`` for each kernel.
+Protocol (lines): parent -> child, first the jobs ``{"jobs": [(name, module, qualname, argument
+types)], "shared": [name]}``, pickled and base64-encoded, then ``skip NAME`` for each kernel
+the parent compiles itself, and for a shared one then ``done NAME`` or ``fail NAME`` when its
+compile ends; child -> parent: ``start NAME``, ``done NAME`` or ``fail NAME`` for each kernel.
 
 The child is started only when a core is idle (`spare_core`): on a machine busy with other
 work it would compile on the same cores, and the duplicated work of the inner kernels both
@@ -87,18 +99,21 @@ def argument_types(kernel, args: tuple) -> tuple:
 class Precompiler:
     """A child process compiling ``jobs`` [(kernel dispatcher, argument types)] in that order
     into the disk cache, and what the parent knows of it (see the module docstring).
-    ``shared``: the kernels of the jobs that the parent's entry kernels call (the contact
-    search, which the statics and the time stepping both link): before its first call of any
-    kernel of the jobs, the parent waits for those the child is compiling, and loads them from
-    the cache when it compiles its caller, instead of compiling them too."""
+    ``shared``: the kernels of the jobs that the parent's entry kernels and the child's other
+    jobs both call (the contact search, which the statics and the time stepping both link):
+    compiled by whichever process reaches one first, the other loading it from the cache;
+    before its first call of any kernel of the jobs, the parent compiles (or waits for) them."""
 
     def __init__(self, jobs: list, shared=()):
         self.names = [kernel_name(k) for k, _ in jobs]
+        self.jobs = {kernel_name(k): (k, tuple(t)) for k, t in jobs}
         self.shared = [n for n in map(kernel_name, shared) if n in self.names]
         self.state = dict.fromkeys(self.names, "queued")      # -> started, done, fail, skipped, gone
         self.waited_s = 0.0
+        self.heard: list[str] = []      # the child's lines, in order
         self._cond = threading.Condition()
-        payload = [(kernel_name(k), k.py_func.__module__, k.py_func.__qualname__, tuple(t)) for k, t in jobs]
+        payload = {"jobs": [(kernel_name(k), k.py_func.__module__, k.py_func.__qualname__, tuple(t)) for k, t in jobs],
+                   "shared": self.shared}
         root = str(Path(__file__).resolve().parents[1])
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([root, *filter(None, [os.environ.get("PYTHONPATH")])]))
         import numba
@@ -121,7 +136,9 @@ class Precompiler:
         for line in self.proc.stdout:
             what, _, name = line.strip().partition(" ")
             with self._cond:
-                if name in self.state and what in ("start", "done", "fail"):
+                self.heard.append(line.strip())
+                # (a kernel this process took over stays its own, whatever the child began)
+                if self.state.get(name) not in (None, "skipped") and what in ("start", "done", "fail"):
                     self.state[name] = {"start": "started"}.get(what, what)
                     self._cond.notify_all()
         with self._cond:        # the child ended: what it did not finish, the parent compiles
@@ -147,7 +164,11 @@ class Precompiler:
             if st == "queued":
                 self.state[name] = "skipped"
                 self._send(f"skip {name}")
-                return
+        if st == "queued":
+            if name in self.shared:     # compiled here now, and the child (which may reach it) told
+                self._compile_shared(name)
+            return
+        with self._cond:
             if st != "started":
                 return
             import time
@@ -155,6 +176,18 @@ class Precompiler:
             while self.state[name] == "started":
                 self._cond.wait(POLL_S)
             self.waited_s += time.perf_counter() - t0
+
+    def _compile_shared(self, name: str) -> None:
+        """Compile the shared kernel ``name`` here (into the cache) and say so to the child,
+        which waits for it when its own compile reaches it; on a failure the child compiles
+        it (and this process again, at its call)."""
+        kernel, types = self.jobs[name]
+        try:
+            kernel.compile(types)
+        except Exception:  # noqa: BLE001 - the call compiles it again and raises what is wrong
+            self._send(f"fail {name}")
+            return
+        self._send(f"done {name}")
 
     def close(self) -> None:
         """Stop the child (its standard input closed, then SIGTERM, then SIGKILL) and wait for it."""
@@ -206,32 +239,83 @@ def precompiling(jobs: list, shared=()):
 
 def _child() -> int:
     import importlib
-    jobs = pickle.loads(base64.b64decode(sys.stdin.readline()))
-    skip, lock = set(), threading.Lock()
+    given = pickle.loads(base64.b64decode(sys.stdin.readline()))
+    jobs, shared = given["jobs"], set(given["shared"])
+    skip, theirs, mine = set(), {}, set()       # skip told; shared kernels the parent ended: done/fail
+    cond = threading.Condition()
 
-    def listen():           # 'skip NAME' lines; the parent gone or done (end of input): stop at once
+    def listen():           # the parent's lines; the parent gone or done (end of input): stop at once
         for line in sys.stdin:
             what, _, name = line.strip().partition(" ")
-            if what == "skip":
-                with lock:
+            with cond:
+                if what == "skip":
                     skip.add(name)
+                elif what in ("done", "fail"):
+                    theirs[name] = what
+                cond.notify_all()
         sys.stdout.flush()
         os._exit(0)
     threading.Thread(target=listen, daemon=True).start()
+
+    def kernel_of(module, qualname):
+        kernel = importlib.import_module(module)
+        for part in qualname.split("."):
+            kernel = getattr(kernel, part)
+        return kernel
+
+    def claim(name) -> bool:
+        """True: this process compiles the shared kernel ``name`` (said to the parent); False:
+        the parent has compiled it (then loaded from the cache)."""
+        with cond:
+            if name in mine:
+                return True
+            if name in skip:
+                while name not in theirs:
+                    cond.wait()
+                if theirs[name] == "done":
+                    return False
+            mine.add(name)
+        print("start", name, flush=True)
+        return True
+
+    def guarded(name, compile_):
+        said = []
+
+        def compile(sig):       # (numba asks a callee's dispatcher for it when it types a call of it)
+            if not claim(name) or said:
+                return compile_(sig)
+            try:
+                entry = compile_(sig)
+            except Exception:
+                said.append(True)
+                print("fail", name, flush=True)
+                raise
+            said.append(True)
+            print("done", name, flush=True)
+            return entry
+        return compile
+
+    for name, module, qualname, _ in jobs:
+        if name in shared:
+            try:
+                kernel = kernel_of(module, qualname)
+                kernel.compile = guarded(name, kernel.compile)
+            except Exception:  # noqa: BLE001 - left as it is: compiled by whoever calls it
+                pass
     for name, module, qualname, argtypes in jobs:
-        with lock:
+        with cond:
             if name in skip:
                 continue
-        print("start", name, flush=True)
+        if name not in shared:
+            print("start", name, flush=True)
         try:
-            kernel = importlib.import_module(module)
-            for part in qualname.split("."):
-                kernel = getattr(kernel, part)
-            kernel.compile(tuple(argtypes))
+            kernel_of(module, qualname).compile(tuple(argtypes))
         except Exception:  # noqa: BLE001 - said to the parent, which compiles it itself
-            print("fail", name, flush=True)
+            if name not in shared:
+                print("fail", name, flush=True)
             continue
-        print("done", name, flush=True)
+        if name not in shared:
+            print("done", name, flush=True)
     return 0
 
 

@@ -88,8 +88,9 @@ def run_fields(scene: Scene, stages=None, options: RunOptions = RunOptions()) ->
     """Run the ``stages`` (`study.plan.STAGES`; None: those of a whole run, `scene_stages`) of
     a scene -> the run archive's variables and attributes (`RunFields`; `run_scene` makes the
     archive of them). The plan is made first (`study.plan.make_plan`: the checks before any
-    work, the springs, the model, the equilibria); each stage asked then runs once, in the
-    order of `STAGES`, on the plan and what the stages before it returned. A study's task asks
+    work, the springs, the model, the equilibria); each stage asked then runs once, on the plan
+    and what the stages before it returned, its variables merged in the order of `STAGES` (the
+    statics and the mesh run before the modes: see below). A study's task asks
     for the stages its outputs need (`study.sweep.outputs.stages_of`) with
     ``options.archive`` False: the attributes that only document an archive (the scene's TOML,
     the provenance) and, without 'mesh', the dynamic run's loaded contacts are left out."""
@@ -99,18 +100,24 @@ def run_fields(scene: Scene, stages=None, options: RunOptions = RunOptions()) ->
     if plan.asks("gear"):
         _merge((coords, data, attrs), gear_stage(plan))
     attrs.update(run_attrs(plan))
+    # the statics and the mesh computed before the modes, whose free decay is the first call of
+    # the time stepping: on a cold kernel cache a second process compiles it meanwhile
+    # (`solver.precompile`), so the run does what does not need it first; merged in the order
+    # of STAGES all the same (the same archive)
+    st, static_fields, mesh_fields = None, None, None
+    if plan.asks("static"):
+        *static_fields, st = static_stage(plan)
+        if plan.asks("mesh"):
+            mesh_fields = mesh_stage(plan, st)
     if plan.asks("modes"):
         _merge((coords, data, attrs), modes_stage(plan))
         if plan.asks("dynamic"):
             cs = data["critical_speed"]
             plan.warn_also(critical_speed_warning(scene, float(cs.values[list(coords["excitation"].values).index("1Z"), 0])))
     attrs["plausibility_warnings"] = "\n".join(plan.warnings)
-    st = None
-    if plan.asks("static"):
-        *fields, st = static_stage(plan)
-        _merge((coords, data, attrs), fields)
-        if plan.asks("mesh"):
-            _merge((coords, data, attrs), mesh_stage(plan, st))
+    for fields in (static_fields, mesh_fields):
+        if fields is not None:
+            _merge((coords, data, attrs), fields)
     if plan.asks("dynamic"):
         _merge((coords, data, attrs), dynamic_stage(plan))
     if plan.asks("strength") and st is not None:

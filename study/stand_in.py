@@ -72,22 +72,20 @@ def stepping_kernel(scene: Scene, model):
 
 def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:
     """[(kernel dispatcher, argument types)] of the kernels a run of the scene calls, in the
-    order to compile them ahead: the contact search (`gearmesh.mesh_contacts`, the dearest
-    part of both loops, which link it; the run waits for it rather than compile it twice: `solver.precompile`), the time stepping (when the run has a
-    dynamic run, ``dynamic`` None: as the scene says, or the slow-ramp transient statics;
-    the dearest, and the latest called), then the static sweep (the statics and the loaded
-    equilibria of the damping conversion)."""
+    order to compile them ahead: the time stepping (when the run has a dynamic run, ``dynamic``
+    None: as the scene says, or the slow-ramp transient statics; the dearest, and the latest
+    called), the contact search (`gearmesh.pair_contacts`, which the loops call and the
+    statics through `mesh_contacts`, with the model's parts as its own arguments: compiled by
+    whichever process reaches it first, `solver.precompile`), then the static sweep (the
+    statics and the loaded equilibria of the damping conversion)."""
     from solver.mbs.dynamics import kernel_arguments
-    from solver.mbs.kernels.gearmesh import contact_geo, mesh_contacts, new_contact_buffer
+    from solver.mbs.kernels.gearmesh import contact_geo, new_contact_buffer, pair_contacts
     from solver.mbs.kernels.statics import static_sweep
     from solver.mbs.statics import sweep_arguments
     from solver.precompile import argument_types
     from study.scene_model import load_table
     model = stand_in_model(scene)
-    rates = np.zeros(model.n_teeth)
-    args = ((0.0, 0.0, 0.0, 0.0), rates, rates, contact_geo(model.gear_par, model.pair_par, model.law_par),
-            new_contact_buffer())       # as the loops call it (and `solver.mbs.dynamics.start_te`)
-    jobs = [(mesh_contacts, argument_types(mesh_contacts, args))]
+    jobs, late = [], []
     if (scene.dynamic.enabled if dynamic is None else dynamic) or scene.quasi_static.method == "transient":
         from solver.mbs.dynamics import run_loads
         kernel = stepping_kernel(scene, model)
@@ -96,9 +94,50 @@ def entry_jobs(scene: Scene, dynamic: bool | None = None) -> list:
                    MAX_ITER=20)
         args = kernel_arguments(model, (1.0, 1e-3, 1.0, 1e-3, table, 1.0), (1e-6, 1, 1, 2), par, theta2=0.0)
         jobs.append((kernel, argument_types(kernel, args)))
+        late = _late_helpers(kernel, args)
+    rates = np.zeros(model.n_teeth)
+    geo = contact_geo(model.gear_par, model.pair_par, model.law_par)
+    args = ((0.0, 0.0, 0.0, 0.0), rates, rates, geo, new_contact_buffer(), *geo[3])     # as the loops call it
+    jobs += [(pair_contacts, argument_types(pair_contacts, args)), *late]
     args = sweep_arguments(model, np.zeros(1), 1.0, 0.0)
     jobs.append((static_sweep, argument_types(static_sweep, args)))
     return jobs
+
+
+def _late_helpers(kernel, args) -> list:
+    """[(kernel, argument types)] of the inner kernels the coupled stepping loop
+    (`explicit_coupled.verlet_coupled`, called with ``args``) types last, as it calls them: the
+    step's end (`stepping.end_step`) and the dissipation power (`mechanics.dissipation_power`).
+    A cold run compiles them with the contact search, before its statics, while the second
+    process compiles the loop, which then loads them from the cache: about 0.8 s of the loop's
+    compile, the longest part of a cold run's first call, moved to the run. Other loops: none."""
+    from solver.mbs.kernels import layout as L
+    from solver.mbs.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.kernels.mechanics import dissipation_power
+    from solver.mbs.kernels.stepping import end_step
+    from solver.precompile import argument_types
+    if kernel is not verlet_coupled:
+        return []
+    mdl, ctl, hub, teeth, out, ws = args
+    gp, pp, lp, kphi, ctooth, parts = mdl
+    n, z = np.int64(0), 0.0         # (counts, statuses; powers)
+    tz2 = int(gp[1, L.TOOTH0])
+    return [(end_step, argument_types(end_step, (ws, teeth, n, n, n, tz2, (z, z, z), ctl[0], n))),
+            (dissipation_power, argument_types(dissipation_power, (teeth[L.RATE], ws.tset[L.T_ACT], n,
+                                                                   (gp.copy(), pp, lp, kphi, ctooth, parts),
+                                                                   ws.rec, n, parts[1])))]
+
+
+def shared_kernels(jobs) -> tuple:
+    """The kernels of ``jobs`` (`entry_jobs`) that a run does not call from Python but both its
+    statics or its stepping loop and the second process's loop link: all but the static sweep
+    and the stepping loop (`solver.precompile`: compiled by whichever process reaches one
+    first)."""
+    from solver.mbs.kernels.explicit import verlet
+    from solver.mbs.kernels.explicit_coupled import verlet_coupled
+    from solver.mbs.kernels.implicit import hht
+    from solver.mbs.kernels.statics import static_sweep
+    return tuple(k for k, _ in jobs if k not in (static_sweep, verlet, verlet_coupled, hht))
 
 
 # the runs asking for their kernels compiled ahead (`compiling_ahead`), each started by its
@@ -127,7 +166,6 @@ def compiling_ahead(scene: Scene, dynamic: bool | None = None):
 def start_ahead(scene: Scene) -> None:
     """Start the compile ahead that `compiling_ahead` asked for ``scene`` (the plan of its run,
     its checks passed, before the FE): nothing when none was asked."""
-    from solver.mbs.kernels.gearmesh import mesh_contacts
     from solver.precompile import precompiling
     for ask in _ASKED:
         if ask["scene"] is scene and ask["started"] is None:
@@ -135,7 +173,7 @@ def start_ahead(scene: Scene) -> None:
                 jobs = entry_jobs(scene, ask["dynamic"])
             except Exception:  # noqa: BLE001 - the run reports the scene's problem, with its field
                 jobs = []
-            ask["started"] = precompiling(jobs, shared=(mesh_contacts,))
+            ask["started"] = precompiling(jobs, shared=shared_kernels(jobs))
             ask["started"].__enter__()
 
 

@@ -54,6 +54,29 @@ def began(p, name, timeout=30.0):
 
 JOBS = lambda k: [(k, (numba.float64,))]  # noqa: E731
 
+# a kernel (outer) and a callee of it that the parent's own kernels call too (inner): shared
+PAIR = TOY + """
+
+@numba.njit(cache=True)
+def inner(x):
+    return x + 1.0
+
+
+@numba.njit(cache=True)
+def outer(x):
+    return inner(x) * 3.0
+"""
+
+
+@pytest.fixture
+def pair(toy, tmp_path):
+    """(outer, inner, jobs, shared) of `PAIR`, in the toy's module and cache."""
+    (tmp_path / "toy_kernels.py").write_text(PAIR)
+    sys.modules.pop("toy_kernels", None)
+    import toy_kernels
+    sig = (numba.float64,)
+    yield toy_kernels.outer, toy_kernels.inner, [(toy_kernels.outer, sig), (toy_kernels.inner, sig)], (toy_kernels.inner,)
+
 
 def test_the_child_compiles_into_the_disk_cache_and_the_parent_loads_it(toy):
     assert not precompile.cached(toy, (numba.float64,))
@@ -176,3 +199,60 @@ def test_the_child_ends_when_its_parent_is_killed(tmp_path):
     else:
         os.kill(child, signal.SIGKILL)
         pytest.fail("the child outlived its parent")
+
+
+def test_a_shared_kernel_the_parent_reaches_first_is_compiled_there_and_the_child_waits_for_it(pair, monkeypatch):
+    """The parent's first entry call takes the shared callee the child has not begun: it
+    compiles it, and the child, its compile of the caller reaching it meanwhile, waits for it
+    and loads it from the cache instead of compiling it too."""
+    outer, inner, jobs, shared = pair
+    compile_, seen = inner.compile, []
+
+    def slow(sig):      # begun 3 s late here: the child meanwhile reaches inner within outer
+        time.sleep(3.0)
+        seen.extend(p.heard)
+        return compile_(sig)
+    monkeypatch.setattr(inner, "compile", slow, raising=False)
+    with precompile.precompiling(jobs, shared) as p:
+        precompile.ready(outer)     # inner: taken and compiled here; then outer: waits for the child's
+        assert p.state["toy_kernels.inner"] == "skipped" and p.state["toy_kernels.outer"] == "done"
+        assert inner.stats.cache_misses         # compiled here
+        assert outer(1.0) == 6.0
+    assert "start toy_kernels.outer" in seen    # the child was in outer while inner was compiled here
+    # the child compiled outer with inner loaded from the cache the parent wrote: it never began inner
+    assert "done toy_kernels.outer" in p.heard, p.heard
+    assert not any(line.endswith("toy_kernels.inner") for line in p.heard), p.heard
+    assert outer.stats.cache_hits and not outer.stats.cache_misses
+
+
+def test_a_shared_kernel_the_child_reaches_first_is_compiled_there_and_the_parent_waits_for_it(pair):
+    outer, inner, jobs, shared = pair
+    with precompile.precompiling(jobs, shared) as p:
+        t_end = time.monotonic() + 60
+        while "start toy_kernels.inner" not in p.heard and time.monotonic() < t_end:
+            time.sleep(0.01)
+        precompile.ready(outer)     # waits for the child's inner (begun within outer), then for outer
+        assert p.state["toy_kernels.inner"] == "done" and p.state["toy_kernels.outer"] == "done"
+        assert outer(1.0) == 6.0
+    assert p.heard.index("start toy_kernels.outer") < p.heard.index("start toy_kernels.inner") \
+        < p.heard.index("done toy_kernels.inner") < p.heard.index("done toy_kernels.outer")
+    # nothing compiled here: both loaded from the child's cache
+    assert outer.stats.cache_hits and not outer.stats.cache_misses and not inner.stats.cache_misses
+
+
+def test_a_shared_kernel_the_parent_fails_to_compile_is_compiled_by_the_child(pair, monkeypatch):
+    outer, inner, jobs, shared = pair
+
+    def refused(sig):
+        time.sleep(1.0)
+        raise RuntimeError("refused")
+    monkeypatch.setattr(inner, "compile", refused, raising=False)
+    with precompile.precompiling(jobs, shared) as p:
+        precompile.ready(outer)     # inner: taken, failed here, said so; then waits for the child's outer
+        assert p.state["toy_kernels.inner"] == "skipped"
+        precompile.ready(outer)
+        t_end = time.monotonic() + 60
+        while "done toy_kernels.outer" not in p.heard and time.monotonic() < t_end:
+            time.sleep(0.05)
+    # the child compiled inner itself (within outer) once told the parent's failed
+    assert "start toy_kernels.inner" in p.heard and "done toy_kernels.outer" in p.heard, p.heard

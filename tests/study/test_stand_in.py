@@ -11,7 +11,7 @@ from solver.mbs.dynamics import simulate
 from solver.mbs.statics import solve_static
 from solver.precompile import argument_types, kernel_name
 from study.scene_model import build_scene_model
-from study.stand_in import entry_jobs, stand_in_model
+from study.stand_in import entry_jobs, shared_kernels, stand_in_model
 
 SMALL = {**scene_overrides("small_pair"), "coupling.model": "paper"}
 
@@ -36,15 +36,18 @@ def called_types(model, monkeypatch) -> dict:
     return seen
 
 
-CONTACTS = "solver.mbs.kernels.gearmesh.mesh_contacts"
+CONTACTS = "solver.mbs.kernels.gearmesh.pair_contacts"
 
 
 def stand_in_types(scene) -> dict:
     """{kernel name: argument types} of the stand-in's entry kernels (the contact search,
-    compiled ahead as the loops call it, apart: tests/study/test_compile_ahead.py)."""
+    compiled ahead as the loops call it, apart: tests/study/test_compile_ahead.py), in
+    their order; the search comes after the stepping loop, before the static sweep."""
     jobs = entry_jobs(scene)
-    assert kernel_name(jobs[0][0]) == CONTACTS
-    return {kernel_name(k): types for k, types in jobs[1:]}
+    names, shared = [kernel_name(k) for k, _ in jobs], [kernel_name(k) for k in shared_kernels(jobs)]
+    assert names.count(CONTACTS) == 1 and shared[0] == CONTACTS and names[-1] == "solver.mbs.kernels.statics.static_sweep"
+    assert names[-1 - len(shared):-1] == shared     # compiled ahead after the loop, before the sweep
+    return {name: types for name, (_, types) in zip(names, jobs) if name not in shared}
 
 
 @pytest.mark.parametrize("overrides", [
@@ -128,3 +131,57 @@ def test_a_run_refused_before_any_work_builds_no_stand_in(monkeypatch):
     with compiling_ahead(small):             # asked, and started by the plan of its own run
         si.start_ahead(small)
     assert len(built) == 1 and built[0][0] is small
+
+
+# in a process of its own with an empty kernel cache: the coupled loop's late helpers compiled
+# from the stand-in's types, then the loop (numba's compile events name what it compiles)
+LATE = r"""
+import json, sys
+from numba.core import event
+import study
+from solver.precompile import kernel_name
+from study.stand_in import entry_jobs, shared_kernels
+jobs = entry_jobs(study.load_scene(None, json.loads(sys.argv[1])))
+late = [(k, t) for k, t in jobs if k in shared_kernels(jobs)[1:]]
+for k, t in late:
+    k.compile(t)
+compiled = []
+class Compiles(event.Listener):
+    def on_start(self, ev):
+        compiled.append(kernel_name(ev.data["dispatcher"]))
+    def on_end(self, ev):
+        pass
+with event.install_listener("numba:compile", Compiles()):
+    jobs[0][0].compile(jobs[0][1])
+print("RESULT", json.dumps({"loop": kernel_name(jobs[0][0]), "late": [kernel_name(k) for k, _ in late],
+                            "signatures": [len(k.signatures) for k, _ in late], "compiled": compiled}))
+"""
+
+
+def test_the_coupled_loop_finds_its_late_helpers_compiled_for_the_stand_in_s_types(tmp_path):
+    """The default model's stepping loop types the step's end and the dissipation power last;
+    a cold run compiles them ahead (with the contact search) from the stand-in's types: the
+    loop's own compile finds them and compiles neither again (no second signature)."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[2]
+    env = dict(os.environ, PYTHONPATH=str(root), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    proc = subprocess.run([sys.executable, "-c", LATE, json.dumps({**SMALL, "coupling.model": "compliance"})],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=540)
+    line = next((x for x in proc.stdout.splitlines() if x.startswith("RESULT ")), None)
+    assert line, proc.stderr[-3000:]
+    res = json.loads(line[7:])
+    assert res["loop"] == "solver.mbs.kernels.explicit_coupled.verlet_coupled"
+    assert res["late"] == ["solver.mbs.kernels.stepping.end_step", "solver.mbs.kernels.mechanics.dissipation_power"]
+    assert res["signatures"] == [1, 1]
+    assert res["compiled"][0] == res["loop"] and not set(res["late"]) & set(res["compiled"]), res["compiled"]
+
+
+def test_the_other_loops_have_no_late_helpers():
+    """(the paper model's loop, the implicit one: only the contact search is shared)"""
+    for overrides in ({}, {"dynamic.method": "implicit"}):
+        jobs = entry_jobs(study.load_scene(None, {**SMALL, **overrides}))
+        assert [kernel_name(k) for k in shared_kernels(jobs)] == [CONTACTS]
