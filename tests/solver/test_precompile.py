@@ -243,11 +243,16 @@ def test_a_shared_kernel_the_child_reaches_first_is_compiled_there_and_the_paren
 def test_a_shared_kernel_the_parent_fails_to_compile_is_compiled_by_the_child(pair, monkeypatch):
     outer, inner, jobs, shared = pair
 
+    held = []
+
     def refused(sig):
-        time.sleep(1.0)
+        # (fails once the child has begun outer, whose typing reaches inner, taken here: on a
+        # busy machine the child may still be starting when this process takes inner)
+        began(held[0], "toy_kernels.outer")
         raise RuntimeError("refused")
     monkeypatch.setattr(inner, "compile", refused, raising=False)
     with precompile.precompiling(jobs, shared) as p:
+        held.append(p)
         precompile.ready(outer)     # inner: taken, failed here, said so; then waits for the child's outer
         assert p.state["toy_kernels.inner"] == "skipped"
         precompile.ready(outer)
