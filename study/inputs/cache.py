@@ -9,7 +9,8 @@ named by `FECache.key` of everything the result depends on:
   recomputed when the stress is asked for);
 * ``ltca-{key}.npz``: a body's bulk compliance (`solver.fe.flank_compliance.BodyCompliance`);
 * ``fields-{key}.npz``: a body's FE fields under the load on a few teeth (mesh, displacement,
-  von Mises stress: `solver.fe.body.BodyField`), for the renders of an archive.
+  von Mises stress: `solver.fe.body.BodyField`), for the renders of an archive (written by the
+  run that made the archive while it held the factorised body, else by the first render).
 * ``rim-{key}.npz``: the teeth and rim of one rim height condensed onto the web
   (`solver.fe.condense`: the condensed stiffness and the DOF positions it belongs to), and
   ``rim-{key}-{load set}.npz`` its products of a compliance load set.
