@@ -123,6 +123,9 @@ def run_fields(scene: Scene, stages=None, options: RunOptions = RunOptions()) ->
     if plan.asks("strength") and st is not None:
         kv = float(data["dynamic_factor"].values) if "dynamic_factor" in data else None
         _merge((coords, data, attrs), strength_stage(plan, st, kv))
+    if plan.archive:        # a run's archive is rendered next: its body fields, while the body is factorised
+        from study.inputs.springs import keep_render_fields
+        keep_render_fields(plan.setups, data["tooth_stiffness"].values)
     return RunFields(coords, data, attrs)
 
 

@@ -330,16 +330,24 @@ def _stiffness(teeth: list, cases: list, P, U: np.ndarray, force: float) -> np.n
     return k
 
 
-def von_mises(model: BodyModel, u: np.ndarray) -> np.ndarray:
-    """Element-mean von Mises stress [Pa] (plane stress) of displacement u, over the points of the
-    element's default quadrature (a condensed body's basis holds one point an element)."""
+def stress_basis(model: BodyModel):
+    """The basis `von_mises` reads the strains with: the body's own, over the points of the
+    element's default quadrature (a condensed body's basis holds one point an element: a new one
+    of those points, worth building once for several displacement fields)."""
     import skfem
-    from skfem.helpers import sym_grad
 
     basis = model.basis
     if basis.X.shape[1] == 1:
         basis = skfem.Basis(basis.mesh, basis.elem)
-    w = basis.interpolate(u)
+    return basis
+
+
+def von_mises(model: BodyModel, u: np.ndarray, basis=None) -> np.ndarray:
+    """Element-mean von Mises stress [Pa] (plane stress) of displacement u, over the points of the
+    element's default quadrature (``basis``: `stress_basis` of the model, made here if None)."""
+    from skfem.helpers import sym_grad
+
+    w = (stress_basis(model) if basis is None else basis).interpolate(u)
     eps = sym_grad(w)                     # (2, 2, nelem, nqp)
     lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
     tr = eps[0, 0] + eps[1, 1]
@@ -366,15 +374,17 @@ class BodyField:
     load_direction: np.ndarray  # (2,)
 
 
-def body_field(model: BodyModel, g: GearGeometry, u: np.ndarray, tooth: int, force: float, pivot_radius: float) -> BodyField:
-    """Pack the vertex displacement and element stress of one load case."""
+def body_field(model: BodyModel, g: GearGeometry, u: np.ndarray, tooth: int, force: float, pivot_radius: float,
+               basis=None) -> BodyField:
+    """Pack the vertex displacement and element stress of one load case (``basis``: the model's
+    `stress_basis`, shared by the load cases of one body; made here if None)."""
     nv = model.mesh.points.shape[0]
     # vertex DOFs of the vector P2 basis: nodal_dofs[c, vertex]
     nd = model.basis.nodal_dofs
     disp = np.column_stack([u[nd[0, :nv]], u[nd[1, :nv]]])
     case = load_case(g, tooth, pivot_radius)
     return BodyField(model.mesh.points, model.mesh.triangles, model.thickness, model.mesh.region == REGION_WEB,
-                     disp, von_mises(model, u), tooth, force, case.point, case.direction)
+                     disp, von_mises(model, u, basis), tooth, force, case.point, case.direction)
 
 
 def _fillet_bands(model: BodyModel, g: GearGeometry, teeth) -> list:

@@ -132,8 +132,19 @@ def factorised_body(setup: GearSetup, stages: dict | None = None):
                           assembly_wall_s=model.assembly_time, assembly_cpu_s=model.assembly_cpu,
                           factor_wall_s=model.factor_time, factor_cpu_s=model.factor_cpu)
         return model
-    key = json.dumps({k: v for k, v in setup.settings.items() if k not in ("force", "pivot")}, sort_keys=True, default=float)
-    return FE_CACHE.body(key, build)
+    return FE_CACHE.body(body_key(setup), build)
+
+
+def body_key(setup: GearSetup) -> str:
+    """The key `factorised_body` keeps the gear's body by: its settings less the load and the
+    pivot (the body does not depend on them)."""
+    return json.dumps({k: v for k, v in setup.settings.items() if k not in ("force", "pivot")}, sort_keys=True, default=float)
+
+
+def held_body(setup: GearSetup):
+    """The gear's factorised body if this process holds it already (`factorised_body` made it
+    and it is among the last kept), else None: nothing is built."""
+    return FE_CACHE.held_body(body_key(setup))
 
 
 CONDENSE = True         # solve bodies with a web or hub through their condensed teeth and rim

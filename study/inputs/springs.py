@@ -34,7 +34,7 @@ def fe_stiffness(setup: GearSetup, teeth=None, keep_fields: bool = False):
     """FE torsion stiffness [N·m/rad] of the gear's teeth (all, or ``teeth``), cached.
 
     The same solve gives each tooth's largest fillet stress (`root_stress`), cached with the map.
-    Returns k (n,) and, when ``keep_fields``, the (model, U) pair for renders (not cached).
+    Returns k (n,) and, when ``keep_fields``, the (model, U) pair of the full solve (not cached).
     """
     from solver.fe import body as fe
     from study.inputs.compliance import factorised_body
@@ -138,19 +138,55 @@ def tooth_springs(setup: GearSetup) -> tuple[np.ndarray, np.ndarray]:
 
 def body_fields(setup: GearSetup, teeth, solve: bool = True) -> list | None:
     """`solver.fe.body.BodyField` (mesh, displacement, von Mises stress) of the gear's body
-    under the reference load on each of ``teeth``, for renders: from the FE cache, else one FE
-    solve (stored in the cache), or None when not cached and ``solve`` is False."""
-    from solver.fe import body as fe
+    under the reference load on each of ``teeth``, for renders: from the FE cache, else solved
+    through the gear's factorised body (`study.inputs.compliance.factorised_body`: the one a run
+    or a map of this process made, else made now) and stored in the cache, or None when not
+    cached and ``solve`` is False."""
+    from study.inputs.compliance import factorised_body
     teeth = [int(t) for t in teeth]
-    key = FE_CACHE.key({**setup.settings, "fields": teeth})
+    key = _fields_key(setup, teeth)
     fields = FE_CACHE.read_fields(key)
     if fields is not None or not solve:
         return fields
-    _, (model, U) = fe_stiffness(setup, teeth=teeth, keep_fields=True)
-    fields = [fe.body_field(model, setup.geometry, U[:, j], t, setup.force, setup.pivot_radius)
+    return _solve_fields(setup, teeth, key, factorised_body(setup))
+
+
+def _fields_key(setup: GearSetup, teeth: list) -> str:
+    return FE_CACHE.key({**setup.settings, "fields": teeth})
+
+
+def _solve_fields(setup: GearSetup, teeth: list, key: str, model) -> list:
+    """The body fields of ``teeth`` through the factorised body ``model`` (one block of solves,
+    the displacements of `solver.fe.body.tooth_stiffness` that the spring map reads), stored
+    in the FE cache under ``key``."""
+    from solver.fe import body as fe
+    _, U = fe.tooth_stiffness(model, setup.geometry, setup.pivot_radius, teeth, setup.force, setup.patch)
+    basis = fe.stress_basis(model)
+    fields = [fe.body_field(model, setup.geometry, U[:, j], t, setup.force, setup.pivot_radius, basis)
               for j, t in enumerate(teeth)]
     FE_CACHE.write_fields(key, fields)
     return fields
+
+
+def keep_render_fields(setups, k_phi) -> list[int]:
+    """Store in the FE cache the body fields a render of the run will draw (`archive_body_fields`:
+    each lightened gear's stiffest and softest tooth of ``k_phi``, its tooth springs as the
+    archive's ``tooth_stiffness``, (2, teeth) with NaN past a gear's teeth), for each gear
+    whose factorised body this process holds already (the run's springs, coupling fit or
+    strength made it): two solves and a file of about a MB, instead of the render factorising
+    the body again. A body not held, or fields already stored, cost nothing. -> the gears stored."""
+    from study.inputs.compliance import held_body
+    done = []
+    for setup in setups:
+        if not setup.lightened:
+            continue
+        teeth = render_teeth(k_phi[setup.gear - 1])
+        key = _fields_key(setup, teeth)
+        model = None if FE_CACHE.has_fields(key) else held_body(setup)
+        if model is not None:
+            _solve_fields(setup, teeth, key, model)
+            done.append(setup.gear)
+    return done
 
 
 def render_teeth(k_phi) -> list[int]:

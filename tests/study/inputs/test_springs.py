@@ -178,3 +178,47 @@ def test_lightened_scene_runs_with_its_fe_springs_in_the_archive():
     ste_solid = run_scene(solid, static=True, dynamic=False)["ste"].values
     # softer driven teeth: more transmission error at every angle
     assert np.all(ds["ste"].values > ste_solid)
+
+
+def test_a_run_stores_the_body_fields_its_render_draws_and_the_render_factorises_no_body(private_fe_cache, monkeypatch,
+                                                                                          tmp_path):
+    """`lightgear run` then `lightgear render`: the run, holding the factorised body (its
+    coupling fit and strength), stores the fields of the render's two teeth; the render (a new
+    process: nothing held) reads them and meshes, assembles and factorises nothing, and they are
+    bit for bit what the render would have solved itself. A study's point stores none, and a run
+    that factorises no body (all its FE read from the disk cache) does not factorise one for them."""
+    from solver.fe import condense
+    from study.plan import RunOptions
+    from study.run import run_fields, run_scene
+    lite = small_scene(**{"quasi_static.rotation": 15.0, "quasi_static.angle_step": 0.5})    # the default model
+    stored = lambda: sorted((tmp_path / "cache" / "fe").glob("fields-*.npz"))    # noqa: E731
+
+    def refuse(*a, **k):
+        raise AssertionError("a body was assembled and factorised")
+
+    run_fields(lite, None, RunOptions(warn=False, archive=False))     # a study's point: its speed first
+    assert stored() == []
+    ds = run_scene(lite, dynamic=False, warn=False)                    # the body still held from the point
+    assert len(stored()) == 1
+    teeth = springs.render_teeth(ds["tooth_stiffness"].sel(gear=2).values)
+    k2 = ds["tooth_stiffness"].sel(gear=2).values[:lite.gear2.teeth]
+    assert teeth == [int(np.argmax(k2)), int(np.argmin(k2))] and k2[teeth[0]] > k2[teeth[1]]
+
+    private_fe_cache.clear()                                          # the render's own process
+    with monkeypatch.context() as m:
+        m.setattr(fe, "assemble", refuse)
+        m.setattr(condense, "assemble_condensed", refuse)
+        fields = springs.archive_body_fields(ds)
+        assert list(fields) == [2] and [f.tooth for f in fields[2]] == teeth
+        stored()[0].unlink()                                          # a run with every FE result on disk
+        run_scene(lite, dynamic=False, warn=False)
+        assert stored() == []                                         # ... holds no body: none made for the fields
+
+    monkeypatch.setenv("LIGHTGEAR_CACHE", str(tmp_path / "empty"))
+    private_fe_cache.clear()
+    solved = springs.body_fields(gear_setup(lite, 2), teeth)           # what the render solved without them
+    for a, b in zip(fields[2], solved, strict=True):
+        assert a.tooth == b.tooth and a.load_N == b.load_N
+        for name in ("points", "triangles", "thickness", "web", "displacement", "von_mises", "load_point"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert np.abs(fields[2][0].displacement).max() > 0 and fields[2][0].von_mises.max() > 0
