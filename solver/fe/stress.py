@@ -282,7 +282,10 @@ def load_case_stress(model, op: StressOperator, teeth, rolls, load_vector) -> np
             out[..., j] = op.apply(U)
         return out
     # columns tooth-major (tooth position * n_rolls + roll), as ``out`` holds them
-    F = sp.hstack([sp.csc_matrix(load_vector(t, float(u))[model.free, None]) for t in teeth for u in rolls]).tocsc()
+    cols = [load_vector(t, float(u))[model.free] for t in teeth for u in rolls]
+    nz = [np.flatnonzero(c) for c in cols]
+    F = sp.csc_matrix((np.concatenate([c[i] for c, i in zip(cols, nz)]), np.concatenate(nz),
+                       np.cumsum([0] + [i.size for i in nz])), shape=(model.free.size, len(cols)))
     pos = np.full(model.basis.N, -1, np.int64)
     pos[model.free] = np.arange(model.free.size)
     dofs = op.dofs

@@ -6,9 +6,10 @@ Per gear (`gear_strength`):
    root fillets, inner half of the rim, web opening edges and ligaments), for a load on each
    tooth the STE loads, at five roll parameters along the profile: the start of the active
    profile, the inner point of single contact, the pitch point, the outer point of single
-   contact (HPSTC) and the tip. One solve per (tooth, roll) through the body's one
-   factorisation (the same body as the springs'), cached on disk with the sites
-   (``strength-{key}.npz`` in the FE cache).
+   contact (HPSTC) and the tip. One load case per (tooth, roll) through the body's one
+   factorisation (the same body as the springs'), all in one block and, on a body with a
+   condensed rim, solved only at the DOFs the sites read (`solver.fe.stress.load_case_stress`),
+   cached on disk with the sites (``strength-{key}.npz`` in the FE cache).
 2. The static contact forces of the STE (each loaded contact's tooth, roll parameter and force:
    `static_loads`) superposed on those load cases, each force shared between the two nearest
    rolls (linear in the roll): the stress at every site node at every STE angle, and its
