@@ -41,7 +41,7 @@ from solver.fe.body import BodyModel, plane_stress_lame, plane_stress_p2_stiffne
 from solver.fe.factor import blas1_solver, congruence, factorise, influence, one_blas_thread
 from solver.fe.mesh import REGION_RIM, REGION_WEB, BodyMesh
 from solver.fe.rim_dofs import MATCH_TOL, RimMismatch, rim_dofs_in_body
-from solver.fe.rim_solves import ReadSet, make_read_set, rim_products
+from solver.fe.rim_solves import ReadSet, RimBack, make_read_set, rim_back, rim_forward, rim_products, rim_reads
 from solver.geometry import Material
 from solver.store import Shelf, digest
 
@@ -128,6 +128,7 @@ class RimBlock:
     # kept K_rr^-1 f (`rim_solve`) and `ReadSet`s (`read_set`): shelves of the rim itself, gone with it
     solves: Shelf = field(default_factory=lambda: Shelf("rim solves", SOLVES_KEPT), repr=False)
     read_sets: Shelf = field(default_factory=lambda: Shelf("rim read sets", SOLVES_KEPT), repr=False)
+    backs: Shelf = field(default_factory=lambda: Shelf("rim back-substitutions", SOLVES_KEPT), repr=False)
 
     @property
     def n_interface(self) -> int:
@@ -168,6 +169,13 @@ class RimBlock:
         key = digest(F.shape, F.data, F.indices.astype(np.int64), F.indptr.astype(np.int64),
                      *(np.asarray(r, np.int64) for r in reads))
         return self.read_sets.kept(key, lambda: make_read_set(self, F, reads))
+
+    def back(self, reads: np.ndarray) -> RimBack:
+        """The rim's part of `CondensedBody.solve_at` for the rim interior indices ``reads``
+        (`solver.fe.rim_solves.rim_back`); the last `SOLVES_KEPT` are kept by the reads' bytes
+        (every web of the rim reads the same strength sites in its teeth and rim)."""
+        reads = np.asarray(reads, np.int64)
+        return self.backs.kept(digest(reads), lambda: rim_back(self, reads))
 
     def rim_solve(self, f: np.ndarray) -> np.ndarray:
         """K_rr^-1 f [m] for loads f (n_interior, k) [N]; the last `SOLVES_KEPT` results are
@@ -270,6 +278,49 @@ class CondensedBody:
         u[self.pos_r] = y - rim.model.solve(np.ascontiguousarray(rim.K_ri @ u_i))
         return u[:, 0] if vec else u
 
+    def _rim_index(self) -> np.ndarray:
+        """Rim interior index of each body free position (-1: not in the rim's interior)."""
+        if self._to_rim is None:
+            to_rim = np.full(self.n_free, -1, np.int64)
+            to_rim[self.pos_r] = np.arange(self.pos_r.size)
+            self._to_rim = to_rim
+        return self._to_rim
+
+    def solve_at(self, f, at: np.ndarray) -> np.ndarray:
+        """K_ff^-1 f [m] at the body free positions ``at`` only ((len(at), k)), for loads f
+        (n_free, k) [N], dense or sparse: the full solve's numbers (to rounding) without its
+        whole field where the loads lie in the rim's interior (teeth and rim). The rim's forward
+        solve runs over the rows the loads reach, the interface displacements come from the
+        Schur complement, the web's (where read) from one web solve, and the rim's back-
+        substitution runs over the rows its reads depend on (`solver.fe.rim_solves`), for every
+        column at once: not the two whole-rim and two web solves of `solve`. Loads elsewhere
+        (web, interface): the full solve."""
+        import scipy.sparse as sp
+
+        fs = sp.csc_matrix(f)
+        at = np.asarray(at, np.int64)
+        to_rim = self._rim_index()
+        if fs.shape[1] == 0 or not np.all(to_rim[fs.indices] >= 0):
+            return self.solve(fs.toarray())[at]
+        rim = self.rim
+        fw = rim_forward(rim, sp.csc_matrix((fs.data, to_rim[fs.indices], fs.indptr), shape=(self.pos_r.size, fs.shape[1])))
+        u_i = -self.schur_solve(fw.B)                       # interface displacement [m], rim interface order
+        out = np.empty((at.size, fs.shape[1]))
+        r = to_rim[at]
+        in_rim = r >= 0
+        if in_rim.any():
+            out[in_rim] = rim_reads(rim, fw, rim.back(r[in_rim]), u_i)
+        where = np.full(self.n_free, -1, np.int64)          # interface index, or web index + n_i
+        where[self.pos_i] = np.arange(self.pos_i.size)
+        where[self.pos_w] = self.pos_i.size + np.arange(self.pos_w.size)
+        q = where[at]
+        iface = ~in_rim & (q < self.pos_i.size)
+        out[iface] = u_i[q[iface]]
+        web = ~in_rim & ~iface
+        if web.any():       # no load in the web: u_w = -K_ww^-1 K_wi u_i
+            out[web] = -self.web_solve(np.ascontiguousarray(self.K_wi @ u_i))[q[web] - self.pos_i.size]
+        return out
+
     def column_reads(self, f, reads: list) -> list:
         """Column j of K_ff^-1 f (f (n_free, k) [N], dense or sparse) at the body free positions
         ``reads[j]`` [m], for each j: the full solve's numbers (to rounding) at a fraction of its
@@ -282,18 +333,15 @@ class CondensedBody:
         f = f.tocsc() if sp.issparse(f) else np.asarray(f, float).reshape(f.shape[0], -1)
         reads = [np.asarray(r, np.int64) for r in reads]
         rim = self.rim
-        if self._to_rim is None:
-            to_rim = np.full(self.n_free, -1, np.int64)
-            to_rim[self.pos_r] = np.arange(self.pos_r.size)
-            self._to_rim = to_rim
+        to_rim = self._rim_index()
         fs = sp.csc_matrix(f)
-        in_rim = all(np.all(self._to_rim[r] >= 0) for r in reads) and np.all(self._to_rim[fs.indices] >= 0)
+        in_rim = all(np.all(to_rim[r] >= 0) for r in reads) and np.all(to_rim[fs.indices] >= 0)
         if not in_rim:
             u = self.solve(fs.toarray())
             return [u[r, j] for j, r in enumerate(reads)]
-        F_r = sp.csc_matrix((fs.data, self._to_rim[fs.indices], fs.indptr), shape=(self.pos_r.size, f.shape[1]))
+        F_r = sp.csc_matrix((fs.data, to_rim[fs.indices], fs.indptr), shape=(self.pos_r.size, f.shape[1]))
         F_r.sort_indices()
-        rs = rim.read_set(F_r, [self._to_rim[r] for r in reads])
+        rs = rim.read_set(F_r, [to_rim[r] for r in reads])
         n = rim.split["n"]
         u_i = -self.schur_solve(rs.B)                        # interface displacement [m], rim interface order
         w2 = np.empty_like(u_i)

@@ -37,21 +37,29 @@ def _closed_block(T, rows: np.ndarray):
     return sp.csc_matrix((sub.data, inv[sub.indices], sub.indptr), shape=(rows.size, rows.size))
 
 
-def make_read_set(rim, F, reads: list) -> ReadSet:
-    """`ReadSet` of the loads F (n_interior, k; CSC) and reads (k arrays of rim interior
-    indices) on the rim interior of ``rim`` (a `solver.fe.condense.RimBlock`)."""
+def _split(rim) -> tuple:
+    """(the interface-last factorisation's factors ``rim.split``, made when the rim's S_R was
+    read from a cache; for each rim interior index the row of Pr1 f and the U11 position of its
+    unknown)."""
     if rim.split is None:           # a rim whose S_R was read from a cache
         rim.make_split()
     sp_ = rim.split
-    n = sp_["n"]
-    if "L21c" not in sp_:
+    if "to_row" not in sp_:
+        n = sp_["n"]
+        inv_order = np.empty(n, np.int64)
+        inv_order[sp_["order"]] = np.arange(n)
+        sp_["to_row"] = sp_["pr"][:n][inv_order]
+        sp_["to_col"] = sp_["pc"][:n][inv_order]
         sp_["L21c"] = sp_["L21"].tocsc()
+    return sp_, sp_["to_row"], sp_["to_col"]
+
+
+def make_read_set(rim, F, reads: list) -> ReadSet:
+    """`ReadSet` of the loads F (n_interior, k; CSC) and reads (k arrays of rim interior
+    indices) on the rim interior of ``rim`` (a `solver.fe.condense.RimBlock`)."""
+    sp_, to_row, to_col = _split(rim)
+    n = sp_["n"]
     L11, Ut11, L21 = sp_["L11"], sp_["Ut11"], sp_["L21c"]
-    pr1, pc1 = sp_["pr"][:n], sp_["pc"][:n]
-    inv_order = np.empty(n, np.int64)
-    inv_order[sp_["order"]] = np.arange(n)
-    to_row = pr1[inv_order]                   # rim interior index -> row of Pr1 f
-    to_col = pc1[inv_order]                   # rim interior index -> U11 position of its unknown
     prb = sp_["pr"][n:] - n
     B = np.zeros((rim.n_interface, F.shape[1]))
     rows, s, at = [], [], []
@@ -116,3 +124,71 @@ def rim_products(rim, R, F, key) -> tuple:
     A = (sp_["U12"][S].T @ z).T[:, pcb]
     rim.products[key] = (G0, A, B)
     return rim.products[key]
+
+
+@dataclass
+class RimForward:
+    """The rim's forward solve of a load set (`rim_forward`): the rows of L11 the loads reach,
+    y = L11^-1 Pr1 F on them, and B = K_ir K_rr^-1 F (n_i, k) [N] (the module doc of
+    `solver.fe.condense`)."""
+
+    rows: np.ndarray      # sorted L11 positions the loads reach
+    y: np.ndarray         # (rows.size, k) L11^-1 Pr1 F on ``rows`` (U11 w = y gives w in m)
+    B: np.ndarray         # (n_i, k) [N], rim interface order
+
+
+def rim_forward(rim, F) -> RimForward:
+    """`RimForward` of the loads F (n_interior, k) [N] (sparse, rim interior indices) on the
+    rim of ``rim`` (a `solver.fe.condense.RimBlock`): one blocked triangular solve of every
+    column over the rows the loads reach."""
+    import scipy.sparse as sp
+
+    sp_, to_row, _ = _split(rim)
+    n = sp_["n"]
+    F = sp.coo_matrix(F)
+    F.sum_duplicates()
+    rows = to_row[F.row]
+    fwd = np.flatnonzero(_reach(sp_["L11"], np.unique(rows)))
+    b = np.zeros((fwd.size, F.shape[1]))
+    b[np.searchsorted(fwd, rows), F.col] = F.data
+    y = _lower_solve(_closed_block(sp_["L11"], fwd), b, 48)
+    B = (sp_["L21c"][:, fwd] @ y)[sp_["pr"][n:] - n]
+    return RimForward(fwd, y, B)
+
+
+@dataclass
+class RimBack:
+    """The rim's part of reading given interior DOFs after every load set (`rim_back`): the
+    rows of U11 the reads depend on (sorted, closed under U11's graph), U11 on them reversed
+    (lower-triangular, CSC), U12 on them (CSR) and where each read lies in them."""
+
+    rows: np.ndarray
+    U_rev: object
+    U12: object
+    at: np.ndarray
+
+
+def rim_back(rim, reads: np.ndarray) -> RimBack:
+    """`RimBack` of the rim interior indices ``reads`` on ``rim`` (a
+    `solver.fe.condense.RimBlock`)."""
+    sp_, _, to_col = _split(rim)
+    cols = to_col[np.asarray(reads, np.int64)]
+    back = np.flatnonzero(_reach(sp_["Ut11"], cols))
+    U = _closed_block(sp_["Ut11"], back).T.tocsc()          # U11 on ``back``: upper-triangular
+    return RimBack(back, U[::-1, ::-1].tocsc(), sp_["U12"][back], np.searchsorted(back, cols))
+
+
+def rim_reads(rim, fw: RimForward, bk: RimBack, u_i: np.ndarray) -> np.ndarray:
+    """K_rr^-1 (F - K_ri u_i) [m] at the reads of ``bk`` ((n_reads, k)): the loads' forward
+    solve ``fw`` and the interface displacements u_i (n_i, k) [m] (rim interface order)
+    through the back-substitution U11 w = y - U12 u_i restricted to the rows the reads depend
+    on (`rim_back`), for every column in one blocked solve."""
+    sp_ = rim.split
+    n = sp_["n"]
+    w2 = np.empty_like(u_i)
+    w2[sp_["pc"][n:] - n] = u_i                 # in the factorisation's interface order
+    rhs = -np.asarray(bk.U12 @ w2)
+    _, i_back, i_fwd = np.intersect1d(bk.rows, fw.rows, assume_unique=True, return_indices=True)
+    rhs[i_back] += fw.y[i_fwd]
+    w = _lower_solve(bk.U_rev, np.ascontiguousarray(rhs[::-1]), 48)[::-1]
+    return w[bk.at]

@@ -6,9 +6,10 @@ Per gear (`gear_strength`):
    root fillets, inner half of the rim, web opening edges and ligaments), for a load on each
    tooth the STE loads, at five roll parameters along the profile: the start of the active
    profile, the inner point of single contact, the pitch point, the outer point of single
-   contact (HPSTC) and the tip. One solve per (tooth, roll) through the body's one
-   factorisation (the same body as the springs'), cached on disk with the sites
-   (``strength-{key}.npz`` in the FE cache).
+   contact (HPSTC) and the tip. One load case per (tooth, roll) through the body's one
+   factorisation (the same body as the springs'), all in one block and, on a body with a
+   condensed rim, solved only at the DOFs the sites read (`solver.fe.stress.load_case_stress`),
+   cached on disk with the sites (``strength-{key}.npz`` in the FE cache).
 2. The static contact forces of the STE (each loaded contact's tooth, roll parameter and force:
    `static_loads`) superposed on those load cases, each force shared between the two nearest
    rolls (linear in the roll): the stress at every site node at every STE angle, and its
@@ -30,7 +31,9 @@ from solver.strength import LOCATIONS  # noqa: F401  (BodyStress.location indexe
 from study.inputs.cache import FE_CACHE
 from study.inputs.gearsetup import GearSetup
 
-STRENGTH_VERSION = "3"      # bump when the sites or the load cases change (in every key)
+# bump when the sites or the load cases change (in every key); 4: the load cases solved only
+# where the sites read them (the same stresses to rounding, 1e-13)
+STRENGTH_VERSION = "4"
 
 
 @dataclass
@@ -81,31 +84,43 @@ def body_stress(setup: GearSetup, teeth, rolls) -> BodyStress:
     return bs
 
 
-def _compute(setup: GearSetup, teeth: np.ndarray, rolls: np.ndarray) -> BodyStress:
+def site_operator(setup: GearSetup, model) -> tuple:
+    """(`solver.fe.stress.StrengthSites`, the `solver.fe.stress.StressOperator` of every site
+    node: root, rim, web in that order, each read in its own region's elements, the location of
+    each node (index into LOCATIONS)) of the gear's factorised body ``model``."""
     import scipy.sparse as sp
 
-    from solver.fe.body import load_case, plane_stress_lame
-    from solver.fe.flank_compliance import flank_load_vector
+    from solver.fe.body import plane_stress_lame
     from solver.fe.mesh import REGION_RIM, REGION_WEB
-    from solver.fe.stress import LIGAMENT_KINDS, SiteRadii, StressOperator, load_case_stress, strength_sites, stress_operator
+    from solver.fe.stress import SiteRadii, StressOperator, strength_sites, stress_operator
     from solver.geometry import bore_radius
-    from study.inputs.compliance import factorised_body
 
-    g, body = setup.geometry, setup.body
-    model = factorised_body(setup)
-    mesh = model.mesh
+    g, body, mesh = setup.geometry, setup.body, model.mesh
     r_rim = g.root_radius - body.rim_height
     radii = SiteRadii(g.root_radius, g.form_radius, r_rim, r_rim - body.web_height, bore_radius(g, body))
     sites = strength_sites(mesh.points, mesh.triangles, mesh.region, radii, g.teeth)
     lam, mu = plane_stress_lame(model.material.youngs_modulus, model.material.poisson_ratio)
-    web = sites.web
     ops = [stress_operator(model.basis, lam, mu, sites.root, mesh.region == REGION_RIM),
            stress_operator(model.basis, lam, mu, sites.rim, mesh.region == REGION_RIM),
-           stress_operator(model.basis, lam, mu, web, mesh.region == REGION_WEB)]
+           stress_operator(model.basis, lam, mu, sites.web, mesh.region == REGION_WEB)]
     nodes = np.concatenate([o.nodes for o in ops])
     op = StressOperator(nodes, *(sp.vstack([getattr(o, c) for o in ops]).tocsr() for c in ("xx", "yy", "xy")))
     location = np.concatenate([np.full(o.nodes.size, i) for i, o in enumerate(ops)])
-    root_tooth = np.concatenate([sites.root_tooth, np.full(sites.rim.size + web.size, -1)])
+    return sites, op, location
+
+
+def _compute(setup: GearSetup, teeth: np.ndarray, rolls: np.ndarray) -> BodyStress:
+    from solver.fe.body import load_case
+    from solver.fe.flank_compliance import flank_load_vector
+    from solver.fe.stress import LIGAMENT_KINDS, load_case_stress
+    from study.inputs.compliance import factorised_body
+
+    g = setup.geometry
+    model = factorised_body(setup)
+    mesh = model.mesh
+    sites, op, location = site_operator(setup, model)
+    nodes = op.nodes
+    root_tooth = np.concatenate([sites.root_tooth, np.full(sites.rim.size + sites.web.size, -1)])
     def flank_load(tooth, u):       # 1 N along the flank normal at roll u, its patch ends exact on the involute
         return flank_load_vector(model, g, load_case(g, tooth, setup.pivot_radius, u), u, 1.0, setup.patch)
     S = load_case_stress(model, op, teeth, rolls, flank_load)

@@ -171,6 +171,37 @@ def test_column_reads_equal_the_whole_body_solve(ring):
     assert np.abs(got2[0] - u2[reads[0], 0]).max() < 1e-9 * np.abs(u2).max()
 
 
+def test_solve_at_reads_rim_interface_and_web_as_the_whole_body(ring):
+    """K^-1 F read only at chosen DOFs (loads in the rim; reads in the rim, on the interface
+    and in the web, the strength sites' mix) through the rim's restricted forward and back
+    solves and the web from the interface: the whole body's full solve there to rounding, for
+    two webs on one rim (the rim's back-substitution made once); a load in the web falls back
+    to the full solve, with the same numbers."""
+    mesh, rim = ring
+    for t_web in (0.006, 0.012):
+        whole = fe.assemble(mesh, T_RIM, t_web, STEEL)
+        cond = cd.assemble_condensed(mesh, T_RIM, t_web, STEEL, rim)
+        _, F = _loads_and_reads(whole)
+        f = sp.csc_matrix(F.tocsr()[whole.free])
+        r = np.hypot(*cd._dof_keys(whole.basis)[whole.free, :2].T)
+        rng = np.random.default_rng(11)
+        at = np.concatenate([rng.choice(np.flatnonzero(r > 0.022), 60, replace=False),
+                             rng.choice(np.flatnonzero(np.abs(r - C) < 1e-9), 10, replace=False),
+                             rng.choice(np.flatnonzero(r < C - 1e-9), 30, replace=False)])
+        rng.shuffle(at)
+        u = whole.solve(f.toarray())
+        got = cond.condensed.solve_at(f, at)
+        assert got.shape == (at.size, f.shape[1])
+        assert np.abs(got - u[at]).max() < 1e-9 * np.abs(u).max()
+        # the web's and the interface's reads are not zero: the test reads the field there
+        assert np.abs(u[at][r[at] <= C + 1e-9]).max() > 1e-3 * np.abs(u).max()
+    assert len(rim.backs) == 1
+    f2 = f.toarray()
+    f2[np.flatnonzero(r < 0.015)[0], 0] = 1.0
+    u2 = whole.solve(f2)
+    assert np.abs(cond.condensed.solve_at(f2, at) - u2[at]).max() < 1e-9 * np.abs(u2).max()
+
+
 def test_congruence_equals_the_solves(ring):
     """C^T K^-1 C by restricted solves and a product over the runs of columns each row reaches
     (`factor.congruence`, the web's condensation onto the interface) equals C^T times the full

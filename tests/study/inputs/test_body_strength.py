@@ -69,6 +69,41 @@ def test_superposed_loads_are_the_sum_of_the_load_cases(driven):
     assert nr == 5
 
 
+def test_load_cases_read_at_the_sites_are_the_full_solves(driven):
+    """The load-case stresses solved only at the DOFs the sites read (the condensed rim's
+    restricted solves, the web from the interface) are the full solve's stresses to rounding
+    at the root, rim and web sites, and the body's cached `BodyStress.S` holds them."""
+    from solver.fe.body import load_case
+    from solver.fe.flank_compliance import flank_load_vector
+    from solver.fe.stress import load_case_stress
+    from study.inputs.compliance import factorised_body
+    from study.inputs.strength import site_operator
+
+    s, _, rolls, bs = driven
+    g = s.geometry
+    model = factorised_body(s)
+    assert model.condensed is not None
+    _, op, location = site_operator(s, model)
+    assert set(location) == {0, 1, 2}
+    teeth, some = [1, 4, 13], rolls[[0, 2, 4]]
+
+    def flank_load(tooth, u):
+        return flank_load_vector(model, g, load_case(g, tooth, s.pivot_radius, u), u, 1.0, s.patch)
+    got = load_case_stress(model, op, teeth, some, flank_load)
+    want = np.empty_like(got)
+    for i, t in enumerate(teeth):
+        for j, u in enumerate(some):
+            U = np.zeros(model.basis.N)
+            U[model.free] = model.solve(flank_load(t, float(u))[model.free])
+            want[:, :, i, j] = op.apply(U)
+    scale = np.abs(want).max()
+    for loc in (0, 1, 2):       # each site kind read, and each to rounding
+        w = want[:, location == loc]
+        assert np.abs(w).max() > 1e-3 * scale
+        assert np.abs(got[:, location == loc] - w).max() < 1e-11 * scale
+    assert np.abs(bs.S[:, :, teeth][:, :, :, [0, 2, 4]] - want).max() < 1e-11 * scale
+
+
 def test_fe_root_stress_of_the_solid_gear_against_iso_6336_3():
     """Solid paper gear, one tooth loaded by F = T/rb at the HPSTC (Method B's load point): the
     FE's largest tensile root stress lies 0-15 % above sigma_F0 = F_t/(b m) Y_F Y_S (Y_B = 1):
