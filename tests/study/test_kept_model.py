@@ -104,7 +104,7 @@ def test_a_tolerance_study_builds_its_model_once_and_archives_what_a_model_per_b
     _clear()
     built.clear()
     each = run_sweep(st, tmp_path / "each.nc", workers=0, progress=False).dataset
-    assert len(built) == 12      # once a task: a build's statics and its dynamic run are two
+    assert len(built) == 6       # once a build: its statics and dynamic run follow each other (`by_model`)
     # the builds differ, and the archives are the same to the bit
     assert np.unique(once["ste_p2p"].values).size == 6
     drop = ["wall_time"]
