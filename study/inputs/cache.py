@@ -173,11 +173,11 @@ class FECache:
             # uncompressed: 1.6 MB for a 21,000-element body, against 1 MB zipped for 0.05 s more
             # of a run's CPU (a run stores its render's fields: `study.inputs.springs.keep_render_fields`)
             np.savez(tmp, points=f0.points, triangles=f0.triangles, thickness=f0.thickness, web=f0.web,
-                                displacement=np.stack([f.displacement for f in fields]),
-                                von_mises=np.stack([f.von_mises for f in fields]),
-                                tooth=np.array([f.tooth for f in fields]), load_N=np.array([f.load_N for f in fields]),
-                                load_point=np.stack([f.load_point for f in fields]),
-                                load_direction=np.stack([f.load_direction for f in fields]))
+                     displacement=np.stack([f.displacement for f in fields]),
+                     von_mises=np.stack([f.von_mises for f in fields]),
+                     tooth=np.array([f.tooth for f in fields]), load_N=np.array([f.load_N for f in fields]),
+                     load_point=np.stack([f.load_point for f in fields]),
+                     load_direction=np.stack([f.load_direction for f in fields]))
             tmp.replace(path)
         except OSError:
             pass
