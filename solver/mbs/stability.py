@@ -179,3 +179,35 @@ def load_covered(model: Model, torque: float, safety: float, force_max: float) -
     load = abs(torque) if abs(torque) > 1e-9 else 1.0
     ratio = max(1.0, force_max * model.base_radii[1] / load)
     return safety * ratio ** (0.5 * stiffening_exponent(model)) < 1.0
+
+
+def pair_frequency_estimate(model: Model, torque: float) -> float:
+    """Highest natural frequency [rad/s] of the loaded plain pair estimated from its laws alone,
+    with no static equilibrium and nothing compiled: one tooth pair carrying the whole load
+    ``torque`` [N·m] (1 N·m if zero) at the pitch point, each tooth on its stiffest root
+    spring (tangent n_k T/phi at the moment it carries) about its pivot, the contact's tangent
+    m1 F/delta between them, the hubs held (hundreds of times the teeth's inertia). The normal
+    force acts on a tooth with the lever r_b - r_pv cos(alpha) about its pivot (the pitch
+    point's line of action, the pivot on the tooth's centre line). The top mode of the
+    linearised pair is this pair's: within 5 % of `highest_frequency` on the shipped pairs
+    and their stiff variants (contact, springs, load, law exponents, pressure angle;
+    `tests/solver/mbs/test_stability_estimate.py`), a little below it. For the plain model
+    only (``model.coupled`` and coupled teeth: ValueError)."""
+    if model.coupled or model.teeth_coupled:
+        raise ValueError("pair_frequency_estimate: the plain model only (no body coupling, no tooth compliance)")
+    gp, lp = model.gear_par, model.law_par
+    load = abs(torque) if abs(torque) > 1e-9 else 1.0
+    force = load / model.geometry[1].base_radius                  # N, along the line of action
+    m1 = float(lp[L.M1])
+    delta = (force / lp[L.K_CON]) ** (1.0 / m1)                    # m
+    k_con = m1 * force / delta                                     # contact tangent [N/m]
+    z1 = model.geometry[0].teeth
+    lever, k_tooth = np.zeros(2), np.zeros(2)
+    for g, geo in enumerate(model.geometry):
+        lever[g] = max(geo.base_radius - gp[g, L.R_PV] * math.cos(geo.spec.pressure_angle), 0.25 * geo.spec.module)
+        k_phi = float(np.max(model.k_phi[:z1] if g == 0 else model.k_phi[z1:]))     # N·m/rad^n_k
+        n_k, moment = float(gp[g, L.N_K]), force * lever[g]
+        k_tooth[g] = n_k * moment / (moment / k_phi) ** (1.0 / n_k)                # N·m/rad
+    K = np.diag(k_tooth) + k_con * np.outer(lever, lever)
+    I_P = gp[:, L.I_P]
+    return float(math.sqrt(scipy.linalg.eigh(K, np.diag(I_P), eigvals_only=True).max()))

@@ -5,6 +5,8 @@ runs). The unit costs are those of a run (`study.estimate`).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from study import estimate
@@ -74,13 +76,51 @@ def check_study_size(study, max_time: float | None) -> int:
     return n
 
 
-def estimate_model(scene):
-    """A model of ``scene`` for the step estimate that needs no FE: uniform tooth springs (an FE
-    map scales the calibrated spring by a ratio near 1) and no body coupling."""
-    from study.scene_model import build_scene_model
-    plain = scene.replace(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform",
-                             "coupling.model": "none"})
-    return build_scene_model(plain)
+def _plain(scene):
+    """``scene`` with uniform tooth springs (an FE map scales the calibrated spring by a ratio
+    near 1) and no body coupling: the model of the estimate, which needs no FE."""
+    return scene.replace(**{"gear1.spring.stiffness": "uniform", "gear2.spring.stiffness": "uniform",
+                            "coupling.model": "none"})
+
+
+def _undamped_bound(scene) -> bool:
+    """Whether the scene's explicit step is the undamped bound 2/omega_max of the loaded pair
+    (`solver.mbs.stability.stability_limit` with the tooth-root dampers implicit): linear root
+    dampers (n_c = 1) that the scene gives or its damping ratios set, no contact damper (the
+    mesh ratio goes to the root dampers) and no flank friction."""
+    from study.scene_model import damping_ratios
+    ratios = damping_ratios(scene)
+    springs = [scene.gear(g).spring for g in (1, 2)]
+    c = scene.contact
+    root_dampers = bool(ratios) or any(not math.isnan(s.c_phi) and s.c_phi > 0 for s in springs)
+    no_contact_damper = "contact" in ratios or (not math.isnan(c.c_con) and c.c_con == 0)
+    return (scene.dynamic.method in ("auto", "explicit") and c.friction == 0 and no_contact_damper
+            and root_dampers and all(s.n_c == 1.0 for s in springs))
+
+
+def estimate_choice(scene):
+    """(model, `solver.mbs.method.MethodChoice`) of a dynamic task for the study's estimate,
+    on its plain model (`_plain`). A given step is taken as it is; where the
+    run's step is the undamped bound (`_undamped_bound`), it comes from the pair's laws alone
+    (`solver.mbs.stability.pair_frequency_estimate`, within 5 % of the linearised pair's):
+    neither statics nor compiled kernels, so the estimate of a cold study costs milliseconds,
+    not the compile of a static sweep the study's own model may never run. Otherwise the
+    run's own choice (`study.scene_model.dynamic_choice`: static equilibria, linearised pair)."""
+    from solver.mbs.dynamics import run_loads
+    from solver.mbs.method import MethodChoice
+    from solver.mbs.stability import IMEX_SAFETY, pair_frequency_estimate
+    from study.scene_model import build_scene_model, dynamic_choice, flankless_model, load_table
+    plain, d = _plain(scene), scene.dynamic
+    if d.time_step > 0:
+        return flankless_model(plain), MethodChoice("implicit" if d.method == "implicit" else "explicit",
+                                                    d.time_step, math.nan, "step given")
+    if _undamped_bound(plain):
+        model = flankless_model(plain)
+        w = pair_frequency_estimate(model, run_loads(load_table(plain), d.torque)[1])
+        return model, MethodChoice("explicit", IMEX_SAFETY * 2.0 / w, w, "estimated from the pair's laws",
+                                   estimated=True)
+    model = build_scene_model(plain)
+    return model, dynamic_choice(plain, model)
 
 
 # A study's task, costed without a model (for the order and batching of the tasks on dask, not
@@ -122,7 +162,6 @@ def sweep_estimate(tasks) -> Estimate:
     distinct body the cache lacks), statics (per static task, by its angles) and dynamics
     (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
     from study.inputs.cache import FE_CACHE
-    from study.scene_model import dynamic_choice
     est = Estimate()
     bodies, body_s = {}, {}
     static_s = 0.0
@@ -162,8 +201,7 @@ def sweep_estimate(tasks) -> Estimate:
         groups += [(t, None) for t in picks]
     rates, dts, choice_of, seconds = [], [], [], 0.0
     for t, group in groups:
-        model = estimate_model(t.scene)
-        choice = dynamic_choice(t.scene, model)
+        model, choice = estimate_choice(t.scene)
         rate = dynamic_seconds(model, choice, 1.0)      # s of run time per s simulated
         rates.append(rate)
         dts.append(choice.dt)
