@@ -242,15 +242,10 @@ def arc_gram(Yt: np.ndarray, start: np.ndarray, length: np.ndarray, rows_max: in
 
 def _reach(T, sources: np.ndarray) -> np.ndarray:
     """Boolean mask of the rows that a lower-triangular solve with T (CSC) can make nonzero from
-    right-hand sides nonzero at ``sources``: one sweep in column order (T's graph only points to
-    higher indices)."""
-    mark = np.zeros(T.shape[0], bool)
-    mark[sources] = True
-    ptr, idx = T.indptr, T.indices
-    for j in range(T.shape[0]):
-        if mark[j]:
-            mark[idx[ptr[j]:ptr[j + 1]]] = True
-    return mark
+    right-hand sides nonzero at ``sources`` (`solver.fe.kernels.reach_mask`: one compiled sweep
+    in column order, T's graph only pointing to higher indices)."""
+    from solver.fe.kernels import reach_mask
+    return reach_mask(T.indptr, T.indices, np.asarray(sources, np.int64))
 
 
 def _lower_solve(T, B: np.ndarray, block: int) -> np.ndarray:

@@ -128,25 +128,24 @@ def flank_load_vector(model: BodyModel, g: GearGeometry, case: LoadCase, u: floa
     e1 = m.p[:, m.facets[1, bf]]
     mid = 0.5 * (e0 + e1)
     near = np.argsort(np.hypot(mid[0] - case.point[0], mid[1] - case.point[1]))[:max(8, samples)]
-    f = np.zeros(model.basis.N)
-    nd = model.basis.nodal_dofs
+    # each sample point on its nearest facet (distances to the facets near the load, all
+    # samples at once); the forces added in the order of the samples, as one loop over them would
+    d0, d1 = e0[:, near], e1[:, near]
+    L2 = ((d1 - d0) ** 2).sum(axis=0)
+    rel = pts[:, :, None] - d0[:, None, :]                         # (2, samples, near)
+    t = np.clip((rel * (d1 - d0)[:, None, :]).sum(axis=0) / L2, 0.0, 1.0)
+    dist = np.hypot(*(d0[:, None, :] + t * (d1 - d0)[:, None, :] - pts[:, :, None]))
+    j = np.argmin(dist, axis=1)
+    tj = t[np.arange(samples), j]
+    fac = bf[near[j]]
+    n0, n1 = m.facets[0, fac], m.facets[1, fac]
+    w = np.stack([(1 - tj) * (1 - 2 * tj), tj * (2 * tj - 1), 4 * tj * (1 - tj)], axis=1)        # (samples, 3)
+    nd, fd = model.basis.nodal_dofs, model.basis.facet_dofs
     q = force / samples
-    for k in range(samples):
-        p = pts[:, k]
-        d0, d1 = e0[:, near], e1[:, near]
-        L2 = ((d1 - d0) ** 2).sum(axis=0)
-        t = np.clip(((p[:, None] - d0) * (d1 - d0)).sum(axis=0) / L2, 0.0, 1.0)
-        dist = np.hypot(*(d0 + t * (d1 - d0) - p[:, None]))
-        j = int(np.argmin(dist))
-        tj = t[j]
-        fac = near[j]
-        n0, n1 = m.facets[0, bf[fac]], m.facets[1, bf[fac]]
-        w0, w1, wm = (1 - tj) * (1 - 2 * tj), tj * (2 * tj - 1), 4 * tj * (1 - tj)
-        for comp in range(2):
-            qc = q * case.direction[comp]
-            f[nd[comp, n0]] += qc * w0
-            f[nd[comp, n1]] += qc * w1
-            f[model.basis.facet_dofs[comp, bf[fac]]] += qc * wm
+    dofs = np.stack([np.stack([nd[comp, n0], nd[comp, n1], fd[comp, fac]], axis=1) for comp in range(2)], axis=1)
+    vals = np.stack([(q * case.direction[comp]) * w for comp in range(2)], axis=1)              # (samples, 2, 3)
+    f = np.zeros(model.basis.N)
+    np.add.at(f, dofs.ravel(), vals.ravel())
     return f
 
 

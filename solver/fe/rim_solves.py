@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.fe.factor import _lower_solve, _reach, one_blas_thread
+from solver.fe.factor import SOLVE_BLOCK, _lower_solve, _reach, one_blas_thread
 
 
 @dataclass
@@ -57,6 +57,7 @@ def _split(rim) -> tuple:
 def make_read_set(rim, F, reads: list) -> ReadSet:
     """`ReadSet` of the loads F (n_interior, k; CSC) and reads (k arrays of rim interior
     indices) on the rim interior of ``rim`` (a `solver.fe.condense.RimBlock`)."""
+    from solver.fe.kernels import lower_solve_rows
     sp_, to_row, to_col = _split(rim)
     n = sp_["n"]
     L11, Ut11, L21 = sp_["L11"], sp_["Ut11"], sp_["L21c"]
@@ -68,12 +69,10 @@ def make_read_set(rim, F, reads: list) -> ReadSet:
         fwd = np.flatnonzero(_reach(L11, to_row[loaded]))
         b = np.zeros(n)
         b[to_row[loaded]] = F.data[F.indptr[j]:F.indptr[j + 1]]
-        y = _lower_solve(_closed_block(L11, fwd), b[fwd, None], 1)[:, 0]
-        B[:, j] = (L21[:, fwd] @ y)[prb]
+        full = lower_solve_rows(L11.indptr, L11.indices, L11.data, fwd, b)
+        B[:, j] = (L21[:, fwd] @ full[fwd])[prb]
         read = to_col[np.asarray(reads[j], np.int64)]
         back = np.flatnonzero(_reach(Ut11, read))
-        full = np.zeros(n)
-        full[fwd] = y
         rows.append(back)
         s.append(full[back])
         at.append(np.searchsorted(back, read))
@@ -111,19 +110,34 @@ def rim_products(rim, R, F, key) -> tuple:
     inv_c[pc1] = np.arange(n)
     b_f = Ff[np.argsort(pr1)]                                     # Pr1 F
     b_r = Rt[inv_c]                                               # (R Pc1)^T
-    L11, Ut11 = sp_["L11"], sp_["Ut11"]
-    reach = (_reach(L11, pr1[np.flatnonzero(np.diff(Ff.indptr))])
-             | _reach(Ut11, pc1[np.flatnonzero(np.diff(Rt.indptr))]))
-    S = np.flatnonzero(reach)
-    y = _lower_solve(L11[S][:, S], b_f[S].toarray(), 48)
-    z = _lower_solve(Ut11[S][:, S], b_r[S].toarray(), 48)
+    ry, yt = _columns_solve(sp_["L11"], b_f)            # y^T on the rows the loads reach
+    rz, zt = _columns_solve(sp_["Ut11"], b_r)           # z^T on the rows the reads depend on
+    _, iy, iz = np.intersect1d(ry, rz, assume_unique=True, return_indices=True)
     prb, pcb = sp_["pr"][n:] - n, sp_["pc"][n:] - n
     with one_blas_thread():
-        G0 = z.T @ y
-    B = (sp_["L21"][:, S] @ y)[prb]
-    A = (sp_["U12"][S].T @ z).T[:, pcb]
+        G0 = zt[:, iz] @ yt[:, iy].T
+        B = np.asarray(sp_["L21"][:, ry] @ yt.T)[prb]
+        A = np.asarray(zt @ sp_["U12"][rz])[:, pcb]
     rim.products[key] = (G0, A, B)
     return rim.products[key]
+
+
+def _columns_solve(T, b) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, X^T on them) of X = T^-1 b for a lower-triangular T (CSC, diagonal stored) and a
+    sparse b (n, k): each block of `SOLVE_BLOCK` neighbouring columns substituted over the rows
+    it reaches only (`solver.fe.kernels.lower_solve_columns`); rows: those any column reaches,
+    sorted (X is zero on the others). Loads along a flank reach a few percent of the rim's
+    rows each: a dense solve over all the rows they reach together multiplies mostly zeros."""
+    import scipy.sparse as sp
+
+    from solver.fe.kernels import lower_solve_columns
+    strict = sp.tril(T, -1, format="csc")
+    bc = sp.csc_matrix(b)
+    bc.sort_indices()
+    n = T.shape[0]
+    rows, xt, _, _, _ = lower_solve_columns(strict.indptr, strict.indices, strict.data, T.diagonal(),
+                                            bc.indptr, bc.indices, bc.data, n, SOLVE_BLOCK)
+    return rows, xt
 
 
 @dataclass

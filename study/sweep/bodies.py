@@ -65,11 +65,13 @@ REACH = STORE.shelf("coupling reach", REACH_SLOTS)
 
 def _reach(scene: Scene, setups: tuple, g: int) -> int:
     """How many pitches apart the mesh loads gear g's teeth together (`mesh_samples`): the spread
-    of a solid body's compliance."""
+    of a solid body's compliance. Kept by what the rigid mesh reads (both teeth, the pair and
+    the flanks), not by the bodies: a study's bodies over one pair of teeth share it."""
+    from solver.store import digest
     from study.inputs.coupling import mesh_samples
-    from study.scene_model import geometry_model
-    return REACH.kept((setups[0].key, setups[1].key, g),
-                      lambda: max(abs(d) for d in mesh_samples(geometry_model(scene), g)))
+    from study.scene_model import _flanks, geometry_model
+    key = digest(repr(setups[0].tooth), repr(setups[1].tooth), repr(scene.pair), repr(_flanks(scene)), str(g))
+    return REACH.kept(key, lambda: max(abs(d) for d in mesh_samples(geometry_model(scene), g)))
 
 
 def fe_jobs(scene: Scene) -> list[tuple[str, object, tuple]]:

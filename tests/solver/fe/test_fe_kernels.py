@@ -5,7 +5,7 @@ import pytest
 import scipy.sparse as sp
 
 from solver.fe.factor import arc_gram
-from solver.fe.kernels import back_substitute_reads, lower_solve_columns, row_arcs
+from solver.fe.kernels import back_substitute_reads, lower_solve_columns, lower_solve_rows, reach_mask, row_arcs
 
 
 def _lower(n, density, seed):
@@ -96,3 +96,30 @@ def testarc_gram_is_the_dense_product():
     W = arc_gram(np.ascontiguousarray(Y.T), start, length, rows_max=16)
     assert np.array_equal(W, W.T)
     assert np.allclose(W, Y.T @ Y, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "python"])
+def test_reach_and_restricted_solve_are_the_dense_solve(compiled):
+    """The rows a triangular solve can reach from a right-hand side's nonzeros hold every
+    nonzero of the solution (and are closed under L's graph); the forward substitution over
+    those rows alone is the dense solve, zero elsewhere."""
+    reach = reach_mask if compiled else reach_mask.py_func
+    solve = lower_solve_rows if compiled else lower_solve_rows.py_func
+    n = 60
+    L, d = _lower(n, 0.04, 5)
+    T = (L + sp.diags(d)).tocsc()                                    # the diagonal among the entries
+    T.sort_indices()
+    rng = np.random.default_rng(6)
+    for seeds in ([3], [10, 40], rng.choice(n, 4, replace=False)):
+        seeds = np.asarray(seeds, np.int64)
+        b = np.zeros(n)
+        b[seeds] = rng.standard_normal(seeds.size)
+        mark = reach(T.indptr, T.indices, seeds)
+        rows = np.flatnonzero(mark)
+        assert np.all(mark[seeds])
+        for j in rows:                                               # closed: j's column stays in the set
+            assert np.all(mark[T.indices[T.indptr[j]:T.indptr[j + 1]]])
+        full = np.linalg.solve(T.toarray(), b)
+        assert np.abs(full[~mark]).max(initial=0.0) == 0.0
+        x = solve(T.indptr, T.indices, T.data, rows, b)
+        assert np.allclose(x, full, rtol=1e-12, atol=1e-14) and not x[~mark].any()
