@@ -43,16 +43,16 @@ def main(argv=None) -> int:
     default = scene
     if not any(o.split("=")[0].strip() == "coupling.model" for o in args.overrides) and scene.coupling.model == "auto":
         scene = scene.replace(**{"coupling.model": "paper"})     # the paper's model reproduces the paper
-    ds = study.run_scene(scene)
+    ds = _run(scene)
     if default.coupling_model != scene.coupling_model:
-        study.add_default_model(ds, study.run_scene(default))     # the default's STE, DTE and modes beside
+        study.add_default_model(ds, _run(default))     # the default's STE, DTE and modes beside
     if "ste" in ds:
-        solid = study.run_scene(study.solid_scene(scene, gears=(2,)), dynamic=False)   # the driven gear solid
+        solid = _run(study.solid_scene(scene, gears=(2,)), dynamic=False)   # the driven gear solid
         ds["ste_solid"] = ("angle", solid["ste"].values, {"units": "um", "long_name": "static transmission error with a solid driven gear"})
         if args.transient_rotation > 0:
             tr_scene = scene.replace(**{"quasi_static.method": "transient",
                                         "quasi_static.rotation": min(args.transient_rotation, scene.quasi_static.rotation)})
-            tr = study.run_scene(tr_scene, dynamic=False)        # the same springs, from the FE cache
+            tr = _run(tr_scene, dynamic=False)        # the same springs, from the FE cache
             n = tr.sizes["angle"]
             full = np.full(ds.sizes["angle"], np.nan)
             full[:n] = tr["ste"].values
@@ -73,6 +73,14 @@ def main(argv=None) -> int:
         for path in study.render(ds, Path(args.output).parent):
             print(f"  figure: {path}")
     return 0
+
+
+def _run(scene, dynamic=None):
+    """`study.run_scene`, its kernels that numba's disk cache lacks compiled by a second process
+    while the run builds its FE (`study.stand_in.compiling_ahead`, as `lightgear run` does)."""
+    from study.stand_in import compiling_ahead
+    with compiling_ahead(scene, dynamic=dynamic):
+        return study.run_scene(scene, dynamic=dynamic)
 
 
 if __name__ == "__main__":
