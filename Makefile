@@ -51,8 +51,8 @@ $(STAMP): pyproject.toml requirements.lock | sysdeps
 	  $(VENV)/bin/uv pip install -q --compile-bytecode --python $(PY) -r requirements.lock \
 	  || { echo "uv could not install the stack: installing it with pip"; \
 	       $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q -r requirements.lock; }
-	@# -qq: setuptools prints a notice on every editable install (any mode), not a problem of this package
-	$(PY) -m pip install -qq --no-deps -e .
+	@# the package itself, editable; -qq: pip's setuptools prints a notice on every editable install
+	$(VENV)/bin/uv pip install -q --no-deps --python $(PY) -e . 2>/dev/null || $(PY) -m pip install -qq --no-deps -e .
 	touch $(STAMP)
 
 # Off-screen rendering (pyvista/VTK) and gmsh need a few shared libraries from the OS; the FE
