@@ -84,12 +84,10 @@ def run_command(args) -> int:
         if note:
             print(note)
     from solver.mbs.dynamics import DivergenceError
-    from study.stand_in import compiling_ahead
     t0 = time.perf_counter()
     try:
-        with compiling_ahead(scene, dynamic=False if args.no_dynamic else None):
-            ds = study.run_scene(scene, static=False if args.no_static else None,
-                                 dynamic=False if args.no_dynamic else None, max_time=max_time, progress=True)
+        ds = study.run_scene(scene, static=False if args.no_static else None, dynamic=False if args.no_dynamic else None,
+                             max_time=max_time, progress=True, compile_ahead=True)
     except DivergenceError as e:
         print(f"lightgear run: diverged: {e}", file=sys.stderr)
         return 3

@@ -65,7 +65,8 @@ class RunFields:
 
 
 def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = None, max_time: float | None = None,
-              progress: bool = False, warn: bool = True, keep_model: bool = False) -> xr.Dataset:
+              progress: bool = False, warn: bool = True, keep_model: bool = False,
+              compile_ahead: bool = False) -> xr.Dataset:
     """Run a scene -> run archive (xarray.Dataset): tooth springs, then the quasi-static STE and
     the dynamic DTE with their spectra. ``static``/``dynamic`` force an analysis on or off
     (None: as the scene's ``quasi_static.enabled`` / ``dynamic.enabled``). Output arrays that
@@ -74,14 +75,23 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
     warnings (see `study.plausibility_warnings`, and a speed far above the highest critical
     speed of the mesh orders) go to stderr (unless ``warn`` is False) and the archive's
     ``plausibility_warnings`` attribute. ``keep_model``: as a study's worker, the model kept
-    for the scenes that differ only in their dynamic run (`study.plan.RunOptions`)."""
+    for the scenes that differ only in their dynamic run (`study.plan.RunOptions`).
+    ``compile_ahead``: the solver kernels this run calls that numba's disk cache lacks are
+    compiled by a second process while the run builds its FE, when a core is idle
+    (`study.stand_in.compiling_ahead`): a machine's first run of a model ends sooner, its
+    results the same to the bit."""
     check_scene_argument("run_scene", scene)
     for name, v in (("static", static), ("dynamic", dynamic)):
         check_argument(v is None or isinstance(v, bool), "run_scene", name, "True, False or None (as the scene says)", v)
     check_argument(max_time is None or (is_number(max_time) and max_time > 0), "run_scene", "max_time",
                    "a positive number of seconds or None", max_time)
+    check_argument(isinstance(compile_ahead, bool), "run_scene", "compile_ahead", "True or False", compile_ahead)
     options = RunOptions(max_time, bool(progress), warn, keep_model)
-    return run_fields(scene, scene_stages(scene, static, dynamic), options).dataset()
+    if not compile_ahead:
+        return run_fields(scene, scene_stages(scene, static, dynamic), options).dataset()
+    from study.stand_in import compiling_ahead
+    with compiling_ahead(scene, dynamic=dynamic):
+        return run_fields(scene, scene_stages(scene, static, dynamic), options).dataset()
 
 
 def run_fields(scene: Scene, stages=None, options: RunOptions = RunOptions()) -> RunFields:

@@ -77,10 +77,8 @@ def main(argv=None) -> int:
 
 def _run(scene, dynamic=None):
     """`study.run_scene`, its kernels that numba's disk cache lacks compiled by a second process
-    while the run builds its FE (`study.stand_in.compiling_ahead`, as `lightgear run` does)."""
-    from study.stand_in import compiling_ahead
-    with compiling_ahead(scene, dynamic=dynamic):
-        return study.run_scene(scene, dynamic=dynamic)
+    while the run builds its FE (``compile_ahead``, as `lightgear run` does)."""
+    return study.run_scene(scene, dynamic=dynamic, compile_ahead=True)
 
 
 if __name__ == "__main__":

@@ -133,6 +133,22 @@ def test_a_run_refused_before_any_work_builds_no_stand_in(monkeypatch):
     assert len(built) == 1 and built[0][0] is small
 
 
+
+def test_run_scene_compiles_ahead_when_told(monkeypatch):
+    """`run_scene(compile_ahead=True)` (what `lightgear run` and the paper example ask) starts
+    the compile ahead of its own scene from its plan, with the run's dynamic choice; by default
+    it starts none, and a value other than a bool is refused naming the argument."""
+    import study.stand_in as si
+    asked = []
+    monkeypatch.setattr(si, "entry_jobs", lambda scene, dynamic=None: asked.append((scene, dynamic)) or [])
+    small = study.load_scene(None, {**SMALL, "dynamic.enabled": False})
+    study.run_scene(small, static=False)
+    assert asked == []
+    study.run_scene(small, static=False, compile_ahead=True)
+    assert asked == [(small, None)] and not si._ASKED
+    with pytest.raises(TypeError, match="run_scene: compile_ahead takes True or False"):
+        study.run_scene(small, compile_ahead="yes")
+
 # in a process of its own with an empty kernel cache: the coupled loop's late helpers compiled
 # from the stand-in's types, then the loop (numba's compile events name what it compiles)
 LATE = r"""
