@@ -19,7 +19,7 @@ from study.estimate import (
     RUNUP_RUNS,
     STATIC_S_PER_ANGLE_TOOTH,
     Estimate,
-    body_seconds,
+    body_estimate,
     check_fe_memory,
     duration_text,
     dynamic_lever,
@@ -163,7 +163,7 @@ def sweep_estimate(tasks) -> Estimate:
     (per dynamic task, by its duration over the step of up to DYNAMIC_SAMPLES of them)."""
     from study.inputs.cache import FE_CACHE
     est = Estimate()
-    bodies, body_s = {}, {}
+    bodies, body_s, rims = {}, {}, set()
     static_s = 0.0
     dyn = [t for t in tasks if t.outputs.dynamic]
     for t in tasks:
@@ -172,11 +172,11 @@ def sweep_estimate(tasks) -> Estimate:
             needed = fe_bodies(gear_setups(t.scene), t.scene.coupling_model)
         except Exception:  # noqa: BLE001 - a scene that cannot be prepared: its task records why
             needed = []
-        for _label, setup, teeth in needed:
+        for label, setup, teeth in needed:
             key = FE_CACHE.key({**setup.settings, "teeth": list(range(setup.teeth)) if teeth is None else teeth})
             if key not in bodies:
                 bodies[key] = setup
-                body_s[key] = body_seconds(setup) * (3.0 if t.scene.coupling_model == "compliance" else 1.0)
+                body_s[key] = body_estimate(label, setup, t.scene.coupling_model, rims)
         if t.outputs.static and t.scene.quasi_static.method == "static":
             static_s += static_angle_count(t.scene) * STATIC_S_PER_ANGLE_TOOTH * (t.scene.gear1.teeth + t.scene.gear2.teeth)
     est.seconds["FE bodies"] = sum(body_s.values())
