@@ -30,7 +30,7 @@ def test_a_run_whose_outputs_do_not_fit_in_memory_is_refused_at_once(example_sce
     (["run", "{small}", "--set", "dynamic.duration=100", "--max-time", "5"], "dynamics (explicit"),
     (["stiffness", "--set", "fe.mesh_size=0.005"], "FE bodies"),
     (["reference", "--set", "fe.mesh_size=0.01"], "gear 2 FE body"),
-    (["run", "--set", "gear2.teeth=10000", "--set", "gear2.body.holes=0"], "FE bodies"),
+    (["run", "--set", "gear2.teeth=10000", "--set", "gear2.body.holes=0", "--max-time", "1000"], "FE bodies"),
 ])
 def test_runs_estimated_beyond_max_time_are_refused_with_the_estimate(args, words, example_scene_file, tmp_path, capsys):
     out = tmp_path / "x.nc"
