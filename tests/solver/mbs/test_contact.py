@@ -170,3 +170,17 @@ def test_contact_search_variant_holds_the_parts_the_model_has(present):
         else:
             assert np.all(rec[:nc, L.C_FT] == 0.0)
     assert 1 in kinds and kinds & {2, 3}
+
+
+def test_wrap_is_the_remainder_to_the_bit():
+    """The angle wrap (the search's flank roll angles) gives the remainder's bits, in the turn
+    around zero where it skips the library call and beyond it, compiled and as Python."""
+    from solver.mbs.kernels.contact import wrap
+    compiled = compiled_call(wrap)
+    rng = np.random.default_rng(7)
+    angles = np.concatenate([rng.uniform(-math.pi, math.pi, 200), rng.uniform(-40.0, 40.0, 200),
+                             [-math.pi, math.pi, 0.0, -0.0, 3 * math.pi, -3 * math.pi, math.nextafter(math.pi, 0.0)]])
+    for a in angles:
+        want = (a + math.pi) % (2.0 * math.pi) - math.pi
+        assert compiled(a) == want and wrap.py_func(a) == want
+        assert -math.pi <= want < math.pi
