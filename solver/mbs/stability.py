@@ -189,8 +189,8 @@ def pair_frequency_estimate(model: Model, torque: float) -> float:
     m1 F/delta between them, the hubs held (hundreds of times the teeth's inertia). The normal
     force acts on a tooth with the lever r_b - r_pv cos(alpha) about its pivot (the pitch
     point's line of action, the pivot on the tooth's centre line). The top mode of the
-    linearised pair is this pair's: within 5 % of `highest_frequency` on the shipped pairs
-    and their stiff variants (contact, springs, load, law exponents, pressure angle;
+    linearised pair is this pair's: within 5 % of `stability_limit`'s (the tooth-root dampers
+    implicit, as the runs step) on the shipped pairs and their stiff variants (contact, springs, load, law exponents, pressure angle;
     `tests/solver/mbs/test_stability_estimate.py`), a little below it. For the plain model
     only (``model.coupled`` and coupled teeth: ValueError)."""
     if model.coupled or model.teeth_coupled:

@@ -103,8 +103,8 @@ def estimate_choice(scene):
     on its plain model (`_plain`). A given step is taken as it is; where the
     run's step is the undamped bound (`_undamped_bound`), it comes from the pair's laws alone
     (`solver.mbs.stability.pair_frequency_estimate`, within 5 % of the linearised pair's):
-    neither statics nor compiled kernels, so the estimate of a cold study costs milliseconds,
-    not the compile of a static sweep the study's own model may never run. Otherwise the
+    neither statics nor compiled kernels, so the estimate of a cold study costs a fraction of a
+    second, not the compile of a static sweep the study's own model may never run. Otherwise the
     run's own choice (`study.scene_model.dynamic_choice`: static equilibria, linearised pair)."""
     from solver.mbs.dynamics import run_loads
     from solver.mbs.method import MethodChoice
