@@ -243,13 +243,20 @@ def point_displacement(model: BodyModel, u: np.ndarray, x: np.ndarray) -> np.nda
     return np.asarray(P @ u).ravel()
 
 
+def sparse_columns(cols, n_rows: int):
+    """CSC matrix (n_rows, len(cols)) of columns given as (rows, values) each: load vectors
+    that touch a few dozen DOFs, stacked without a dense block."""
+    import scipy.sparse as sp
+    return sp.csc_matrix((np.concatenate([v for _, v in cols]), np.concatenate([r for r, _ in cols]),
+                          np.cumsum([0] + [r.size for r, _ in cols])), shape=(n_rows, len(cols)))
+
+
 def _map_loads(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth: list, force: float, patch: float,
                free_sparse: bool = False):
     """(load cases, their nodal forces F (N_dofs, n) [N], the probes P (2n, N_dofs) of their
     tooth-centreline points: rows x of all points, then y) of the spring map. ``free_sparse``:
     F on the free DOFs only, (n_free, n) CSC (a few dozen nonzeros a column, against a dense
     block of some 70,000 rows)."""
-    import scipy.sparse as sp
     cases = [load_case(g, i, pivot_radius) for i in teeth]
     edges = boundary_edges(model)
     if free_sparse:
@@ -260,8 +267,7 @@ def _map_loads(model: BodyModel, g: GearGeometry, pivot_radius: float, teeth: li
             dofs, f = load_vector(model, c, force, patch, edges, sparse=True)
             keep = (pos[dofs] >= 0) & (f != 0)                         # (a clamped DOF takes no load)
             cols.append((pos[dofs[keep]], f[keep]))
-        F = sp.csc_matrix((np.concatenate([f for _, f in cols]), np.concatenate([at for at, _ in cols]),
-                           np.cumsum([0] + [at.size for at, _ in cols])), shape=(model.free.size, len(cases)))
+        F = sparse_columns(cols, model.free.size)
     else:
         F = np.column_stack([load_vector(model, c, force, patch, edges) for c in cases])
     P = model.basis.probes(np.column_stack([c.centre_point for c in cases])).tocsr()

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.fe.body import BodyModel, LoadCase, load_case
+from solver.fe.body import BodyModel, LoadCase, load_case, sparse_columns
 from solver.geometry import GearGeometry
 
 
@@ -229,8 +229,7 @@ def _reads_and_loads(target: BodyModel, g: GearGeometry, loads: FlankLoads) -> t
             f = flank_load_vector(target, g, load_case(g, int(b) % z, 0.0, ui), ui, 1.0, loads.patch)
             nz = np.flatnonzero(f)
             cols.append((nz, f[nz]))
-    F = sp.csc_matrix((np.concatenate([c[1] for c in cols]), np.concatenate([c[0] for c in cols]),
-                       np.cumsum([0] + [c[0].size for c in cols])), shape=(target.basis.N, len(cols)))
+    F = sparse_columns(cols, target.basis.N)
     return R, F
 
 

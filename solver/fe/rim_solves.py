@@ -92,9 +92,7 @@ def rim_products(rim, R, F, key) -> tuple:
 
     if key in rim.products:
         return rim.products[key]
-    if rim.split is None:           # a rim whose S_R was read from a cache
-        rim.make_split()
-    sp_ = rim.split
+    sp_, _, _ = _split(rim)
     free, n = rim.model.free, sp_["n"]
     F = sp.csr_matrix(F)
     R = sp.csr_matrix(R)

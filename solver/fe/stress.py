@@ -269,7 +269,7 @@ def load_case_stress(model, op: StressOperator, teeth, rolls, load_vector) -> np
     the displacements only at the DOFs ``op`` reads (`StressOperator.dofs`), every load case in
     one block: the full solve's stresses to rounding at a fraction of its cost. Any other body:
     one block of right-hand sides per roll through its one factorisation."""
-    import scipy.sparse as sp
+    from solver.fe.body import sparse_columns
 
     teeth = [int(t) for t in teeth]
     out = np.empty((3, op.nodes.size, len(teeth), len(rolls)))
@@ -282,10 +282,13 @@ def load_case_stress(model, op: StressOperator, teeth, rolls, load_vector) -> np
             out[..., j] = op.apply(U)
         return out
     # columns tooth-major (tooth position * n_rolls + roll), as ``out`` holds them
-    cols = [load_vector(t, float(u))[model.free] for t in teeth for u in rolls]
-    nz = [np.flatnonzero(c) for c in cols]
-    F = sp.csc_matrix((np.concatenate([c[i] for c, i in zip(cols, nz)]), np.concatenate(nz),
-                       np.cumsum([0] + [i.size for i in nz])), shape=(model.free.size, len(cols)))
+    cols = []
+    for t in teeth:
+        for u in rolls:
+            f = load_vector(t, float(u))[model.free]
+            nz = np.flatnonzero(f)
+            cols.append((nz, f[nz]))
+    F = sparse_columns(cols, model.free.size)
     pos = np.full(model.basis.N, -1, np.int64)
     pos[model.free] = np.arange(model.free.size)
     dofs = op.dofs
