@@ -7,6 +7,7 @@ their variables; the archive (`study.archive`) packs them.
 """
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
@@ -87,10 +88,8 @@ def run_scene(scene: Scene, static: bool | None = None, dynamic: bool | None = N
                    "a positive number of seconds or None", max_time)
     check_argument(isinstance(compile_ahead, bool), "run_scene", "compile_ahead", "True or False", compile_ahead)
     options = RunOptions(max_time, bool(progress), warn, keep_model)
-    if not compile_ahead:
-        return run_fields(scene, scene_stages(scene, static, dynamic), options).dataset()
     from study.stand_in import compiling_ahead
-    with compiling_ahead(scene, dynamic=dynamic):
+    with compiling_ahead(scene, dynamic=dynamic) if compile_ahead else contextlib.nullcontext():
         return run_fields(scene, scene_stages(scene, static, dynamic), options).dataset()
 
 

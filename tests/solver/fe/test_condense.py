@@ -25,6 +25,12 @@ def ring():
     return mesh, cd.rim_block(mesh, T_RIM, STEEL, C)
 
 
+def _bodies(mesh, rim, t_web: float) -> tuple:
+    """The body of ``mesh`` with a web ``t_web`` [m] thick, factorised whole and through the
+    condensed ``rim``."""
+    return fe.assemble(mesh, T_RIM, t_web, STEEL), cd.assemble_condensed(mesh, T_RIM, t_web, STEEL, rim)
+
+
 def _loads_and_reads(model, n_loads=7, seed=3):
     """Scattered loads and point reads in the rim, away from the interface, in the numbering
     of ``model``'s basis (the loads chosen by DOF position: the same in any numbering)."""
@@ -51,8 +57,7 @@ def test_condensed_body_solves_as_the_whole_body(ring, t_web):
     """Two webs on one condensed rim: every load (in rim, web and on the interface) gives the
     whole body's displacement field to rounding."""
     mesh, rim = ring
-    whole = fe.assemble(mesh, T_RIM, t_web, STEEL)
-    cond = cd.assemble_condensed(mesh, T_RIM, t_web, STEEL, rim)
+    whole, cond = _bodies(mesh, rim, t_web)
     assert cond.condensed is not None and cond.n_dofs == whole.n_dofs
     assert np.array_equal(cond.free, whole.free)
     f = np.random.default_rng(1).standard_normal((whole.free.size, 4))
@@ -70,8 +75,7 @@ def test_rim_products_give_the_influence_coefficients(ring):
     mesh, rim = ring
     R_rim, F_rim = _loads_and_reads(rim.model)
     for t_web in (0.006, 0.012):
-        whole = fe.assemble(mesh, T_RIM, t_web, STEEL)
-        cond = cd.assemble_condensed(mesh, T_RIM, t_web, STEEL, rim)
+        whole, cond = _bodies(mesh, rim, t_web)
         R, F = _loads_and_reads(whole)                 # the same loads and reads, body numbering
         ref = influence(whole, R, F)
         G = cond.condensed.influence(R_rim, F_rim, "test-set")
@@ -151,8 +155,7 @@ def test_column_reads_equal_the_whole_body_solve(ring):
     once); loads off the rim fall back to the full solve, with the same numbers."""
     mesh, rim = ring
     for t_web in (0.006, 0.012):
-        whole = fe.assemble(mesh, T_RIM, t_web, STEEL)
-        cond = cd.assemble_condensed(mesh, T_RIM, t_web, STEEL, rim)
+        whole, cond = _bodies(mesh, rim, t_web)
         _, F = _loads_and_reads(whole)
         f = np.ascontiguousarray(F.toarray()[whole.free])
         reads = _column_reads(whole, f.shape[1], seed=7)
@@ -179,8 +182,7 @@ def test_solve_at_reads_rim_interface_and_web_as_the_whole_body(ring):
     to the full solve, with the same numbers."""
     mesh, rim = ring
     for t_web in (0.006, 0.012):
-        whole = fe.assemble(mesh, T_RIM, t_web, STEEL)
-        cond = cd.assemble_condensed(mesh, T_RIM, t_web, STEEL, rim)
+        whole, cond = _bodies(mesh, rim, t_web)
         _, F = _loads_and_reads(whole)
         f = sp.csc_matrix(F.tocsr()[whole.free])
         r = np.hypot(*cd._dof_keys(whole.basis)[whole.free, :2].T)
